@@ -1,0 +1,92 @@
+"""pipeline.records.manifest - the record catalogue ``records/MANIFEST.csv``.
+
+Input : ``records/MANIFEST.csv`` (one row per file: id, file, event, year, magnitude, station,
+        component, sets, source, units, npts, dt_s, pga_g, sha256, ...).
+Output: ``CatalogueEntry`` objects; ``verify`` reports any listed file that is missing or whose
+        sha256 differs from the catalogue, by name.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from pipeline.errors import ManifestError
+
+REQUIRED_COLUMNS = ("id", "file", "event", "year", "magnitude", "station", "component", "sets",
+                    "source", "units", "sha256")
+
+
+@dataclass(frozen=True)
+class CatalogueEntry:
+    """One record file of the catalogue (metadata as published; acceleration units of the file)."""
+
+    id: str
+    path: Path
+    event: str
+    year: int | None
+    magnitude: float | None
+    station: str
+    component: str
+    sets: tuple[str, ...]
+    source: str
+    units: str
+    sha256: str
+    extra: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def metadata(self) -> dict:
+        """Flat metadata for tables and netCDF attributes."""
+        return {"id": self.id, "file": str(self.path), "event": self.event, "year": self.year,
+                "magnitude": self.magnitude, "station": self.station, "component": self.component,
+                "sets": ";".join(self.sets), "source": self.source, "units": self.units,
+                "sha256": self.sha256}
+
+
+def _number(text, kind):
+    text = (text or "").strip()
+    return kind(text) if text else None
+
+
+def load_catalogue(manifest_path) -> list[CatalogueEntry]:
+    """Parse the catalogue; paths are resolved relative to the manifest's folder."""
+    manifest_path = Path(manifest_path)
+    if not manifest_path.is_file():
+        raise ManifestError(f"{manifest_path}: record catalogue not found")
+    with open(manifest_path, newline="", encoding="utf-8") as handle:
+        reader = csv.DictReader(handle)
+        missing = [c for c in REQUIRED_COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            raise ManifestError(f"{manifest_path}: missing column(s) {', '.join(missing)}; "
+                                f"expected {', '.join(REQUIRED_COLUMNS)}")
+        entries = []
+        for row in reader:
+            entries.append(CatalogueEntry(
+                id=row["id"], path=manifest_path.parent / row["file"], event=row["event"],
+                year=_number(row["year"], int), magnitude=_number(row["magnitude"], float),
+                station=row["station"], component=row["component"],
+                sets=tuple(s for s in row["sets"].split(";") if s), source=row["source"],
+                units=row["units"], sha256=row["sha256"],
+                extra={k: v for k, v in row.items() if k not in REQUIRED_COLUMNS}))
+    return entries
+
+
+def sha256_of(path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def verify(entries) -> list[str]:
+    """Problems found, one line per file: missing files and sha256 mismatches (empty if none)."""
+    problems = []
+    for entry in entries:
+        if not entry.path.is_file():
+            problems.append(f"{entry.path}: listed in the catalogue as {entry.id} but missing")
+        elif sha256_of(entry.path) != entry.sha256:
+            problems.append(f"{entry.path}: changed since it was catalogued (sha256 differs from "
+                            f"MANIFEST.csv); restore the original or update the catalogue")
+    return problems
