@@ -131,6 +131,19 @@ def _locate_bad_token(lines, first_data_line, predicate):
     return None, None
 
 
+def _line_of_value(lines, first_data_line, ordinal):
+    """1-based line number holding the ordinal-th (1-based) data value (or the last data line)."""
+    count, last = 0, first_data_line
+    for offset, line in enumerate(lines[first_data_line:]):
+        n_tokens = len(line.split())
+        if n_tokens:
+            last = first_data_line + offset + 1
+        count += n_tokens
+        if count >= ordinal:
+            return first_data_line + offset + 1
+    return last
+
+
 def _not_a_float(token):
     try:
         float(token)
@@ -226,10 +239,11 @@ def parse_peer_at2(source, headonly: bool = False):
                           line=line_no)
     if values.size < npts:
         raise RecordError(name, f"truncated data: found {values.size} values but the header says "
-                          f"NPTS = {npts}", line=len(lines))
+                          f"NPTS = {npts}", line=_line_of_value(lines, first_data_line, values.size))
     if values.size > npts:
         raise RecordError(name, f"found {values.size} values but the header says NPTS = {npts}; "
-                          "expected exactly NPTS values", line=len(lines))
+                          "expected exactly NPTS values (first extra value on this line)",
+                          line=_line_of_value(lines, first_data_line, npts + 1))
     return values * factor, dt, header
 
 

@@ -1,0 +1,47 @@
+"""The rockfrag command: records stage output, clean errors, exit codes."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+
+import pandas as pd
+
+from pipeline.cli import main
+
+
+def test_records_writes_table_and_plots(tmp_path, capsys):
+    status = main(["records", "--set", "bolu", "--plot", "--output", str(tmp_path), "--no-progress"])
+    assert status == 0
+    table = pd.read_csv(tmp_path / "records.csv")
+    assert list(table["id"]) == ["DUZCE/BOL000", "DUZCE/BOL090"]
+    assert {"pga_m_s2", "pgv_m_s", "arias_m_s", "cav_m_s", "d5_95_s", "sa_1s_m_s2"} <= set(table.columns)
+    assert (tmp_path / "records" / "DUZCE_BOL090.png").stat().st_size > 10_000
+    assert "PGA [g]" in capsys.readouterr().out
+
+
+def test_bad_file_is_one_line_and_nonzero(tmp_path, bolu_path):
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    shutil.copy(bolu_path, folder / "good.AT2")
+    (folder / "bad.AT2").write_text("PEER\nx\nUNITS OF G\nNPTS= 10, DT= .01 SEC\n .1 abc\n")
+    result = subprocess.run([sys.executable, "-m", "pipeline", "records", "--set", str(folder),
+                             "--output", str(tmp_path / "out"), "--no-progress"],
+                            capture_output=True, text=True)
+    assert result.returncode == 1
+    assert "Traceback" not in result.stderr
+    assert "bad.AT2, line 5" in result.stderr and "'abc'" in result.stderr
+    assert len(pd.read_csv(tmp_path / "out" / "records.csv")) == 1  # the good file went on
+
+
+def test_bad_recipe_exits_2_without_traceback(tmp_path):
+    recipe = tmp_path / "recipe.toml"
+    recipe.write_text('[[steps]]\nname = "taper"\nmax_percentage = 3\n')
+    result = subprocess.run([sys.executable, "-m", "pipeline", "records", "--set", "bolu",
+                             "--processing", str(recipe), "--output", str(tmp_path)],
+                            capture_output=True, text=True)
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    assert "steps[0].max_percentage" in result.stderr and "0.0 to 0.5" in result.stderr
+    assert not (tmp_path / "records.csv").exists()
