@@ -375,7 +375,15 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
                     tolerance = atol * scale[i] + rtol * max(abs(x[i]), abs(x_new[i]))
                     error_norm += (err[i] / tolerance) ** 2
                 error_norm = math.sqrt(error_norm / 4.0)
-                if error_norm <= 1.0 or h < 1e-14:
+                if h < 1e-14:
+                    break
+                if (error_norm <= 1.0 and phase == ROCKING and x[0] == 0.0 and sigma * x[1] > 0.0
+                        and sigma * x_new[0] <= 0.0):
+                    # a whole excursion after an impact fits inside this step: shorten the step so
+                    # that the next impact is seen (this is how Zeno cascades are followed)
+                    h = h * 0.25
+                    continue
+                if error_norm <= 1.0:
                     break
                 h = h * max(0.2, 0.9 * error_norm ** -0.2)
             n_steps += 1
