@@ -439,6 +439,12 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
             t = t + h_taken
             for i in range(4):
                 x[i] = x_new[i]
+            if model == SSI and phase == REST and abs(x[2] - y_static) < 1e-7 * y_static \
+                    and abs(x[3]) < 1e-7 * y_static * omega:
+                # the free vertical vibration has died out: snap to the static equilibrium so that
+                # the closed-form rest phase takes over (the support force changes by < 1e-7 g)
+                x[2] = y_static
+                x[3] = 0.0
             if model == SSI:
                 support = _support(model, params, x)
                 if support < min_support:

@@ -35,7 +35,7 @@ def quarter_period(theta0, alpha=BLOCK.alpha, p=P):
         return 2 * u / math.sqrt(2 * p * p * (math.cos(phi0) - math.cos(phi))) if u > 0 else \
             2 / math.sqrt(2 * p * p * math.sin(phi0))
 
-    value, _ = quad(integrand, 0.0, math.sqrt(alpha - phi0), epsabs=1e-14, epsrel=1e-13, limit=200)
+    value, _ = quad(integrand, 0.0, math.sqrt(alpha - phi0), epsabs=1e-13, epsrel=1e-11, limit=200)
     return value
 
 

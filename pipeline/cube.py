@@ -1,0 +1,147 @@
+"""pipeline.cube - the result schema of a study: a labelled xarray cube and its netCDF file.
+
+Input : per-run summary vectors from the solvers, arranged (record, im_level, soil, block, model),
+        plus record, soil, block metadata and the study configuration.
+Output: an ``xarray.Dataset`` following CF-1.12 (every variable with ``units`` and ``long_name``,
+        ``outcome`` with ``flag_values``/``flag_meanings``), written atomically as compressed netCDF4
+        (``reports/cube.nc``) that plain ``xarray.open_dataset`` reads.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import xarray as xr
+
+from pipeline import __version__
+from pipeline.models import kernels
+from pipeline.outputs import atomic_path
+
+OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = 0, 1, 2, 3
+OUTCOME_MEANINGS = "no_uplift rocking overturned solver_failed"
+
+DIMS = ("record", "im_level", "soil", "block", "model")
+
+VARIABLES = {
+    # name: (summary index or None, units, long_name)
+    "peak_angle": (kernels.S_PEAK, "rad", "peak absolute rocking angle"),
+    "time_of_peak": (kernels.S_TIME_OF_PEAK, "s", "time of the peak rocking angle"),
+    "n_impacts": (kernels.S_N_IMPACTS, "1", "number of impacts (pivot switches at theta = 0)"),
+    "time_of_uplift": (kernels.S_TIME_OF_UPLIFT, "s", "time of first uplift (NaN: never uplifted)"),
+    "peak_settlement": (kernels.S_PEAK_Y, "m", "peak settlement of the active pivot (SSI; NaN for rigid base)"),
+    "min_support_force": (kernels.S_MIN_SUPPORT, "N", "minimum vertical foundation force (negative: tension)"),
+}
+
+
+def summaries_to_variables(summaries, blocks, model_names, n_soils):
+    """Turn a summary array (record, level, soil, block, model, N_SUMMARY) into named arrays."""
+    out = {}
+    for name, (index, _, _) in VARIABLES.items():
+        out[name] = summaries[..., index].copy()
+    alpha = np.array([b.alpha for b in blocks])[None, None, None, :, None]
+    half_width = np.array([b.b for b in blocks])[None, None, None, :, None]
+    mass = np.array([b.mass for b in blocks])[None, None, None, :, None]
+    status = summaries[..., kernels.S_STATUS].astype(np.int8)
+    out["outcome"] = status
+    out["peak_angle_ratio"] = out["peak_angle"] / alpha
+    out["peak_uplift"] = 2.0 * half_width * np.sin(np.minimum(out["peak_angle"], math.pi / 2))
+    out["time_of_uplift"] = np.where(out["time_of_uplift"] < 0, np.nan, out["time_of_uplift"])
+    out["min_support_force"] = out["min_support_force"] * mass
+    rigid = np.array([name == "housner" for name in model_names])[None, None, None, None, :]
+    out["peak_settlement"] = np.where(rigid, np.nan, out["peak_settlement"])
+    out["min_support_force"] = np.where(rigid, np.nan, out["min_support_force"])
+    return out
+
+
+def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance) -> xr.Dataset:
+    """Assemble the labelled cube.
+
+    records : list of Record (metadata); record_im : (n_record,) IM of each processed record [SI];
+    scale_factors : (n_record, n_level); summaries : (n_record, n_level, n_soil, n_block, n_model, N_SUMMARY);
+    stiffness : (n_soil, n_block) interface stiffness [N/m]; provenance : dict of JSON-able facts.
+    """
+    model_names = list(config.models)
+    values = summaries_to_variables(summaries, config.blocks, model_names, len(config.soils))
+    unit = config.level_unit
+    im_si_unit = "m/s" if config.measure == "pgv" else "m/s^2"
+    measure_name = {"pga": "peak ground acceleration", "pgv": "peak ground velocity",
+                    "sa": f"spectral acceleration Sa({config.period:g} s, {config.damping:.0%})"}[config.measure]
+    data_vars = {}
+    for name, array in values.items():
+        if name == "outcome":
+            data_vars[name] = (DIMS, array, {
+                "long_name": "outcome of the run", "units": "1",
+                "flag_values": np.array([0, 1, 2, 3], dtype=np.int8), "flag_meanings": OUTCOME_MEANINGS})
+        elif name == "peak_angle_ratio":
+            data_vars[name] = (DIMS, array, {"long_name": "peak rocking angle over slenderness alpha",
+                                             "units": "1"})
+        elif name == "peak_uplift":
+            data_vars[name] = (DIMS, array, {"long_name": "peak uplift of the lifted corner, 2 b sin(theta_max)",
+                                             "units": "m"})
+        else:
+            _, units, long_name = VARIABLES[name]
+            data_vars[name] = (DIMS, array, {"long_name": long_name, "units": units})
+    data_vars["scale_factor"] = (("record", "im_level"), scale_factors,
+                                 {"long_name": "factor applied to the processed record", "units": "1"})
+    data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
+                                        {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
+    coords = {
+        "record": ("record", [r.id for r in records], {"long_name": "record id (records/MANIFEST.csv)"}),
+        "im_level": ("im_level", np.asarray(config.levels),
+                     {"long_name": f"intensity level: {measure_name}", "units": unit}),
+        "im_level_si": ("im_level", config.levels_si, {"long_name": f"intensity level: {measure_name}",
+                                                       "units": im_si_unit}),
+        "soil": ("soil", [s.name for s in config.soils], {"long_name": "soil class"}),
+        "block": ("block", [b.name for b in config.blocks], {"long_name": "block"}),
+        "model": ("model", model_names, {"long_name": "rocking model"}),
+        "record_event": ("record", [str(r.metadata.get("event", "")) for r in records], {"long_name": "earthquake"}),
+        "record_station": ("record", [str(r.metadata.get("station", "")) for r in records], {"long_name": "station"}),
+        "record_component": ("record", [str(r.metadata.get("component", "")) for r in records],
+                             {"long_name": "component"}),
+        "record_pga": ("record", [float(np.max(np.abs(r.acceleration))) for r in records],
+                       {"long_name": "PGA of the processed record", "units": "m/s^2"}),
+        "record_im": ("record", np.asarray(record_im), {"long_name": f"{measure_name} of the processed record",
+                                                        "units": im_si_unit}),
+        "soil_shear_modulus": ("soil", [s.shear_modulus for s in config.soils],
+                               {"long_name": "soil shear modulus G_s", "units": "Pa"}),
+        "soil_constrained_modulus": ("soil", [s.constrained_modulus for s in config.soils],
+                                     {"long_name": "soil constrained modulus 2G(1-nu)/(1-2nu) (paper's E_d)",
+                                      "units": "Pa"}),
+        "soil_damping_ratio": ("soil", [s.damping_ratio for s in config.soils],
+                               {"long_name": "damping ratio xi of the vertical dashpot", "units": "1"}),
+        "block_R": ("block", [b.R for b in config.blocks], {"long_name": "semi-diagonal R", "units": "m"}),
+        "block_alpha": ("block", [b.alpha for b in config.blocks], {"long_name": "slenderness angle alpha",
+                                                                    "units": "rad"}),
+        "block_b": ("block", [b.b for b in config.blocks], {"long_name": "half-width b", "units": "m"}),
+        "block_h": ("block", [b.h for b in config.blocks], {"long_name": "half-height h", "units": "m"}),
+        "block_mass": ("block", [b.mass for b in config.blocks], {"long_name": "mass", "units": "kg"}),
+        "block_uplift_acceleration": ("block", [b.uplift_acceleration() for b in config.blocks],
+                                      {"long_name": "Housner uplift threshold g tan(alpha)", "units": "m/s^2"}),
+    }
+    dataset = xr.Dataset(data_vars, coords=coords)
+    dataset.attrs = {
+        "Conventions": "CF-1.12",
+        "title": f"rockfrag study '{config.name}': rocking response cube",
+        "institution": "rockfrag",
+        "source": f"rockfrag {__version__}",
+        "rockfrag_version": __version__,
+        "intensity_measure": config.measure,
+        "study_config": config.as_json(),
+        "config_hash": config.config_hash,
+        "record_checksums": json.dumps({r.id: r.metadata.get("sha256", "") for r in records}),
+        "processing": json.dumps(provenance.get("processing", {})),
+        "processing_steps": json.dumps(provenance.get("processing_steps", {})),
+        "references": "Housner (1963); SSI-rocking model from the Lagrangian of the paper "
+                      "'A Simplified Mechanical Model for Rocking Structures on Compliant Foundations'",
+    }
+    return dataset
+
+
+def write_netcdf(dataset: xr.Dataset, path) -> None:
+    """Compressed netCDF4, written to a temp file and renamed (never half-written)."""
+    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
+                if var.dtype.kind in "fi"}
+    with atomic_path(path) as temporary:
+        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
