@@ -9,7 +9,7 @@ ROCKFRAG := $(BIN)/rockfrag
 REPORTS := reports
 
 .DEFAULT_GOAL := help
-.PHONY: help install test records fragility bench clean
+.PHONY: help install test records cube fragility bench clean
 
 help:  ## list the targets
 	@echo "rockfrag make targets:"
@@ -31,6 +31,9 @@ records: $(STAMP)  ## intensity-measure table and per-record plots of all shippe
 
 fragility: $(STAMP)  ## run the whole pipeline (records -> cube -> IDA -> fragility -> report)
 	$(ROCKFRAG) fragility --output $(REPORTS)
+
+cube: $(STAMP)  ## run the default study into reports/cube.nc (resumes after an interruption)
+	$(ROCKFRAG) run --output $(REPORTS)
 
 bench: $(STAMP)  ## solver and study benchmarks (prints figures; not part of the tests)
 	$(BIN)/python benchmarks/run.py

@@ -66,12 +66,33 @@ def command_records(args) -> int:
     return EXIT_PARTIAL if failures else 0
 
 
+def _study_config(args):
+    from pipeline.config import load_study
+
+    overrides = {}
+    if getattr(args, "record_set", None):
+        overrides.setdefault("study", {})["record_sets"] = args.record_set
+    config = load_study(args.study, overrides or None)
+    return config, Path(args.output) if args.output else config.output
+
+
+def command_run(args) -> int:
+    from pipeline.study import run_study
+
+    config, output = _study_config(args)
+    dataset, stats = run_study(config, output=output, workers=1 if args.serial else None,
+                               scheduler=args.scheduler, dask_workers=args.workers,
+                               progress=not args.no_progress)
+    runs = stats["runs_computed"]
+    rate = f", {runs / stats['seconds']:.0f} runs/s" if runs else ""
+    print(f"wrote {output / 'cube.nc'} ({stats['seconds']:.1f} s{rate}; "
+          f"{stats['cells_reused']} of {stats['cells']} cells reused from checkpoints)")
+    return EXIT_PARTIAL if stats["failures"] else 0
+
+
 def command_fragility(args) -> int:
-    """Whole pipeline. Until the study stage exists it stops after the records stage."""
-    args.plot = False
-    status = command_records(args)
-    print("rockfrag fragility: the study, IDA, fragility and report stages are not available in "
-          f"rockfrag {__version__} yet; stopped after the records stage.")
+    """The whole pipeline: study cube, then the later stages that exist."""
+    status = command_run(args)
     return status
 
 
@@ -91,9 +112,23 @@ def build_parser() -> argparse.ArgumentParser:
                               "response spectrum of every record as PNG")
     records.set_defaults(handler=command_records)
 
-    fragility = commands.add_parser("fragility", help="run the whole pipeline into the output folder")
-    _add_record_arguments(fragility)
-    fragility.set_defaults(handler=command_fragility)
+    for name, handler, text in (("run", command_run, "run a study into the cube (cube.nc)"),
+                                ("fragility", command_fragility,
+                                 "run the whole pipeline: cube, IDA, fragility, report")):
+        sub = commands.add_parser(name, help=text)
+        sub.add_argument("study", nargs="?", type=Path, default=None,
+                         help="study TOML file (default: the shipped pipeline/defaults.toml)")
+        sub.add_argument("--set", dest="record_set", action="append", metavar="NAME",
+                         help="record set(s), overriding the study's study.record_sets")
+        sub.add_argument("--output", type=Path, default=None, metavar="DIR",
+                         help="output folder (default: the study's study.output, reports/)")
+        sub.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                         help="run on an existing dask.distributed cluster, e.g. tcp://host:8786")
+        sub.add_argument("--workers", type=int, default=None, metavar="N",
+                         help="start a local dask cluster with N worker processes")
+        sub.add_argument("--serial", action="store_true", help="run in this process (debugging)")
+        sub.add_argument("--no-progress", action="store_true", help="hide progress bars")
+        sub.set_defaults(handler=handler)
     return parser
 
 

@@ -188,6 +188,8 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
 
     store = CheckpointStore(output / ".checkpoints")
+    for stale in list(output.glob(".*.part")) + list(store.folder.glob(".*.part")):
+        stale.unlink(missing_ok=True)  # left by a killed run; the finished files are complete
     all_cells = [cells_for_record(record, config, recipe) for record in records]
     n_levels = len(config.levels)
     tasks = []

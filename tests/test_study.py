@@ -1,0 +1,204 @@
+"""Study engine: configuration errors, the cube's schema and values, executors, resume."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from pipeline.config import load_study
+from pipeline.errors import ConfigError
+from pipeline.models import simulate
+from pipeline.processing import process_record
+from pipeline.records import load_records
+from pipeline.soils import soil_block_stiffness
+from pipeline.study import run_study
+
+SMALL = """
+soils = ["sand", "rock"]
+models = ["housner", "ssi"]
+[study]
+name = "small"
+record_sets = ["bolu"]
+[intensity]
+levels = [0.1, 0.3, 0.6, 1.0]
+[blocks.paper]
+R = 9.39
+alpha = 0.44
+mass = 326197.0
+E_b = 210e9
+footprint_area = 8.0
+soil_depth = 2.0
+[blocks.slender-cabinet]
+b = 0.3
+h = 1.5
+mass = 2000.0
+E_b = 200e9
+footprint_area = 0.48
+soil_depth = 1.0
+[blocks.squat-machinery]
+b = 1.5
+h = 2.0
+mass = 30000.0
+"""
+
+
+@pytest.fixture(scope="module")
+def small_study(tmp_path_factory):
+    path = tmp_path_factory.mktemp("study") / "small.toml"
+    path.write_text(SMALL)
+    return path
+
+
+@pytest.fixture(scope="module")
+def small_cube(small_study, tmp_path_factory):
+    output = tmp_path_factory.mktemp("serial")
+    dataset, stats = run_study(load_study(small_study), output=output, workers=1, progress=False, log=lambda m: None)
+    return output, dataset, stats
+
+
+@pytest.mark.parametrize("text, field", [
+    ('[intensity]\nmeasure = "pgd"\n', "intensity.measure"),
+    ('[intensity]\nlevels = { start = 1.0, stop = 0.5, count = 4 }\n', "intensity.levels"),
+    ('[intensity]\nlevels = [0.1, 0.05]\n', "intensity.levels"),
+    ('[intensity]\nperiod = -1.0\n', "intensity.period"),
+    ('soils = ["mud"]\n', "soils"),
+    ('models = ["newmark"]\n', "models"),
+    ('[solver]\nswitch = "sticky"\n', "solver.switch"),
+    ('[solver]\noverturn_angle = 2.0\n', "solver.overturn_angle"),
+    ('[blocks.bad]\nb = -1.0\nh = 2.0\n', "block bad.b"),
+    ('[blocks.bad]\nb = 1.0\nh = 2.0\nR = 3.0\nalpha = 0.3\n', "block bad"),
+    ('[blocks.bad]\nb = 1.0\nh = 2.0\ncolour = "red"\n', "blocks.bad.colour"),
+    ('[intensity]\nlevels = [0.1]\nsoils = ["sand"]\n', "intensity.soils"),
+])
+def test_invalid_study_names_field_and_file(tmp_path, text, field):
+    path = tmp_path / "study.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as caught:
+        load_study(path)
+    assert caught.value.field == field, str(caught.value)
+    assert str(path) in str(caught.value)
+
+
+def test_default_study_matches_the_issue():
+    config = load_study()
+    assert len(config.levels) == 40 and config.measure == "pga"
+    assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
+    assert config.models == ("housner", "ssi") and len(config.blocks) == 3
+    paper = config.blocks[0]
+    assert paper.R == 9.39 and paper.alpha == 0.44
+    uplift_g = [b.uplift_acceleration() / 9.80665 for b in config.blocks]
+    assert config.levels[0] < 0.5 * min(uplift_g)  # starts well below every uplift threshold
+
+
+def test_cube_schema_is_cf_labelled(small_cube):
+    output, _, _ = small_cube
+    cube = xr.open_dataset(output / "cube.nc")
+    assert cube.attrs["Conventions"] == "CF-1.12"
+    for key in ("rockfrag_version", "study_config", "config_hash", "record_checksums", "processing"):
+        assert cube.attrs[key]
+    assert dict(cube.sizes) == {"record": 2, "im_level": 4, "soil": 2, "block": 3, "model": 2}
+    for name, variable in cube.data_vars.items():
+        assert "units" in variable.attrs and "long_name" in variable.attrs, name
+    assert cube.outcome.attrs["flag_meanings"].split() == ["no_uplift", "rocking", "overturned", "solver_failed"]
+    assert cube.im_level.attrs["units"] == "g"
+
+
+def test_cube_values_match_direct_solver_calls(small_cube):
+    _, cube, _ = small_cube
+    config = load_study(None, {"study": {"record_sets": ["bolu"]}})
+    records, _ = load_records("bolu")
+    record = process_record(records[1])
+    scale = 0.6 * 9.80665 / np.max(np.abs(record.acceleration))
+    block = cube.block.values.tolist().index("slender-cabinet")
+    from pipeline.config import study_from_dict
+    import tomllib
+
+    blocks = study_from_dict(tomllib.loads(SMALL)).blocks
+    t_end = (record.acceleration.size - 1) * record.dt + 10.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        housner = simulate("housner", record.acceleration * scale, record.dt, blocks[block], t_end=t_end)
+        soil = config.soils[3]  # rock
+        ssi = simulate("ssi", record.acceleration * scale, record.dt, blocks[block],
+                       k=soil_block_stiffness(soil, blocks[block]), xi=soil.damping_ratio, t_end=t_end)
+    cell = cube.sel(record="DUZCE/BOL090", im_level=0.6, block="slender-cabinet")
+    assert cell.scale_factor.item() == pytest.approx(scale, rel=1e-12)
+    # Housner does not depend on the soil: the same value on every soil
+    np.testing.assert_array_equal(cell.peak_angle.sel(model="housner").values, housner.peak_angle)
+    assert cell.peak_angle.sel(model="ssi", soil="rock").item() == pytest.approx(ssi.peak_angle, rel=1e-12)
+    assert cell.n_impacts.sel(model="ssi", soil="rock").item() == ssi.n_impacts
+    assert cell.peak_angle_ratio.sel(model="housner", soil="sand").item() == pytest.approx(
+        housner.peak_angle / blocks[block].alpha)
+    assert np.isnan(cell.peak_settlement.sel(model="housner")).all()
+
+
+def test_outcomes_are_ordered_with_intensity(small_cube):
+    """Below g tan(alpha) nothing uplifts; the lowest level is below every block's threshold."""
+    _, cube, _ = small_cube
+    lowest = cube.outcome.isel(im_level=0)
+    assert (lowest == 0).all()
+    uplift_g = cube.block_uplift_acceleration / 9.80665
+    housner = cube.sel(model="housner")
+    below = housner.outcome.where(cube.im_level < uplift_g)
+    assert ((below == 0) | below.isnull()).all()
+
+
+@pytest.mark.slow
+def test_dask_local_cluster_gives_the_identical_cube(small_study, small_cube, tmp_path):
+    _, serial, _ = small_cube
+    distributed, stats = run_study(load_study(small_study), output=tmp_path, dask_workers=2, progress=False,
+                                   log=lambda m: None)
+    assert stats["runs_computed"] > 0
+    xr.testing.assert_identical(serial.drop_attrs(), distributed.drop_attrs())
+
+
+def test_resume_reuses_checkpoints_and_changed_soil_touches_only_its_cells(small_study, small_cube, tmp_path):
+    output, cube, stats = small_cube
+    assert stats["cells_reused"] == 0
+    again, stats_again = run_study(load_study(small_study), output=output, workers=1, progress=False,
+                                   log=lambda m: None)
+    assert stats_again["runs_computed"] == 0 and stats_again["cells_reused"] == stats["cells"]
+    xr.testing.assert_identical(cube, again)
+    changed = load_study(small_study, {"soils_custom": {"rock": {"shear_modulus": 2e9}}})
+    _, stats_changed = run_study(changed, output=output, workers=1, progress=False, log=lambda m: None)
+    # one soil x 3 blocks x 2 records of SSI cells; Housner cells and the other soil are reused
+    assert stats_changed["runs_computed"] == 3 * 2 * 4
+
+
+@pytest.mark.slow
+def test_killed_run_resumes_without_recomputing(small_study, tmp_path):
+    """kill -9 during a run, run again: finished cells are not recomputed, the cube is identical."""
+    study = tmp_path / "study.toml"
+    study.write_text(SMALL.replace('record_sets = ["bolu"]', 'record_sets = ["far-field"]')
+                     .replace("levels = [0.1, 0.3, 0.6, 1.0]", "levels = [0.3, 0.6, 1.0]"))
+    output = tmp_path / "out"
+    command = [sys.executable, "-m", "pipeline", "run", str(study), "--output", str(output), "--no-progress",
+               "--serial"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    checkpoints = output / ".checkpoints"
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(checkpoints.glob("*.npy"))) < 20:
+        time.sleep(0.05)
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    finished = {p: p.stat().st_mtime_ns for p in checkpoints.glob("*.npy")}
+    assert finished and not (output / "cube.nc").exists()
+    result = subprocess.run(command, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert f"{len(finished)} of" in result.stdout or f"{len(finished)} of" in result.stderr
+    for path, mtime in finished.items():
+        assert path.stat().st_mtime_ns == mtime, "a finished cell was recomputed"
+    assert not list(output.glob(".*.part")) and not list(checkpoints.glob(".*.part"))
+    fresh = tmp_path / "fresh"
+    subprocess.run([*command[:6], str(fresh), *command[7:]], check=True, capture_output=True)
+    xr.testing.assert_identical(xr.open_dataset(output / "cube.nc").drop_attrs(),
+                                xr.open_dataset(fresh / "cube.nc").drop_attrs())
