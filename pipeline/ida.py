@@ -1,0 +1,172 @@
+"""pipeline.ida - stage 7: the cube -> incremental dynamic analysis (IDA) curves and capacities.
+
+Input : the study cube (``cube.nc``): peak_angle_ratio and outcome over (record, im_level, soil,
+        block, model).
+Output: ``reports/ida.nc`` with, per soil, block and model:
+        - ``edp``: the IDA curve of each record, theta_max/alpha against the intensity level, with
+          overturned runs as +inf (the flatline) and NOT smoothed: a record may overturn at one level
+          and survive a higher one ("resurrection"), and that stays visible;
+        - ``edp_fractile``: 16/50/84% fractiles of the response given intensity (counted, inf-aware);
+        - ``im_fractile``: 16/50/84% fractiles of the intensity given response (from each record's
+          first crossing of the response level);
+        - ``first_overturn_im`` and ``last_resurrection_free_im``: per-record overturning capacity, as
+          the first overturning level and the level above which every level overturns.
+``hunt_and_fill`` traces one record's overturning capacity adaptively (Vamvatsikos & Cornell 2004).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from pipeline.cube import OUTCOME_OVERTURNED
+from pipeline.outputs import atomic_path
+
+FRACTILES = (0.16, 0.50, 0.84)
+RESPONSE_LEVELS = np.round(np.concatenate([np.linspace(0.05, 1.0, 20), np.linspace(1.5, 5.0, 8)]), 4)
+"""Response levels theta_max/alpha at which the intensity-given-response fractiles are computed."""
+
+
+def ida_edp(cube: xr.Dataset) -> xr.DataArray:
+    """theta_max/alpha per run, +inf where the block overturned (the IDA flatline)."""
+    edp = cube.peak_angle_ratio.where(cube.outcome != OUTCOME_OVERTURNED, np.inf)
+    edp.attrs = {"long_name": "peak rocking angle over alpha (inf = overturned)", "units": "1"}
+    return edp
+
+
+def first_crossing_im(edp, levels, threshold):
+    """Per record: the intensity at which the IDA curve first reaches ``threshold``.
+
+    Linear interpolation between the last level below and the first level at or above; where the
+    first level at or above is the overturning flatline, that level. NaN if never reached.
+    edp : (n_record, n_level); levels : (n_level,).
+    """
+    capacity = np.full(edp.shape[0], np.nan)
+    for r, curve in enumerate(edp):
+        above = np.flatnonzero(curve >= threshold)
+        if above.size == 0:
+            continue
+        j = above[0]
+        if j == 0 or not np.isfinite(curve[j]):
+            capacity[r] = levels[j]
+            continue
+        lower, upper = curve[j - 1], curve[j]  # lower < threshold <= upper
+        capacity[r] = levels[j - 1] + (threshold - lower) / (upper - lower) * (levels[j] - levels[j - 1])
+    return capacity
+
+
+def overturning_capacities(outcome, levels):
+    """Per record: the first overturning level, and the lowest level from which every higher level
+    overturns (no resurrection above it). NaN where the block does not overturn / still survives at
+    the highest level. outcome : (n_record, n_level) integer outcome codes.
+    """
+    overturned = outcome == OUTCOME_OVERTURNED
+    first = np.full(overturned.shape[0], np.nan)
+    stable = np.full(overturned.shape[0], np.nan)
+    for r, row in enumerate(overturned):
+        hits = np.flatnonzero(row)
+        if hits.size == 0:
+            continue
+        first[r] = levels[hits[0]]
+        if row[-1]:
+            survivors = np.flatnonzero(~row)
+            stable[r] = levels[survivors[-1] + 1] if survivors.size else levels[0]
+    return first, stable
+
+
+def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
+    """All IDA products of a cube (see the module docstring)."""
+    edp = ida_edp(cube)
+    levels = cube.im_level.values
+    unit = cube.im_level.attrs.get("units", "")
+    edp_fractile = xr.DataArray(
+        np.quantile(edp.values, FRACTILES, axis=0, method="inverted_cdf"),
+        dims=("fractile", *edp.dims[1:]), coords={"fractile": list(FRACTILES), **{d: cube[d] for d in edp.dims[1:]}},
+        attrs={"long_name": "fractile of theta_max/alpha given intensity (inf = overturned)", "units": "1"})
+    stack_dims = ("soil", "block", "model")
+    shape = tuple(cube.sizes[d] for d in stack_dims)
+    first = np.full((cube.sizes["record"], *shape), np.nan)
+    stable = np.full_like(first, np.nan)
+    im_given_edp = np.full((len(FRACTILES), RESPONSE_LEVELS.size, *shape), np.nan)
+    edp_t = edp.transpose("record", "im_level", *stack_dims).values
+    outcome_t = cube.outcome.transpose("record", "im_level", *stack_dims).values
+    for index in np.ndindex(*shape):
+        curves = edp_t[(slice(None), slice(None), *index)]
+        first[(slice(None), *index)], stable[(slice(None), *index)] = overturning_capacities(
+            outcome_t[(slice(None), slice(None), *index)], levels)
+        for j, response in enumerate(RESPONSE_LEVELS):
+            capacity = first_crossing_im(curves, levels, response)
+            # records that never reach the response are above the highest level: inf for fractiles
+            capacity = np.where(np.isnan(capacity), np.inf, capacity)
+            im_given_edp[(slice(None), j, *index)] = np.quantile(capacity, FRACTILES, method="inverted_cdf")
+    im_given_edp[~np.isfinite(im_given_edp)] = np.nan
+    coords = {d: cube[d] for d in ("record", "im_level", *stack_dims)}
+    dataset = xr.Dataset({
+        "edp": edp,
+        "edp_fractile": edp_fractile,
+        "im_fractile": (("fractile", "response_level", *stack_dims), im_given_edp,
+                        {"long_name": "fractile of the intensity at which theta_max/alpha is first reached "
+                                      "(NaN: above the highest level)", "units": unit}),
+        "first_overturn_im": (("record", *stack_dims), first,
+                              {"long_name": "first intensity level at which the block overturned", "units": unit}),
+        "last_resurrection_free_im": (("record", *stack_dims), stable,
+                                      {"long_name": "intensity above which every level overturns "
+                                                    "(no resurrection)", "units": unit}),
+        "resurrected": (("record", *stack_dims), (stable > first).astype(np.int8),
+                        {"long_name": "1 if the block survived a level above its first overturning level",
+                         "units": "1"}),
+    }, coords={**coords, "fractile": list(FRACTILES),
+               "response_level": ("response_level", RESPONSE_LEVELS, {"long_name": "theta_max/alpha", "units": "1"})})
+    dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag IDA curves",
+                     "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", "")}
+    return dataset
+
+
+def write_ida(dataset: xr.Dataset, path) -> None:
+    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
+                if var.dtype.kind == "f"}
+    with atomic_path(path) as temporary:
+        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+
+
+def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_runs=200):
+    """Adaptive overturning capacity of one record (hunt up, then fill by bisection).
+
+    Parameters
+    ----------
+    overturns : callable(im) -> bool
+        Runs the analysis at intensity ``im`` and says whether the block overturned.
+    start : float
+        First intensity to try (below the expected capacity).
+    step, growth : float
+        First hunting increment and its growth factor per step (Vamvatsikos & Cornell).
+    tolerance : float
+        Relative width of the final bracket [-].
+
+    Returns
+    -------
+    (capacity, lower, upper, runs): capacity is the bracket midpoint of the first overturning
+    intensity found by the hunt (NaN if none within ``max_runs``).
+    """
+    runs = 0
+    lower, im, increment = 0.0, start, step
+    while runs < max_runs:
+        runs += 1
+        if overturns(im):
+            upper = im
+            break
+        lower = im
+        im = im + increment
+        increment *= growth
+    else:
+        return math.nan, lower, math.nan, runs
+    while (upper - lower) > tolerance * upper and runs < max_runs:
+        middle = 0.5 * (lower + upper)
+        runs += 1
+        if overturns(middle):
+            upper = middle
+        else:
+            lower = middle
+    return 0.5 * (lower + upper), lower, upper, runs
