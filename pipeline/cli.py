@@ -91,9 +91,28 @@ def command_run(args) -> int:
 
 
 def command_fragility(args) -> int:
-    """The whole pipeline: study cube, then the later stages that exist."""
-    status = command_run(args)
-    return status
+    """The whole pipeline: study cube, IDA, fragility and risk, report."""
+    import time
+
+    from pipeline.fragility import fragility_stage
+    from pipeline.ida import ida_stage
+    from pipeline.report import report_stage
+    from pipeline.study import run_study
+
+    started = time.perf_counter()
+    config, output = _study_config(args)
+    cube, stats = run_study(config, output=output, workers=1 if args.serial else None,
+                            scheduler=args.scheduler, dask_workers=args.workers, progress=not args.no_progress)
+    print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
+    ida = ida_stage(cube, output)
+    print(f"wrote {output / 'ida.nc'}")
+    fragility, risk = fragility_stage(cube, ida, config, output)
+    for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
+        print(f"wrote {output / name}")
+    pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started)
+    print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
+    print(f"done in {time.perf_counter() - started:.0f} s")
+    return EXIT_PARTIAL if stats["failures"] else 0
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -45,6 +45,11 @@ class StudyConfig:
     switch: str
     tail: float
     overturn_angle: float
+    hazard_file: str
+    design_life: float
+    bootstrap: int
+    seed: int
+    confidence: float
     source: str
     raw: dict
 
@@ -134,6 +139,8 @@ ALLOWED_KEYS = {
     "study": {"name", "record_sets", "processing", "output"},
     "intensity": {"measure", "period", "damping", "levels"},
     "solver": {"switch", "tail", "overturn_angle"},
+    "hazard": {"file", "design_life"},
+    "fragility": {"bootstrap", "seed", "confidence"},
 }
 
 
@@ -202,6 +209,13 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         tail=_number(solver, "tail", "solver", source, 0.0, 600.0, default=10.0),
         overturn_angle=_number(solver, "overturn_angle", "solver", source, 0.0, math.pi / 2,
                                default=math.pi / 2, low_open=True),
+        hazard_file=str(data.get("hazard", {}).get("file", "")),
+        design_life=_number(data.get("hazard", {}), "design_life", "hazard", source, 0.0, 10000.0, default=50.0,
+                            low_open=True),
+        bootstrap=int(_number(data.get("fragility", {}), "bootstrap", "fragility", source, 0, 100000, default=100)),
+        seed=int(_number(data.get("fragility", {}), "seed", "fragility", source, 0, 2**32, default=0)),
+        confidence=_number(data.get("fragility", {}), "confidence", "fragility", source, 0.0, 1.0, default=0.9,
+                           low_open=True),
         source=source, raw=data)
 
 

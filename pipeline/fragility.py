@@ -334,3 +334,26 @@ def pelicun_table(dataset: xr.Dataset) -> pd.DataFrame:
 def write_csv(table: pd.DataFrame, path) -> None:
     with atomic_path(path) as temporary:
         table.to_csv(temporary, index=False, float_format="%.6g")
+
+
+def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output):
+    """Fit, add the risk, and write fragility.nc, fragility.csv, fragility_pelicun.csv and risk.csv."""
+    from pathlib import Path
+
+    from pipeline.risk import load_hazard, risk_dataset
+
+    output = Path(output)
+    states = damage_states_from_config(config.raw)
+    dataset = fragility_dataset(cube, states=states, ida=ida, n_bootstrap=config.bootstrap, seed=config.seed,
+                                confidence=config.confidence)
+    hazard = load_hazard(config.hazard_file or None)
+    risk = risk_dataset(dataset, hazard, config.design_life)
+    combined = dataset.merge(risk)
+    combined.attrs.update(dataset.attrs)
+    combined.attrs.update(risk.attrs)
+    write_fragility(combined, output / "fragility.nc")
+    table = fragility_table(dataset)
+    table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])
+    write_csv(table, output / "fragility.csv")
+    write_csv(pelicun_table(dataset), output / "fragility_pelicun.csv")
+    return combined, risk

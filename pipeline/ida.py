@@ -170,3 +170,12 @@ def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_ru
         else:
             lower = middle
     return 0.5 * (lower + upper), lower, upper, runs
+
+
+def ida_stage(cube: xr.Dataset, output) -> xr.Dataset:
+    """Compute the IDA products of a cube and write ``ida.nc`` into ``output``."""
+    from pathlib import Path
+
+    dataset = ida_dataset(cube)
+    write_ida(dataset, Path(output) / "ida.nc")
+    return dataset
