@@ -45,8 +45,13 @@ class Block:
     def __post_init__(self):
         geometry_bh = self.b is not None and self.h is not None
         geometry_ra = self.R is not None and self.alpha is not None
-        if geometry_bh == geometry_ra:
-            raise ConfigError(f"block {self.name}", "give either b and h, or R and alpha (not both)")
+        if geometry_bh and geometry_ra:
+            # both given (e.g. dataclasses.replace of a validated block): accept only if consistent
+            if not (math.isclose(math.hypot(self.b, self.h), self.R, rel_tol=1e-9)
+                    and math.isclose(math.atan2(self.b, self.h), self.alpha, rel_tol=1e-9)):
+                raise ConfigError(f"block {self.name}", "give either b and h, or R and alpha (not both)")
+        elif not (geometry_bh or geometry_ra):
+            raise ConfigError(f"block {self.name}", "give either b and h, or R and alpha")
         if geometry_bh:
             b = _check(f"block {self.name}.b", self.b, 0, 1e4, "m")
             h = _check(f"block {self.name}.h", self.h, 0, 1e4, "m")

@@ -31,6 +31,9 @@ class RecordError(PipelineError):
         where = f"{self.path}, line {line}" if line is not None else self.path
         super().__init__(f"{where}: {message}")
 
+    def __reduce__(self):  # picklable, so errors cross process and dask boundaries intact
+        return (type(self), (self.path, self.reason, self.line))
+
 
 class ConfigError(PipelineError):
     """A configuration value (TOML file or argument) is missing or out of range.
@@ -51,6 +54,9 @@ class ConfigError(PipelineError):
         self.reason = message
         prefix = f"{source}: " if source else ""
         super().__init__(f"{prefix}{field}: {message}")
+
+    def __reduce__(self):
+        return (type(self), (self.field, self.reason, self.source))
 
 
 class ManifestError(PipelineError):

@@ -200,6 +200,35 @@ def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, switch="con
     return summaries
 
 
+def simulate_histories(model, ag, dt, cases, *, switch="consistent", restitution=None, t_end=None,
+                       g=STANDARD_GRAVITY, overturn_angle=math.pi / 2, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL):
+    """Rotation histories of one ground motion for many (block, k, xi) cases in one compiled call.
+
+    Returns
+    -------
+    t : ndarray (n,) [s]; theta : ndarray (n_case, n) [rad] (NaN after overturning);
+    y : ndarray (n_case, n) [m]; summaries : ndarray (n_case, kernels.N_SUMMARY).
+    """
+    spec = get_model(model)
+    ag = _ground(ag, dt)
+    rows, y0s = [], []
+    for block, k, xi in cases:
+        params, y0 = parameter_vector(spec, block, k=k, xi=xi, switch=switch, restitution=restitution, g=g,
+                                      overturn_angle=overturn_angle, rtol=rtol, atol=atol)
+        rows.append(params)
+        y0s.append(y0)
+    record_end = (ag.size - 1) * dt
+    n_total = max(2, int(round(((record_end + DEFAULT_TAIL) if t_end is None else t_end) / dt)) + 1)
+    n_tail = max(0, n_total - ag.size)
+    if n_total < ag.size:
+        ag = ag[:n_total]
+    histories = np.empty((len(rows), ag.size + n_tail, 4))
+    summaries = np.zeros((len(rows), kernels.N_SUMMARY))
+    kernels.history_batch_kernel(spec.kernel_code, ag, float(dt), n_tail, np.array(rows), np.array(y0s),
+                                 histories, summaries)
+    return np.arange(ag.size + n_tail) * dt, histories[:, :, 0], histories[:, :, 2], summaries
+
+
 from pipeline.models import housner as _housner  # noqa: E402  (registration at import)
 from pipeline.models import ssi as _ssi  # noqa: E402
 
@@ -207,4 +236,5 @@ register(_housner.MODEL)
 register(_ssi.MODEL)
 register(_ssi.PAPER_MODEL)
 
-__all__ = ["MODELS", "RockingResult", "Status", "get_model", "register", "simulate", "simulate_batch"]
+__all__ = ["MODELS", "RockingResult", "Status", "get_model", "register", "simulate", "simulate_batch",
+           "simulate_histories"]

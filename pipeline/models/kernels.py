@@ -544,3 +544,16 @@ def batch_kernel(model, ag, dt, n_tail, scales, params_table, y0s, summaries):
         for row in range(params_table.shape[0]):
             simulate_kernel(model, scaled, dt, n_tail, params_table[row], 0.0, 0.0, y0s[row], 0.0,
                             empty, impacts, summaries[row, j])
+
+
+@njit(cache=True)
+def history_batch_kernel(model, ag, dt, n_tail, params_table, y0s, histories, summaries):
+    """Run one ground motion for each parameter row, keeping the histories.
+
+    params_table : (n_case, N_PARAMS); y0s : (n_case,); histories : (n_case, n + n_tail, 4) and
+    summaries : (n_case, N_SUMMARY), filled.
+    """
+    impacts = np.empty(0)
+    for row in range(params_table.shape[0]):
+        simulate_kernel(model, ag, dt, n_tail, params_table[row], 0.0, 0.0, y0s[row], 0.0,
+                        histories[row], impacts, summaries[row])

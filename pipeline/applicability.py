@@ -1,0 +1,181 @@
+"""pipeline.applicability - when is Housner's rigid base good enough? (paper section 2)
+
+Input : blocks, a record set, a few intensity levels (multiples of each block's uplift PGA) and a
+        sweep of soil shear modulus G_s (default 10 MPa - 100 GPa) and block modulus E_b.
+Output: ``reports/applicability.nc`` with, per block, E_b, level and G_s: the ratio of SSI to Housner
+        median peak angle, the difference in overturning fraction, and the median correlation of the
+        rotation histories; and per block, E_b and level the modulus above which Housner stays within
+        the tolerance (10% by default), to compare with the paper's 300-1000 MPa, also expressed as the
+        relative stiffness E_b/G_s. A figure (``applicability-sweep.png``) shows it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from pipeline.calibrate import correlation
+from pipeline.models import simulate_histories
+from pipeline.outputs import atomic_path
+from pipeline.soils import interface_stiffness
+from pipeline.units import STANDARD_GRAVITY
+
+DEFAULT_SHEAR_MODULI = np.geomspace(10e6, 100e9, 13)
+DEFAULT_LEVEL_FACTORS = (1.5, 2.5, 4.0)
+
+
+def _record_task(acceleration, dt, pga, blocks, block_moduli, level_factors, shear_moduli, xi, tail):
+    """Pure task: for one record, Housner and SSI at each block/E_b/level/G_s (histories compared)."""
+    n_b, n_e, n_l, n_g = len(blocks), len(block_moduli), len(level_factors), len(shear_moduli)
+    peak_h = np.full((n_b, n_l), np.nan)
+    over_h = np.zeros((n_b, n_l))
+    peak_s = np.full((n_b, n_e, n_l, n_g), np.nan)
+    over_s = np.zeros((n_b, n_e, n_l, n_g))
+    corr = np.full((n_b, n_e, n_l, n_g), np.nan)
+    t_end = (acceleration.size - 1) * dt + tail
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for b, block in enumerate(blocks):
+            for l, factor in enumerate(level_factors):
+                ag = acceleration * factor * block.uplift_acceleration() / pga
+                _, theta_h, _, summary_h = simulate_histories("housner", ag, dt, [(block, None, None)], t_end=t_end)
+                peak_h[b, l] = summary_h[0, 1]
+                over_h[b, l] = summary_h[0, 0] == 2
+                from dataclasses import replace
+
+                cases = []
+                for modulus in block_moduli:
+                    stiff_block = replace(block, E_b=modulus)
+                    for shear in shear_moduli:
+                        k = interface_stiffness(shear, modulus, block.footprint_area, block.soil_depth)
+                        cases.append((stiff_block, k, xi))
+                _, theta_s, _, summary_s = simulate_histories("ssi", ag, dt, cases, t_end=t_end)
+                reference = np.nan_to_num(theta_h[0], nan=np.pi / 2)
+                for index in range(len(cases)):
+                    e, g = divmod(index, n_g)
+                    peak_s[b, e, l, g] = summary_s[index, 1]
+                    over_s[b, e, l, g] = summary_s[index, 0] == 2
+                    corr[b, e, l, g] = correlation(reference, np.nan_to_num(theta_s[index], nan=np.pi / 2))
+    return peak_h, over_h, peak_s, over_s, corr
+
+
+def threshold_modulus(shear_moduli, ratio, tolerance):
+    """Smallest G_s from which |ratio - 1| <= tolerance holds for every stiffer value (log interpolation).
+
+    NaN if even the stiffest G_s is outside the tolerance; the softest G_s if all are inside.
+    """
+    error = np.abs(np.asarray(ratio) - 1.0)
+    inside = error <= tolerance
+    if not inside[-1] or np.isnan(error[-1]):
+        return np.nan
+    outside = np.flatnonzero(~inside)
+    if outside.size == 0:
+        return float(shear_moduli[0])
+    j = outside[-1]  # last G outside; j + 1 is inside
+    x0, x1 = np.log(shear_moduli[j]), np.log(shear_moduli[j + 1])
+    e0, e1 = error[j], error[j + 1]
+    fraction = (e0 - tolerance) / (e0 - e1) if e0 != e1 else 1.0
+    return float(np.exp(x0 + fraction * (x1 - x0)))
+
+
+def run_applicability(records, blocks, *, shear_moduli=DEFAULT_SHEAR_MODULI, block_moduli=(30e9, 210e9),
+                      level_factors=DEFAULT_LEVEL_FACTORS, xi=0.05, tail=5.0, tolerance=0.10, workers=None,
+                      progress=True) -> xr.Dataset:
+    """The sweep over records (in parallel) and its summary dataset."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    from tqdm import tqdm
+
+    shear_moduli = np.asarray(shear_moduli, float)
+    arguments = [(r.acceleration, r.dt, float(np.max(np.abs(r.acceleration))), list(blocks), list(block_moduli),
+                  list(level_factors), shear_moduli, xi, tail) for r in records]
+    if workers == 1:
+        results = [_record_task(*a) for a in tqdm(arguments, desc="applicability", disable=not progress)]
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = [pool.submit(_record_task, *a) for a in arguments]
+            results = [f.result() for f in tqdm(futures, desc="applicability", unit="rec", disable=not progress)]
+    peak_h = np.array([r[0] for r in results])
+    over_h = np.array([r[1] for r in results])
+    peak_s = np.array([r[2] for r in results])
+    over_s = np.array([r[3] for r in results])
+    corr = np.array([r[4] for r in results])
+    # medians over the records that did not overturn in either model
+    survived = (over_h[:, :, None, :, None] == 0) & (over_s == 0)
+    ssi_angles = np.where(survived, peak_s, np.nan)
+    housner_angles = np.where(survived, np.broadcast_to(peak_h[:, :, None, :, None], peak_s.shape), np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ratio = np.nanmedian(ssi_angles, axis=0) / np.nanmedian(housner_angles, axis=0)
+        overturn_difference = over_s.mean(axis=0) - over_h.mean(axis=0)[:, None, :, None]
+        median_correlation = np.nanmedian(corr, axis=0)
+    thresholds = np.full(ratio.shape[:3], np.nan)
+    for index in np.ndindex(*ratio.shape[:3]):
+        thresholds[index] = threshold_modulus(shear_moduli, ratio[index], tolerance)
+    dims = ("block", "block_modulus", "level", "shear_modulus")
+    coords = {"block": [b.name for b in blocks],
+              "block_modulus": ("block_modulus", np.asarray(block_moduli, float),
+                                {"long_name": "block Young's modulus E_b", "units": "Pa"}),
+              "level": ("level", np.asarray(level_factors, float),
+                        {"long_name": "PGA over the block's uplift PGA g tan(alpha)", "units": "1"}),
+              "shear_modulus": ("shear_modulus", shear_moduli, {"long_name": "soil shear modulus G_s", "units": "Pa"}),
+              "block_R": ("block", [b.R for b in blocks], {"long_name": "semi-diagonal R", "units": "m"}),
+              "block_alpha": ("block", [b.alpha for b in blocks], {"long_name": "slenderness alpha", "units": "rad"})}
+    dataset = xr.Dataset({
+        "peak_angle_ratio_ssi_housner": (dims, ratio, {"long_name": "median peak angle SSI / Housner "
+                                                                    "(records surviving in both)", "units": "1"}),
+        "overturning_fraction_difference": (dims, overturn_difference,
+                                            {"long_name": "overturning fraction SSI minus Housner", "units": "1"}),
+        "history_correlation": (dims, median_correlation,
+                                {"long_name": "median Pearson correlation of SSI and Housner rotation histories",
+                                 "units": "1"}),
+        "threshold_shear_modulus": (dims[:3], thresholds,
+                                    {"long_name": f"G_s above which Housner stays within {tolerance:.0%} of SSI",
+                                     "units": "Pa"}),
+        "threshold_relative_stiffness": (dims[:3], coords["block_modulus"][1][None, :, None] / thresholds,
+                                         {"long_name": "relative stiffness E_b / G_s at the threshold", "units": "1"}),
+    }, coords=coords)
+    dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag applicability of the rigid-base model",
+                     "tolerance": tolerance, "n_records": len(records), "damping_ratio": xi,
+                     "paper_threshold": "G_s between 300 and 1000 MPa"}
+    return dataset
+
+
+def write_applicability(dataset, output) -> list[Path]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    output = Path(output)
+    encoding = {n: {"zlib": True} for n, v in dataset.data_vars.items() if v.dtype.kind == "f"}
+    with atomic_path(output / "applicability.nc") as temporary:
+        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    tolerance = dataset.attrs["tolerance"]
+    n_blocks = dataset.sizes["block"]
+    figure, axes = plt.subplots(1, n_blocks, figsize=(4.6 * n_blocks, 4.6), sharey=True, squeeze=False,
+                                constrained_layout=True)
+    shear = dataset.shear_modulus.values / 1e6
+    for axis, block in zip(axes[0], dataset.block.values):
+        for e_index, modulus in enumerate(dataset.block_modulus.values):
+            for l_index, level in enumerate(dataset.level.values):
+                ratio = dataset.peak_angle_ratio_ssi_housner.sel(block=block).values[e_index, l_index]
+                axis.semilogx(shear, ratio, color=f"C{l_index}", ls=["-", "--", ":"][e_index % 3], marker=".",
+                              label=f"E_b = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
+        axis.axhspan(1 - tolerance, 1 + tolerance, color="0.85")
+        axis.axvspan(300, 1000, color="C2", alpha=0.12)
+        axis.axhline(1.0, color="k", lw=0.7)
+        axis.set_title(f"{block}", fontsize=10)
+        axis.set_xlabel("soil shear modulus G_s [MPa]")
+        axis.grid(alpha=0.3, which="both")
+    axes[0, 0].set_ylabel("median θmax SSI / Housner [-]")
+    axes[0, -1].legend(fontsize=6.5)
+    figure.suptitle(f"Rigid-base error against soil stiffness (grey: ±{tolerance:.0%}; green: paper's 300-1000 MPa)")
+    path = output / "applicability-sweep.png"
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, dpi=120, format="png")
+    plt.close(figure)
+    return [output / "applicability.nc", path]
