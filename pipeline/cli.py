@@ -109,7 +109,20 @@ def command_fragility(args) -> int:
     fragility, risk = fragility_stage(cube, ida, config, output)
     for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
         print(f"wrote {output / name}")
-    pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started)
+    applicability = None
+    if not args.skip_applicability:
+        from pipeline.applicability import run_applicability, write_applicability
+        from pipeline.processing import load_recipe, process_record
+        from pipeline.records import load_records
+
+        recipe = load_recipe(config.processing or None)
+        raw, _ = load_records(list(config.record_sets))
+        applicability = run_applicability([process_record(r, recipe) for r in raw], config.blocks,
+                                          workers=1 if args.serial else None, progress=not args.no_progress)
+        for path in write_applicability(applicability, output):
+            print(f"wrote {path}")
+    pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
+                             applicability)
     print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
     print(f"done in {time.perf_counter() - started:.0f} s")
     return EXIT_PARTIAL if stats["failures"] else 0
@@ -229,6 +242,9 @@ def build_parser() -> argparse.ArgumentParser:
                          help="start a local dask cluster with N worker processes")
         sub.add_argument("--serial", action="store_true", help="run in this process (debugging)")
         sub.add_argument("--no-progress", action="store_true", help="hide progress bars")
+        if name == "fragility":
+            sub.add_argument("--skip-applicability", action="store_true",
+                             help="skip the soil-stiffness sweep of `rockfrag applicability` (saves minutes)")
         sub.set_defaults(handler=handler)
     calibrate = commands.add_parser("calibrate", help="fit the SSI stiffness k and damping xi to a reference "
                                     "rotation history (paper eq. 17)")

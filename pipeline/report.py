@@ -364,7 +364,7 @@ def write_report(figures, output_dir) -> tuple[Path, list[Path]]:
 
 
 def build_figures(config, cube, ida, fragility, risk, records, measures, raw_bolu, processed_bolu,
-                  runtime_s, stiffness_of) -> list[Figure]:
+                  runtime_s, stiffness_of, applicability=None) -> list[Figure]:
     """All figures of the report, in order."""
     figures = [summary_page(config, cube, fragility, risk, runtime_s), records_table(records, measures),
                spectra(records)]
@@ -384,10 +384,15 @@ def build_figures(config, cube, ida, fragility, risk, records, measures, raw_bol
         figures.append(three_outcome_figure(fragility, block))
     if {"housner", "ssi"} <= set(cube.model.values):
         figures.append(applicability_figure(cube))
+    if applicability is not None:
+        from pipeline.applicability import sweep_figure
+
+        figures.append(Figure("applicability-sweep", sweep_figure(applicability),
+                              "Rigid-base error against a fine sweep of soil stiffness."))
     return figures
 
 
-def report_stage(config, cube, ida, fragility, risk, output, runtime_s):
+def report_stage(config, cube, ida, fragility, risk, output, runtime_s, applicability=None):
     """Load the records for the record pages, build every figure, write PNGs and the PDF."""
     import warnings
 
@@ -408,5 +413,5 @@ def report_stage(config, cube, ida, fragility, risk, output, runtime_s):
     except Exception as error:  # the catalogue may be absent for a user's own record folder
         warnings.warn(f"Bolu record not available for the comparison figure: {error}")
     figures = build_figures(config, cube, ida, fragility, risk, records, measures, raw_bolu, processed_bolu,
-                            runtime_s, soil_block_stiffness)
+                            runtime_s, soil_block_stiffness, applicability)
     return write_report(figures, output)

@@ -25,13 +25,14 @@ def pipeline_output(tmp_path_factory):
 def expected_figures(n_blocks, n_ssi_models=1):
     # summary, records table, spectra, Bolu processing, Bolu comparison, IDA per block,
     # per block: fragility by soil (per SSI model) + by model + outcomes, applicability
-    return 5 + n_blocks + n_blocks * (n_ssi_models + 2) + 1
+    return 5 + n_blocks + n_blocks * (n_ssi_models + 2) + 1 + 1  # + the applicability sweep
 
 
 @pytest.mark.slow
 def test_every_output_file_is_written(pipeline_output):
     output, _ = pipeline_output
-    for name in ("cube.nc", "ida.nc", "fragility.nc", "fragility.csv", "fragility_pelicun.csv", "report.pdf"):
+    for name in ("cube.nc", "ida.nc", "fragility.nc", "fragility.csv", "fragility_pelicun.csv", "report.pdf",
+                 "applicability.nc", "applicability-sweep.png"):
         assert (output / name).stat().st_size > 0, name
     pngs = sorted((output / "figures").glob("*.png"))
     assert len(pngs) == expected_figures(3)
