@@ -52,10 +52,10 @@ def command_records(args) -> int:
         raise PipelineError("no record could be read; nothing to do")
     table, pngs = records_stage(records, recipe, args.output, plot=args.plot,
                                 progress=not args.no_progress)
+    import pandas as pd
+
     shown = table[["id", "event", "station", "component", *TABLE_COLUMNS]].rename(columns=TABLE_COLUMNS)
-    with_options = __import__("pandas").option_context("display.max_rows", None, "display.width", 200,
-                                                       "display.max_colwidth", 28)
-    with with_options:
+    with pd.option_context("display.max_rows", None, "display.width", 200, "display.max_colwidth", 28):
         print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     print(f"\nwrote {args.output / 'records.csv'} ({len(table)} records)")
     if pngs:

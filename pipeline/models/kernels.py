@@ -309,6 +309,7 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
     h = dt * 0.25
     segment = 0
     failed = False
+    start_now = False
     while segment < n_samples - 1 and not failed:
         t_seg = segment * dt
         t_seg_end = (segment + 1) * dt
@@ -318,9 +319,10 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
         a_slope = (a_next - a_start) / dt
         while t < t_seg_end - 1e-12 * dt:
             if phase == REST:
-                # start rocking at once if the uplift condition already holds
+                # start rocking at once if the uplift condition holds (or an uplift was just located)
                 accel = _ground_in_segment(a_start, a_slope, t_seg, t)
-                if abs(accel) > math.tan(alpha) * _support(model, params, x):
+                if start_now or abs(accel) > math.tan(alpha) * _support(model, params, x):
+                    start_now = False
                     phase = ROCKING
                     sigma = -1.0 if accel > 0 else 1.0
                     x[0] = 0.0
@@ -347,20 +349,10 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
                         if a_slope != 0.0:
                             t_cross = t_seg + (target - a_start) / a_slope
                         t = min(max(t_cross, t), t_seg_end)
-                        phase = ROCKING
-                        sigma = -1.0 if a_end > 0 else 1.0
-                        if not uplifted:
-                            uplifted = True
-                            time_of_uplift = t
-                        if status == STATUS_NO_UPLIFT:
-                            status = STATUS_ROCKING
-                        n_events += 1
-                        if n_events > max_events:
-                            failed = True
-                            break
                         if t >= t_seg_end - 1e-12 * dt:
-                            t = t_seg_end
+                            t = t_seg_end  # starts at the top of the next segment
                             break
+                        start_now = True
                         continue
                     t = t_seg_end
                     break
@@ -488,16 +480,7 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
                     sigma = 0.0
                 n_events += 1
             elif event_kind == 2:
-                n_events += 1
-                phase = ROCKING
-                sigma = -1.0 if _ground_in_segment(a_start, a_slope, t_seg, t) > 0 else 1.0
-                x[0] = 0.0
-                x[1] = 0.0
-                if not uplifted:
-                    uplifted = True
-                    time_of_uplift = t
-                if status == STATUS_NO_UPLIFT:
-                    status = STATUS_ROCKING
+                start_now = True  # uplift located: the top of the loop starts rocking here
             if n_events > max_events:
                 failed = True
                 break
