@@ -31,7 +31,7 @@ from pipeline import __version__
 from pipeline.cube import build_cube, write_netcdf
 from pipeline.errors import PipelineError
 from pipeline.measures import pga, pgv, spectral_acceleration
-from pipeline.models import kernels, simulate_batch
+from pipeline.models import get_model, kernels, simulate_batch
 from pipeline.outputs import atomic_path
 from pipeline.processing import load_recipe, process_record
 from pipeline.records import load_records
@@ -71,8 +71,6 @@ def cells_for_record(record, config, recipe) -> list[Cell]:
     for block_index, block in enumerate(config.blocks):
         block_spec = {k: v for k, v in asdict(block).items() if k not in ("name", "description")}
         for model in config.models:
-            from pipeline.models import get_model
-
             if not get_model(model).needs_foundation:
                 cells.append(Cell(_hash({**common, "block": block_spec, "model": model}), block_index, None, model))
                 continue

@@ -46,19 +46,42 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
     t = 0.0
     peak, impacts, overturned = 0.0, [], False
     zeno_speed = math.sqrt(2 * p2 * math.sin(alpha) * 1e-6 * alpha)
+    y_static = G / omega**2 if omega else 0.0
+
+    def vertical(time, x):
+        return [0.0, 0.0, x[3], G - omega**2 * x[2] - 2 * xi * omega * x[3]]
+
+    def uplift(time, x):
+        return abs(ground(time)) - math.tan(alpha) * support(x)
+    uplift.terminal = True
+    uplift.direction = 1
+
     while t < t_end - 1e-12:
-        # rest: the state is at equilibrium here (every test case starts there and returns there)
-        threshold = math.tan(alpha) * support(state)
-        k0 = int(math.floor(t / dt + 1e-9))
         start = None
-        for i in range(k0, int(t_end / dt)):
-            a0, a1 = ground(max(t, i * dt)), ground((i + 1) * dt)
-            if abs(a1) > threshold:
-                target = math.copysign(threshold, a1)
-                s = max(t, i * dt) if abs(a0) > threshold else i * dt + (target - ground(i * dt)) / (
-                    (ground((i + 1) * dt) - ground(i * dt)) / dt)
-                start = (max(s, t), -math.copysign(1.0, a1))
-                break
+        if model != "housner" and (abs(state[2] - y_static) > 1e-9 * y_static or abs(state[3]) > 1e-9 * y_static * omega):
+            # rest with a vertical vibration left over: integrate it until the uplift condition holds
+            if uplift(t, state) > 0:
+                start = (t, -math.copysign(1.0, ground(t)))
+            else:
+                solution = solve_ivp(vertical, (t, t_end), state, method="DOP853", rtol=rtol, atol=atol * y_static,
+                                     max_step=dt, events=uplift)
+                state = solution.y[:, -1].copy()
+                t = solution.t[-1]
+                if not solution.t_events[0].size:
+                    break
+                start = (t, -math.copysign(1.0, ground(t)))
+        else:
+            # rest at static equilibrium: the support force is m g; scan the piecewise-linear ground motion
+            threshold = math.tan(alpha) * G
+            k0 = int(math.floor(t / dt + 1e-9))
+            for i in range(k0, int(t_end / dt)):
+                a0, a1 = ground(max(t, i * dt)), ground((i + 1) * dt)
+                if abs(a1) > threshold:
+                    target = math.copysign(threshold, a1)
+                    s = max(t, i * dt) if abs(a0) > threshold else i * dt + (target - ground(i * dt)) / (
+                        (ground((i + 1) * dt) - ground(i * dt)) / dt)
+                    start = (max(s, t), -math.copysign(1.0, a1))
+                    break
         if start is None:
             break
         t, sigma = start
@@ -81,8 +104,14 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
             for x_ext in solution.y_events[2]:
                 peak = max(peak, abs(x_ext[0]))
             peak = max(peak, float(np.max(np.abs(solution.y[0]))))
+            started_at = t
             state = solution.y[:, -1].copy()
             t = solution.t[-1]
+            if solution.t_events[0].size and t - started_at < 1e-12:
+                # an excursion of zero length (a start that does not lift): back to rest
+                state[0] = state[1] = 0.0
+                t = min(t + 1e-9, t_end)
+                break
             if solution.t_events[1].size:
                 return math.pi / 2, np.array(impacts), True
             if not solution.t_events[0].size:
