@@ -31,7 +31,7 @@ from pipeline import __version__
 from pipeline.cube import build_cube, write_netcdf
 from pipeline.errors import PipelineError
 from pipeline.measures import pga, pgv, spectral_acceleration
-from pipeline.models import get_model, kernels, simulate_batch
+from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, kernels, simulate_batch
 from pipeline.outputs import atomic_path
 from pipeline.processing import load_recipe, process_record
 from pipeline.records import load_records
@@ -66,7 +66,8 @@ def cells_for_record(record, config, recipe) -> list[Cell]:
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
-              "solver": {"switch": config.switch, "tail": config.tail, "overturn": config.overturn_angle}}
+              "solver": {"switch": config.switch, "tail": config.tail, "overturn": config.overturn_angle,
+                         "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
     cells = []
     for block_index, block in enumerate(config.blocks):
         block_spec = {k: v for k, v in asdict(block).items() if k not in ("name", "description")}
