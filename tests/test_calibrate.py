@@ -44,7 +44,7 @@ def test_recovers_known_stiffness_and_damping_from_noisy_reference(bolu):
     ref_rotation = np.interp(ref_time, reference.t, reference.theta)
     ref_rotation += rng.normal(0, 0.03 * np.max(np.abs(ref_rotation)), ref_time.size)
     result = calibrate(ref_time, ref_rotation, ag, dt, PAPER_BLOCK, k_range=(1e8, 9e8), xi_range=(0.01, 0.07),
-                       n_k=15, n_xi=7, soil_shear_modulus=80e6)
+                       n_k=25, n_xi=7, soil_shear_modulus=80e6)  # the default grid
     assert result.k == pytest.approx(k_true, rel=0.05)
     assert result.xi == pytest.approx(xi_true, abs=0.011)
     assert result.correlation > 0.95 and result.correlation >= result.correlation_grid - 1e-12
