@@ -22,6 +22,9 @@ def atomic_path(destination):
     os.close(handle)
     try:
         yield Path(temporary)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(temporary, 0o666 & ~umask)  # mkstemp makes 0600; results are ordinary files
         os.replace(temporary, destination)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
