@@ -243,46 +243,41 @@ def _fragility_panel(axis, fragility, levels, block, soil, model, state, colour,
         axis.plot([], [], color=colour, label=f"{label} (no fit)", **style)
 
 
-def fragility_by_soil(fragility, block, model) -> Figure:
+def _fragility_figure(fragility, block, series, title, caption, name) -> Figure:
+    """One panel per damage state; ``series`` is a list of (soil, model, colour, line style, label)."""
     states = list(fragility.damage_state.values)
     levels = fragility.im_level.values
-    fig, axes = plt.subplots(1, len(states), figsize=(3.4 * len(states), 3.8), sharey=True, constrained_layout=True)
-    for axis, state in zip(np.atleast_1d(axes), states):
-        for index, soil in enumerate(fragility.soil.values):
-            _fragility_panel(axis, fragility, levels, block, soil, model, state, _colour(soil, index),
-                             MODEL_STYLES.get(model, {}), soil)
+    fig, axes = plt.subplots(1, len(states), figsize=(3.4 * len(states), 3.8), sharey=True, squeeze=False,
+                             constrained_layout=True)
+    for axis, state in zip(axes[0], states):
+        for soil, model, colour, style, label in series:
+            _fragility_panel(axis, fragility, levels, block, soil, model, state, colour, style, label)
         axis.set_xscale("log")
         axis.set_title(state, fontsize=10)
         axis.set_xlabel(f"{fragility.attrs.get('intensity_measure', 'IM').upper()} "
                         f"[{fragility.im_level.attrs.get('units', '')}]")
         axis.grid(alpha=0.3, which="both")
-    np.atleast_1d(axes)[0].set_ylabel("P(damage state | IM) [-]")
-    np.atleast_1d(axes)[-1].legend(fontsize=7, loc="upper left")
-    fig.suptitle(f"Fragility by soil: block '{block}', model {model}")
-    _caption(fig, "Points: fraction of records reaching the state at each level; lines: lognormal MLE; "
-                  "band: bootstrap confidence bounds of the median.")
-    return Figure(f"fragility-soils-{block}", fig, "Fragility curves compared across soils.")
+    axes[0, 0].set_ylabel("P(damage state | IM) [-]")
+    axes[0, -1].legend(fontsize=7, loc="upper left")
+    fig.suptitle(title)
+    _caption(fig, caption)
+    return Figure(name, fig, title)
+
+
+def fragility_by_soil(fragility, block, model) -> Figure:
+    series = [(soil, model, _colour(soil, i), MODEL_STYLES.get(model, {}), soil)
+              for i, soil in enumerate(fragility.soil.values)]
+    return _fragility_figure(fragility, block, series, f"Fragility by soil: block '{block}', model {model}",
+                             "Points: fraction of records reaching the state at each level; lines: lognormal MLE; "
+                             "band: bootstrap confidence bounds of the median.", f"fragility-soils-{block}")
 
 
 def fragility_by_model(fragility, block, soils) -> Figure:
-    states = list(fragility.damage_state.values)
-    levels = fragility.im_level.values
-    fig, axes = plt.subplots(1, len(states), figsize=(3.4 * len(states), 3.8), sharey=True, constrained_layout=True)
-    for axis, state in zip(np.atleast_1d(axes), states):
-        for index, soil in enumerate(soils):
-            for model in fragility.model.values:
-                _fragility_panel(axis, fragility, levels, block, soil, model, state, _colour(soil, index),
-                                 MODEL_STYLES.get(model, {}), f"{model}, {soil}")
-        axis.set_xscale("log")
-        axis.set_title(state, fontsize=10)
-        axis.set_xlabel(f"{fragility.attrs.get('intensity_measure', 'IM').upper()} "
-                        f"[{fragility.im_level.attrs.get('units', '')}]")
-        axis.grid(alpha=0.3, which="both")
-    np.atleast_1d(axes)[0].set_ylabel("P(damage state | IM) [-]")
-    np.atleast_1d(axes)[-1].legend(fontsize=7, loc="upper left")
-    fig.suptitle(f"Fragility by model: block '{block}', softest and stiffest soil")
-    _caption(fig, "Dashed: Housner (rigid base); solid: SSI-rocking.")
-    return Figure(f"fragility-models-{block}", fig, "Fragility curves, Housner vs SSI.")
+    series = [(soil, model, _colour(soil, i), MODEL_STYLES.get(model, {}), f"{model}, {soil}")
+              for i, soil in enumerate(soils) for model in fragility.model.values]
+    return _fragility_figure(fragility, block, series,
+                             f"Fragility by model: block '{block}', softest and stiffest soil",
+                             "Dashed: Housner (rigid base); solid: SSI-rocking.", f"fragility-models-{block}")
 
 
 def three_outcome_figure(fragility, block) -> Figure:
