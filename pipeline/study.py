@@ -139,7 +139,11 @@ def _executor(workers, scheduler, dask_workers):
 
         cluster = None
         if scheduler:
-            client = Client(scheduler)
+            try:
+                client = Client(scheduler, timeout="10s")
+            except (OSError, TimeoutError, ValueError) as error:
+                raise PipelineError(f"cannot connect to the dask scheduler at {scheduler!r} ({error}); "
+                                    "expected the address of a running scheduler, e.g. tcp://host:8786") from None
         else:
             cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)

@@ -45,3 +45,22 @@ def test_bad_recipe_exits_2_without_traceback(tmp_path):
     assert "Traceback" not in result.stderr
     assert "steps[0].max_percentage" in result.stderr and "0.0 to 0.5" in result.stderr
     assert not (tmp_path / "records.csv").exists()
+
+
+def test_bad_study_exits_2_with_the_field(tmp_path):
+    study = tmp_path / "study.toml"
+    study.write_text('[intensity]\nlevels = { start = 0.5, stop = 0.1, count = 5 }\n')
+    result = subprocess.run([sys.executable, "-m", "pipeline", "run", str(study), "--output", str(tmp_path / "out")],
+                            capture_output=True, text=True)
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert "intensity.levels" in result.stderr and str(study) in result.stderr
+    assert not (tmp_path / "out" / "cube.nc").exists()
+
+
+def test_unreachable_scheduler_is_one_line(tmp_path):
+    study = tmp_path / "study.toml"
+    study.write_text('soils = ["rock"]\n[study]\nrecord_sets = ["bolu"]\n[intensity]\nlevels = [0.5]\n')
+    result = subprocess.run([sys.executable, "-m", "pipeline", "run", str(study), "--output", str(tmp_path / "out"),
+                             "--scheduler", "tcp://127.0.0.1:9", "--no-progress"], capture_output=True, text=True)
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert "cannot connect to the dask scheduler" in result.stderr
