@@ -35,7 +35,7 @@ VARIABLES = {
 }
 
 
-def summaries_to_variables(summaries, blocks, model_names, n_soils):
+def summaries_to_variables(summaries, blocks, model_names):
     """Turn a summary array (record, level, soil, block, model, N_SUMMARY) into named arrays."""
     out = {}
     for name, (index, _, _) in VARIABLES.items():
@@ -63,7 +63,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     stiffness : (n_soil, n_block) interface stiffness [N/m]; provenance : dict of JSON-able facts.
     """
     model_names = list(config.models)
-    values = summaries_to_variables(summaries, config.blocks, model_names, len(config.soils))
+    values = summaries_to_variables(summaries, config.blocks, model_names)
     unit = config.level_unit
     im_si_unit = "m/s" if config.measure == "pgv" else "m/s^2"
     measure_name = {"pga": "peak ground acceleration", "pgv": "peak ground velocity",

@@ -159,10 +159,9 @@ def intensity_measures(acceleration, dt, sa_periods=(0.2, 1.0, 2.0)) -> dict:
 
 
 MEASURES = {
-    "pga": lambda a, dt, **kw: pga(a),
-    "pgv": lambda a, dt, **kw: pgv(a, dt),
-    "sa": lambda a, dt, period=1.0, damping=0.05: spectral_acceleration(a, dt, period, damping),
-    "arias": lambda a, dt, **kw: arias_intensity(a, dt),
-    "cav": lambda a, dt, **kw: cav(a, dt),
+    "pga": lambda a, dt, **options: pga(a),
+    "pgv": lambda a, dt, **options: pgv(a, dt),
+    "sa": lambda a, dt, period=1.0, damping=0.05, **options: spectral_acceleration(a, dt, period, damping),
 }
-"""Intensity measures a study may scale records to (name -> f(acceleration, dt, **options))."""
+"""Intensity measures a study can scale records to: name -> f(acceleration [m/s^2], dt [s], **options)
+returning SI values. A new scaling measure is one entry here plus its unit in config.MEASURE_UNITS."""

@@ -30,7 +30,7 @@ import numpy as np
 from pipeline import __version__
 from pipeline.cube import build_cube, write_netcdf
 from pipeline.errors import PipelineError
-from pipeline.measures import pga, pgv, spectral_acceleration
+from pipeline.measures import MEASURES
 from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, kernels, simulate_batch
 from pipeline.outputs import atomic_path
 from pipeline.processing import load_recipe, process_record
@@ -50,11 +50,7 @@ class Cell:
 
 def record_intensity(acceleration, dt, config) -> float:
     """The study's intensity measure of a processed record [SI]."""
-    if config.measure == "pga":
-        return pga(acceleration)
-    if config.measure == "pgv":
-        return pgv(acceleration, dt)
-    return spectral_acceleration(acceleration, dt, config.period, config.damping)
+    return MEASURES[config.measure](acceleration, dt, period=config.period, damping=config.damping)
 
 
 def _hash(payload) -> str:

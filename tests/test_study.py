@@ -202,3 +202,20 @@ def test_killed_run_resumes_without_recomputing(small_study, tmp_path):
     subprocess.run([*command[:6], str(fresh), *command[7:]], check=True, capture_output=True)
     xr.testing.assert_identical(xr.open_dataset(output / "cube.nc").drop_attrs(),
                                 xr.open_dataset(fresh / "cube.nc").drop_attrs())
+
+
+def test_sa_scaling_reaches_the_requested_spectral_acceleration(tmp_path):
+    from pipeline.measures import spectral_acceleration
+
+    study = tmp_path / "sa.toml"
+    study.write_text(SMALL.replace("[intensity]", '[intensity]\nmeasure = "sa"\nperiod = 0.5')
+                     .replace('models = ["housner", "ssi"]', 'models = ["housner"]'))
+    config = load_study(study)
+    cube, _ = run_study(config, output=tmp_path / "out", workers=1, progress=False, log=lambda m: None)
+    records, _ = load_records("bolu")
+    for record in records:
+        processed = process_record(record)
+        for level, scale in zip(cube.im_level_si.values, cube.scale_factor.sel(record=record.id).values):
+            # Sa is linear in the scale factor: the scaled record has exactly the requested Sa(0.5 s)
+            assert spectral_acceleration(processed.acceleration * scale, processed.dt, 0.5) == pytest.approx(level, rel=1e-9)
+    assert cube.im_level.attrs["units"] == "g" and "Sa(0.5 s" in cube.im_level.attrs["long_name"]

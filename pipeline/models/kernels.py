@@ -69,23 +69,8 @@ E1, E3, E4, E5, E6, E7 = (71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253
 
 
 @njit(cache=True)
-def ground_acceleration(ag, dt, t):
-    """Ground acceleration [m/s^2] at time t: linear between samples, zero after the record."""
-    position = t / dt
-    k = int(math.floor(position))
-    n = ag.size
-    if k < 0:
-        return 0.0
-    if k >= n - 1:
-        if k == n - 1 and position - k < 1e-12:
-            return ag[n - 1]
-        return 0.0
-    fraction = position - k
-    return ag[k] + (ag[k + 1] - ag[k]) * fraction
-
-
-@njit(cache=True)
 def _ground_in_segment(a_start, a_slope, t_start, t):
+    """Ground acceleration [m/s^2] at t inside a sample interval (linear between samples)."""
     return a_start + a_slope * (t - t_start)
 
 
