@@ -111,16 +111,10 @@ def command_fragility(args) -> int:
         print(f"wrote {output / name}")
     applicability = None
     if not args.skip_applicability:
-        from pipeline.applicability import run_applicability, write_applicability
-        from pipeline.processing import load_recipe, process_record
-        from pipeline.records import load_records
+        from pipeline.applicability import applicability_stage
 
-        recipe = load_recipe(config.processing or None)
-        raw, _ = load_records(list(config.record_sets))
-        applicability = run_applicability([process_record(r, recipe) for r in raw], config.blocks,
-                                          workers=1 if args.serial else None, progress=not args.no_progress)
-        for path in write_applicability(applicability, output):
-            print(f"wrote {path}")
+        applicability = applicability_stage(config, output, workers=1 if args.serial else None,
+                                            progress=not args.no_progress)
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
                              applicability)
     print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
