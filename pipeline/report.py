@@ -99,22 +99,33 @@ def summary_page(config, cube, fragility, risk, runtime_s) -> Figure:
     return Figure("summary", fig, "Summary of the study and the fitted fragility parameters.")
 
 
-def records_table(records, measures) -> Figure:
-    fig = plt.figure(figsize=(11.7, 8.3))
-    axis = fig.add_axes([0.01, 0.05, 0.98, 0.88])
-    axis.axis("off")
+ROWS_PER_TABLE_PAGE = 45
+
+
+def records_tables(records, measures) -> list[Figure]:
+    """Intensity-measure table of the record set, ROWS_PER_TABLE_PAGE records per page."""
     header = ["record", "event", "station", "PGA [g]", "PGV [m/s]", "Ia [m/s]", "D5-95 [s]", "Sa(1s) [g]"]
     rows = [[r.id, str(r.metadata.get("event", ""))[:24], str(r.metadata.get("station", ""))[:20],
              f"{m['pga_m_s2'] / STANDARD_GRAVITY:.3f}", f"{m['pgv_m_s']:.3f}", f"{m['arias_m_s']:.2f}",
              f"{m['d5_95_s']:.1f}", f"{m['sa_1s_m_s2'] / STANDARD_GRAVITY:.3f}"] for r, m in zip(records, measures)]
-    table = axis.table(cellText=rows, colLabels=header, loc="upper center", cellLoc="left")
-    table.auto_set_font_size(False)
-    table.set_fontsize(6 if len(rows) > 30 else 8)
-    table.scale(1, 0.95 if len(rows) > 30 else 1.2)
-    axis.set_title("Intensity measures of the processed records", fontsize=12)
-    _caption(fig, "PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) after processing "
-                  "(demean, detrend, taper, zero-phase band-pass, baseline).")
-    return Figure("records-table", fig, "Intensity measures of the record set.")
+    pages = [rows[i:i + ROWS_PER_TABLE_PAGE] for i in range(0, len(rows), ROWS_PER_TABLE_PAGE)] or [[]]
+    figures = []
+    for number, page in enumerate(pages, start=1):
+        fig = plt.figure(figsize=(11.7, 8.3))
+        axis = fig.add_axes([0.01, 0.05, 0.98, 0.88])
+        axis.axis("off")
+        table = axis.table(cellText=page or [[""] * len(header)], colLabels=header, loc="upper center",
+                           cellLoc="left")
+        table.auto_set_font_size(False)
+        table.set_fontsize(6 if len(page) > 30 else 8)
+        table.scale(1, 0.95 if len(page) > 30 else 1.2)
+        suffix = f" ({number}/{len(pages)})" if len(pages) > 1 else ""
+        axis.set_title(f"Intensity measures of the processed records{suffix}", fontsize=12)
+        _caption(fig, "PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) after processing "
+                      "(demean, detrend, taper, zero-phase band-pass, baseline).")
+        figures.append(Figure("records-table" + (f"-{number}" if len(pages) > 1 else ""), fig,
+                              "Intensity measures of the record set."))
+    return figures
 
 
 def spectra(records) -> Figure:
@@ -361,7 +372,7 @@ def write_report(figures, output_dir) -> tuple[Path, list[Path]]:
 def build_figures(config, cube, ida, fragility, risk, records, measures, raw_bolu, processed_bolu,
                   runtime_s, stiffness_of, applicability=None) -> list[Figure]:
     """All figures of the report, in order."""
-    figures = [summary_page(config, cube, fragility, risk, runtime_s), records_table(records, measures),
+    figures = [summary_page(config, cube, fragility, risk, runtime_s), *records_tables(records, measures),
                spectra(records)]
     if raw_bolu is not None:
         figures.append(bolu_processing(raw_bolu, processed_bolu))

@@ -88,3 +88,15 @@ def test_pdf_is_deterministic(tmp_path):
     first, _ = write_report(one(), tmp_path / "a")
     second, _ = write_report(one(), tmp_path / "b")
     assert first.read_bytes() == second.read_bytes()
+
+
+def test_record_table_is_paginated(all_records):
+    from pipeline.report import ROWS_PER_TABLE_PAGE, records_tables
+
+    measures = [{"pga_m_s2": 1.0, "pgv_m_s": 1.0, "arias_m_s": 1.0, "d5_95_s": 1.0, "sa_1s_m_s2": 1.0}] * len(all_records)
+    pages = records_tables(all_records, measures)
+    assert len(pages) == -(-len(all_records) // ROWS_PER_TABLE_PAGE)
+    rows = [len(page.figure.axes[0].tables[0].get_celld()) // 8 - 1 for page in pages]  # minus the header
+    assert sum(rows) == len(all_records)
+    for page in pages:
+        plt.close(page.figure)
