@@ -21,7 +21,6 @@ from pipeline.calibrate import correlation
 from pipeline.models import simulate_histories
 from pipeline.outputs import atomic_path
 from pipeline.soils import interface_stiffness
-from pipeline.units import STANDARD_GRAVITY
 
 DEFAULT_SHEAR_MODULI = np.geomspace(10e6, 100e9, 13)
 DEFAULT_LEVEL_FACTORS = (1.5, 2.5, 4.0)
@@ -194,29 +193,29 @@ def write_applicability(dataset, output) -> list[Path]:
     return [output / "applicability.nc", path]
 
 
-def applicability_stage(config, output, workers=None, progress=True, log=print):
-    """Run the default sweep for a study, or reuse ``applicability.nc`` when its inputs are unchanged."""
+def applicability_stage(config, output, workers=None, progress=True, log=print, loaded=None):
+    """Run the default sweep for a study, or reuse ``applicability.nc`` when its inputs are unchanged.
+
+    ``loaded`` may pass ``study.study_records(config)`` to avoid reading the records again.
+    """
     import hashlib
     import json
 
     from pipeline import __version__
-    from pipeline.processing import load_recipe, process_record
-    from pipeline.records import load_records
+    from pipeline.study import study_records
 
     output = Path(output)
-    recipe = load_recipe(config.processing or None)
-    raw, _ = load_records(list(config.record_sets))
+    records, _, recipe = loaded or study_records(config, log)
     key = hashlib.sha256(json.dumps({
         "version": __version__, "recipe": recipe.as_dict(), "blocks": [repr(b) for b in config.blocks],
-        "records": [r.metadata.get("sha256", r.id) for r in raw]}, sort_keys=True).encode()).hexdigest()[:16]
+        "records": [r.metadata.get("sha256", r.id) for r in records]}, sort_keys=True).encode()).hexdigest()[:16]
     existing = output / "applicability.nc"
     if existing.is_file():
         with xr.open_dataset(existing) as cached:
             if cached.attrs.get("input_hash") == key:
                 log(f"reused {existing} (inputs unchanged)")
                 return cached.load()
-    dataset = run_applicability([process_record(r, recipe) for r in raw], config.blocks, workers=workers,
-                                progress=progress)
+    dataset = run_applicability(records, config.blocks, workers=workers, progress=progress)
     dataset.attrs["input_hash"] = key
     for path in write_applicability(dataset, output):
         log(f"wrote {path}")

@@ -99,10 +99,14 @@ def command_fragility(args) -> int:
     from pipeline.report import report_stage
     from pipeline.study import run_study
 
+    from pipeline.study import study_records
+
     started = time.perf_counter()
     config, output = _study_config(args)
+    loaded = study_records(config, log=lambda message: print(message, file=sys.stderr))
     cube, stats = run_study(config, output=output, workers=1 if args.serial else None,
-                            scheduler=args.scheduler, dask_workers=args.workers, progress=not args.no_progress)
+                            scheduler=args.scheduler, dask_workers=args.workers, progress=not args.no_progress,
+                            loaded=loaded)
     print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
@@ -114,9 +118,9 @@ def command_fragility(args) -> int:
         from pipeline.applicability import applicability_stage
 
         applicability = applicability_stage(config, output, workers=1 if args.serial else None,
-                                            progress=not args.no_progress)
+                                            progress=not args.no_progress, loaded=loaded)
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
-                             applicability)
+                             applicability, loaded)
     print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
     print(f"done in {time.perf_counter() - started:.0f} s")
     return EXIT_PARTIAL if stats["failures"] else 0
@@ -179,17 +183,12 @@ def command_applicability(args) -> int:
     import numpy as np
 
     from pipeline.applicability import run_applicability, write_applicability
-    from pipeline.processing import load_recipe, process_record
-    from pipeline.records import load_records
+    from pipeline.study import study_records
 
     config, output = _study_config(args)
-    recipe = load_recipe(config.processing or None)
-    raw, failures = load_records(list(config.record_sets))
-    for failure in failures:
-        print(f"rockfrag: skipped {failure}", file=sys.stderr)
     if args.g_range[0] <= 0 or args.g_range[1] <= args.g_range[0]:
         raise PipelineError(f"--g-range {args.g_range}: need 0 < G_min < G_max [Pa]")
-    records = [process_record(r, recipe) for r in raw]
+    records, _, _ = study_records(config, log=lambda message: print(message, file=sys.stderr))
     dataset = run_applicability(records, config.blocks, shear_moduli=np.geomspace(*args.g_range, args.n_g),
                                 block_moduli=tuple(args.block_moduli), level_factors=tuple(args.levels),
                                 tolerance=args.tolerance, workers=1 if args.serial else None,

@@ -10,7 +10,6 @@ Output: ``reports/figures/NN-name.png`` (one per figure) and ``reports/report.pd
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -398,18 +397,18 @@ def build_figures(config, cube, ida, fragility, risk, records, measures, raw_bol
     return figures
 
 
-def report_stage(config, cube, ida, fragility, risk, output, runtime_s, applicability=None):
-    """Load the records for the record pages, build every figure, write PNGs and the PDF."""
+def report_stage(config, cube, ida, fragility, risk, output, runtime_s, applicability=None, loaded=None):
+    """Build every figure (records from ``loaded`` = ``study.study_records(config)``, or read them),
+    write the PNGs and the PDF."""
     import warnings
 
     from pipeline.measures import intensity_measures
-    from pipeline.processing import load_recipe, process_record
+    from pipeline.processing import process_record
     from pipeline.records import load_records
     from pipeline.soils import soil_block_stiffness
+    from pipeline.study import study_records
 
-    recipe = load_recipe(config.processing or None)
-    raw_records, _ = load_records(list(config.record_sets))
-    records = [process_record(record, recipe) for record in raw_records]
+    records, _, recipe = loaded or study_records(config, log=lambda message: None)
     measures = [intensity_measures(r.acceleration, r.dt, sa_periods=(1.0,)) for r in records]
     raw_bolu = processed_bolu = None
     try:

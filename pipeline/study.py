@@ -165,20 +165,32 @@ def _executor(workers, scheduler, dask_workers):
             lambda: pool.shutdown(wait=False, cancel_futures=True))
 
 
-def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers=None,
-              progress=True, log=print):
-    """Run (or resume) a study and write ``cube.nc``; returns (dataset, statistics dict)."""
-    from tqdm import tqdm
+def study_records(config, log=print):
+    """The study's records, processed with its recipe: (records, failures, recipe).
 
-    started = time.perf_counter()
-    output = Path(output or config.output)
+    Every stage that needs the study's records (study, applicability, report) takes them from here,
+    so ``rockfrag fragility`` reads and processes them once.
+    """
     recipe = load_recipe(config.processing or None)
     raw_records, failures = load_records(list(config.record_sets))
     for failure in failures:
         log(f"rockfrag: skipped {failure}")
     if not raw_records:
         raise PipelineError("no record could be read; nothing to run")
-    records = [process_record(record, recipe) for record in raw_records]
+    return [process_record(record, recipe) for record in raw_records], failures, recipe
+
+
+def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers=None,
+              progress=True, log=print, loaded=None):
+    """Run (or resume) a study and write ``cube.nc``; returns (dataset, statistics dict).
+
+    ``loaded`` may pass the result of ``study_records`` to avoid reading the records again.
+    """
+    from tqdm import tqdm
+
+    started = time.perf_counter()
+    output = Path(output or config.output)
+    records, failures, recipe = loaded or study_records(config, log)
     record_im = np.array([record_intensity(r.acceleration, r.dt, config) for r in records])
     if np.any(record_im <= 0):
         bad = records[int(np.argmin(record_im))].id

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 import pytest
 import xarray as xr
 from scipy.stats import norm
 
 from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from pipeline.fragility import (DAMAGE_STATES, curves_cross, damage_states_from_config, fit_binomial,
-                                fit_censored_capacities, fragility_dataset, lognormal_cdf, pelicun_table)
+                                fit_censored_capacities, fragility_dataset, pelicun_table)
 from pipeline.risk import annual_frequency, load_hazard, probability_in_life
 
 

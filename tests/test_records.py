@@ -5,7 +5,6 @@ from __future__ import annotations
 import shutil
 
 import numpy as np
-import obspy
 import pytest
 
 from pipeline.errors import ManifestError, RecordError

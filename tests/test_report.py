@@ -44,7 +44,6 @@ def test_every_output_file_is_written(pipeline_output):
 
 @pytest.mark.slow
 def test_no_figure_is_empty(pipeline_output):
-    import tomllib
     import xarray as xr
 
     from pipeline.config import load_study

@@ -234,7 +234,6 @@ def simulate_kernel(model, ag, dt, n_tail, params, theta0, thetadot0, y0, ydot0,
         Filled with the results (see S_* indices).
     """
     n_samples = ag.size + n_tail
-    t_end = (n_samples - 1) * dt
     record_history = history.shape[0] > 0
     alpha = params[P_ALPHA]
     radius = params[P_R]

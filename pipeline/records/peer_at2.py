@@ -13,7 +13,6 @@ so ``obspy.read("x.AT2")`` detects the format by itself.
 
 from __future__ import annotations
 
-import io
 import math
 import os
 import re
