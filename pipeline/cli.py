@@ -2,7 +2,9 @@
 
 Input : command-line arguments. Output: files in the output folder (``reports/`` by default) and a
 short summary on stdout. A user error (bad record, bad parameter) prints one line on stderr and
-exits with status 2, without a traceback; files already written stay valid.
+exits with status 2, without a traceback; files already written stay valid. Skipped records give
+status 1; anything else (a bug) one line, a traceback log file in the output folder and status 3
+(``EXIT_CODES``). A command holds the lock of its output folder (pipeline.locking) while it runs.
 """
 
 from __future__ import annotations
@@ -50,8 +52,14 @@ def command_records(args) -> int:
     records, failures, recipe = _load(args)
     if not records:
         raise PipelineError("no record could be read; nothing to do")
+    unprocessed = []
     table, pngs = records_stage(records, recipe, args.output, plot=args.plot,
-                                progress=not args.no_progress)
+                                progress=not args.no_progress, failures=unprocessed)
+    for failure in unprocessed:
+        print(f"rockfrag: skipped {failure}", file=sys.stderr)
+    failures = [*failures, *unprocessed]
+    if table.empty:
+        raise PipelineError("no record could be processed; nothing to do")
     import pandas as pd
 
     shown = table[["id", "event", "station", "component", *TABLE_COLUMNS]].rename(columns=TABLE_COLUMNS)
@@ -286,17 +294,100 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+EXIT_INTERNAL_ERROR = 3
+
+EXIT_CODES = """exit status:
+  0    success
+  1    finished, but some records were skipped (each named on stderr with its reason)
+  2    user error: bad input file, option or study value, output folder unusable or in use
+       (one line naming the file, field and allowed range; nothing already written is lost)
+  3    internal error (a bug): one line naming the stage and input, the traceback in a log file
+  130  interrupted (Ctrl-C); files already written are complete"""
+
+
+def _input_of(args) -> str:
+    """The input a command was processing, for the one-line internal-error message."""
+    parts = []
+    for name, label in (("study", "study"), ("reference", "reference"), ("record", "record"),
+                        ("record_set", "records"), ("processing", "recipe")):
+        value = getattr(args, name, None)
+        if value:
+            parts.append(f"{label} {', '.join(map(str, value)) if isinstance(value, list) else value}")
+    return "; ".join(parts) or "the shipped defaults"
+
+
+def _error_log_path(args) -> Path:
+    """A new log file in the output folder, or in the temporary folder if that is not writable."""
+    import os
+    import tempfile
+    import time
+
+    name = f"rockfrag-error-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}.log"
+    for folder in (getattr(args, "output", None) or Path("reports"), Path(tempfile.gettempdir())):
+        try:
+            Path(folder).mkdir(parents=True, exist_ok=True)
+            path = Path(folder) / name
+            with open(path, "x", encoding="utf-8"):
+                pass
+            return path
+        except OSError:
+            continue
+    return Path(tempfile.gettempdir()) / name
+
+
+def _report_internal_error(args, error) -> int:
+    """Last line of defence: one line on stderr, the full traceback in a log file; rc 3."""
+    import traceback
+
+    stage = getattr(args, "command", "?")
+    notes = "; ".join(getattr(error, "__notes__", []))
+    text = "".join(traceback.format_exception(error))
+    log_path = _error_log_path(args)
+    try:
+        log_path.write_text(f"rockfrag {__version__} {stage}: {' '.join(sys.argv)}\n{text}", encoding="utf-8")
+        where = f"traceback in {log_path}"
+    except OSError:
+        where = "traceback could not be written to a log file"
+    message = " ".join(f"{type(error).__name__}: {error}".split())[:300]
+    print(f"rockfrag: internal error in stage '{stage}' while processing {_input_of(args)}"
+          f"{' (' + notes + ')' if notes else ''}: {message}; {where}; please report it", file=sys.stderr)
+    return EXIT_INTERNAL_ERROR
+
+
+def _file_problem(error: OSError) -> str | None:
+    """One line for an OS error about a named file (disk full, permission, missing folder)."""
+    if error.filename is None or not error.strerror:
+        return None
+    return f"{error.filename}: {error.strerror}"
+
+
 def main(argv=None) -> int:
     parser = build_parser()
+    parser.epilog = EXIT_CODES
+    parser.formatter_class = argparse.RawDescriptionHelpFormatter
     args = parser.parse_args(argv)
     try:
-        return args.handler(args)
+        output = getattr(args, "output", None)
+        if output is None:
+            return args.handler(args)
+        from pipeline.locking import output_lock
+
+        with output_lock(output):
+            return args.handler(args)
     except PipelineError as error:
-        print(f"rockfrag: error: {error}", file=sys.stderr)
+        print(f"rockfrag: error: {' '.join(str(error).splitlines())}", file=sys.stderr)
         return EXIT_USER_ERROR
     except KeyboardInterrupt:
         print("rockfrag: interrupted; files already written are complete", file=sys.stderr)
         return 130
+    except OSError as error:
+        problem = _file_problem(error)
+        if problem is None:
+            return _report_internal_error(args, error)
+        print(f"rockfrag: error: {problem}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    except Exception as error:  # noqa: BLE001 - the last line of defence, see EXIT_CODES
+        return _report_internal_error(args, error)
 
 
 if __name__ == "__main__":

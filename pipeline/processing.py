@@ -24,7 +24,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from pipeline import __version__
-from pipeline.errors import ConfigError
+from pipeline.errors import ConfigError, RecordError
 
 PROCESSING_STEPS: dict = {}
 PARAMETER_RANGES: dict[str, tuple[float, float]] = {}
@@ -275,8 +275,13 @@ def tail_checks(acceleration, dt, tail_seconds=5.0, velocity_ratio=0.3, displace
 
 
 def process_record(record, recipe: ProcessingRecipe | None = None):
-    """Apply the recipe to a copy of the record; return the new, corrected ``Record``."""
+    """Apply the recipe to a copy of the record; return the new, corrected ``Record``.
+
+    Raises ``RecordError`` (naming the record's file and the step) when the record cannot be
+    processed: a numerical failure of a step, or a result that is not finite or is all zero.
+    """
     recipe = recipe or load_recipe()
+    source = record.metadata.get("file") or record.id
     trace = record.trace.copy()
     trace.data = np.asarray(trace.data, dtype=np.float64)
     overrides = recipe.overrides.get(record.id, {})
@@ -288,6 +293,33 @@ def process_record(record, recipe: ProcessingRecipe | None = None):
         context["bandpass"].get("nyquist_fraction", 0.8),
         context["bandpass"].get("use_header_corners", True))[0]
     for name, params in steps:
-        trace = PROCESSING_STEPS[name](trace, context=context, **params)
+        try:
+            with np.errstate(over="raise", invalid="raise", divide="raise"):
+                trace = PROCESSING_STEPS[name](trace, context=context, **params)
+        except PROCESSING_FAILURES as error:
+            raise RecordError(source, f"record {record.id} cannot be processed: step {name!r} failed "
+                              f"({type(error).__name__}: {str(error)[:200]})") from None
+    if not np.all(np.isfinite(trace.data)):
+        raise RecordError(source, f"record {record.id}: processing gave non-finite accelerations")
+    if not np.any(trace.data):
+        raise RecordError(source, f"record {record.id}: processed accelerations are all zero")
     trace.stats.qa = tail_checks(trace.data, trace.stats.delta, **recipe.qa)
     return record.with_trace(trace)
+
+
+PROCESSING_FAILURES = (ValueError, ArithmeticError, np.linalg.LinAlgError, MemoryError)
+"""What a step raises on a record it cannot handle (too short, degenerate sampling, overflow)."""
+
+
+def process_records(records, recipe: ProcessingRecipe | None = None):
+    """Process each record; one that cannot be processed is skipped: (processed, failures).
+
+    ``failures`` holds one ``RecordError`` per skipped record, with its reason.
+    """
+    processed, failures = [], []
+    for record in records:
+        try:
+            processed.append(process_record(record, recipe))
+        except RecordError as error:
+            failures.append(error)
+    return processed, failures

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.errors import RecordError
 from pipeline.measures import intensity_measures, response_spectrum
 from pipeline.outputs import atomic_path
 from pipeline.processing import integrate, process_record
@@ -82,14 +83,24 @@ def plot_record(raw, processed, path):
     plt.close(figure)
 
 
-def records_stage(records, recipe, output_dir, plot=False, progress=True):
-    """Process each record, tabulate its measures, optionally plot it; returns (table, png paths)."""
+def records_stage(records, recipe, output_dir, plot=False, progress=True, failures=None):
+    """Process each record, tabulate its measures, optionally plot it; returns (table, png paths).
+
+    A record that cannot be processed is left out; its ``RecordError`` is appended to ``failures``
+    (raised if ``failures`` is None).
+    """
     from tqdm import tqdm
 
     output_dir = Path(output_dir)
     rows, pngs = [], []
     for raw in tqdm(records, desc="records", unit="rec", disable=not progress):
-        processed = process_record(raw, recipe)
+        try:
+            processed = process_record(raw, recipe)
+        except RecordError as error:
+            if failures is None:
+                raise
+            failures.append(error)
+            continue
         rows.append(measures_row(raw, processed))
         if plot:
             png = output_dir / "records" / (raw.id.replace("/", "_") + ".png")

@@ -17,11 +17,15 @@ executor runs the same pure task function, so the cube is identical whatever the
 
 from __future__ import annotations
 
+import ctypes
 import hashlib
 import json
 import os
+import signal
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -29,11 +33,12 @@ import numpy as np
 
 from pipeline import __version__
 from pipeline.cube import build_cube, write_netcdf
-from pipeline.errors import PipelineError
+from pipeline.checkpoints import CheckpointStore
+from pipeline.errors import PipelineError, RecordError
+from pipeline.locking import output_lock
 from pipeline.measures import MEASURES
 from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, kernels, simulate_batch
-from pipeline.outputs import atomic_path
-from pipeline.processing import load_recipe, process_record
+from pipeline.processing import load_recipe, process_records
 from pipeline.records import load_records
 from pipeline.soils import soil_block_stiffness
 
@@ -96,28 +101,6 @@ def compute_cells(acceleration, dt, scales, jobs, switch, tail, overturn_angle):
     return results
 
 
-class CheckpointStore:
-    """One .npy file per finished cell under ``folder``; written atomically."""
-
-    def __init__(self, folder):
-        self.folder = Path(folder)
-        self.folder.mkdir(parents=True, exist_ok=True)
-
-    def path(self, key):
-        return self.folder / f"{key}.npy"
-
-    def has(self, key):
-        return self.path(key).is_file()
-
-    def load(self, key):
-        return np.load(self.path(key))
-
-    def save(self, key, array):
-        with atomic_path(self.path(key)) as temporary:
-            with open(temporary, "wb") as handle:
-                np.save(handle, array)
-
-
 def _warm_up():
     """Compile (or load from the on-disk cache) the kernels once before starting workers."""
     from pipeline.blocks import Block
@@ -127,8 +110,38 @@ def _warm_up():
     simulate_batch("ssi", np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
 
 
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+
+
+def _die_with_parent(parent_pid):
+    """Worker initializer: end this worker when the study process dies, even by ``kill -9``.
+
+    Linux delivers SIGKILL on the parent's death (prctl PR_SET_PDEATHSIG); a watchdog thread that
+    polls the parent pid covers other systems and the window before prctl took effect.
+    """
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the watchdog alone
+        pass
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="rockfrag-parent-watchdog", daemon=True).start()
+
+
+def _is_lost_worker(error) -> bool:
+    """A worker process died under the task (OOM killer, kill -9): the task may be retried."""
+    return isinstance(error, BrokenProcessPool) or type(error).__name__ == "KilledWorker"
+
+
 def _executor(workers, scheduler, dask_workers):
-    """(submit, as_completed, shutdown) for the chosen executor."""
+    """(submit, as_completed, shutdown(finished: bool)) for the chosen executor."""
     if scheduler or dask_workers:
         from dask.distributed import Client, LocalCluster
         from dask.distributed import as_completed as dask_completed
@@ -144,8 +157,9 @@ def _executor(workers, scheduler, dask_workers):
             cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)
             client = Client(cluster)
+            client.run(_die_with_parent, os.getpid())  # local workers are this process's children
 
-        def shutdown():
+        def shutdown(finished):
             client.close()
             if cluster is not None:
                 cluster.close()
@@ -159,53 +173,118 @@ def _executor(workers, scheduler, dask_workers):
             def result(self):
                 return self._value
 
-        return (lambda *a: Immediate(compute_cells(*a)), lambda futures: list(futures), lambda: None)
-    pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count())
+        return (lambda *a: Immediate(compute_cells(*a)), lambda futures: list(futures), lambda finished: None)
+    pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count(), initializer=_die_with_parent,
+                               initargs=(os.getpid(),))
     return (lambda *a: pool.submit(compute_cells, *a), as_completed,
-            lambda: pool.shutdown(wait=False, cancel_futures=True))
+            lambda finished: pool.shutdown(wait=finished, cancel_futures=True))
+
+
+def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2):
+    """Run ``tasks`` on executors from ``make_executor()``; returns the tasks lost ``attempts`` times.
+
+    A task whose worker process died (BrokenProcessPool, dask KilledWorker) is run again in a fresh
+    executor; results already received are kept (``on_result(task, result)`` saw them). Any other
+    exception propagates.
+    """
+    pending = list(tasks)
+    for _ in range(attempts):
+        if not pending:
+            break
+        submit, completed, shutdown = make_executor()
+        lost, finished = [], False
+        try:
+            futures = {submit(*submit_arguments(task)): task for task in pending}
+            for future in completed(list(futures)):
+                try:
+                    result = future.result()
+                except Exception as error:
+                    if not _is_lost_worker(error):
+                        raise
+                    lost.append(futures[future])
+                    continue
+                on_result(futures[future], result)
+            finished = True
+        finally:
+            shutdown(finished and not lost)
+        pending = lost
+    return pending
 
 
 def study_records(config, log=print):
     """The study's records, processed with its recipe: (records, failures, recipe).
 
     Every stage that needs the study's records (study, applicability, report) takes them from here,
-    so ``rockfrag fragility`` reads and processes them once.
+    so ``rockfrag fragility`` reads and processes them once. A record that cannot be read or
+    processed is skipped and reported (``log``); the others go on.
     """
     recipe = load_recipe(config.processing or None)
     raw_records, failures = load_records(list(config.record_sets))
+    processed, processing_failures = process_records(raw_records, recipe)
+    failures = [*failures, *processing_failures]
     for failure in failures:
         log(f"rockfrag: skipped {failure}")
-    if not raw_records:
+    if not processed:
         raise PipelineError("no record could be read; nothing to run")
-    return [process_record(record, recipe) for record in raw_records], failures, recipe
+    return processed, failures, recipe
+
+
+def _check_workers(workers, dask_workers):
+    for option, value in (("--workers", dask_workers), ("workers", workers)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value <= 0):
+            raise PipelineError(f"{option} {value!r}: expected a whole number of worker processes >= 1")
+
+
+def _scalable(records, record_im, log):
+    """Split records into those with a positive finite intensity and RecordErrors for the rest."""
+    keep, failures = [], []
+    for index, (record, im) in enumerate(zip(records, record_im)):
+        if np.isfinite(im) and im > 0:
+            keep.append(index)
+        else:
+            failure = RecordError(record.metadata.get("file") or record.id,
+                                  f"record {record.id}: intensity measure is {im:g}; it cannot be scaled")
+            log(f"rockfrag: skipped {failure}")
+            failures.append(failure)
+    return keep, failures
 
 
 def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers=None,
-              progress=True, log=print, loaded=None):
+              progress=True, log=print, loaded=None, wait=False):
     """Run (or resume) a study and write ``cube.nc``; returns (dataset, statistics dict).
 
     ``loaded`` may pass the result of ``study_records`` to avoid reading the records again.
+    The output folder is locked for the run (a second run stops, or waits with ``wait=True``).
     """
+    _check_workers(workers, dask_workers)
+    output = Path(output or config.output)
+    with output_lock(output, wait=wait):
+        return _run_locked(config, output, workers, scheduler, dask_workers, progress, log, loaded)
+
+
+def _run_locked(config, output, workers, scheduler, dask_workers, progress, log, loaded):
     from tqdm import tqdm
 
     started = time.perf_counter()
-    output = Path(output or config.output)
     records, failures, recipe = loaded or study_records(config, log)
+    failures = list(failures)
     record_im = np.array([record_intensity(r.acceleration, r.dt, config) for r in records])
-    if np.any(record_im <= 0):
-        bad = records[int(np.argmin(record_im))].id
-        raise PipelineError(f"record {bad}: intensity measure is zero; it cannot be scaled")
+    keep, unscalable = _scalable(records, record_im, log)
+    failures += unscalable
+    if not keep:
+        raise PipelineError("no record has a positive intensity measure; nothing to run")
+    records, record_im = [records[i] for i in keep], record_im[keep]
     scale_factors = config.levels_si[None, :] / record_im[:, None]
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
 
-    store = CheckpointStore(output / ".checkpoints")
-    for stale in list(output.glob(".*.part")) + list(store.folder.glob(".*.part")):
-        stale.unlink(missing_ok=True)  # left by a killed run; the finished files are complete
-    all_cells = [cells_for_record(record, config, recipe) for record in records]
     n_levels = len(config.levels)
+    summary_shape = (n_levels, kernels.N_SUMMARY)
+    store = CheckpointStore(output / ".checkpoints", log=log)
+    all_cells = [cells_for_record(record, config, recipe) for record in records]
+    results = store.load_verified([c.key for cells in all_cells for c in cells], summary_shape, np.float64)
     tasks = []
-    for index, (record, cells) in enumerate(zip(records, all_cells)):
-        missing = [c for c in cells if not store.has(c.key)]
+    for index, cells in enumerate(all_cells):
+        missing = [c for c in cells if c.key not in results]
         if missing:
             jobs = [(c.key, c.model, config.blocks[c.block_index],
                      None if c.soil_index is None else stiffness[c.soil_index, c.block_index],
@@ -219,30 +298,43 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
         f"{len(config.blocks)} blocks x {len(config.models)} models; {n_cells - n_missing} of {n_cells} "
         f"cells from checkpoints, {runs_total} runs to do")
 
+    lost = []
     if tasks:
         _warm_up()
-        submit, completed, shutdown = _executor(workers, scheduler, dask_workers)
-        try:
-            futures = {}
-            for index, jobs in tasks:
-                record = records[index]
-                future = submit(record.acceleration, record.dt, scale_factors[index], jobs,
-                                config.switch, config.tail, config.overturn_angle)
-                futures[future] = jobs
-            with tqdm(total=runs_total, unit="run", desc="study", disable=not progress, smoothing=0.1) as bar:
-                for future in completed(list(futures)):
-                    for key, summary in future.result().items():
-                        store.save(key, summary)
-                    bar.update(len(futures[future]) * n_levels)
-        finally:
-            shutdown()
+        with tqdm(total=runs_total, unit="run", desc="study", disable=not progress, smoothing=0.1) as bar:
+            def keep_result(task, computed):
+                for key, summary in computed.items():
+                    store.save(key, summary)
+                    results[key] = summary
+                bar.update(len(task[1]) * n_levels)
+
+            lost = run_tasks(tasks,
+                             lambda task: (records[task[0]].acceleration, records[task[0]].dt,
+                                           scale_factors[task[0]], task[1], config.switch, config.tail,
+                                           config.overturn_angle),
+                             lambda: _executor(workers, scheduler, dask_workers), keep_result)
+    if lost:
+        lost_indices = {index for index, _ in lost}
+        for index in sorted(lost_indices):
+            record = records[index]
+            failure = RecordError(record.metadata.get("file") or record.id,
+                                  f"record {record.id}: a worker process died twice while computing its cells "
+                                  "(out of memory?); finished cells are kept, rerun to retry")
+            log(f"rockfrag: skipped {failure}")
+            failures.append(failure)
+        kept = [i for i in range(len(records)) if i not in lost_indices]
+        if not kept:
+            raise PipelineError("every record's computation was lost (worker processes killed); "
+                                "finished cells are kept, rerun to continue")
+        records, record_im, scale_factors = [records[i] for i in kept], record_im[kept], scale_factors[kept]
+        all_cells = [all_cells[i] for i in kept]
 
     summaries = np.full((len(records), n_levels, len(config.soils), len(config.blocks), len(config.models),
                          kernels.N_SUMMARY), np.nan)
     for r, cells in enumerate(all_cells):
         for cell in cells:
             model_index = config.models.index(cell.model)
-            result = store.load(cell.key)
+            result = results[cell.key]
             if cell.soil_index is None:
                 summaries[r, :, :, cell.block_index, model_index] = result[:, None, :]
             else:
@@ -253,5 +345,6 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
     write_netcdf(dataset, output / "cube.nc")
     elapsed = time.perf_counter() - started
     statistics = {"runs_computed": runs_total, "cells_reused": n_cells - n_missing, "cells": n_cells,
-                  "seconds": elapsed, "failures": [str(f) for f in failures]}
+                  "seconds": elapsed, "failures": [str(f) for f in failures],
+                  "checkpoints_quarantined": [str(p) for p in store.quarantined]}
     return dataset, statistics

@@ -15,6 +15,7 @@ user states.
 from __future__ import annotations
 
 import functools
+import math
 import os
 from dataclasses import dataclass, field
 from importlib.metadata import entry_points
@@ -26,7 +27,7 @@ import numpy as np
 from pipeline.errors import ManifestError, RecordError
 from pipeline.records import peer_at2
 from pipeline.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
-from pipeline.units import acceleration_factor
+from pipeline.units import STANDARD_GRAVITY, acceleration_factor
 
 RECORDS_DIR = Path(os.environ.get("ROCKFRAG_RECORDS", Path(__file__).resolve().parents[2] / "records"))
 """Folder holding the shipped records and ``MANIFEST.csv`` (override with $ROCKFRAG_RECORDS)."""
@@ -130,6 +131,8 @@ def read_record(path, format: str | None = None, units: str | None = None):
         raise RecordError(path, "file not found")
     _load_plugin_formats()
     name = format if format in FORMATS else (None if format else detect_format(path))
+    if name is None and format is None and path.suffix.lower() == ".at2":
+        name = "PEER_AT2"  # not recognised, but named as AT2: the reader says what is wrong with it
     if name is not None:
         stream = FORMATS[name].read_format(path)
         return stream[0]
@@ -165,6 +168,70 @@ def _read_with_obspy(path, format, units):
     trace.stats.units = "m/s^2"
     trace.stats.quantity = "acceleration"
     return trace
+
+
+# ---------------------------------------------------------------- plausibility of a record
+
+MIN_SAMPLES = 16
+"""Fewer samples cannot be filtered, baseline-corrected or scaled meaningfully."""
+
+DT_RANGE = (1e-4, 0.5)
+"""Plausible time steps of strong-motion records [s] (published records use 0.001 to 0.05 s)."""
+
+MAX_PEAK_G = 20.0
+"""Largest plausible peak ground acceleration [g]; the largest ever recorded is below 5 g."""
+
+
+def check_record(record) -> None:
+    """``RecordError`` naming the file if ``record`` cannot be a ground-acceleration record.
+
+    Checks the number of samples, the time step, and that the accelerations are finite, not all
+    zero and not implausibly large (which usually means wrong units).
+    """
+    source = record.metadata.get("file") or record.id
+    data = np.asarray(record.acceleration, dtype=np.float64)
+    dt = record.dt
+    if data.size < MIN_SAMPLES:
+        raise RecordError(source, f"only {data.size} samples; a record needs at least {MIN_SAMPLES}")
+    if not (math.isfinite(dt) and DT_RANGE[0] <= dt <= DT_RANGE[1]):
+        raise RecordError(source, f"time step DT = {dt:g} s is implausible; allowed "
+                          f"{DT_RANGE[0]:g} to {DT_RANGE[1]:g} s")
+    if not np.all(np.isfinite(data)):
+        raise RecordError(source, "contains NaN or infinite accelerations; expected finite values")
+    peak_g = float(np.max(np.abs(data))) / STANDARD_GRAVITY
+    if peak_g == 0:
+        raise RecordError(source, "all accelerations are zero; nothing to scale")
+    if peak_g > MAX_PEAK_G:
+        raise RecordError(source, f"peak acceleration {peak_g:.3g} g is implausible; allowed up to "
+                          f"{MAX_PEAK_G:g} g (check the units)")
+
+
+def _path_ids(paths, stems) -> list[str]:
+    """Ids from file names, lengthened with parent folders where two names clash."""
+    ids = list(stems)
+    for depth in range(2, 64):
+        clashing = {i for i in ids if ids.count(i) > 1}
+        if not clashing:
+            break
+        ids = ["/".join(Path(p).with_suffix("").parts[-depth:]) if i in clashing else i
+               for i, p in zip(ids, paths)]
+    return ids
+
+
+def unique_ids(records) -> list:
+    """The records with ids made unique: clashing user-file ids get the path's last folders."""
+    clashing = [r for r in records if sum(o.id == r.id for o in records) > 1 and r.metadata.get("sets") == "user"]
+    if not clashing:
+        return records
+    new_ids = dict(zip(map(id, clashing), _path_ids([r.metadata["file"] for r in clashing],
+                                                       [r.id for r in clashing])))
+    renamed = []
+    for record in records:
+        if id(record) in new_ids:
+            metadata = {**record.metadata, "id": new_ids[id(record)]}
+            record = Record(new_ids[id(record)], record.trace, metadata)
+        renamed.append(record)
+    return renamed
 
 
 # ---------------------------------------------------------------- catalogue and record sets
@@ -223,19 +290,30 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
     items = [selection] if isinstance(selection, (str, Path)) else list(selection)
     entries = {entry.id: entry for entry in catalogue(records_dir)}
     sets = record_sets(records_dir)
-    records, failures, seen = [], [], set()
+    records, failures, seen, contents = [], [], set(), {}
 
     def add(loader, key, target):
         if key in seen:
             return
         seen.add(key)
         try:
-            records.append(loader(target))
+            record = loader(target)
+            check_record(record)
         except RecordError as error:
             failures.append(error)
+            return
+        digest = record.metadata.get("sha256")
+        if digest and digest in contents:
+            failures.append(RecordError(record.metadata.get("file") or record.id,
+                                        f"same content as record {contents[digest]}; skipped as a duplicate"))
+            return
+        contents[digest] = record.id
+        records.append(record)
 
     for item in items:
         text = str(item)
+        if not text.strip():
+            raise ManifestError("empty record selection ''; name a record set, a record id, a folder or a file")
         if text in sets or text in entries:
             for entry in (entries[i] for i in sets.get(text, [text])):
                 problems = verify([entry]) if verify_checksums and entry.id not in seen else []
@@ -249,13 +327,13 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
             if not files:
                 raise RecordError(text, f"folder holds no record files ({', '.join(RECORD_SUFFIXES)})")
             for path in files:
-                add(lambda p: _load_user_file(p, units), str(path), path)
+                add(lambda p: _load_user_file(p, units), str(path.resolve()), path)
         elif Path(text).is_file():
-            add(lambda p: _load_user_file(p, units), text, Path(text))
+            add(lambda p: _load_user_file(p, units), str(Path(text).resolve()), Path(text))
         else:
             raise ManifestError(f"unknown record selection {text!r}: not a record set "
                                 f"({', '.join(sorted(sets))}), a record id, a folder or a file")
-    return records, failures
+    return unique_ids(records), failures
 
 
 register_format("PEER_AT2", peer_at2.is_peer_at2, peer_at2.read_peer_at2)
