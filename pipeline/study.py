@@ -22,6 +22,7 @@ import hashlib
 import json
 import os
 import signal
+import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -249,27 +250,32 @@ def _scalable(records, record_im, log):
     return keep, failures
 
 
+def _to_stderr(message):
+    print(message, file=sys.stderr)
+
+
 def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers=None,
-              progress=True, log=print, loaded=None, wait=False):
+              progress=True, log=print, loaded=None, wait=False, warn=_to_stderr):
     """Run (or resume) a study and write ``cube.nc``; returns (dataset, statistics dict).
 
     ``loaded`` may pass the result of ``study_records`` to avoid reading the records again.
+    ``log`` receives progress lines, ``warn`` one line per skipped record or damaged checkpoint.
     The output folder is locked for the run (a second run stops, or waits with ``wait=True``).
     """
     _check_workers(workers, dask_workers)
     output = Path(output or config.output)
     with output_lock(output, wait=wait):
-        return _run_locked(config, output, workers, scheduler, dask_workers, progress, log, loaded)
+        return _run_locked(config, output, workers, scheduler, dask_workers, progress, log, warn, loaded)
 
 
-def _run_locked(config, output, workers, scheduler, dask_workers, progress, log, loaded):
+def _run_locked(config, output, workers, scheduler, dask_workers, progress, log, warn, loaded):
     from tqdm import tqdm
 
     started = time.perf_counter()
-    records, failures, recipe = loaded or study_records(config, log)
+    records, failures, recipe = loaded or study_records(config, warn)
     failures = list(failures)
     record_im = np.array([record_intensity(r.acceleration, r.dt, config) for r in records])
-    keep, unscalable = _scalable(records, record_im, log)
+    keep, unscalable = _scalable(records, record_im, warn)
     failures += unscalable
     if not keep:
         raise PipelineError("no record has a positive intensity measure; nothing to run")
@@ -279,7 +285,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
     n_levels = len(config.levels)
     summary_shape = (n_levels, kernels.N_SUMMARY)
-    store = CheckpointStore(output / ".checkpoints", log=log)
+    store = CheckpointStore(output / ".checkpoints", log=warn)
     all_cells = [cells_for_record(record, config, recipe) for record in records]
     results = store.load_verified([c.key for cells in all_cells for c in cells], summary_shape, np.float64)
     tasks = []
@@ -320,7 +326,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
             failure = RecordError(record.metadata.get("file") or record.id,
                                   f"record {record.id}: a worker process died twice while computing its cells "
                                   "(out of memory?); finished cells are kept, rerun to retry")
-            log(f"rockfrag: skipped {failure}")
+            warn(f"rockfrag: skipped {failure}")
             failures.append(failure)
         kept = [i for i in range(len(records)) if i not in lost_indices]
         if not kept:
