@@ -203,8 +203,8 @@ def recipe_from_dict(data: dict, source="<dict>") -> ProcessingRecipe:
     steps = []
     for index, raw in enumerate(raw_steps):
         where = f"steps[{index}]"
-        if not isinstance(raw, dict) or "name" not in raw:
-            raise ConfigError(where, "each step needs a name", source)
+        if not isinstance(raw, dict) or not isinstance(raw.get("name"), str):
+            raise ConfigError(where, "each step needs a name (text)", source)
         params = {k: v for k, v in raw.items() if k != "name"}
         _validate_step(raw["name"], params, source, where)
         steps.append((raw["name"], params))
@@ -213,6 +213,12 @@ def recipe_from_dict(data: dict, source="<dict>") -> ProcessingRecipe:
         raise ConfigError("steps", "step 'pad' needs a 'bandpass' step (its length depends on freqmin)", source)
     if names.count("pad") != names.count("unpad"):
         raise ConfigError("steps", "every 'pad' step needs a matching 'unpad' step", source)
+    for table in ("qa", "overrides"):
+        if not isinstance(data.get(table, {}), dict):
+            raise ConfigError(table, f"{data[table]!r} is not a table; expected [{table}]", source)
+    unknown = sorted(set(data) - {"steps", "qa", "overrides"})
+    if unknown:
+        raise ConfigError(unknown[0], "unknown key; allowed: steps, qa, overrides", source)
     qa = dict(QA_DEFAULTS)
     for key, value in data.get("qa", {}).items():
         if key not in QA_RANGES:
@@ -223,7 +229,11 @@ def recipe_from_dict(data: dict, source="<dict>") -> ProcessingRecipe:
         qa[key] = float(value)
     overrides = data.get("overrides", {})
     for record_id, by_step in overrides.items():
+        if not isinstance(by_step, dict):
+            raise ConfigError(f"overrides.{record_id}", "expected a table of steps", source)
         for step_name, params in by_step.items():
+            if not isinstance(params, dict):
+                raise ConfigError(f"overrides.{record_id}.{step_name}", "expected a table of parameters", source)
             if step_name not in names:
                 raise ConfigError(f"overrides.{record_id}.{step_name}", "step not in the recipe; "
                                   f"steps: {', '.join(names)}", source)
@@ -242,6 +252,8 @@ def load_recipe(path=None) -> ProcessingRecipe:
                 text = handle.read()
         except OSError as error:
             raise ConfigError("processing", f"cannot read recipe: {error.strerror}", str(path)) from None
+        except UnicodeDecodeError:
+            raise ConfigError("processing", "not a text file; expected a TOML recipe", str(path)) from None
         source = str(path)
     try:
         data = tomllib.loads(text)

@@ -185,11 +185,11 @@ def test_killed_run_resumes_without_recomputing(small_study, tmp_path):
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     checkpoints = output / ".checkpoints"
     deadline = time.time() + 120
-    while time.time() < deadline and len(list(checkpoints.glob("*.npy"))) < 20:
+    while time.time() < deadline and len(list(checkpoints.glob("*.ckpt"))) < 20:
         time.sleep(0.05)
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
-    finished = {p: p.stat().st_mtime_ns for p in checkpoints.glob("*.npy")}
+    finished = {p: p.stat().st_mtime_ns for p in checkpoints.glob("*.ckpt")}
     assert finished and not (output / "cube.nc").exists()
     result = subprocess.run(command, capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
