@@ -13,6 +13,11 @@ the soil: they are computed once per block and shared by every soil.
 Executors: in-process (workers=1), all local cores (default, process pool), or dask.distributed
 (``scheduler`` address of a running cluster, or ``dask_workers`` to start a LocalCluster). Every
 executor runs the same pure task function, so the cube is identical whatever the executor.
+
+Reliability: checkpoints verify themselves (pipeline.checkpoints; a damaged one is quarantined and
+recomputed), the output folder is locked for the run (pipeline.locking), pool workers die with the
+study process (parent-death signal), cells of a worker that was killed are retried once in a fresh
+pool and then reported, and a record that cannot be processed or scaled is skipped with its reason.
 """
 
 from __future__ import annotations
@@ -158,7 +163,7 @@ def _executor(workers, scheduler, dask_workers):
             cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
                                    dashboard_address=None)
             client = Client(cluster)
-            client.run(_die_with_parent, os.getpid())  # local workers are this process's children
+            # local dask workers already exit when this process dies (distributed's parent-alive pipe)
 
         def shutdown(finished):
             client.close()
