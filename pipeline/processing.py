@@ -334,4 +334,7 @@ def process_records(records, recipe: ProcessingRecipe | None = None):
             processed.append(process_record(record, recipe))
         except RecordError as error:
             failures.append(error)
+        except Exception as error:  # a bug: say which record it met (shown by the CLI's rc-3 line)
+            error.add_note(f"record {record.id} ({record.metadata.get('file', '')})")
+            raise
     return processed, failures

@@ -172,26 +172,26 @@ def _executor(workers, scheduler, dask_workers):
 
         return (lambda *a: client.submit(compute_cells, *a, pure=False), dask_completed, shutdown)
     if workers == 1:
-        class Immediate:
-            def __init__(self, value):
-                self._value = value
+        class InProcess:  # computed when asked for, so errors surface where pool errors do
+            def __init__(self, arguments):
+                self._arguments = arguments
 
             def result(self):
-                return self._value
+                return compute_cells(*self._arguments)
 
-        return (lambda *a: Immediate(compute_cells(*a)), lambda futures: list(futures), lambda finished: None)
+        return (lambda *a: InProcess(a), lambda futures: list(futures), lambda finished: None)
     pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count(), initializer=_die_with_parent,
                                initargs=(os.getpid(),))
     return (lambda *a: pool.submit(compute_cells, *a), as_completed,
             lambda finished: pool.shutdown(wait=finished, cancel_futures=True))
 
 
-def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2):
+def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, describe=str):
     """Run ``tasks`` on executors from ``make_executor()``; returns the tasks lost ``attempts`` times.
 
     A task whose worker process died (BrokenProcessPool, dask KilledWorker) is run again in a fresh
     executor; results already received are kept (``on_result(task, result)`` saw them). Any other
-    exception propagates.
+    exception propagates, with a note naming the task (``describe(task)``).
     """
     pending = list(tasks)
     for _ in range(attempts):
@@ -206,6 +206,7 @@ def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2):
                     result = future.result()
                 except Exception as error:
                     if not _is_lost_worker(error):
+                        error.add_note(describe(futures[future]))
                         raise
                     lost.append(futures[future])
                     continue
@@ -323,7 +324,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                              lambda task: (records[task[0]].acceleration, records[task[0]].dt,
                                            scale_factors[task[0]], task[1], config.switch, config.tail,
                                            config.overturn_angle),
-                             lambda: _executor(workers, scheduler, dask_workers), keep_result)
+                             lambda: _executor(workers, scheduler, dask_workers), keep_result,
+                             describe=lambda task: f"record {records[task[0]].id}")
     if lost:
         lost_indices = {index for index, _ in lost}
         for index in sorted(lost_indices):

@@ -440,3 +440,14 @@ def test_cube_lists_every_record_checksum_when_names_clash(tmp_path):
     dataset, _ = run_study(load_study(study), output=tmp_path / "out", workers=1, **QUIET)
     assert sorted(dataset.record.values) == ["a/X", "b/X"]
     assert sorted(json.loads(dataset.attrs["record_checksums"])) == ["a/X", "b/X"]
+
+
+def test_internal_error_in_a_cell_names_the_record(tiny_study, tmp_path, capsys, monkeypatch):
+    def broken_cells(*args, **kwargs):
+        raise IndexError("kernel bug")
+
+    monkeypatch.setattr("pipeline.study.compute_cells", broken_cells)
+    status = cli.main(["run", str(tiny_study), "--output", str(tmp_path / "out"), "--serial", "--no-progress"])
+    assert status == cli.EXIT_INTERNAL_ERROR
+    assert_one_line_error(capsys.readouterr().err, "stage 'run'", str(tiny_study), "(record pulse)",
+                          "IndexError: kernel bug")
