@@ -141,6 +141,11 @@ def _die_with_parent(parent_pid):
     threading.Thread(target=watch, name="rockfrag-parent-watchdog", daemon=True).start()
 
 
+def worker_pool(max_workers) -> ProcessPoolExecutor:
+    """A process pool whose workers die with this process (use it for every local pool)."""
+    return ProcessPoolExecutor(max_workers=max_workers, initializer=_die_with_parent, initargs=(os.getpid(),))
+
+
 def _is_lost_worker(error) -> bool:
     """A worker process died under the task (OOM killer, kill -9): the task may be retried."""
     return isinstance(error, BrokenProcessPool) or type(error).__name__ == "KilledWorker"
@@ -180,8 +185,7 @@ def _executor(workers, scheduler, dask_workers):
                 return compute_cells(*self._arguments)
 
         return (lambda *a: InProcess(a), lambda futures: list(futures), lambda finished: None)
-    pool = ProcessPoolExecutor(max_workers=workers or os.cpu_count(), initializer=_die_with_parent,
-                               initargs=(os.getpid(),))
+    pool = worker_pool(workers or os.cpu_count())
     return (lambda *a: pool.submit(compute_cells, *a), as_completed,
             lambda finished: pool.shutdown(wait=finished, cancel_futures=True))
 

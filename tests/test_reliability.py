@@ -415,7 +415,10 @@ def test_workers_die_with_their_parent(tmp_path):
     deadline = time.monotonic() + 5
     while time.monotonic() < deadline and any(_alive(p) for p in workers):
         time.sleep(0.05)
-    assert not any(_alive(p) for p in workers)
+    orphans = [p for p in workers if _alive(p)]
+    for pid in orphans:  # do not leave them behind when the test fails
+        os.kill(pid, signal.SIGKILL)
+    assert not orphans
 
 
 def _alive(pid) -> bool:
