@@ -134,7 +134,12 @@ class CheckpointStore:
         source = self.path(key)
         target_folder = self.folder / QUARANTINE
         target_folder.mkdir(exist_ok=True)
-        target = target_folder / f"{source.name}.{time.strftime('%Y%m%dT%H%M%S')}"
+        stamp = time.strftime("%Y%m%dT%H%M%S")
+        target = target_folder / f"{source.name}.{stamp}"
+        for number in range(1, 1000):
+            if not target.exists():
+                break
+            target = target_folder / f"{source.name}.{stamp}.{number}"
         source.replace(target)
         self.quarantined.append(target)
         self.log(f"rockfrag: checkpoint {source} is damaged ({reason}); moved to {target} and recomputing")
