@@ -204,7 +204,14 @@ def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, des
         submit, completed, shutdown = make_executor()
         lost, finished = [], False
         try:
-            futures = {submit(*submit_arguments(task)): task for task in pending}
+            futures = {}
+            for task in pending:
+                try:
+                    futures[submit(*submit_arguments(task))] = task
+                except Exception as error:  # the pool broke while tasks were being submitted
+                    if not _is_lost_worker(error):
+                        raise
+                    lost.append(task)
             for future in completed(list(futures)):
                 try:
                     result = future.result()
