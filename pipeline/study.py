@@ -43,7 +43,8 @@ from pipeline.checkpoints import CheckpointStore
 from pipeline.errors import PipelineError, RecordError
 from pipeline.locking import output_lock
 from pipeline.measures import MEASURES
-from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, kernels, simulate_batch
+from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, simulate_batch
+from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
 from pipeline.processing import load_recipe, process_records
 from pipeline.records import load_records
 from pipeline.soils import soil_block_stiffness
@@ -73,13 +74,12 @@ def cells_for_record(record, config, recipe) -> list[Cell]:
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
-              "solver": {"switch": config.switch, "tail": config.tail, "overturn": config.overturn_angle,
-                         "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
+              "solver": {**solver_options(config), "tail": config.tail, "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
     cells = []
     for block_index, block in enumerate(config.blocks):
         block_spec = {k: v for k, v in asdict(block).items() if k not in ("name", "description")}
         for model in config.models:
-            if not get_model(model).needs_foundation:
+            if get_model(model).is_rigid_base:
                 cells.append(Cell(_hash({**common, "block": block_spec, "model": model}), block_index, None, model))
                 continue
             for soil_index, soil in enumerate(config.soils):
@@ -89,10 +89,16 @@ def cells_for_record(record, config, recipe) -> list[Cell]:
     return cells
 
 
-def compute_cells(acceleration, dt, scales, jobs, switch, tail, overturn_angle):
+def solver_options(config) -> dict:
+    """The study's solver settings as ``simulate_batch`` keywords (pipeline.models.SolverOptions)."""
+    return {"switch": config.switch, "bed": config.bed, "overturn_angle": config.overturn_angle}
+
+
+def compute_cells(acceleration, dt, scales, jobs, options, tail):
     """Pure task function (runs in a worker): summaries for each job.
 
-    jobs : list of (key, model, block, k, xi). Returns {key: ndarray (n_scale, N_SUMMARY)}.
+    jobs : list of (key, model, block, k, xi); options : ``solver_options``.
+    Returns {key: summary records (n_scale,)}.
     """
     results = {}
     t_end = (acceleration.size - 1) * dt + tail
@@ -101,19 +107,19 @@ def compute_cells(acceleration, dt, scales, jobs, switch, tail, overturn_angle):
         by_model.setdefault(model, []).append((key, block, k, xi))
     for model, group in by_model.items():
         summaries = simulate_batch(model, acceleration, dt, scales, [(b, k, xi) for _, b, k, xi in group],
-                                   switch=switch, t_end=t_end, overturn_angle=overturn_angle)
+                                   t_end=t_end, **options)
         for (key, *_), summary in zip(group, summaries):
             results[key] = summary
     return results
 
 
-def _warm_up():
+def _warm_up(models):
     """Compile (or load from the on-disk cache) the kernels once before starting workers."""
     from pipeline.blocks import Block
 
     block = Block(name="warm-up", R=1.0, alpha=0.2, mass=1.0)
-    simulate_batch("housner", np.zeros(3), 0.01, [1.0], [(block, None, None)])
-    simulate_batch("ssi", np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
+    for model in models:
+        simulate_batch(model, np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
 
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
@@ -301,10 +307,9 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
 
     n_levels = len(config.levels)
-    summary_shape = (n_levels, kernels.N_SUMMARY)
     store = CheckpointStore(output / ".checkpoints", log=warn)
     all_cells = [cells_for_record(record, config, recipe) for record in records]
-    results = store.load_verified([c.key for cells in all_cells for c in cells], summary_shape, np.float64)
+    results = store.load_verified([c.key for cells in all_cells for c in cells], (n_levels,), SUMMARY_DTYPE)
     tasks = []
     for index, cells in enumerate(all_cells):
         missing = [c for c in cells if c.key not in results]
@@ -323,7 +328,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
     lost = []
     if tasks:
-        _warm_up()
+        _warm_up(config.models)
         with tqdm(total=runs_total, unit="run", desc="study", disable=not progress, smoothing=0.1) as bar:
             def keep_result(task, computed):
                 for key, summary in computed.items():
@@ -333,8 +338,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
             lost = run_tasks(tasks,
                              lambda task: (records[task[0]].acceleration, records[task[0]].dt,
-                                           scale_factors[task[0]], task[1], config.switch, config.tail,
-                                           config.overturn_angle),
+                                           scale_factors[task[0]], task[1], solver_options(config),
+                                           config.tail),
                              lambda: _executor(workers, scheduler, dask_workers), keep_result,
                              describe=lambda task: f"record {records[task[0]].id}")
     if lost:
@@ -353,14 +358,13 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         records, record_im, scale_factors = [records[i] for i in kept], record_im[kept], scale_factors[kept]
         all_cells = [all_cells[i] for i in kept]
 
-    summaries = np.full((len(records), n_levels, len(config.soils), len(config.blocks), len(config.models),
-                         kernels.N_SUMMARY), np.nan)
+    summaries = new_summaries((len(records), n_levels, len(config.soils), len(config.blocks), len(config.models)))
     for r, cells in enumerate(all_cells):
         for cell in cells:
             model_index = config.models.index(cell.model)
             result = results[cell.key]
             if cell.soil_index is None:
-                summaries[r, :, :, cell.block_index, model_index] = result[:, None, :]
+                summaries[r, :, :, cell.block_index, model_index] = result[:, None]
             else:
                 summaries[r, :, cell.soil_index, cell.block_index, model_index] = result
     provenance = {"processing": recipe.as_dict(),
