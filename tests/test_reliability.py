@@ -454,3 +454,14 @@ def test_internal_error_in_a_cell_names_the_record(tiny_study, tmp_path, capsys,
     assert status == cli.EXIT_INTERNAL_ERROR
     assert_one_line_error(capsys.readouterr().err, "stage 'run'", str(tiny_study), "(record pulse)",
                           "IndexError: kernel bug")
+
+
+def test_user_file_id_never_takes_a_catalogue_id(tmp_path):
+    from pipeline.records import load_records
+
+    write_at2(tmp_path / "mine" / "x" / "DUZCE" / "BOL090.AT2", amplitude_g=0.2)
+    write_at2(tmp_path / "mine" / "y" / "BOL090.AT2", amplitude_g=0.3)
+    records, failures = load_records(["DUZCE/BOL090", str(tmp_path / "mine")])
+    ids = [r.id for r in records]
+    assert not failures and len(set(ids)) == 3 and "DUZCE/BOL090" in ids
+    assert records[0].metadata["file"].endswith("BOL090.AT2") and "x/DUZCE/BOL090" in ids and "y/BOL090" in ids

@@ -206,32 +206,18 @@ def check_record(record) -> None:
                           f"{MAX_PEAK_G:g} g (check the units)")
 
 
-def _path_ids(paths, stems) -> list[str]:
-    """Ids from file names, lengthened with parent folders where two names clash."""
-    ids = list(stems)
+def unique_ids(records) -> list:
+    """The records with unique ids: a user file whose name clashes with another record's id gets
+    its path's last folders in its id (``site-a/X``, ``site-b/X``); catalogue ids never change."""
+    ids = [r.id for r in records]
+    movable = [r.metadata.get("sets") == "user" and bool(r.metadata.get("file")) for r in records]
     for depth in range(2, 64):
         clashing = {i for i in ids if ids.count(i) > 1}
-        if not clashing:
+        if not any(i in clashing and m for i, m in zip(ids, movable)):
             break
-        ids = ["/".join(Path(p).with_suffix("").parts[-depth:]) if i in clashing else i
-               for i, p in zip(ids, paths)]
-    return ids
-
-
-def unique_ids(records) -> list:
-    """The records with ids made unique: clashing user-file ids get the path's last folders."""
-    clashing = [r for r in records if sum(o.id == r.id for o in records) > 1 and r.metadata.get("sets") == "user"]
-    if not clashing:
-        return records
-    new_ids = dict(zip(map(id, clashing), _path_ids([r.metadata["file"] for r in clashing],
-                                                       [r.id for r in clashing])))
-    renamed = []
-    for record in records:
-        if id(record) in new_ids:
-            metadata = {**record.metadata, "id": new_ids[id(record)]}
-            record = Record(new_ids[id(record)], record.trace, metadata)
-        renamed.append(record)
-    return renamed
+        ids = ["/".join(Path(r.metadata["file"]).with_suffix("").parts[-depth:]) if i in clashing and m else i
+               for i, r, m in zip(ids, records, movable)]
+    return [r if i == r.id else Record(i, r.trace, {**r.metadata, "id": i}) for i, r in zip(ids, records)]
 
 
 # ---------------------------------------------------------------- catalogue and record sets
