@@ -465,3 +465,29 @@ def test_user_file_id_never_takes_a_catalogue_id(tmp_path):
     ids = [r.id for r in records]
     assert not failures and len(set(ids)) == 3 and "DUZCE/BOL090" in ids
     assert records[0].metadata["file"].endswith("BOL090.AT2") and "x/DUZCE/BOL090" in ids and "y/BOL090" in ids
+
+
+_real_compute_cells = __import__("pipeline.study", fromlist=["compute_cells"]).compute_cells
+
+
+def _oom_on_fine_sampling(acceleration, dt, *args):
+    """compute_cells, except that a worker given the 0.005 s record is killed (as by the OOM killer)."""
+    if dt == 0.005:
+        os.kill(os.getpid(), signal.SIGKILL)
+    return _real_compute_cells(acceleration, dt, *args)
+
+
+def test_record_whose_worker_dies_twice_is_reported_and_the_rest_kept(tmp_path, monkeypatch):
+    write_at2(tmp_path / "records" / "coarse.AT2", amplitude_g=0.3)
+    write_at2(tmp_path / "records" / "fine.AT2", amplitude_g=0.3, dt=0.005, npts=800)
+    study = tmp_path / "study.toml"
+    study.write_text(small_study_text(tmp_path / "records", levels=[0.5], soils=["rock"]))
+    monkeypatch.setattr("pipeline.study.compute_cells", _oom_on_fine_sampling)
+    warnings = []
+    dataset, stats = run_study(load_study(study), output=tmp_path / "out", workers=2, progress=False,
+                               log=lambda message: None, warn=warnings.append)
+    assert list(dataset.record.values) == ["coarse"]
+    assert len(stats["failures"]) == 1 and "fine.AT2" in stats["failures"][0]
+    assert "worker process died twice" in stats["failures"][0]
+    assert any("skipped" in w and "fine.AT2" in w for w in warnings)
+    assert len(list((tmp_path / "out" / ".checkpoints").glob("*.ckpt"))) == 6  # coarse's cells are kept
