@@ -10,11 +10,16 @@ status 1; anything else (a bug) one line, a traceback log file in the output fol
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import tempfile
+import time
+import traceback
 from pathlib import Path
 
 from pipeline import __version__
 from pipeline.errors import PipelineError
+from pipeline.locking import output_lock
 
 EXIT_USER_ERROR = 2
 EXIT_PARTIAL = 1
@@ -318,10 +323,6 @@ def _input_of(args) -> str:
 
 def _error_log_path(args) -> Path:
     """A new log file in the output folder, or in the temporary folder if that is not writable."""
-    import os
-    import tempfile
-    import time
-
     name = f"rockfrag-error-{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}.log"
     for folder in (getattr(args, "output", None) or Path("reports"), Path(tempfile.gettempdir())):
         try:
@@ -337,8 +338,6 @@ def _error_log_path(args) -> Path:
 
 def _report_internal_error(args, error) -> int:
     """Last line of defence: one line on stderr, the full traceback in a log file; rc 3."""
-    import traceback
-
     stage = getattr(args, "command", "?")
     notes = "; ".join(getattr(error, "__notes__", []))
     text = "".join(traceback.format_exception(error))
@@ -370,8 +369,6 @@ def main(argv=None) -> int:
         output = getattr(args, "output", None)
         if output is None:
             return args.handler(args)
-        from pipeline.locking import output_lock
-
         with output_lock(output):
             return args.handler(args)
     except PipelineError as error:
