@@ -62,6 +62,7 @@ SNAP_TO_STATIC_FRACTION = 1e-7  # SSI: leftover vertical vibration below this is
 ZENO_STEP_SHRINK = 0.25         # a whole excursion inside one step: retry with this fraction
 MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
+TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
 
 # Dormand-Prince 5(4) tableau
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
@@ -617,10 +618,11 @@ def bed_event(params, x, f0, x_new, k7, h, motion, t, before, after, min_fractio
 
 
 @njit(cache=True)
-def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, summary, impact_times):
+def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, event_at_end, summary, impact_times):
     """Uplift, flights, touch-downs, corner uplift, support and friction demand after a step.
 
-    before, after: contact indicators at the step's ends; indicators 0, 1 are the corners' penetrations.
+    before, after: contact indicators at the step's ends; indicators 0, 1 are the corners' penetrations;
+    event_at_end: the step ends on a located contact change (a take-off or landing exactly there).
     """
     lift_minus = -after[0]
     lift_plus = -after[1]
@@ -642,7 +644,9 @@ def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, summary, imp
         summary["n_flights"] += 1.0
     if flying and flying_before:
         summary["airborne_time"] += h
-    elif flying or flying_before:
+    elif flying_before and event_at_end:
+        summary["airborne_time"] += h  # landed at the step's end
+    elif (flying or flying_before) and not event_at_end:
         summary["airborne_time"] += 0.5 * h  # a transition not located inside this step
     force, _ = bed_force(x1, params)
     if force < summary["min_support_force"]:
@@ -695,17 +699,24 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         kind, index, s_event = bed_event(params, x, f0, x_new, k7, h, motion, t, before, after,
                                          EVENT_TIME_RESOLUTION / h)
         h_taken = h
+        event_at_end = False
         if kind != EVENT_NONE and s_event < 1.0:
             h_taken = refine_event(kind, index, code, ROCKING, 0.0, t, x, f0, h, s_event, motion, params, k,
                                    x_new, err)
+            far_side = after[index]
             contact_indicators(x_new, params, after)
+            if kind == EVENT_CONTACT and ((after[index] > 0.0) != (far_side > 0.0) or after[index] == 0.0):
+                # the step ends exactly on the contact change: book it as crossed
+                after[index] = math.copysign(TINY_INDICATOR, far_side)
+            event_at_end = kind == EVENT_CONTACT
         track_peak(x, f0, x_new, k7, h_taken, t, summary, params["overturn"])
         if kind != EVENT_OVERTURN:
             next_row = write_rows(history, next_row, dt, t, h_taken, x, f0, x_new, k7)
         for i in range(4):
             x[i] = x_new[i]
         t = t + h_taken
-        bed_bookkeeping(params, x, h_taken, t, ground(motion, t), k7, before, after, summary, impact_times)
+        bed_bookkeeping(params, x, h_taken, t, ground(motion, t), k7, before, after, event_at_end, summary,
+                        impact_times)
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
