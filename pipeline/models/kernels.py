@@ -34,7 +34,7 @@ from pipeline.models.housner import housner_rhs
 from pipeline.models.jit import njit
 from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
 from pipeline.models.winkler import (N_CONTACT_INDICATORS, bed_force, contact_indicator, contact_indicators,
-                                     friction_demand, winkler_rhs)
+                                     friction_demand, settled_beyond_reach, winkler_rhs)
 
 # phases of the pivot loop
 REST = 0
@@ -720,6 +720,9 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
+        if (history.shape[0] == 0 and t > ag.size * dt and after[0] > 0.0 and after[1] > 0.0
+                and settled_beyond_reach(x, params, summary["peak_angle"])):
+            break  # the ground is at rest and the block can no longer reach its peak or lift (no history kept)
         if kind == EVENT_OVERTURN:
             overturned = True
             summary["time_of_overturn"] = t
