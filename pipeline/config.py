@@ -140,7 +140,9 @@ class Table:
         for key, item in value.items():
             where = f"{field}.{key}" if field else key
             if key not in self.fields:
-                raise ConfigError(where, _unknown_key(key, self.fields, top_level=not field), source)
+                dotted = (f" (a table name with a dot must be quoted: [{field.rsplit('.', 1)[0]}.\"{field.rsplit('.', 1)[1]}"
+                          f".{key}\"])" if isinstance(item, dict) and field.count(".") == 1 else "")
+                raise ConfigError(where, _unknown_key(key, self.fields, top_level=not field) + dotted, source)
             self.fields[key].check(item, where, source)
         return value
 
