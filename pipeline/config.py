@@ -33,8 +33,9 @@ import numpy as np
 from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.models import MODELS, SWITCH_RULES
-from pipeline.soils import SOILS, SoilClass
+from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
 from pipeline.units import STANDARD_GRAVITY
+from pipeline.validation import Number, shown as _shown
 
 MEASURE_UNITS = {"pga": ("g", STANDARD_GRAVITY), "sa": ("g", STANDARD_GRAVITY), "pgv": ("m/s", 1.0)}
 BEDS = ("continuous", "two-spring")
@@ -45,38 +46,6 @@ uplift intensity."""
 
 
 # ---------------------------------------------------------------- the schema
-
-@dataclass(frozen=True)
-class Number:
-    """A real (or whole, ``integer=True``) number in a range; booleans are not numbers."""
-
-    low: float | None = None
-    high: float | None = None
-    low_open: bool = False
-    high_open: bool = False
-    integer: bool = False
-    unit: str = ""
-
-    def describe(self) -> str:
-        parts = []
-        if self.low is not None:
-            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
-        if self.high is not None:
-            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
-        kind = "a whole number" if self.integer else "a number"
-        unit = f" [{self.unit}]" if self.unit else ""
-        return f"{kind} {' and '.join(parts)}{unit}" if parts else f"{kind}{unit}"
-
-    def check(self, value, field, source):
-        wanted = int if self.integer else (int, float)
-        if isinstance(value, bool) or not isinstance(value, wanted) or not math.isfinite(value):
-            raise ConfigError(field, f"{_shown(value)}; must be {self.describe()}", source)
-        too_low = self.low is not None and (value <= self.low if self.low_open else value < self.low)
-        too_high = self.high is not None and (value >= self.high if self.high_open else value > self.high)
-        if too_low or too_high:
-            raise ConfigError(field, f"{value:g} out of range; must be {self.describe()}", source)
-        return int(value) if self.integer else float(value)
-
 
 @dataclass(frozen=True)
 class Text:
@@ -185,24 +154,6 @@ class Checked:
         return self.function(value, field, source)
 
 
-def _shown(value) -> str:
-    """A value as the user wrote it in TOML, with its type."""
-    if isinstance(value, bool):
-        return f"{str(value).lower()} is a boolean"
-    if isinstance(value, int):
-        return f"{value} is a whole number"
-    if isinstance(value, float):
-        return f"{value:g} is a number"
-    if isinstance(value, str):
-        return f"{value!r} is a string"
-    if isinstance(value, list):
-        text = json.dumps(value, default=str)
-        return f"{text if len(text) < 40 else text[:37] + '...'} is a list"
-    if isinstance(value, dict):
-        return "a table"
-    return f"{value!r} is a {type(value).__name__}"
-
-
 def _unknown_key(key, allowed, top_level=False) -> str:
     close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.75)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
@@ -212,13 +163,7 @@ def _unknown_key(key, allowed, top_level=False) -> str:
 
 
 TEXT = Text()
-SOIL_TABLE = Table({
-    "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),
-    "poisson_ratio": Number(0, 0.5, high_open=True),
-    "density": Number(0, 1e5, low_open=True, unit="kg/m^3"),
-    "damping_ratio": Number(0, 1, high_open=True),
-    "why": TEXT,
-})
+SOIL_TABLE = Table({**SOIL_RANGES, "why": TEXT})
 # Types only: the ranges of a block are Block's own (pipeline/blocks.py), reported with the user's field.
 BLOCK_TABLE = Table({key: Number() for key in ("b", "h", "R", "alpha", "mass", "E_b", "footprint_area",
                                                 "soil_depth")} | {"why": TEXT})
