@@ -32,12 +32,15 @@ import numpy as np
 
 from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError
+from pipeline.measures import MEASURES
 from pipeline.models import MODELS, SWITCH_RULES
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number, shown as _shown
 
 MEASURE_UNITS = {"pga": ("g", STANDARD_GRAVITY), "sa": ("g", STANDARD_GRAVITY), "pgv": ("m/s", 1.0)}
+SCALING_MEASURES = tuple(name for name in MEASURES if name in MEASURE_UNITS)
+"""Measures a study can scale to: computed by pipeline.measures and with a display unit here."""
 BEDS = ("continuous", "two-spring")
 """Foundation beds of the ``winkler`` model (``[solver] bed``)."""
 LEVEL_REFERENCES = ("", "uplift")
@@ -189,7 +192,7 @@ SCHEMA = Table({
                     "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"),
                     # report metadata, read by pipeline.report
                     "title": TEXT, "project": TEXT, "author": TEXT}),
-    "intensity": Table({"measure": Text(tuple(MEASURE_UNITS)), "period": Number(0.01, 20.0, unit="s"),
+    "intensity": Table({"measure": Text(SCALING_MEASURES), "period": Number(0.01, 20.0, unit="s"),
                         "damping": Number(0.0, 0.5), "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True))}),
     "solver": Table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
                      "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
