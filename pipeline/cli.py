@@ -293,8 +293,8 @@ def command_applicability(args) -> int:
     dataset = applicability_stage(config, output, workers=args.workers, progress=not args.no_progress,
                                   loaded=loaded)
     table = (dataset.threshold_shear_modulus / 1e6).to_dataframe()["threshold_shear_modulus"].unstack()
-    print(f"G_s [MPa] above which Housner is within {config.applicability.tolerance:.0%} of SSI (rows: block, "
-          "E_b [Pa]; columns: PGA / uplift PGA; NaN: not within tolerance even at the stiffest G_s):")
+    print(f"G_s [MPa] above which Housner is within {config.applicability.tolerance:.0%} of each model (rows: "
+          "model, block, E_b [Pa]; columns: PGA / uplift PGA; NaN: not within tolerance even at the stiffest G_s):")
     print(table.round(0).to_string())
     return 0
 

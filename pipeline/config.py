@@ -33,7 +33,7 @@ import numpy as np
 from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.measures import MEASURES
-from pipeline.models import MODELS, SWITCH_RULES
+from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number, shown as _shown
@@ -41,8 +41,6 @@ from pipeline.validation import Number, shown as _shown
 MEASURE_UNITS = {"pga": ("g", STANDARD_GRAVITY), "sa": ("g", STANDARD_GRAVITY), "pgv": ("m/s", 1.0)}
 SCALING_MEASURES = tuple(name for name in MEASURES if name in MEASURE_UNITS)
 """Measures a study can scale to: computed by pipeline.measures and with a display unit here."""
-BEDS = ("continuous", "two-spring")
-"""Foundation beds of the ``winkler`` model (``[solver] bed``)."""
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
 uplift intensity."""
@@ -196,7 +194,7 @@ SCHEMA = Table({
                         "damping": Number(0.0, 0.5), "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True))}),
     "solver": Table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
                      "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
-                     "bed": Text(BEDS)}),
+                     "bed": Text(tuple(BED_TYPES))}),
     "hazard": Table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
     "fragility": Table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                         "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
@@ -432,7 +430,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
 
     custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
     soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
-    models = _select("models", data.get("models", ["housner", "ssi"]), {m: m for m in MODELS}, source)
+    models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
     library = {name: _block("blocks_custom", name, spec, source) for name, spec in data.get("blocks_custom", {}).items()}
     if "blocks" not in data:
         raise ConfigError("blocks", "no block defined; add [blocks.NAME] tables", source)

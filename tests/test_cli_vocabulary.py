@@ -103,6 +103,7 @@ def test_workers_is_a_pool_size_and_scheduler_chooses_dask():
 
 SWEEP_STUDY = """
 soils = ["rock"]
+models = ["housner", "winkler"]
 [study]
 record_sets = ["DUZCE/BOL090"]
 [applicability]
@@ -126,7 +127,7 @@ def test_applicability_command_and_fragility_stage_share_one_definition(tmp_path
     output = tmp_path / "out"
     assert main(["applicability", str(study), "--output", str(output), "--workers", "1", "--no-progress"]) == 0
     written = xr.open_dataset(output / "applicability.nc").load()
-    assert written.sizes == {"block": 1, "block_modulus": 1, "level": 1, "shear_modulus": 3}
+    assert written.sizes == {"model": 1, "block": 1, "block_modulus": 1, "level": 1, "shear_modulus": 3}
     assert written.shear_modulus.values[[0, -1]].tolist() == [1e8, 1e10]
 
     messages = []
