@@ -243,7 +243,8 @@ def study_records(config, log=print):
     processed is skipped and reported (``log``); the others go on.
     """
     recipe = load_recipe(config.processing or None)
-    raw_records, failures = load_records(list(config.record_sets))
+    raw_records, failures = load_records(list(config.record_sets), units=config.record_units or None,
+                                         dt=config.record_dt)
     processed, processing_failures = process_records(raw_records, recipe)
     failures = [*failures, *processing_failures]
     for failure in failures:
