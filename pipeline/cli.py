@@ -10,6 +10,8 @@ status 1; anything else (a bug) one line, a traceback log file in the output fol
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import sys
 import tempfile
@@ -461,11 +463,27 @@ def _output_folder(args) -> Path | None:
     return _study_config(args)[1]
 
 
+def _parse_arguments(parser, argv):
+    """argparse's namespace; a usage error is one line (argparse's own, without the usage block)."""
+    captured = io.StringIO()
+    try:
+        with contextlib.redirect_stderr(captured):
+            return parser.parse_args(argv)
+    except SystemExit as stop:
+        lines = [line for line in captured.getvalue().splitlines() if line.strip()]
+        if stop.code in (0, None) or not lines:
+            sys.stderr.write(captured.getvalue())
+            raise
+        command = lines[-1].split(": error:", 1)[0]
+        print(f"{lines[-1]} (see '{command} --help')", file=sys.stderr)
+        raise SystemExit(EXIT_USER_ERROR) from None
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     parser.epilog = EXIT_CODES
     parser.formatter_class = argparse.RawDescriptionHelpFormatter
-    args = parser.parse_args(argv)
+    args = _parse_arguments(parser, argv)
     try:
         output = _output_folder(args)
         if output is None:

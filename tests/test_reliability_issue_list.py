@@ -1,7 +1,7 @@
 """Issue 13's list of ~30 probes, one row each: every one must end with one line on stderr and the
 documented exit status (README, ``rockfrag --help``), never a traceback. Rows whose fix belongs to
-another part of the issue (the study-file validation layer, calibration, CLI vocabulary) carry
-``OTHERS``: expected to fail until that work is merged, then they must pass (xfail is not strict)."""
+the calibration part of the issue carry ``OTHERS``: expected to fail until that work is merged, then
+they must pass (xfail is not strict; remove the mark once they pass)."""
 
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ from pipeline import cli
 from pipeline.checkpoints import SUFFIX
 from tests.reliability_helpers import error_lines, small_study_text, write_at2
 
-OTHERS = pytest.mark.xfail(strict=False, reason="fixed by another helper's part of issue 13 (validation layer, "
-                                                "calibration, CLI options); must pass once merged")
+OTHERS = pytest.mark.xfail(strict=False, reason="fixed by the calibration helper's part of issue 13; must pass "
+                                                "once merged")
 
 
 def run_cli(argv) -> tuple[int, str, str]:
@@ -88,9 +88,9 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
     #    calibration helper's tests check the converted values)
     ("typo under soils_custom", lambda p: ["run", replaced(p, 'soils = ["rock"]', 'soils = ["wet"]',
                                                            "[soils_custom.wet]\nshear_modulus = 5e7\ndamping_raito = 0.2\n"),
-                                           "--output", p / "o", *RUN], 2, ["damping_raito"], (OTHERS,)),
+                                           "--output", p / "o", *RUN], 2, ["damping_raito"], ()),
     ("typo under damage_states", lambda p: ["run", study_with(p, '[damage_states.x]\nedp = "overturned"\nthreshhold = 1\n'),
-                                            "--output", p / "o", *RUN], 2, ["threshhold"], (OTHERS,)),
+                                            "--output", p / "o", *RUN], 2, ["threshhold"], ()),
     ("calibrate text cell in theta", lambda p: ["calibrate", _write(p / "t.csv", "time [s],theta [rad],other\n" + "".join(
         f"{0.01 * i},{'x' if i == 5 else 1e-4 * i},{i}\n" for i in range(30))), "--record", p / "records" / "good.AT2",
         "--output", p / "o", "--grid-only", "--n-k", "2", "--n-xi", "2"], 2, ["theta"], (OTHERS,)),
@@ -108,33 +108,33 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
     ("DT 1e-300", lambda p: ["records", "--set", bad_record(p, dt=1e-300), "--output", p / "o", "--no-progress"], 1,
      ["bad.AT2", "DT = 1e-300"], ()),
     ("blocks.x = 5", lambda p: ["run", study_with(p, "[blocks]\nx = 5\n"), "--output", p / "o", *RUN], 2,
-     ["blocks"], (OTHERS,)),
+     ["blocks"], ()),
     ("measure list", lambda p: ["run", replaced(p, "[intensity]", '[intensity]\nmeasure = ["pga"]'),
-                                "--output", p / "o", *RUN], 2, ["measure"], (OTHERS,)),
+                                "--output", p / "o", *RUN], 2, ["measure"], ()),
     ("soils nested list", lambda p: ["run", _write(p / "s.toml", (p / "study.toml").read_text().replace(
-        'soils = ["rock"]', 'soils = [["rock"]]')), "--output", p / "o", *RUN], 2, ["soils"], (OTHERS,)),
+        'soils = ["rock"]', 'soils = [["rock"]]')), "--output", p / "o", *RUN], 2, ["soils"], ()),
     ("output = 5", lambda p: ["run", _write(p / "s.toml", (p / "study.toml").read_text().replace(
-        'name = "tiny"', 'name = "tiny"\noutput = 5')), *RUN], 2, ["output"], (OTHERS,)),
+        'name = "tiny"', 'name = "tiny"\noutput = 5')), *RUN], 2, ["output"], ()),
     ("record_sets = 5", lambda p: ["run", _write(p / "s.toml", 'soils = ["rock"]\n[study]\nrecord_sets = 5\n'),
-                                   "--output", p / "o", *RUN], 2, ["record_sets"], (OTHERS,)),
+                                   "--output", p / "o", *RUN], 2, ["record_sets"], ()),
     ("poisson_ratio text", lambda p: ["run", replaced(p, 'soils = ["rock"]', 'soils = ["wet"]',
                                                       '[soils_custom.wet]\nshear_modulus = 5e7\npoisson_ratio = "a"\n'),
-                                      "--output", p / "o", *RUN], 2, ["poisson_ratio"], (OTHERS,)),
+                                      "--output", p / "o", *RUN], 2, ["poisson_ratio"], ()),
     ("binary study", lambda p: ["run", _write_bytes(p / "b.toml", b"\x00\xff\xfe\x01"), "--output", p / "o", *RUN], 2,
-     ["b.toml"], (OTHERS,)),
+     ["b.toml"], ()),
     ("study is a folder", lambda p: ["run", p / "records", "--output", p / "o", *RUN], 2, ["records"], ()),
     ("hazard CSV text cell", lambda p: ["run", text_cell_hazard(p), "--output", p / "o", *RUN], 2, ["hazard"],
-     (OTHERS,)),
+     ()),
     ("calibrate all-zero reference", lambda p: ["calibrate", zero_reference(p), "--record", p / "records" / "good.AT2",
                                                 "--output", p / "o", "--grid-only", "--n-k", "2", "--n-xi", "2"],
      2, ["zero.csv"], (OTHERS,)),
     ("calibrate --n-k 0", lambda p: ["calibrate", p / "reference.csv", "--record", p / "records" / "good.AT2",
-                                     "--output", p / "o", "--grid-only", "--n-k", "0"], 2, ["n-k"], (OTHERS,)),
+                                     "--output", p / "o", "--grid-only", "--n-k", "0"], 2, ["n-k"], ()),
     ("applicability --n-g 0", lambda p: ["applicability", p / "study.toml", "--output", p / "o", "--n-g", "0",
-                                         "--serial", "--no-progress"], 2, ["n-g"], (OTHERS,)),
+                                         "--serial", "--no-progress"], 2, ["n-g"], ()),
     # 6. --workers -1
     ("--workers -1", lambda p: ["run", p / "study.toml", "--output", p / "o", "--workers", "-1", "--no-progress"], 2,
-     ["--workers"], ()),
+     ["--workers", "-1"], ()),
     # 7. inconsistent or unchecked records and values
     ("all-zero record in records", lambda p: ["records", "--set", bad_record(p, amplitude_g=0.0), "--output", p / "o", "--no-progress"],
      1, ["bad.AT2", "zero"], ()),
@@ -147,23 +147,23 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
     ("binary AT2", lambda p: _write_bytes(p / "records" / "bad.AT2", b"\x00\x01\x02" * 50) and
      ["records", "--set", p / "records", "--output", p / "o", "--no-progress"], 1, ["bad.AT2", "binary"], ()),
     ('models = "housner"', lambda p: ["run", _write(p / "s.toml", (p / "study.toml").read_text().replace(
-        'models = ["housner"]', 'models = "housner"')), "--output", p / "o", *RUN], 2, ["models", "!'h'"], (OTHERS,)),
+        'models = ["housner"]', 'models = "housner"')), "--output", p / "o", *RUN], 2, ["models", "!'h'"], ()),
     ("shear_modulus = 0", lambda p: ["run", study_with(p, "[soils_custom.wet]\nshear_modulus = 0\n"), "--output",
-                                     p / "o", *RUN], 2, ["shear_modulus", "> 0"], (OTHERS,)),
+                                     p / "o", *RUN], 2, ["shear_modulus", "> 0"], ()),
     ("count = true", lambda p: ["run", _write(p / "s.toml", (p / "study.toml").read_text().replace(
         "levels = [0.5]", "levels = { start = 0.1, stop = 1.0, count = true }")), "--output", p / "o", *RUN], 2,
-     ["count"], (OTHERS,)),
+     ["count"], ()),
     ("negative --levels", lambda p: ["applicability", p / "study.toml", "--output", p / "o", "--levels", "-1",
-                                     "--serial", "--no-progress"], 2, ["levels"], (OTHERS,)),
+                                     "--serial", "--no-progress"], 2, ["levels"], ()),
     ("negative --tolerance", lambda p: ["applicability", p / "study.toml", "--output", p / "o", "--tolerance", "-0.1",
-                                        "--serial", "--no-progress"], 2, ["tolerance"], (OTHERS,)),
+                                        "--serial", "--no-progress"], 2, ["tolerance"], ()),
     ("negative --soil-g", lambda p: ["calibrate", p / "reference.csv", "--record", p / "records" / "good.AT2",
                                      "--output", p / "o", "--soil-g", "-1", "--grid-only", "--n-k", "2", "--n-xi", "2"],
-     2, ["soil-g"], (OTHERS,)),
-    ('--set ""', lambda p: ["records", "--set", "", "--output", p / "o"], 2, ["empty record selection"], ()),
+     2, ["soil-g"], ()),
+    ('--set ""', lambda p: ["records", "--set", "", "--output", p / "o"], 2, ["--set", "empty"], ()),
     ("damage_states error before the cube", lambda p: ["run", study_with(
         p, '[damage_states.x]\nedp = "nonsense"\nthreshold = 1\n'), "--output", p / "o", *RUN], 2,
-     ["damage_states.x.edp", "probe.toml"], (OTHERS,)),
+     ["damage_states.x.edp", "probe.toml"], ()),
 ]
 
 
