@@ -494,3 +494,17 @@ def test_record_whose_worker_dies_twice_is_reported_and_the_rest_kept(tmp_path, 
     assert "worker process died twice" in stats["failures"][0]
     assert any("skipped" in w and "fine.AT2" in w for w in warnings)
     assert len(list((tmp_path / "out" / ".checkpoints").glob("*.ckpt"))) == 6  # coarse's cells are kept
+
+
+@pytest.mark.parametrize("npts", [3, 5, 9])
+def test_short_record_that_processing_cannot_handle_is_skipped_not_a_traceback(npts, tmp_path, capsys):
+    write_at2(tmp_path / "records" / "good.AT2")
+    write_at2(tmp_path / "records" / "short.AT2", values=[0.1, -0.2, 0.15, -0.05, 0.02, 0.3, -0.1, 0.05, 0.01][:npts])
+    status = cli.main(["records", "--set", str(tmp_path / "records"), "--output", str(tmp_path / "out"),
+                       "--no-progress"])
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err
+    if status == cli.EXIT_PARTIAL:  # skipped by processing, with the step that failed
+        assert_one_line_error(captured.err, "short.AT2", "cannot be processed")
+    else:
+        assert status == 0 and len(pd.read_csv(tmp_path / "out" / "records.csv")) == 2

@@ -172,8 +172,9 @@ def _read_with_obspy(path, format, units):
 
 # ---------------------------------------------------------------- plausibility of a record
 
-MIN_SAMPLES = 16
-"""Fewer samples cannot be filtered, baseline-corrected or scaled meaningfully."""
+MIN_SAMPLES = 3
+"""Fewer samples are not a ground motion (a longer record that processing cannot handle is skipped
+there, with the step that failed)."""
 
 DT_RANGE = (1e-4, 0.5)
 """Plausible time steps of strong-motion records [s] (published records use 0.001 to 0.05 s)."""
