@@ -230,7 +230,8 @@ def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, des
                 on_result(futures[future], result)
             finished = True
         finally:
-            shutdown(finished and not lost)
+            # a broken pool is joined before the next one forks, so no thread of it is caught mid-way
+            shutdown(bool(lost) or finished)
         pending = lost
     return pending
 

@@ -66,7 +66,7 @@ def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
 
     output = tmp_path / "out"
     command = [sys.executable, "-m", "pipeline", "run", str(study), "--output", str(output), "--no-progress"]
-    environment = {**os.environ, "PYTHONPATH": str(ROOT)}
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
     outcomes = []
     for attempt in range(KILLS):
         # forget some finished cells so that every attempt has work left to interrupt
@@ -90,7 +90,12 @@ def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
             if seen_children and process.poll() is None:
                 os.kill(rng.choice(sorted(seen_children)), signal.SIGKILL)
                 outcomes.append("worker killed")
-            _, stderr = process.communicate(timeout=120)
+            try:
+                _, stderr = process.communicate(timeout=120)
+            except subprocess.TimeoutExpired:  # a hang: dump every thread's stack (faulthandler) for the report
+                process.send_signal(signal.SIGABRT)
+                _, stderr = process.communicate(timeout=30)
+                pytest.fail(f"run hung after a worker was killed; threads:\n{stderr[-8000:]}")
             assert process.returncode == 0, stderr  # the lost cells were retried in a fresh pool
             assert "Traceback" not in stderr
         else:
