@@ -77,12 +77,15 @@ def _study_config(args):
 
 
 def command_run(args) -> int:
-    from pipeline.study import run_study
+    from pipeline.showcase import showcase_stage
+    from pipeline.study import run_study, study_records
 
     config, output = _study_config(args)
+    loaded = study_records(config, log=lambda message: print(message, file=sys.stderr))
     dataset, stats = run_study(config, output=output, workers=1 if args.serial else None,
                                scheduler=args.scheduler, dask_workers=args.workers,
-                               progress=not args.no_progress)
+                               progress=not args.no_progress, loaded=loaded)
+    showcase_stage(config, output, loaded)
     runs = stats["runs_computed"]
     rate = f", {runs / stats['seconds']:.0f} runs/s" if runs else ""
     print(f"wrote {output / 'cube.nc'} ({stats['seconds']:.1f} s{rate}; "
@@ -97,9 +100,8 @@ def command_fragility(args) -> int:
     from pipeline.fragility import fragility_stage
     from pipeline.ida import ida_stage
     from pipeline.report import report_stage
-    from pipeline.study import run_study
-
-    from pipeline.study import study_records
+    from pipeline.showcase import showcase_stage
+    from pipeline.study import run_study, study_records
 
     started = time.perf_counter()
     config, output = _study_config(args)
@@ -108,6 +110,7 @@ def command_fragility(args) -> int:
                             scheduler=args.scheduler, dask_workers=args.workers, progress=not args.no_progress,
                             loaded=loaded)
     print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
+    showcase_stage(config, output, loaded)
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
     fragility, risk = fragility_stage(cube, ida, config, output)
@@ -120,8 +123,9 @@ def command_fragility(args) -> int:
         applicability = applicability_stage(config, output, workers=1 if args.serial else None,
                                             progress=not args.no_progress, loaded=loaded)
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
-                             applicability, loaded)
-    print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
+                             applicability, progress=not args.no_progress)
+    print(f"wrote {pdf} ({len(pngs)} numbered pages), {output / 'report.html'} and {len(pngs)} page images "
+          f"in {output / 'figures'}/")
     print(f"done in {time.perf_counter() - started:.0f} s")
     return EXIT_PARTIAL if stats["failures"] else 0
 

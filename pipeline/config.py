@@ -135,12 +135,13 @@ def _block(name, data, source):
 
 ALLOWED_KEYS = {
     "": {"study", "intensity", "soils", "models", "solver", "blocks", "soils_custom", "damage_states",
-         "hazard", "fragility"},
+         "hazard", "fragility", "report"},
     "study": {"name", "record_sets", "processing", "output"},
     "intensity": {"measure", "period", "damping", "levels"},
     "solver": {"switch", "tail", "overturn_angle"},
     "hazard": {"file", "design_life"},
     "fragility": {"bootstrap", "seed", "confidence"},
+    "report": {"title", "project", "author", "showcase_record", "showcase_block", "friction_coefficient"},
 }
 
 
