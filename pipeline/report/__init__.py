@@ -67,6 +67,27 @@ def _text_pages(name, section, title, items, caption=""):
     return planned
 
 
+def title_page(results: Results) -> Planned:
+    """Page 1: title, project and author large, then the study in a few lines."""
+    settings = results.settings
+    people = [(str(settings[key]), size) for key, size in (("project", 16), ("author", 12)) if settings.get(key)]
+    items = title_items(results)
+
+    def draw():
+        from pipeline.report.layout import new_page
+
+        figure = new_page("")
+        figure.text(0.5, 0.66, results.title, fontsize=24, weight="bold", ha="center", va="bottom", wrap=True)
+        y = 0.62
+        for text, size in people:
+            figure.text(0.5, y, text, fontsize=size, ha="center", va="top")
+            y -= 0.05
+        return draw_text_page("", items, top=y - 0.06, figure=figure)
+
+    body = "".join(f"<p><strong>{html.escape(text)}</strong></p>" for text, _ in people)
+    return Planned("title", "Title", results.title, draw, "", body + items_html(items))
+
+
 def _figure(name, section, title, function, *args, caption=""):
     return Planned(name, section, title, lambda: function(*args, caption), caption)
 
@@ -92,7 +113,7 @@ def records_items(results: Results) -> list[Item]:
 def plan(results: Results) -> list[Planned]:
     """Every page of the report in order (contents excluded: it is made from this list)."""
     cube, ida, fragility, showcase = results.cube, results.ida, results.fragility, results.showcase
-    planned = _text_pages("title", "Title", results.title, title_items(results))
+    planned = [title_page(results)]
     planned += _text_pages("summary", "Summary", "Summary of the fitted fragility functions", summary_items(results))
     planned += _text_pages("methods", "Methods", "Methods and assumptions", methods_items(results))
     planned += _text_pages("limitations", "Limitations", "Limitations: where the models are outside their validity",

@@ -312,7 +312,7 @@ def applicability_page(cube, caption, limit=0.10):
     reference = next(m for m in models if m.rigid_base)
     founded = [m for m in models if not m.rigid_base]
     styles = model_styles(models)
-    figure = new_page(f"Applicability of the rigid base: foundation models over {short_label(reference)}", caption)
+    figure = new_page(f"Applicability of the rigid base: each foundation model over {reference.name}", caption)
     axis = panels(figure, gridspec_kw=dict(top=0.85))[0, 0]
     shear = cube.soil_shear_modulus.values / 1e6
     order = np.argsort(shear)
@@ -329,9 +329,8 @@ def applicability_page(cube, caption, limit=0.10):
             survived = (sub.outcome.sel(model=[reference.name, model.name]) == OUTCOME_ROCKING).all("model")
             ratio = (sub.peak_angle.sel(model=model.name).where(survived).median(["record", "im_level"]) /
                      rigid_angle.where(survived).median(["record", "im_level"])).values
-            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)],
-                          color=styles[model.name]["color"], ls=styles[model.name]["ls"],
-                          label=f"{block}, {short_label(model)}")
+            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], color=f"C{b_index % 10}",
+                      ls=styles[model.name]["ls"], lw=1.4, label=f"{block}, {model.name}")
     axis.axhspan(1 - limit, 1 + limit, color="0.88", label=f"within ±{limit:.0%} of the rigid base", zorder=0)
     axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, label="paper's limit: G_s = 300-1000 MPa", zorder=0)
     axis.axhline(1.0, color="k", lw=0.8)

@@ -100,9 +100,9 @@ def outside_legend(figure, axes, **options):
             if label not in seen and not label.startswith("_"):
                 seen.add(label)
                 handles.append(handle)
-                labels.append(textwrap.fill(label, 30))
+                labels.append(textwrap.fill(label, 26))
     if handles:
-        figure.legend(handles, labels, loc="upper left", bbox_to_anchor=LEGEND_ANCHOR, fontsize=8, frameon=False,
+        figure.legend(handles, labels, loc="upper left", bbox_to_anchor=LEGEND_ANCHOR, fontsize=7.5, frameon=False,
                       **options)
 
 

@@ -66,13 +66,9 @@ def n_runs(cube) -> int:
 
 
 def title_items(results: Results):
+    """The title page below the title: study, size of the run, what the report holds."""
     config, cube = results.config, results.cube
-    settings = results.settings
-    items = []
-    for key, label in (("project", "Project"), ("author", "Author")):
-        if settings.get(key):
-            items.append(paragraph(f"{label}: {settings[key]}"))
-    items += [
+    items = [
         paragraph(f"Study '{config.name}' ({config.source}); configuration hash {cube.attrs.get('config_hash', '')}; "
                   f"computed with rockfrag {cube.attrs.get('rockfrag_version', __version__)}."),
         paragraph(f"{cube.sizes['record']} record components, {cube.sizes['im_level']} intensity levels, "

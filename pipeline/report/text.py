@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from pipeline.report.layout import new_page
 
 TOP, BOTTOM = 0.925, 0.085  # figure fractions available to text
-LINE = 0.0225  # one line of 9.5 pt text on the A4-landscape page [figure fraction]
-WRAP = 165  # characters per line of 9.5 pt text across the page
+LINE = 0.021  # one line of 9.5 pt text on the A4-landscape page [figure fraction]
+WRAP = 150  # characters per line of 9.5 pt text across the page
 CHAR = 0.0062  # width of one 8.5 pt table character [figure fraction], for column positions
 LEFT = 0.02
 
@@ -108,10 +108,10 @@ def _column_positions(item) -> list[float]:
     return positions
 
 
-def draw_text_page(title, items, caption=""):
-    """One page figure with the items drawn top-down."""
-    figure = new_page(title, caption)
-    y = TOP
+def draw_text_page(title, items, caption="", top=TOP, figure=None):
+    """One page figure with the items drawn top-down from ``top``."""
+    figure = figure or new_page(title, caption)
+    y = top
     for item in items:
         if item.kind == "heading":
             y -= 0.4 * LINE
