@@ -232,6 +232,18 @@ def test_limitations_state_the_tension_fraction_per_soil_and_block():
     assert run_fraction(cube, tension_flag(cube), model_info("housner")) is None  # not computed: NaN
 
 
+def test_tension_flag_not_applicable_is_not_counted():
+    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+
+    flags = np.full((10, 2, 2, 1, 2), -1, dtype=np.int8)  # -1: the model cannot pull (tensionless, rigid)
+    flags[..., 1] = 0
+    flags[:2, :, 1, 0, 1] = 1
+    cube = _fake_cube(flags)
+    assert run_fraction(cube, tension_flag(cube), model_info("housner")) is None
+    fraction = run_fraction(cube, tension_flag(cube), model_info("ssi"))
+    assert float(fraction.sel(soil="rock", block="b")) == pytest.approx(0.2) and float(fraction.sel(soil="clay", block="b")) == 0.0
+
+
 def test_tension_falls_back_to_negative_support_force():
     from pipeline.report.adapters import model_info, run_fraction, tension_flag
 
@@ -251,8 +263,8 @@ def test_sliding_fraction_above_the_friction_coefficient():
     demand[:4, 1, 0, 0, 1] = 0.7  # 4 of 20 runs on clay need more than mu = 0.5
     cube = _fake_cube(np.zeros_like(demand), demand)
     fraction = run_fraction(cube, friction_flag(cube, 0.5), model_info("ssi"))
-    assert float(fraction.sel(soil="clay")) == pytest.approx(0.2)
-    assert float(fraction.sel(soil="rock")) == 0.0
+    assert float(fraction.sel(soil="clay", block="b")) == pytest.approx(0.2)
+    assert float(fraction.sel(soil="rock", block="b")) == 0.0
     assert friction_flag(cube.drop_vars("peak_friction_demand"), 0.5) is None
 
 

@@ -263,11 +263,11 @@ def html_document(title: str, rendered: list[Page]) -> str:
                      f"<h2>{html.escape(page.title)}</h2>")
         if page.html is not None:
             parts.append(page.html)
-            if page.caption:
-                parts.append(f"<p class='caption'>{html.escape(page.caption)}</p>")
         else:
             encoded = base64.b64encode(page.png).decode("ascii")
             parts.append(f"<img alt='{html.escape(page.title)}' src='data:image/png;base64,{encoded}'>")
+        if page.caption:
+            parts.append(f"<p class='caption'>{html.escape(page.caption)}</p>")
         parts.append("</section>")
     parts.append(f"<footer><p class='note'>rockfrag {__version__}</p></footer></body></html>")
     return "\n".join(parts)

@@ -29,6 +29,7 @@ class ModelInfo:
     label: str
     rigid_base: bool
     description: str
+    can_pull: bool | None = None  # None: the registry does not say
 
 
 def model_info(name: str) -> ModelInfo:
@@ -41,7 +42,7 @@ def model_info(name: str) -> ModelInfo:
     rigid = bool(getattr(model, "is_rigid_base", not model.needs_foundation))
     description = getattr(model, "description", "")
     label = getattr(model, "label", None) or f"{name}: {description.split(';')[0]}"
-    return ModelInfo(name, label, rigid, description)
+    return ModelInfo(name, label, rigid, description, getattr(model, "can_pull", None))
 
 
 def models_of(dataset) -> list[ModelInfo]:
@@ -171,8 +172,9 @@ def run_fraction(cube, flag, model: ModelInfo):
 
 def tension_flag(cube):
     """1 where the foundation pulled on the block, 0 where not, NaN where not computed."""
-    if "support_tension" in cube:
-        return cube.support_tension
+    if "support_tension" in cube:  # flags -1 not applicable, 0 no tension, 1 tension (or NaN)
+        flag = cube.support_tension
+        return flag.where(flag >= 0)
     if "min_support_force" in cube:
         force = cube.min_support_force
         return (force < 0).where(force.notnull())
@@ -185,3 +187,10 @@ def friction_flag(cube, coefficient):
         return None
     demand = cube.peak_friction_demand
     return (demand > coefficient).where(demand.notnull())
+
+
+def uplift_intensity(cube, block) -> float:
+    """Intensity at which the block starts to rock, in the unit of its levels (g tan(alpha) for PGA)."""
+    if "block_uplift_intensity" in cube.variables:
+        return float(cube.block_uplift_intensity.sel(block=block))
+    return float(cube.block_uplift_acceleration.sel(block=block)) / 9.80665

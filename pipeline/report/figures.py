@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from pipeline.report.adapters import (OUTCOME_ROCKING, block_levels, cell, measure_label, model_styles, models_of, short_label,
-                                      state_labels)
+from pipeline.report.adapters import (OUTCOME_ROCKING, block_levels, cell, measure_label, model_styles, models_of,
+                                      short_label, state_labels, uplift_intensity)
 from pipeline.report.layout import GRID, FRACTILE_STYLES, log_axis, new_page, outside_legend, panels, soil_colour
 
 G = 9.80665
@@ -318,9 +318,9 @@ def applicability_page(cube, caption, limit=0.10):
     order = np.argsort(shear)
     markers = "os^Dv"
     for b_index, block in enumerate(cube.block.values):
-        uplift_g = float(cube.block_uplift_acceleration.sel(block=block)) / G
+        uplift = uplift_intensity(cube, block)
         levels = block_levels(cube, block)
-        band = (levels >= 1.2 * uplift_g) & (levels <= 3.0 * uplift_g)
+        band = (levels >= 1.2 * uplift) & (levels <= 3.0 * uplift)
         if not band.any():
             continue
         sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band))

@@ -176,8 +176,10 @@ def methods_items(results: Results):
                                                               rtol=1e-3) else "as listed"
     measure = str(cube.im_level.attrs.get("long_name", "")).replace("intensity level: ", "")
     scale = cube.scale_factor.values
+    relative = cube.im_level.attrs.get("units") == "1"
     text = (f"Each processed record is scaled linearly to {levels.size} levels of {measure} "
-            f"({measure_label(cube)}), {levels.min():.3g} to {levels.max():.3g}, spacing {spacing}; scale factors "
+            f"({measure_label(cube)}), {levels.min():.3g} to {levels.max():.3g}"
+            f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}; scale factors "
             f"{np.nanmin(scale):.3g} to {np.nanmax(scale):.3g}.")
     if "intensity" in cube.variables and "block" in cube["intensity"].dims:
         ranges = ", ".join(f"{b}: {block_levels(cube, b).min():.3g}-{block_levels(cube, b).max():.3g}"
@@ -223,6 +225,9 @@ def limitations_items(results: Results):
             continue
         fraction = run_fraction(cube, flag, model)
         if fraction is None:
+            if model.can_pull is False:
+                items.append(paragraph(f"{model.label}: the foundation cannot pull (tensionless); the block "
+                                       "lifts off instead."))
             continue
         found = True
         overall = float(fraction.mean())
