@@ -70,33 +70,34 @@ def _time_window(showcase):
 
 
 def showcase_response_page(showcase, caption):
-    """Ground motion on top, then per soil theta(t) (left) and settlement (right), shared y-scales."""
+    """Ground motion on top, then per soil theta(t) (left) and the foundation's settlement (right);
+    one y-scale per column, time cropped to the strong motion."""
     import xarray as xr
 
     block = showcase.attrs["showcase_block"]
     figure = new_page(f"{showcase.attrs['showcase_record']}, block '{block}' (R = "
                       f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
                       "rad): rocking on each soil", caption)
-    soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s]
+    soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
     models = models_of(xr.Dataset(coords={"model": list(dict.fromkeys(map(str, showcase.case_model.values)))}))
     styles = model_styles(models)
-    rows = max(len(soils), 1)
-    grid = figure.add_gridspec(rows + 1, 2, height_ratios=[0.8] + [1.0] * rows,
-                               **dict(GRID, left=0.085, wspace=0.2, hspace=0.18))
-    ground = figure.add_subplot(grid[0, :])
     start, end = _time_window(showcase)
+    margins = dict(left=0.075, right=GRID["right"], wspace=0.22)
+    ground = figure.add_gridspec(1, 1, top=GRID["top"], bottom=0.79, **margins).subplots()
     ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35", lw=0.7)
     ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
                    color="0.9", zorder=0, label="5-95% Arias window")
-    ground.set_ylabel("ground acc. [g]")
+    ground.set_ylabel("ground [g]")
     ground.set_xlim(start, end)
     ground.grid(alpha=0.3)
+    ground.tick_params(labelbottom=False)
+    grid = figure.add_gridspec(len(soils), 2, top=0.74, bottom=GRID["bottom"], hspace=0.12, **margins)
+    peak = np.nanmax(np.abs(showcase.theta.values)) if np.isfinite(showcase.theta.values).any() else 0.0
+    scale, unit = (1000.0, "mrad") if peak < 0.1 else (1.0, "rad")
     theta_axes, settle_axes = [], []
-    for row, soil in enumerate(soils or [""]):
-        theta_axis = figure.add_subplot(grid[row + 1, 0], sharex=ground,
-                                        sharey=theta_axes[0] if theta_axes else None)
-        settle_axis = figure.add_subplot(grid[row + 1, 1], sharex=ground,
-                                         sharey=settle_axes[0] if settle_axes else None)
+    for row, soil in enumerate(soils):
+        theta_axis = figure.add_subplot(grid[row, 0], sharex=ground, sharey=theta_axes[0] if theta_axes else None)
+        settle_axis = figure.add_subplot(grid[row, 1], sharex=ground, sharey=settle_axes[0] if settle_axes else None)
         theta_axes.append(theta_axis)
         settle_axes.append(settle_axis)
         for model in models:
@@ -105,22 +106,22 @@ def showcase_response_page(showcase, caption):
             if not mask.any():
                 continue
             index = int(np.flatnonzero(mask)[0])
-            theta_axis.plot(showcase.time.values, showcase.theta.values[index], label=short_label(model),
+            theta_axis.plot(showcase.time.values, showcase.theta.values[index] * scale, label=short_label(model),
                             **styles[model.name])
             if not model.rigid_base:
                 settle_axis.plot(showcase.time.values, showcase.settlement.values[index] * 1000,
                                  **styles[model.name])
-        theta_axis.set_ylabel(f"{soil}\nθ [rad]" if soil else "θ [rad]")
-        settle_axis.set_ylabel("y − y_static [mm]")
+        theta_axis.set_ylabel(f"θ [{unit}]")
+        settle_axis.set_ylabel("Δy [mm]")
+        theta_axis.text(0.01, 0.92, soil, transform=theta_axis.transAxes, fontsize=9, weight="bold", va="top",
+                        bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
         for axis in (theta_axis, settle_axis):
             axis.grid(alpha=0.3)
-            if row < rows - 1:
-                axis.tick_params(labelbottom=False)
-    theta_axes[0].set_title("rocking angle (rigid base drawn as the reference on every soil)", fontsize=9)
-    settle_axes[0].set_title("vertical displacement of the foundation (downwards positive)", fontsize=9)
+            axis.tick_params(labelbottom=row == len(soils) - 1)
+    theta_axes[0].set_title("rocking angle θ (the rigid base is the same on every soil)", fontsize=9)
+    settle_axes[0].set_title("settlement of the foundation from its static position, Δy (down +)", fontsize=9)
     theta_axes[-1].set_xlabel("time [s]")
     settle_axes[-1].set_xlabel("time [s]")
-    ground.tick_params(labelbottom=False)
     outside_legend(figure, [ground, *theta_axes])
     return figure
 
@@ -130,23 +131,17 @@ def _finite_capped(values):
 
 
 def ida_page(ida, block, caption):
-    """One panel per rigid-base model (first row) and per foundation model x soil."""
+    """One panel per rigid-base model and per foundation model x soil, filling the page in reading order."""
     models = models_of(ida)
-    rigid = [m for m in models if m.rigid_base]
-    founded = [m for m in models if not m.rigid_base]
     soils = list(map(str, ida.soil.values))
-    columns = max(len(soils), len(rigid), 1)
-    rows = (1 if rigid else 0) + len(founded)
+    drawn = [(m, None) for m in models if m.rigid_base]
+    drawn += [(m, soil) for m in models if not m.rigid_base for soil in soils]
+    columns = min(len(drawn), 3 if len(drawn) <= 6 else 4)
+    rows = math.ceil(len(drawn) / columns)
     figure = new_page(f"IDA curves: block '{block}'", caption)
-    axes = panels(figure, rows, columns, sharex=True, sharey=True)
+    axes = panels(figure, rows, columns, sharex=True, sharey=True, gridspec_kw=dict(hspace=0.3))
     levels = block_levels(ida, block)
-    drawn = [(0, j, m, None) for j, m in enumerate(rigid)]
-    offset = 1 if rigid else 0
-    drawn += [(offset + i, j, m, soil) for i, m in enumerate(founded) for j, soil in enumerate(soils)]
-    used = set()
-    for row, column, model, soil in drawn:
-        axis = axes[row, column]
-        used.add((row, column))
+    for axis, (model, soil) in zip(axes.flat, drawn):
         picked = cell(ida, model, block, soil)
         for curve in picked.edp.transpose("record", "im_level").values:
             axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
@@ -155,24 +150,22 @@ def ida_page(ida, block, caption):
             axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
                       label=f"{float(q):.0%} fractile", **style)
         axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
-        axis.set_title(f"{short_label(model)}" if soil is None else f"{model.name} on {soil}", fontsize=9)
+        axis.set_title(short_label(model) if soil is None else f"{model.name} on {soil}", fontsize=9)
         axis.grid(alpha=0.3)
         axis.set_xlim(0, IDA_CAP * 1.05)
-    axes[0, 0].plot([], [], color="0.65", lw=0.5, label="one record")
-    axes[0, 0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
-    for row in range(rows):
-        for column in range(columns):
-            axis = axes[row, column]
-            if (row, column) not in used:
-                axis.set_visible(False)
-                continue
-            if column == 0:
-                axis.set_ylabel(measure_label(ida))
-            below = (row + 1, column)
-            if row == rows - 1 or below not in used:
-                axis.set_xlabel("θmax/α [-]")
-                axis.tick_params(labelbottom=True)
-    outside_legend(figure, [axes[0, 0]])
+    axes.flat[0].plot([], [], color="0.65", lw=0.5, label="one record")
+    axes.flat[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
+    for index, axis in enumerate(axes.flat):
+        if index >= len(drawn):
+            axis.set_visible(False)
+            continue
+        row, column = divmod(index, columns)
+        if column == 0:
+            axis.set_ylabel(measure_label(ida))
+        if index + columns >= len(drawn):  # nothing drawn below: label the x axis here
+            axis.set_xlabel("θmax/α [-]")
+            axis.tick_params(labelbottom=True)
+    outside_legend(figure, [axes.flat[0]])
     return figure
 
 

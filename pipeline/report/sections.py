@@ -273,6 +273,8 @@ def limitations_items(results: Results):
     rigid = {m.name for m in models if m.rigid_base}
     first_soil = str(fragility.soil.values[0])
     outside = outside[~outside.model.isin(rigid) | (outside.soil == first_soil)]
+    order = {name: {str(v): i for i, v in enumerate(fragility[name].values)} for name in ("block", "model", "soil")}
+    outside = outside.sort_values(["block", "model", "soil"], key=lambda column: column.map(order[column.name]))
     if outside.empty:
         items.append(paragraph("Every fitted median lies inside the studied intensity range."))
     else:
