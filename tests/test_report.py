@@ -329,3 +329,27 @@ def test_showcase_file_has_units_and_one_case_per_rigid_model(pipeline_output):
     assert models.count("housner") == 1 and soils[models.index("housner")] == ""
     assert models.count("ssi") == 2
     assert np.nanmax(np.abs(showcase.theta.values)) > 0  # the block rocks under Bolu
+
+
+def test_efficiency_page_when_the_module_and_file_exist(monkeypatch, tmp_path):
+    import sys
+    import types
+
+    from pipeline.report import _efficiency_plotter
+    from pipeline.report.layout import PAGE_SIZE
+    from pipeline.report.sections import Results
+
+    module = types.ModuleType("pipeline.efficiency")
+
+    def plot_efficiency(dataset):
+        figure, axis = plt.subplots(figsize=(4, 3))
+        axis.plot(dataset.x.values, dataset.x.values)
+        return figure
+
+    module.plot_efficiency = plot_efficiency
+    monkeypatch.setitem(sys.modules, "pipeline.efficiency", module)
+    results = Results(None, None, None, None, tmp_path, efficiency=xr.Dataset({"x": ("i", [1.0, 2.0])}))
+    figure = _efficiency_plotter(results)()
+    assert tuple(figure.get_size_inches()) == PAGE_SIZE
+    plt.close(figure)
+    assert _efficiency_plotter(Results(None, None, None, None, tmp_path)) is None  # no efficiency.nc: no page

@@ -169,7 +169,7 @@ def plan(results: Results) -> list[Planned]:
                                caption="Medians over records and levels from 1.2 to 3 times each block's uplift "
                                        "threshold where both models rocked without overturning; top axis: the "
                                        "study's soils."))
-    if results.applicability is not None:
+    if results.applicability is not None and "peak_angle_ratio_ssi_housner" in results.applicability:
         planned.append(_figure("applicability-sweep", "Applicability", "Rigid-base error against soil stiffness",
                                pages.sweep_page, results.applicability,
                                caption=f"`rockfrag applicability`: median over "
@@ -193,7 +193,10 @@ def _efficiency_plotter(results):
 
     def draw():
         figure = plot_efficiency(results.efficiency)
+        figure = getattr(figure, "figure", figure)  # a function may return its axes
         figure.set_size_inches(*PAGE_SIZE)
+        if figure.get_layout_engine() is not None:  # keep clear of the page footer
+            figure.get_layout_engine().set(rect=(0, 0.05, 1, 0.95))
         return figure
 
     return draw
