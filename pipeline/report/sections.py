@@ -38,8 +38,13 @@ class Results:
 
     @property
     def settings(self) -> dict:
-        settings = self.config.raw.get("report", {})
-        return settings if isinstance(settings, dict) else {}
+        """``[report]`` keys; title, project and author fall back to the ``[study]`` table's."""
+        report = self.config.raw.get("report", {})
+        study = self.config.raw.get("study", {})
+        settings = {key: study.get(key) for key in ("title", "project", "author") if isinstance(study, dict)}
+        settings.update({key: value for key, value in (report if isinstance(report, dict) else {}).items()
+                         if value not in ("", None)})
+        return settings
 
     @property
     def title(self) -> str:
