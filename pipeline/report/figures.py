@@ -119,7 +119,8 @@ def showcase_response_page(showcase, caption):
             axis.grid(alpha=0.3)
             axis.tick_params(labelbottom=row == len(soils) - 1)
     theta_axes[0].set_title("rocking angle θ (the rigid base is the same on every soil)", fontsize=9)
-    settle_axes[0].set_title("settlement of the foundation from its static position, Δy (down +)", fontsize=9)
+    settle_axes[0].set_title("settlement Δy from the static position (down +; each model's reference point)",
+                             fontsize=9)
     theta_axes[-1].set_xlabel("time [s]")
     settle_axes[-1].set_xlabel("time [s]")
     outside_legend(figure, [ground, *theta_axes])
