@@ -1,6 +1,6 @@
 """Time the report stage alone on the result files of a finished study (not part of the tests).
 
-Usage: ``python benchmarks/report_stage.py OUTPUT_DIR [STUDY.toml]`` - reads cube.nc, ida.nc,
+Usage: ``python benchmarks/report_stage.py OUTPUT_DIR [STUDY.toml [WORKERS]]`` (WORKERS 1: no PNG worker) - reads cube.nc, ida.nc,
 fragility.nc (and showcase.nc, applicability.nc) from OUTPUT_DIR, rewrites report.pdf, report.html and
 figures/, and prints the wall time and the number of pages.
 """
@@ -20,16 +20,16 @@ from pipeline.config import load_study  # noqa: E402
 from pipeline.report import report_stage  # noqa: E402
 
 
-def main(output, study=None):
+def main(output, study=None, workers=None):
     output = Path(output)
-    config = load_study(study)
+    config = load_study(study or None)
     datasets = {}
     for name in ("cube", "ida", "fragility"):
         with xr.open_dataset(output / f"{name}.nc") as dataset:
             datasets[name] = dataset.load()
     started, cpu = time.perf_counter(), _cpu_seconds()
     pdf, pngs = report_stage(config, datasets["cube"], datasets["ida"], datasets["fragility"], None, output,
-                             progress=False)
+                             progress=False, workers=int(workers) if workers else None)
     elapsed, cpu = time.perf_counter() - started, _cpu_seconds() - cpu
     print(f"report stage: {elapsed:.1f} s wall, {cpu:.1f} s CPU (this process and its PNG worker) for "
           f"{len(pngs)} pages ({elapsed / len(pngs):.2f} s per page); {pdf}")
@@ -42,4 +42,4 @@ def _cpu_seconds():
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:3])
+    main(*sys.argv[1:4])
