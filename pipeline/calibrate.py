@@ -200,15 +200,17 @@ def load_reference(path, time_unit=None, angle_unit=None) -> Reference:
     if len(lines) > MAX_REFERENCE_ROWS:
         raise RecordError(path, f"{len(lines)} rows; at most {MAX_REFERENCE_ROWS} (resample the reference)")
     try:
-        table = pd.read_csv(path, comment="#", sep=None, engine="python", dtype=str, skipinitialspace=True)
+        table = pd.read_csv(path, comment="#", sep=None, engine="python", dtype=str, header=None, na_filter=False,
+                            skipinitialspace=True)
     except Exception as error:
         raise RecordError(path, f"cannot read the reference table ({error})") from None
-    header_rows = 1
-    if len(table.columns) >= 2 and all(_is_number(name) for name in table.columns[:2]):
-        table = pd.read_csv(path, comment="#", sep=None, engine="python", dtype=str, header=None,
-                            skipinitialspace=True)
-        table.columns = ["time", "rotation", *table.columns[2:]]
-        header_rows = 0
+    header_rows = 0
+    if len(table) and table.shape[1] >= 2 and not all(_is_number(cell) for cell in table.iloc[0, :2]):
+        header_rows = 1  # the first line names the columns
+        table.columns = [str(name).strip() for name in table.iloc[0]]
+        table = table.iloc[1:].reset_index(drop=True)
+    else:
+        table.columns = [f"column {number + 1}" for number in range(table.shape[1])]
     if table.shape[1] < 2 or len(table) < 10:
         raise RecordError(path, "expected two columns (time, rotation) and at least 10 rows")
     time_name, angle_name = table.columns[:2]

@@ -152,23 +152,31 @@ def _ground_motion(args):
 
 
 def command_calibrate(args) -> int:
-    from pipeline.calibrate import calibrate, load_reference, write_outputs
+    from pipeline.calibrate import calibrate, check_reference, load_reference, write_outputs
 
     block, config = _block_from_study(args.block, args.study)
-    ref_time, ref_rotation = load_reference(args.reference, args.time_unit, args.angle_unit)
+    reference = load_reference(args.reference, args.time_unit, args.angle_unit)
+    print(reference.describe_units())
     record, ag = _ground_motion(args)
+    check_reference(reference.time, reference.rotation, (len(ag) - 1) * record.dt, record.dt,
+                    source=str(args.reference), time_unit=reference.time_unit)
     soil_g = args.soil_g
     if soil_g is None and args.soil:
         soils = {s.name: s for s in config.soils}
         if args.soil not in soils:
             raise PipelineError(f"unknown soil {args.soil!r}; soils of the study: {', '.join(soils)}")
         soil_g = soils[args.soil].shear_modulus
-    result = calibrate(ref_time, ref_rotation, ag, record.dt, block, k_range=tuple(args.k_range),
-                       xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi, soil_shear_modulus=soil_g,
-                       switch=config.switch, local=not args.grid_only)
-    files = write_outputs(result, ref_time, ref_rotation, ag, record.dt, block, args.output, config.switch)
-    print(f"grid optimum : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation {result.correlation_grid:.4f}")
-    print(f"local optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation {result.correlation:.4f}")
+    result = calibrate(reference.time, reference.rotation, ag, record.dt, block, model=args.model,
+                       k_range=tuple(args.k_range), xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi,
+                       soil_shear_modulus=soil_g, switch=config.switch, local=not args.grid_only,
+                       log=lambda line: print(line, file=sys.stderr))
+    files = write_outputs(result, reference.time, reference.rotation, ag, record.dt, block, args.output,
+                          config.switch)
+    print(f"grid optimum  : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation (eq. 17) "
+          f"{result.correlation_grid:.4f}")
+    if not args.grid_only:
+        print(f"global optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation (eq. 17) "
+              f"{result.correlation:.4f} ({result.n_simulations} simulations, {result.seconds:.1f} s)")
     print(f"RMS error {result.rms_error:.3g} rad; peak angle {result.peak_model:.4g} rad vs reference "
           f"{result.peak_reference:.4g} rad ({result.peak_error:+.1%})")
     if result.area_over_depth is not None:
@@ -258,11 +266,12 @@ def build_parser() -> argparse.ArgumentParser:
                            help="stiffness grid [N/m] (default 1e8 9e8 = the paper's 1e5-9e5 kN/m)")
     calibrate.add_argument("--xi-range", type=float, nargs=2, default=[0.01, 0.07], metavar=("MIN", "MAX"),
                            help="damping-ratio grid [-] (default 0.01 0.07)")
-    calibrate.add_argument("--n-k", type=int, default=25, help="grid points in k (log-spaced)")
-    calibrate.add_argument("--n-xi", type=int, default=7, help="grid points in xi")
-    calibrate.add_argument("--grid-only", action="store_true", help="skip the local optimisation")
-    calibrate.add_argument("--time-unit", choices=["s", "ms"], default=None)
-    calibrate.add_argument("--angle-unit", choices=["rad", "mrad", "deg"], default=None)
+    calibrate.add_argument("--n-k", type=int, default=25, help="coarse grid points in k (log-spaced, >= 2)")
+    calibrate.add_argument("--n-xi", type=int, default=7, help="coarse grid points in xi (>= 1)")
+    calibrate.add_argument("--grid-only", action="store_true", help="the coarse grid only (the paper's procedure)")
+    calibrate.add_argument("--time-unit", default=None, help="s, ms, us, min (default: from the header, else s)")
+    calibrate.add_argument("--angle-unit", default=None, help="rad, mrad, deg (default: from the header, else rad)")
+    calibrate.add_argument("--model", default="ssi", help="model to calibrate: any with a foundation (default ssi)")
     calibrate.add_argument("--output", type=Path, default=Path("reports"), metavar="DIR")
     calibrate.set_defaults(handler=command_calibrate)
 
