@@ -66,7 +66,10 @@ PEAK_FRACTION = 0.2  # window ends follow peaks of |reference| above this fracti
 MAX_WINDOWS = 10
 SURVIVORS = 3  # candidates carried from one window to the next
 GRID_SEEDS = 2  # fresh candidates taken from the coarse grid at each window
-LOCAL_OFFSETS = (-1.0, -0.5, 0.0, 0.5, 1.0)  # local batch grid, in current steps
+LOCAL_OFFSETS = (-1.0, -0.5, 0.0, 0.5, 1.0)  # local batch grid around fresh seeds, in current steps
+SURVIVOR_OFFSETS = (-0.5, 0.0, 0.5)  # local batch grid around survivors of the previous window
+JUMP = 0.01  # an objective rising by more than this (and doubling) from one window to the next lost the basin
+MAX_EXTRA_WINDOWS = 12
 NELDER_MEAD_EVALUATIONS = 30
 MIN_STEP = 0.002  # smallest local step, as a fraction of the log k and xi ranges
 
@@ -389,44 +392,98 @@ def _grid_basins(scores, n_k, n_xi, points, count):
     return basins
 
 
-def _refine(search, objective, seeds, steps, n, t_end, fixed_xi, evaluations):
-    """Polish each seed on the window of n samples: a 5x5 local batch grid, then bounded Nelder-Mead."""
-    offsets = np.array([(a, 0.0 if fixed_xi else b) for a in LOCAL_OFFSETS
-                        for b in (LOCAL_OFFSETS if not fixed_xi else (0.0,))])
-    local = np.concatenate([np.clip(seed + offsets * steps, 0.0, 1.0) for seed in seeds])
-    theta = search.histories(local, t_end)
+def _index_of(points, point):
+    return int(np.argmin(np.max(np.abs(points - point), axis=1)))
+
+
+def _local_offsets(values, fixed_xi):
+    return np.array([(a, 0.0 if fixed_xi else b) for a in values for b in ((0.0,) if fixed_xi else values)])
+
+
+def _refine(search, objective, seeds, n, t_end, fixed_xi, evaluations):
+    """Polish seeds (point, local offsets, steps) on the window of n samples: a local batch grid around
+    every seed in one compiled call, then bounded Nelder-Mead from each block's best point."""
+    blocks = [np.clip(point + _local_offsets(offsets, fixed_xi) * steps, 0.0, 1.0) for point, offsets, steps in seeds]
+    theta = search.histories(np.concatenate(blocks), t_end)
     scores = objective(_interpolate(theta, search.dt, objective.times[:n]), n)
-    refined = []
-    for number in range(len(seeds)):
-        block = slice(number * len(offsets), (number + 1) * len(offsets))
-        best = int(np.argmin(scores[block]))
-        start, start_score = local[block][best], float(scores[block][best])
 
-        def cost(point):
-            history = search.histories([np.clip(point, 0.0, 1.0)], t_end)
-            return float(objective(_interpolate(history, search.dt, objective.times[:n]), n)[0])
+    def cost(point):
+        history = search.histories([np.clip(point, 0.0, 1.0)], t_end)
+        return float(objective(_interpolate(history, search.dt, objective.times[:n]), n)[0])
 
-        if fixed_xi:
-            simplex = np.array([start, start + [steps[0] / 2, 0.0]])[:, :1]
-            result = minimize(lambda x: cost([x[0], start[1]]), start[:1], method="Nelder-Mead",
-                              bounds=[(0.0, 1.0)], options={"initial_simplex": simplex, "xatol": 1e-5,
-                                                            "fatol": 1e-7, "maxfev": evaluations})
-            point = np.array([result.x[0], start[1]])
-        else:
-            simplex = np.clip(np.array([start, start + [steps[0] / 2, 0.0], start + [0.0, steps[1] / 2]]), 0, 1)
-            if np.allclose(simplex[1], simplex[0]):
-                simplex[1] = start - [steps[0] / 2, 0.0]
-            if np.allclose(simplex[2], simplex[0]):
-                simplex[2] = start - [0.0, steps[1] / 2]
-            result = minimize(cost, start, method="Nelder-Mead", bounds=[(0.0, 1.0), (0.0, 1.0)],
-                              options={"initial_simplex": simplex, "xatol": 1e-5, "fatol": 1e-7,
-                                       "maxfev": evaluations})
-            point = np.clip(result.x, 0.0, 1.0)
-        if result.fun < start_score:
-            refined.append((float(result.fun), point))
-        else:
-            refined.append((start_score, start))
+    refined, offset = [], 0
+    for block, (_, _, steps) in zip(blocks, seeds):
+        block_scores = scores[offset:offset + len(block)]
+        offset += len(block)
+        best = int(np.argmin(block_scores))
+        start, start_score = block[best], float(block_scores[best])
+        point, value = _nelder_mead(cost, start, steps, fixed_xi, evaluations)
+        refined.append((value, point) if value < start_score else (start_score, start))
     return refined
+
+
+def _nelder_mead(cost, start, steps, fixed_xi, evaluations):
+    """Bounded Nelder-Mead in the unit box from ``start`` with an initial simplex of half a step."""
+    options = {"xatol": 1e-5, "fatol": 1e-7, "maxfev": evaluations}
+    if fixed_xi:
+        u = start[0] + steps[0] / 2 if start[0] + steps[0] / 2 <= 1 else start[0] - steps[0] / 2
+        result = minimize(lambda x: cost([x[0], start[1]]), start[:1], method="Nelder-Mead", bounds=[(0.0, 1.0)],
+                          options={**options, "initial_simplex": np.array([[start[0]], [u]])})
+        return np.array([float(np.clip(result.x[0], 0, 1)), start[1]]), float(result.fun)
+    simplex = np.array([start, start + [steps[0] / 2, 0.0], start + [0.0, steps[1] / 2]])
+    for corner, direction in ((1, 0), (2, 1)):
+        if simplex[corner, direction] > 1.0:
+            simplex[corner, direction] = start[direction] - steps[direction] / 2
+    result = minimize(cost, start, method="Nelder-Mead", bounds=[(0.0, 1.0), (0.0, 1.0)],
+                      options={**options, "initial_simplex": simplex})
+    return np.clip(result.x, 0.0, 1.0), float(result.fun)
+
+
+def _continuation(search, objective, grid, grid_on_times, shape, windows, steps, fixed_xi, log):
+    """Track the optimum through growing windows; returns (point, objective on the whole reference, windows).
+
+    Seeds: the survivors of the previous window and the coarse grid's best basins on this window. A
+    window whose best objective jumps (more than doubles and rises by more than JUMP) lost the optimum's
+    basin: it is retried after an intermediate window, at most MAX_EXTRA_WINDOWS times. Not the last
+    window: its objective rises with the noise of a long quiet tail, not with a lost basin.
+    """
+    pending = list(windows)
+    candidates, previous_n, previous_score, extra, number = [], 0, math.inf, 0, 0
+    while pending:
+        n = pending[0]
+        last = len(pending) == 1
+        survivors = [point for _, point in candidates[:2 if last else SURVIVORS]]
+        grid_scores = objective(grid_on_times, n)
+        if last and survivors:  # the longest, dearest window: polish the survivors, a grid basin only if better
+            seeds = [(point, (0.0,), steps) for point in survivors]
+            survivor_best = float(np.min(objective(_interpolate(search.histories(survivors, float(
+                objective.times[n - 1]) + search.dt), search.dt, objective.times[:n]), n)))
+            fresh = [p for p in _grid_basins(grid_scores, *shape, grid, GRID_SEEDS)
+                     if grid_scores[_index_of(grid, p)] < survivor_best]
+        else:
+            seeds = [(point, SURVIVOR_OFFSETS, steps) for point in survivors]
+            fresh = _grid_basins(grid_scores, *shape, grid, GRID_SEEDS + len(seeds))
+        fresh = [p for p in fresh if all(np.max(np.abs(p - s[0]) / steps) > 0.5 for s in seeds)][:GRID_SEEDS]
+        seeds += [(point, LOCAL_OFFSETS, steps) for point in fresh]
+        refined = _refine(search, objective, seeds, n, float(objective.times[n - 1]) + search.dt, fixed_xi,
+                          NELDER_MEAD_EVALUATIONS)
+        best = min(score for score, _ in refined)
+        lost = candidates and best > 2.0 * previous_score and best > previous_score + JUMP
+        if lost and not last and extra < MAX_EXTRA_WINDOWS and n - previous_n > 20:
+            pending.insert(0, (previous_n + n) // 2)
+            extra += 1
+            continue
+        pending.pop(0)
+        number += 1
+        points = np.array([point for _, point in refined])
+        candidates = _distinct(points, np.array([score for score, _ in refined]), steps, SURVIVORS)
+        previous_n, previous_score = n, candidates[0][0]
+        if log:
+            k_now, xi_now = search.physical(candidates[0][1])
+            log(f"window {number} (0-{objective.times[n - 1]:.2f} s, {len(pending)} to go): best k = {k_now:.4g} "
+                f"N/m, xi = {xi_now:.4f}, objective {candidates[0][0]:.4f}")
+        steps = np.maximum(steps * 0.7, MIN_STEP)
+    return candidates[0][1], candidates[0][0], number
 
 
 def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi):
@@ -509,25 +566,12 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
 
     steps = np.array([1.0 / (n_k - 1), 1.0 / (n_xi - 1) if n_xi > 1 else 1.0])
     best_point, best_score = grid[grid_best], float(full_scores[grid_best])
-    candidates = []
-    for number, n in enumerate(windows if local else []):
-        last = number == len(windows) - 1
-        window_scores = full_scores if last else objective(grid_on_times, n)
-        fresh = _grid_basins(window_scores, n_k, n_xi, grid, GRID_SEEDS + len(candidates))
-        seeds = [point for _, point in candidates[:2 if last else SURVIVORS]]
-        seeds += [point for point in fresh if all(np.max(np.abs(point - s) / steps) > 0.5 for s in seeds)][:GRID_SEEDS]
-        window_end = float(times[n - 1]) + dt
-        refined = _refine(search, objective, seeds, steps, n, window_end, fixed_xi,
-                          NELDER_MEAD_EVALUATIONS + (10 if last else 0))
-        points = np.array([point for _, point in refined])
-        candidates = _distinct(points, np.array([score for score, _ in refined]), steps, SURVIVORS)
-        if log:
-            k_now, xi_now = search.physical(candidates[0][1])
-            log(f"window {number + 1}/{len(windows)} (0-{times[n - 1]:.2f} s): best k = {k_now:.4g} N/m, "
-                f"xi = {xi_now:.4f}, objective {candidates[0][0]:.4f}")
-        steps = np.maximum(steps * 0.7, MIN_STEP)
-    if candidates and candidates[0][0] < best_score:
-        best_point, best_score = candidates[0][1], candidates[0][0]
+    n_windows = 0
+    if local:
+        point, score, n_windows = _continuation(search, objective, grid, grid_on_times, (n_k, n_xi), windows, steps, fixed_xi,
+                                     log)
+        if score < best_score:
+            best_point, best_score = point, score
 
     k_fit, xi_fit = search.physical(best_point)
     theta = search.histories([best_point], t_end)
@@ -546,7 +590,7 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
         peak_error=(peak_model - peak_reference) / peak_reference, peak_reference=peak_reference,
         peak_model=peak_model, area_over_depth=area_over_depth, soil_shear_modulus=soil_shear_modulus,
         block_modulus=block.E_b, model=model, objective=best_score, n_simulations=search.count,
-        n_windows=len(windows) if local else 0, seconds=clock.perf_counter() - started,
+        n_windows=n_windows, seconds=clock.perf_counter() - started,
         surface_k=[search.physical((u, 0))[0] for u in u_grid],
         surface_xi=[search.physical((0, v))[1] for v in v_grid],
         surface=surface.reshape(n_k, n_xi).tolist())
