@@ -556,8 +556,9 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
     grid = np.array([(u, v) for u in u_grid for v in v_grid])
     grid_theta = search.histories(grid, t_end)
     grid_on_times = _interpolate(grid_theta, dt, times)
-    grid_on_reference = _interpolate(grid_theta, dt, ref_time)
-    surface = np.array([correlation(ref_rotation, row) for row in grid_on_reference])
+    # eq. 17 at the reference's own steps, one row at a time (a long reference times the grid is too big)
+    surface = np.array([correlation(ref_rotation, _interpolate(grid_theta[i:i + 1], dt, ref_time)[0])
+                        for i in range(len(grid))])
     full_scores = objective(grid_on_times, times.size)
     grid_best = int(np.argmin(full_scores))
     if log:
@@ -568,8 +569,8 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
     best_point, best_score = grid[grid_best], float(full_scores[grid_best])
     n_windows = 0
     if local:
-        point, score, n_windows = _continuation(search, objective, grid, grid_on_times, (n_k, n_xi), windows, steps, fixed_xi,
-                                     log)
+        point, score, n_windows = _continuation(search, objective, grid, grid_on_times, (n_k, n_xi), windows,
+                                                steps, fixed_xi, log)
         if score < best_score:
             best_point, best_score = point, score
 
