@@ -68,7 +68,7 @@ SURVIVORS = 3  # candidates carried from one window to the next
 GRID_SEEDS = 2  # fresh candidates taken from the coarse grid at each window
 LOCAL_OFFSETS = (-1.0, -0.5, 0.0, 0.5, 1.0)  # local batch grid around fresh seeds, in current steps
 SURVIVOR_OFFSETS = (-0.5, 0.0, 0.5)  # local batch grid around survivors of the previous window
-JUMP = 0.01  # an objective rising by more than this (and doubling) from one window to the next lost the basin
+FLOOR_SLACK = 0.002  # objective allowed above three noise floors before a window counts as lost
 MAX_EXTRA_WINDOWS = 12
 NELDER_MEAD_EVALUATIONS = 30
 MIN_STEP = 0.002  # smallest local step, as a fraction of the log k and xi ranges
@@ -305,6 +305,17 @@ class _Objective:
         if smoothing_hz and smoothing_hz < 0.8 * nyquist:
             self.sos = butter(4, smoothing_hz, fs=1.0 / step, output="sos")
         self.smoothed_reference = self.smooth(reference)
+        # white-noise variance left inside the pass band, estimated from what the low-pass removed
+        self.noise_variance = 0.0
+        if self.sos is not None:
+            removed = float(np.var(reference - self.smoothed_reference))
+            self.noise_variance = removed * smoothing_hz / (nyquist - smoothing_hz)
+
+    def noise_floor(self, n):
+        """Objective expected for the true parameters on the first n samples: 1 - correlation of a signal
+        with itself plus the in-band noise, about half the noise-to-signal variance ratio."""
+        signal_variance = float(np.var(self.smoothed_reference[:n]))
+        return 0.5 * self.noise_variance / signal_variance if signal_variance > 0 else math.inf
 
     def smooth(self, values):
         if self.sos is None or values.shape[-1] < 30:
@@ -443,9 +454,9 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
     """Track the optimum through growing windows; returns (point, objective on the whole reference, windows).
 
     Seeds: the survivors of the previous window and the coarse grid's best basins on this window. A
-    window whose best objective jumps (more than doubles and rises by more than JUMP) lost the optimum's
-    basin: it is retried after an intermediate window, at most MAX_EXTRA_WINDOWS times. Not the last
-    window: its objective rises with the noise of a long quiet tail, not with a lost basin.
+    window whose best objective more than doubles and exceeds three times the noise floor (what the
+    true parameters would score, given the noise estimated in the reference) lost the optimum's basin:
+    it is retried after an intermediate window, at most MAX_EXTRA_WINDOWS times.
     """
     pending = list(windows)
     candidates, previous_n, previous_score, extra, number = [], 0, math.inf, 0, 0
@@ -468,8 +479,8 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
         refined = _refine(search, objective, seeds, n, float(objective.times[n - 1]) + search.dt, fixed_xi,
                           NELDER_MEAD_EVALUATIONS)
         best = min(score for score, _ in refined)
-        lost = candidates and best > 2.0 * previous_score and best > previous_score + JUMP
-        if lost and not last and extra < MAX_EXTRA_WINDOWS and n - previous_n > 20:
+        lost = candidates and best > 2.0 * previous_score and best > 3.0 * objective.noise_floor(n) + FLOOR_SLACK
+        if lost and extra < MAX_EXTRA_WINDOWS and n - previous_n > 20:
             pending.insert(0, (previous_n + n) // 2)
             extra += 1
             continue
