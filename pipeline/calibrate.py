@@ -11,18 +11,22 @@ Output: ``CalibrationResult``: the best grid point and the global optimum (k [N/
 
 Why not a grid and one local search: the correlation surface of a rocking response is a needle field.
 A few impacts after uplift, 1 % in k or 0.0005 in xi moves the impacts enough to drop eq. 17 from 1.0
-to 0.8, so a grid finds the truth only by luck and a local search from a grid point stays where it
-started. The search therefore grows the fitted time window (continuation in time):
+to 0.75-0.9, so a grid finds the truth only by luck and a local search from a grid point stays where
+it started. The search therefore grows the fitted time window (continuation in time):
 
 1. One compiled batch call runs the coarse grid (``n_k`` log-spaced k times ``n_xi`` xi) over the whole
    reference; the objective of every grid point on every window is then a cheap array operation.
 2. Windows end just after successive large peaks of the (smoothed) reference, then the whole record.
    On a short window the surface is smooth and its minimum is near the truth; each longer window
    sharpens the minimum, and the previous optimum lies inside its basin.
-3. Per window, every candidate (the survivors of the previous window plus the best distinct basins of
-   the grid on this window) is polished by a 5 x 5 local batch grid and a bounded Nelder-Mead search
-   (scipy) in (log k, xi); the best three distinct candidates survive.
-4. The last window is the whole reference; the winner is the candidate with the lowest objective there.
+3. Per window, every candidate (the three survivors of the previous window plus the two best distinct
+   basins of the grid on this window) is polished by a local batch grid (3 x 3 around survivors, 5 x 5
+   around grid seeds; one compiled call) and a bounded Nelder-Mead search (scipy) in (log k, xi).
+4. A window whose best objective doubles and exceeds three noise floors (the objective the true
+   parameters would score, from the noise estimated in the reference) lost the basin: it is retried
+   after an intermediate window.
+5. The last window is the whole reference: the survivors are polished, a grid basin only if it scores
+   better; the winner has the lowest objective there.
 
 The objective is robust to noise and amplitude errors: (1 - correlation) + 0.5 ln(sigma_model /
 sigma_reference)^2 on both signals low-passed at ``smoothing_hz`` (default 10 Hz, zero phase). The
