@@ -12,7 +12,7 @@ from scipy.optimize import brentq
 from scipy.special import ellipkinc
 
 from pipeline.blocks import Block
-from pipeline.models import Status, simulate
+from pipeline.models import Outcome, simulate
 
 G = 9.80665
 BLOCK = Block(name="test", R=1.0, alpha=0.2, mass=1000.0)
@@ -102,7 +102,7 @@ def test_uplift_just_below_and_above_threshold(sign):
     threshold = G * math.tan(BLOCK.alpha)
     below = simulate("housner", sign * np.full(200, 0.999 * threshold), 0.01, BLOCK)
     above = simulate("housner", sign * np.full(200, 1.001 * threshold), 0.01, BLOCK)
-    assert below.status == Status.NO_UPLIFT and not below.uplifted and below.peak_angle == 0.0
+    assert below.status == Outcome.NO_UPLIFT and not below.uplifted and below.peak_angle == 0.0
     assert above.uplifted and above.time_of_uplift == pytest.approx(0.0, abs=0.011)
     # rocking starts towards theta * ag < 0
     rocked = above.theta[np.nanargmax(np.abs(above.theta))]
