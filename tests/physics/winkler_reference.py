@@ -232,3 +232,26 @@ def effective_restitution(peaks, alpha):
     peaks = np.asarray(peaks, dtype=float)
     drop = np.cos(alpha - peaks) - math.cos(alpha)
     return np.sqrt(drop[1:] / drop[:-1])
+
+
+def product_response(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g=G, theta0=0.0,
+                     thetadot0=0.0):
+    """The product's ``simulate("winkler", ...)`` in the reference's dict form (for side-by-side tests)."""
+    from pipeline.blocks import Block
+    from pipeline.models import simulate
+
+    block = Block(name="winkler-test", b=b, h=h, mass=mass)
+    result = simulate("winkler", ag, dt, block, k=K, xi=xi, bed=bed, t_end=t_end, theta0=theta0,
+                      thetadot0=thetadot0, g=g)
+    response = {name: getattr(result, name) for name in (
+        "t", "theta", "theta_dot", "y", "y_dot", "peak_angle", "uplifted", "time_of_uplift", "n_flights",
+        "airborne_time", "peak_uplift", "overturned", "min_support_force")}
+    response["result"] = result
+    return response
+
+
+def solve(solver, *args, **kwargs):
+    """Run the case through ``reference_winkler`` (solver "reference") or the product ("product")."""
+    if solver == "reference":
+        return reference_winkler(*args, **kwargs)
+    return product_response(*args, **kwargs)
