@@ -127,3 +127,7 @@ if __name__ == "__main__":
     solver_throughput(records)
     study_timing()
     hunt_and_fill_savings(records)
+
+    from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/ is on sys.path)
+
+    winkler_against_opensees()

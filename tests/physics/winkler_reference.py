@@ -99,8 +99,13 @@ def energy(theta, theta_dot, y, y_dot, b, h, mass, K, bed, g=G):
 
 
 def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g=G, theta0=0.0,
-                      thetadot0=0.0, y0=None, rtol=1e-10, overturn_angle=math.pi / 2):
-    """Response of the block on the bed to ag (see the module docstring for inputs and outputs)."""
+                      thetadot0=0.0, y0=None, rtol=1e-10, overturn_angle=math.pi / 2, law=None):
+    """Response of the block on the bed to ag (see the module docstring for inputs and outputs).
+
+    ``law`` replaces ``bed_force`` (same signature) to study other contact laws, e.g. a dashpot that
+    keeps acting out of the ground as in an OpenSees Parallel(ENT, Viscous) spring.
+    """
+    law = bed_force if law is None else law
     ag = np.asarray(ag, dtype=float)
     record_end = (ag.size - 1) * dt
     t_end = record_end + 5.0 if t_end is None else t_end
@@ -122,7 +127,7 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
 
         def rhs(t, x):
             theta, theta_dot, y, y_dot = x
-            force, moment = bed_force(theta, theta_dot, y, y_dot, b, K, C, bed)
+            force, moment = law(theta, theta_dot, y, y_dot, b, K, C, bed)
             theta_dd, y_dd = accelerations(theta, theta_dot, y, a0 + slope * (t - t_i), force / mass,
                                            moment / mass, h, j, g)
             return [theta_dot, theta_dd, y_dot, y_dd]
@@ -214,6 +219,17 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
             "uplifted": not math.isnan(time_of_uplift), "time_of_uplift": time_of_uplift,
             "n_flights": n_flights, "airborne_time": airborne_time, "peak_uplift": peak_uplift,
             "overturned": overturned}
+
+
+def dashpot_always_force(theta, theta_dot, y, y_dot, b, K, C, bed="two-spring"):
+    """Two-spring law as OpenSees builds it: Parallel(ENT spring K/2, Viscous dashpot C/2) at each corner.
+    The spring carries compression only; the dashpot acts at all times, so it pulls on a lifting corner."""
+    force = moment = 0.0
+    for s in (-b, b):
+        f = 0.5 * K * max(0.0, y + s * math.sin(theta)) + 0.5 * C * (y_dot + s * math.cos(theta) * theta_dot)
+        force += f
+        moment += s * f
+    return force, moment
 
 
 def rocking_peaks(theta):
