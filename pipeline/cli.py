@@ -195,7 +195,7 @@ def command_applicability(args) -> int:
                                 progress=not args.no_progress)
     paths = write_applicability(dataset, output)
     table = (dataset.threshold_shear_modulus / 1e6).to_dataframe()["threshold_shear_modulus"].unstack()
-    print(f"G_s [MPa] above which Housner is within {args.tolerance:.0%} of SSI (rows: block, E_b [Pa]; "
+    print(f"G_s [MPa] above which Housner is within {args.tolerance:.0%} of each model (rows: model, block, E_b [Pa]; "
           "columns: PGA / uplift PGA; NaN: not within tolerance even at the stiffest G_s):")
     print(table.round(0).to_string())
     for path in paths:

@@ -22,7 +22,7 @@ import numpy as np
 
 from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError
-from pipeline.models import MODELS, SWITCH_RULES
+from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.soils import SOILS, SoilClass
 from pipeline.units import STANDARD_GRAVITY
 
@@ -43,6 +43,7 @@ class StudyConfig:
     blocks: tuple[Block, ...]
     models: tuple[str, ...]
     switch: str
+    bed: str
     tail: float
     overturn_angle: float
     hazard_file: str
@@ -138,7 +139,7 @@ ALLOWED_KEYS = {
          "hazard", "fragility"},
     "study": {"name", "record_sets", "processing", "output"},
     "intensity": {"measure", "period", "damping", "levels"},
-    "solver": {"switch", "tail", "overturn_angle"},
+    "solver": {"switch", "bed", "tail", "overturn_angle"},
     "hazard": {"file", "design_life"},
     "fragility": {"bootstrap", "seed", "confidence"},
 }
@@ -186,7 +187,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         if name not in available:
             raise ConfigError("soils", f"unknown soil {name!r}; available: {', '.join(available)}", source)
         soils.append(available[name])
-    models = data.get("models", ["housner", "ssi"])
+    models = data.get("models", ["housner", "ssi", "winkler"])
     for name in models:
         if name not in MODELS:
             raise ConfigError("models", f"unknown model {name!r}; available: {', '.join(MODELS)}", source)
@@ -196,6 +197,9 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     switch = solver.get("switch", "consistent")
     if switch not in SWITCH_RULES:
         raise ConfigError("solver.switch", f"{switch!r}; allowed: {', '.join(SWITCH_RULES)}", source)
+    bed = solver.get("bed", "continuous")
+    if bed not in BED_TYPES:
+        raise ConfigError("solver.bed", f"{bed!r}; allowed: {', '.join(BED_TYPES)}", source)
     if not soils or not models:
         raise ConfigError("soils" if not soils else "models", "empty list", source)
     return StudyConfig(
@@ -205,7 +209,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         period=_number(intensity, "period", "intensity", source, 0.01, 20.0, default=1.0),
         damping=_number(intensity, "damping", "intensity", source, 0.0, 0.5, default=0.05),
         levels=_levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source, unit),
-        soils=tuple(soils), blocks=tuple(blocks), models=tuple(models), switch=switch,
+        soils=tuple(soils), blocks=tuple(blocks), models=tuple(models), switch=switch, bed=bed,
         tail=_number(solver, "tail", "solver", source, 0.0, 600.0, default=10.0),
         overturn_angle=_number(solver, "overturn_angle", "solver", source, 0.0, math.pi / 2,
                                default=math.pi / 2, low_open=True),

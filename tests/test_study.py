@@ -91,7 +91,7 @@ def test_default_study_matches_the_issue():
     config = load_study()
     assert len(config.levels) == 40 and config.measure == "pga"
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
-    assert config.models == ("housner", "ssi") and len(config.blocks) == 3
+    assert config.models == ("housner", "ssi", "winkler") and len(config.blocks) == 3
     paper = config.blocks[0]
     assert paper.R == 9.39 and paper.alpha == 0.44
     uplift_g = [b.uplift_acceleration() / 9.80665 for b in config.blocks]

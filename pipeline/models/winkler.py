@@ -63,12 +63,16 @@ def bed_force(x, params):
 
     F [m/s^2] pushes the block up; M [m^2/s^2] is int q(s) s ds (positive when the +b side carries more).
     """
+    return bed_force_at(x, params, math.sin(x[0]), math.cos(x[0]))
+
+
+@njit(cache=True)
+def bed_force_at(x, params, sin_t, cos_t):
+    """``bed_force`` with sin(theta) and cos(theta) already known."""
     b = params["b"]
     omega = params["omega"]
     stiffness = omega * omega           # K/m
     damping = 2.0 * params["xi"] * omega  # C/m
-    sin_t = math.sin(x[0])
-    cos_t = math.cos(x[0])
     if params["bed"] == BED_TWO_SPRING:
         force = 0.0
         moment = 0.0
@@ -99,8 +103,12 @@ def bed_force(x, params):
 @njit(cache=True)
 def accelerations(theta, theta_dot, y, y_dot, ag, force, moment, h, j, g):
     """(theta'', y'') from the two equations of motion (module docstring); force, moment per mass."""
-    sin_t = math.sin(theta)
-    cos_t = math.cos(theta)
+    return accelerations_at(math.sin(theta), math.cos(theta), theta_dot, ag, force, moment, h, j, g)
+
+
+@njit(cache=True)
+def accelerations_at(sin_t, cos_t, theta_dot, ag, force, moment, h, j, g):
+    """``accelerations`` with sin(theta) and cos(theta) already known."""
     vertical = g - force - h * cos_t * theta_dot * theta_dot
     rotational = g * h * sin_t - h * cos_t * ag - cos_t * moment
     determinant = j - h * h * sin_t * sin_t
@@ -114,9 +122,11 @@ def winkler_rhs(x, accel, params, out):
     """dx/dt for x = [theta, theta', y, y']."""
     h = params["h"]
     b = params["b"]
-    force, moment = bed_force(x, params)
-    theta_acc, y_acc = accelerations(x[0], x[1], x[2], x[3], accel, force, moment, h,
-                                     (b * b + 4.0 * h * h) / 3.0, params["g"])
+    sin_t = math.sin(x[0])
+    cos_t = math.cos(x[0])
+    force, moment = bed_force_at(x, params, sin_t, cos_t)
+    theta_acc, y_acc = accelerations_at(sin_t, cos_t, x[1], accel, force, moment, h,
+                                        (b * b + 4.0 * h * h) / 3.0, params["g"])
     out[0] = x[1]
     out[1] = theta_acc
     out[2] = x[3]
@@ -137,6 +147,19 @@ def contact_indicator(index, x, params):
         return delta
     omega = params["omega"]
     return delta + 2.0 * params["xi"] / omega * (x[3] + s * math.cos(x[0]) * x[1])
+
+
+@njit(cache=True)
+def contact_indicators(x, params, out):
+    """All four ``contact_indicator`` values at once (one sin and cos)."""
+    b = params["b"]
+    sin_t = math.sin(x[0])
+    rate = 2.0 * params["xi"] / params["omega"] * b * math.cos(x[0]) * x[1]
+    base_rate = 2.0 * params["xi"] / params["omega"] * x[3]
+    out[0] = x[2] - b * sin_t
+    out[1] = x[2] + b * sin_t
+    out[2] = out[0] + base_rate - rate
+    out[3] = out[1] + base_rate + rate
 
 
 @njit(cache=True)

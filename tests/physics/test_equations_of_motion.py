@@ -76,7 +76,7 @@ def test_kernel_rhs_is_euler_lagrange(sigma):
         state = np.array([sigma * rng.uniform(0, alpha), rng.normal(0, 1.0),
                           rng.uniform(-0.01, 0.05), rng.normal(0, 0.1)])
         accel = rng.normal(0, 5.0)
-        params = new_params()
+        params = new_params(1)[0]
         for name, value in zip(("R", "alpha", "g", "kappa", "omega", "xi"), (radius, alpha, g, 0.75, omega, xi)):
             params[name] = value
         kernels.rhs(SSI, kernels.ROCKING, sigma, state, accel, params, out)
@@ -90,7 +90,7 @@ def test_kernel_rhs_is_euler_lagrange(sigma):
 
 def test_stiff_limit_of_rhs_is_housner_eq1():
     """With y'' = 0 imposed (rigid base), the theta equation is Housner's eq. 1."""
-    params = new_params()
+    params = new_params(1)[0]
     radius, alpha, g = 3.0, 0.3, 9.80665
     for name, value in zip(("R", "alpha", "g", "kappa"), (radius, alpha, g, 0.75)):
         params[name] = value
