@@ -124,3 +124,17 @@ def test_energy_is_conserved_through_contact_changes(solver, bed, omega_over_p):
     assert np.sum(np.diff(np.sign(response["theta"])) != 0) >= 3, "too few contact changes to test"
     drift = np.max(np.abs(e - e[0])) / initial_kinetic
     assert drift < (1e-4 if solver == "product" else 1e-7)
+
+
+@pytest.mark.parametrize("bed", ["continuous", "two-spring"])
+def test_friction_demand_of_a_quasi_static_push_is_ag_over_g(bed):
+    """Below uplift a slowly pushed block barely moves, so the base must hold H = m ag against N = m g:
+    peak_friction_demand = max(ag) / g (tilt and inertia corrections are below 1e-3 here)."""
+    K = stiffness(30)
+    peak = 0.9 * quasi_static_uplift_acceleration(bed, K)
+    duration, dt = 20.0, 0.01
+    t = np.arange(0.0, duration + dt / 2, dt)
+    ag = peak * 0.5 * (1 - np.cos(np.pi * t / duration))
+    response = solve("product", ag, dt, BLOCK.b, BLOCK.h, BLOCK.mass, K, 0.05, bed, t_end=duration)
+    assert not response["uplifted"]
+    assert response["result"].peak_friction_demand == pytest.approx(peak / G, rel=1e-3)
