@@ -211,7 +211,7 @@ def write_applicability(dataset, output) -> list[Path]:
 
 
 def applicability_stage(config, output, workers=None, progress=True, log=print, loaded=None):
-    """Run the default sweep for a study, or reuse ``applicability.nc`` when its inputs are unchanged.
+    """Run the study's sweep (``config.applicability``), or reuse ``applicability.nc`` when its inputs are unchanged.
 
     ``loaded`` may pass ``study.study_records(config)`` to avoid reading the records again.
     """
@@ -221,13 +221,16 @@ def applicability_stage(config, output, workers=None, progress=True, log=print, 
     from pipeline import __version__
     from pipeline.study import study_records
 
+    from dataclasses import asdict
+
     output = Path(output)
     records, _, recipe = loaded or study_records(config, log)
+    sweep = config.applicability  # the study's [applicability] table: one definition for every caller
     models = [name for name in config.models if not get_model(name).is_rigid_base] or list(DEFAULT_MODELS)
     options = {"switch": config.switch, "bed": config.bed}
     key = hashlib.sha256(json.dumps({
         "version": __version__, "recipe": recipe.as_dict(), "blocks": [repr(b) for b in config.blocks],
-        "models": models, "options": options,
+        "models": models, "options": options, "sweep": asdict(sweep),
         "records": [r.metadata.get("sha256", r.id) for r in records]}, sort_keys=True).encode()).hexdigest()[:16]
     existing = output / "applicability.nc"
     if existing.is_file():
@@ -235,7 +238,9 @@ def applicability_stage(config, output, workers=None, progress=True, log=print, 
             if cached.attrs.get("input_hash") == key:
                 log(f"reused {existing} (inputs unchanged)")
                 return cached.load()
-    dataset = run_applicability(records, config.blocks, workers=workers, progress=progress, models=models,
+    dataset = run_applicability(records, config.blocks, shear_moduli=sweep.shear_moduli,
+                                block_moduli=sweep.block_moduli, level_factors=sweep.levels,
+                                tolerance=sweep.tolerance, workers=workers, progress=progress, models=models,
                                 options=options)
     dataset.attrs["input_hash"] = key
     for path in write_applicability(dataset, output):

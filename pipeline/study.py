@@ -178,7 +178,8 @@ def study_records(config, log=print):
     so ``rockfrag fragility`` reads and processes them once.
     """
     recipe = load_recipe(config.processing or None)
-    raw_records, failures = load_records(list(config.record_sets))
+    raw_records, failures = load_records(list(config.record_sets), units=config.record_units or None,
+                                         dt=config.record_dt)
     for failure in failures:
         log(f"rockfrag: skipped {failure}")
     if not raw_records:

@@ -73,8 +73,8 @@ def small_cube(small_study, tmp_path_factory):
     ('models = ["newmark"]\n', "models"),
     ('[solver]\nswitch = "sticky"\n', "solver.switch"),
     ('[solver]\noverturn_angle = 2.0\n', "solver.overturn_angle"),
-    ('[blocks.bad]\nb = -1.0\nh = 2.0\n', "block bad.b"),
-    ('[blocks.bad]\nb = 1.0\nh = 2.0\nR = 3.0\nalpha = 0.3\n', "block bad"),
+    ('[blocks.bad]\nb = -1.0\nh = 2.0\n', "blocks.bad.b"),
+    ('[blocks.bad]\nb = 1.0\nh = 2.0\nR = 3.0\nalpha = 0.3\n', "blocks.bad"),
     ('[blocks.bad]\nb = 1.0\nh = 2.0\ncolour = "red"\n', "blocks.bad.colour"),
     ('[intensity]\nlevels = [0.1]\nsoils = ["sand"]\n', "intensity.soils"),
 ])

@@ -34,7 +34,7 @@ from pipeline.models.housner import housner_rhs
 from pipeline.models.jit import njit
 from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
 from pipeline.models.winkler import (N_CONTACT_INDICATORS, bed_force, contact_indicator, contact_indicators,
-                                     friction_demand, winkler_rhs)
+                                     friction_demand, settled_beyond_reach, winkler_rhs)
 
 # phases of the pivot loop
 REST = 0
@@ -58,7 +58,7 @@ EVENT_VALUE_FRACTION = 1e-12    # ... or when the event function is this fractio
 EVENT_REFINEMENTS = 12          # real steps spent sharpening one event time at most
 STATE_SCALE_FLOOR = 1e-9        # scales of y, y_dot for a rigid base (no foundation)
 AT_REST_FRACTION = 1e-12        # SSI: vertical vibration this small counts as static (closed-form rest)
-SNAP_TO_STATIC_FRACTION = 1e-7  # SSI: leftover vertical vibration below this is snapped to statics
+SNAP_TO_STATIC_FRACTION = 1e-4  # SSI: leftover vertical vibration below this is snapped to statics
 ZENO_STEP_SHRINK = 0.25         # a whole excursion inside one step: retry with this fraction
 MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
@@ -555,7 +555,7 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
             if phase == REST and abs(x[2] - y_static) < SNAP_TO_STATIC_FRACTION * y_static \
                     and abs(x[3]) < SNAP_TO_STATIC_FRACTION * y_static * omega:
                 # the free vertical vibration has died out: snap to the static equilibrium so that
-                # the closed-form rest phase takes over (the support force changes by < 1e-7 g)
+                # the closed-form rest phase takes over (the support force changes by < 1e-4 g)
                 x[2] = y_static
                 x[3] = 0.0
             force = ssi_support(x, params)
@@ -720,6 +720,9 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
+        if (history.shape[0] == 0 and t > ag.size * dt and after[0] > 0.0 and after[1] > 0.0
+                and settled_beyond_reach(x, params, summary["peak_angle"])):
+            break  # the ground is at rest and the block can no longer reach its peak or lift (no history kept)
         if kind == EVENT_OVERTURN:
             overturned = True
             summary["time_of_overturn"] = t

@@ -150,6 +150,38 @@ def contact_indicator(index, x, params):
 
 
 @njit(cache=True)
+def settled_beyond_reach(x, params, peak_angle):
+    """True when, with the ground at rest and the base in full contact, the block can no longer reach its
+    recorded peak angle nor lift a corner: its energy above the settled state is below a quarter of the
+    elastic energy of either (small-tilt stiffness of the bed, K_r - m g h). The bed only dissipates, so
+    the rest of the response cannot change the peak angle, uplift or flights; the batch kernels (which
+    keep no history) stop there."""
+    b = params["b"]
+    h = params["h"]
+    g = params["g"]
+    omega = params["omega"]
+    stiffness = omega * omega  # K/m
+    tilt_stiffness = stiffness * b * b * (1.0 if params["bed"] == BED_TWO_SPRING else 1.0 / 3.0) - g * h
+    if tilt_stiffness <= 0.0:
+        return False  # the bed cannot even hold the block upright elastically
+    y_static = g / stiffness
+    sin_t = math.sin(x[0])
+    cos_t = math.cos(x[0])
+    j = (b * b + 4.0 * h * h) / 3.0
+    kinetic = 0.5 * ((h * cos_t * x[1]) ** 2 + (x[3] + h * sin_t * x[1]) ** 2 + (j - h * h) * x[1] * x[1])
+    # bed energy in full contact (the caller checks it): two springs K/2, or
+    # int_{-b}^{b} 1/2 (K/2b) (y + s sin)^2 ds = K/2 (y^2 + b^2 sin^2 / 3) for the continuous bed
+    if params["bed"] == BED_TWO_SPRING:
+        bed = 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t)
+    else:
+        bed = 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t / 3.0)
+    excess = kinetic + g * (h * cos_t - x[2]) + bed - (g * (h - y_static) + 0.5 * stiffness * y_static * y_static)
+    lift_angle = y_static / b  # a corner lifts at about this tilt (settled base)
+    reach = 0.25 * 0.5 * tilt_stiffness * min(peak_angle, lift_angle) ** 2
+    return excess < reach
+
+
+@njit(cache=True)
 def contact_indicators(x, params, out):
     """All four ``contact_indicator`` values at once (one sin and cos)."""
     b = params["b"]
