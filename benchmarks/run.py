@@ -165,5 +165,9 @@ if __name__ == "__main__":
     per_run_cost(records)
     study_timing()
     hunt_and_fill_savings(records)
+
+    from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/ is on sys.path)
+
+    winkler_against_opensees()
     print("\n5. ", end="")
     calibration.run()
