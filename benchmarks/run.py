@@ -127,3 +127,6 @@ if __name__ == "__main__":
     solver_throughput(records)
     study_timing()
     hunt_and_fill_savings(records)
+    import fragility as fragility_benchmark  # benchmarks/fragility.py (this folder is on sys.path)
+
+    fragility_benchmark.run(print=print)

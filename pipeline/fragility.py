@@ -516,14 +516,16 @@ def bootstrap_cell(levels, exceed, total, rows, groups):
     """
     n_boot, n_state = exceed.shape[:2]
     medians, betas = np.full((n_boot, n_state), np.nan), np.full((n_boot, n_state), np.nan)
+    independent = [g[0] for g in groups if len(g) == 1 and rows[g[0]].method in ("mle-binomial", "step-between-levels")]
+    if independent:  # all independently fitted states of the cell in one batch, warm-started at the point
+        start_median = np.tile([rows[s].median for s in independent], (n_boot, 1))
+        start_beta = np.tile([rows[s].beta if rows[s].beta > 0 else 0.4 for s in independent], (n_boot, 1))
+        medians[:, independent], betas[:, independent] = fit_independent(
+            levels, exceed[:, independent], total[:, independent], start=(start_median, start_beta))
     for group in groups:
         first = rows[group[0]]
         if len(group) == 1 and first.method == "exact-g-tan-alpha":
             medians[:, group[0]], betas[:, group[0]] = first.median, 0.0
-        elif len(group) == 1 and first.method in ("mle-binomial", "step-between-levels"):
-            s = group[0]
-            start = (np.full(n_boot, first.median), np.full(n_boot, first.beta)) if first.beta > 0 else None
-            medians[:, s], betas[:, s] = fit_independent(levels, exceed[:, s], total[:, s], start=start)
         elif len(group) > 1:
             e, t = exceed[:, group], total[:, group]
             separated, *_ = separation(e, t)
