@@ -103,6 +103,9 @@ def command_fragility(args) -> int:
 
     started = time.perf_counter()
     config, output = _study_config(args)
+    from pipeline.risk import study_hazard
+
+    study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
     loaded = study_records(config, log=lambda message: print(message, file=sys.stderr))
     cube, stats = run_study(config, output=output, workers=1 if args.serial else None,
                             scheduler=args.scheduler, dask_workers=args.workers, progress=not args.no_progress,
@@ -110,7 +113,7 @@ def command_fragility(args) -> int:
     print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
-    fragility, risk = fragility_stage(cube, ida, config, output)
+    fragility, risk = fragility_stage(cube, ida, config, output, progress=not args.no_progress)
     for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
         print(f"wrote {output / name}")
     applicability = None

@@ -785,7 +785,7 @@ def write_csv(table: pd.DataFrame, path) -> None:
         table.to_csv(temporary, index=False, float_format="%.6g")
 
 
-def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=True, log=None):
+def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=None, log=None):
     """Fit, add the risk, and write fragility.nc, fragility.csv and fragility_pelicun.csv.
 
     The hazard curve is read (and checked against the study's intensity measure) before any fit.
@@ -796,6 +796,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=
     from pipeline.risk import risk_dataset, study_hazard
 
     log = log or (lambda message: print(message, file=sys.stderr))
+    progress = sys.stderr.isatty() if progress is None else progress
     output = Path(output)
     hazard = study_hazard(config)
     states = damage_states_from_config(config.raw)
