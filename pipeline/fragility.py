@@ -350,10 +350,10 @@ def deviance(levels, exceed, total, median, beta):
 
 def lognormal_cdf(im, median, beta):
     """P(DS | im) of a lognormal fragility; a step at the median where beta == 0."""
-    im = np.asarray(im, float)
-    if beta == 0:
-        return (im >= median).astype(float)
-    return ndtr(np.log(im / median) / beta)
+    im, median, beta = (np.asarray(v, float) for v in (im, median, beta))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        smooth = ndtr(np.log(im / median) / beta)
+    return np.where(beta == 0, (im >= median).astype(float), smooth)
 
 
 def fit_censored_capacities(capacities, censor_at):

@@ -148,6 +148,16 @@ def test_cube_fit_recovers_medians_and_uplift_is_the_exact_step(fitted):
     np.testing.assert_allclose(cell.outcome_probability.sum("outcome_class").values, 1.0)
 
 
+def test_runs_that_contradict_the_exact_uplift_step_are_reported():
+    cube = synthetic_cube(n_records=40)
+    outcome = cube.outcome.values
+    below = np.flatnonzero(cube.im_level.values < UPLIFT_G)[-1]
+    outcome[:5, below] = OUTCOME_ROCKING  # five records "uplift" below g tan(alpha)
+    row = fragility_dataset(cube, n_bootstrap=0).isel(soil=0, block=0, model=0).sel(damage_state="uplift")
+    assert row.status.item() == "deterministic-threshold"
+    assert "disagree with the exact g tan(alpha) step" in row.fit_warning.item()
+
+
 def test_bootstrap_bounds_contain_the_point_estimate(fitted):
     fitted_rows = fitted.status.isin(["fitted", "extrapolated"])
     for name, low, high in (("median", "median_low", "median_high"), ("beta", "beta_low", "beta_high")):
