@@ -124,16 +124,20 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     """The physical intensity of every (block, im_level) in the study's display unit, and the unit.
 
     Works for both cube layouts: one physical ``im_level`` coordinate shared by all blocks, or a
-    dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate
-    (``intensity`` in display units, or ``im_level_si`` in SI). Returns (n_block, n_level).
+    dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate (in the
+    display unit, e.g. ``intensity`` [g], or in SI, e.g. ``im_level_si`` [m/s^2]; found by its dims and
+    units). Returns (n_block, n_level).
     """
     n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
-    for name in ("intensity", "im_intensity"):
-        if name in cube.coords and "block" in cube[name].dims:
-            return cube[name].transpose("block", "im_level").values.astype(float), cube[name].attrs.get("units", "")
-    if "im_level_si" in cube.coords and "block" in cube.im_level_si.dims:
-        unit, factor = DISPLAY_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
-        return cube.im_level_si.transpose("block", "im_level").values / factor, unit
+    display, factor = DISPLAY_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
+    per_block = [name for name, coord in cube.coords.items() if set(coord.dims) == {"block", "im_level"}]
+    for name in sorted(per_block, key=lambda n: n not in ("intensity", "im_intensity")):
+        units = cube[name].attrs.get("units", "")
+        values = cube[name].transpose("block", "im_level").values.astype(float)
+        if units == display:
+            return values, units
+        if (units in ("m/s^2", "m s-2", "m/s", "m s-1") or name == "im_level_si") and display:
+            return values / factor, display
     levels = cube.im_level.values.astype(float)
     return np.broadcast_to(levels, (n_block, n_level)).copy(), cube.im_level.attrs.get("units", "")
 

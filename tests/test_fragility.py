@@ -265,7 +265,8 @@ def test_per_block_intensity_layout_gives_the_same_fits():
 def test_si_intensity_coordinate_is_read_in_display_units():
     cube = synthetic_cube(n_records=20).assign_coords(im_level=np.arange(25.0))
     si = np.geomspace(0.05, 3.0, 25)[None, :] * STANDARD_GRAVITY
-    cube = cube.assign_coords(im_level_si=(("block", "im_level"), si))
+    cube = cube.assign_coords(im_level_si=(("block", "im_level"), si, {"units": "m/s^2"}),
+                              im_level=("im_level", np.arange(25.0), {"units": "1"}))
     intensity, unit = intensity_levels(cube)
     np.testing.assert_allclose(intensity[0], np.geomspace(0.05, 3.0, 25))
     assert unit == "g"
