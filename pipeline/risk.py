@@ -73,6 +73,13 @@ def _measure_from_imt(imt: str, source: str) -> tuple[str, float | None, float]:
 
 
 def _read_rockfrag_csv(text: str, source: str):
+    rows = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+    try:
+        values = np.array([[float(v) for v in line.split(",")[:2]] for line in rows[1:]])
+    except ValueError as error:
+        _fail(f"not a table of numbers (intensity, annual frequency of exceedance): {error}", source)
+    if values.ndim != 2 or values.shape[1] < 2:
+        _fail("not a table of numbers: expected two columns, intensity and annual frequency of exceedance", source)
     header = dict(re.findall(r"^#\s*(measure|period|units)\s*[=:]\s*(\S+)", text, flags=re.M | re.I))
     header = {k.lower(): v for k, v in header.items()}
     if "measure" not in header:
@@ -87,13 +94,6 @@ def _read_rockfrag_csv(text: str, source: str):
     unit = header.get("units", UNITS[measure])
     if unit != UNITS[measure]:
         _fail(f"units {unit!r}; a {measure} hazard curve must be in {UNITS[measure]}", source)
-    rows = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
-    try:
-        values = np.array([[float(v) for v in line.split(",")[:2]] for line in rows[1:]])
-    except ValueError as error:
-        _fail(f"expected two numeric columns (intensity, annual frequency of exceedance): {error}", source)
-    if values.ndim != 2 or values.shape[1] < 2:
-        _fail("expected two columns: intensity, annual frequency of exceedance", source)
     return values[:, 0], values[:, 1], measure, (period if measure == "sa" else None), {}
 
 

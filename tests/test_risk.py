@@ -92,3 +92,14 @@ def test_bad_hazard_file_is_named(tmp_path):
     many.write_text("\n".join([*lines, lines[-1]]) + "\n")
     with pytest.raises(ConfigError, match="2 sites"):
         load_hazard(many, "pga")
+
+
+def test_the_study_file_is_refused_before_any_run_when_its_hazard_is_for_another_measure(tmp_path):
+    from pipeline.config import load_study
+
+    study = tmp_path / "study.toml"
+    study.write_text(f'[hazard]\nfile = "{DATA / "usgs_hazard_SA1P0.json"}"\n')
+    with pytest.raises(ConfigError, match="hazard.file.*Sa\\(1 s\\).*PGA"):
+        load_study(study)
+    study.write_text(f'[intensity]\nmeasure = "sa"\nperiod = 1.0\n[hazard]\nfile = "{DATA / "usgs_hazard_SA1P0.json"}"\n')
+    assert load_study(study).measure == "sa"
