@@ -35,6 +35,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from pipeline.config import MEASURE_UNITS
 from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from pipeline.errors import ConfigError
 from pipeline.lognormal_fit import (CROSSING_TOLERANCE, curves_cross, deviance, fit_binomial,  # noqa: F401
@@ -115,9 +116,6 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
 
 # ---------------------------------------------------------------- intensity levels of a cube
 
-DISPLAY_UNITS = {"pga": ("g", STANDARD_GRAVITY), "sa": ("g", STANDARD_GRAVITY), "pgv": ("m/s", 1.0)}
-
-
 def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     """The physical intensity of every (block, im_level) in the study's display unit, and the unit.
 
@@ -127,7 +125,7 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     units). Returns (n_block, n_level).
     """
     n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
-    display, factor = DISPLAY_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
+    display, factor = MEASURE_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
     per_block = [name for name, coord in cube.coords.items() if set(coord.dims) == {"block", "im_level"}]
     for name in sorted(per_block, key=lambda n: n not in ("intensity", "im_intensity")):
         units = cube[name].attrs.get("units", "")

@@ -26,12 +26,13 @@ import numpy as np
 import xarray as xr
 from scipy.special import ndtr
 
+from pipeline.config import MEASURE_UNITS
 from pipeline.errors import ConfigError
 
 EXAMPLE_HAZARD = "hazard_example.csv"
 """Shipped example, PGA only: H(s) = 1e-4 s^-2.5 [1/yr], s = PGA [g] (Cornell et al. 2002 power-law form)."""
 
-UNITS = {"pga": "g", "sa": "g", "pgv": "m/s"}
+UNITS = {measure: unit for measure, (unit, _) in MEASURE_UNITS.items()}
 """The intensity unit of each measure in a hazard curve (the study's display unit)."""
 
 PERIOD_TOLERANCE = 1e-6
