@@ -35,7 +35,6 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pipeline.config import MEASURE_UNITS
 from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from pipeline.errors import ConfigError
 from pipeline.lognormal_fit import (CROSSING_TOLERANCE, curves_cross, deviance, fit_binomial,  # noqa: F401
@@ -124,6 +123,8 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     display unit, e.g. ``intensity`` [g], or in SI, e.g. ``im_level_si`` [m/s^2]; found by its dims and
     units). Returns (n_block, n_level).
     """
+    from pipeline.config import MEASURE_UNITS  # config imports this module (DamageState) at load
+
     n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
     display, factor = MEASURE_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
     per_block = [name for name, coord in cube.coords.items() if set(coord.dims) == {"block", "im_level"}]

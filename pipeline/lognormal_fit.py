@@ -235,8 +235,9 @@ def fit_censored_capacities(capacities, censor_at):
         return -(np.sum(-0.5 * z**2 - np.log(beta)) + n_censored * log_ndtr(-z_censor))
 
     start = [log_observed.mean(), np.log(max(log_observed.std(), 0.05))]
-    result = minimize(negative, x0=start, method="L-BFGS-B",
-                      bounds=[(log_observed.min() - 5, log_observed.max() + 10), (np.log(1e-3), np.log(5.0))])
+    # two parameters and a smooth likelihood: Nelder-Mead is fast here (L-BFGS-B spent ~0.3 s per cell)
+    result = minimize(negative, x0=start, method="Nelder-Mead",
+                      options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000})
     return float(np.exp(result.x[0])), float(np.exp(result.x[1]))
 
 
