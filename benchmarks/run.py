@@ -164,6 +164,11 @@ if __name__ == "__main__":
     per_run_cost(records)
     study_timing()
     hunt_and_fill_savings(records)
+
+    from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/ is on sys.path)
+
+    winkler_against_opensees()
+
     import fragility as fragility_benchmark  # benchmarks/fragility.py (this folder is on sys.path)
 
     fragility_benchmark.run(print=print)
