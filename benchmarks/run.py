@@ -171,3 +171,8 @@ if __name__ == "__main__":
     winkler_against_opensees()
     print("\n5. ", end="")
     calibration.run()
+
+    import fragility as fragility_benchmark  # benchmarks/fragility.py (this folder is on sys.path)
+
+    print("\n6. ", end="")
+    fragility_benchmark.run(print=print)

@@ -209,13 +209,16 @@ def command_fragility(args) -> int:
 
     started = time.perf_counter()
     config, output = _study_config(args)
+    from pipeline.risk import study_hazard
+
+    study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
     executor = _executor_options(args)
     loaded = study_records(config, log=_log)
     cube, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded, **executor)
     print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
-    fragility, risk = fragility_stage(cube, ida, config, output)
+    fragility, risk = fragility_stage(cube, ida, config, output, progress=not args.no_progress)
     for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
         print(f"wrote {output / name}")
     applicability = None
