@@ -297,6 +297,13 @@ def limitations_items(results: Results):
                             "studied range", "status"], rows))
         if len(outside) > EXTRAPOLATION_ROWS:
             items.append(note(f"... and {len(outside) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
+        try:
+            from pipeline.fragility import STATUS
+        except ImportError:
+            STATUS = {}
+        for word in dict.fromkeys(outside.status):
+            if word in STATUS:
+                items.append(note(f"{word}: {STATUS[word]}."))
     if unfitted:
         items.append(note(f"{unfitted} curves could not be fitted (too few exceedances): no median is given."))
 
