@@ -263,9 +263,9 @@ def limitations_items(results: Results):
                                    f"μ = {coefficient:g}."))
             continue
         items.append(paragraph(
-            f"{model.label}: every model assumes the base does not slide. Holding it needed a friction coefficient "
-            f"above μ = {coefficient:g} in {_percent(float(fraction.mean()))} of the runs; there the block would "
-            "slide or slide-rock and the rocking results overstate the rotation. Fraction of runs above μ:"))
+            f"Every model assumes the base does not slide. {model.label}: holding the base needed a friction "
+            f"coefficient above μ = {coefficient:g} in {_percent(float(fraction.mean()))} of the runs; there the "
+            "block would slide or slide-rock, which the rocking results do not describe. Fraction of runs above μ:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values))
     if not found:
         items.append(paragraph("No model of this study reports the friction demand (|H|/N at the base); every model "
@@ -273,11 +273,11 @@ def limitations_items(results: Results):
 
     items.append(heading("Extrapolated fragility medians"))
     status = extrapolation(fragility, results.output)
-    outside = status[~status.status.isin(["within", "no fit"])]
-    unfitted = int((status.status == "no fit").sum())
     rigid = {m.name for m in models if m.rigid_base}
     first_soil = str(fragility.soil.values[0])
-    outside = outside[~outside.model.isin(rigid) | (outside.soil == first_soil)]
+    status = status[~status.model.isin(rigid) | (status.soil == first_soil)]  # a rigid base once per block
+    outside = status[~status.status.isin(["within", "no fit"])]
+    unfitted = int((status.status == "no fit").sum())
     order = {name: {str(v): i for i, v in enumerate(fragility[name].values)} for name in ("block", "model", "soil")}
     outside = outside.sort_values(["block", "model", "soil"], key=lambda column: column.map(order[column.name]))
     if outside.empty:
