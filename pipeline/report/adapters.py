@@ -30,6 +30,7 @@ class ModelInfo:
     rigid_base: bool
     description: str
     can_pull: bool | None = None  # None: the registry does not say
+    uses_bed: bool = False  # a bed of springs (solver.bed), not the pivot-switch rule
 
 
 def model_info(name: str) -> ModelInfo:
@@ -42,7 +43,8 @@ def model_info(name: str) -> ModelInfo:
     rigid = bool(getattr(model, "is_rigid_base", not model.needs_foundation))
     description = getattr(model, "description", "")
     label = getattr(model, "label", None) or f"{name}: {description.split(';')[0]}"
-    return ModelInfo(name, label, rigid, description, getattr(model, "can_pull", None))
+    return ModelInfo(name, label, rigid, description, getattr(model, "can_pull", None),
+                     bool(getattr(model, "uses_bed", False)))
 
 
 def models_of(dataset) -> list[ModelInfo]:

@@ -16,6 +16,7 @@ import numpy as np
 from pipeline import __version__
 from pipeline.report.adapters import (OUTCOME_FAILED, block_levels, cell, extrapolation, friction_flag,
                                       measure_label, models_of, run_fraction, state_labels, tension_flag)
+from pipeline.report.layout import pretty
 from pipeline.report.text import bullet, heading, note, paragraph, table
 
 DEFAULT_FRICTION_COEFFICIENT = 0.5
@@ -143,14 +144,17 @@ def _processing_text(cube):
 def methods_items(results: Results):
     config, cube, fragility = results.config, results.cube, results.fragility
     items = [heading("Models and their assumptions")]
+    bed = (config.raw.get("solver", {}) or {}).get("bed", "continuous")
     for model in models_of(cube):
-        role = ("rigid base: the result does not depend on the soil; computed once per block" if model.rigid_base
-                else f"on a foundation of interface stiffness k (paper eq. 19) and the soil's damping ratio; "
-                     f"pivot switch rule '{config.switch}'")
-        name = model.label if model.label.startswith(f"{model.name}:") else f"{model.name} ({model.label})"
-        items.append(bullet(f"{name.split(':')[0]}: {model.description}; {role}."))
+        if model.rigid_base:
+            role = "rigid base: the result does not depend on the soil; computed once per block"
+        else:
+            rule = f"bed '{bed}'" if model.uses_bed else f"pivot switch rule '{config.switch}'"
+            role = f"on a foundation of interface stiffness k (paper eq. 19) and the soil's damping ratio; {rule}"
+        name = model.label if model.label.startswith(f"{model.name}:") else f"{model.label} [{model.name}]"
+        items.append(bullet(pretty(f"{name.split(': ')[0]}: {model.description}; {role}.")))
     items.append(paragraph(
-        f"All models: planar rocking of a rigid block about its base corners; the base does not slide; "
+        f"All models: planar rocking of a rigid block; the base does not slide; "
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
         f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
         f"failed integration (excluded from the fits)."))
