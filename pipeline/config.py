@@ -198,6 +198,8 @@ SCHEMA = Table({
     "hazard": Table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
     "fragility": Table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                         "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
+    "report": Table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
+                     "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True)}),
     "applicability": Table({
         "g_range": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
         "n_g": Number(2, 200, integer=True),
@@ -401,14 +403,17 @@ def _check_damage_states(data, source):
         raise ConfigError(error.field, error.reason, source) from None
 
 
-def _check_hazard(path, source):
-    """The hazard curve loads (file exists, two numeric columns, decreasing frequency)."""
+def _check_hazard(path, source, measure="pga", period=None):
+    """The hazard curve loads (file exists, numeric, decreasing frequency) and is for the study's
+    intensity measure (and Sa period). No file and a measure other than PGA: no risk, nothing to check."""
     from pipeline.risk import load_hazard
 
     if path and Path(path).is_dir():
         raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
+    if not path and measure != "pga":
+        return
     try:
-        load_hazard(path or None)
+        load_hazard(path or None, measure, period if measure == "sa" else None)
     except ConfigError as error:
         raise ConfigError(error.field, f"{error.source}: {error.reason}", source) from None
     except (ValueError, UnicodeDecodeError, OSError) as error:
@@ -437,7 +442,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     blocks = _select("blocks", data["blocks"], library, source)
     levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
     _check_damage_states(data, source)
-    _check_hazard(hazard.get("file", ""), source)
+    _check_hazard(hazard.get("file", ""), source, measure, float(intensity.get("period", 1.0)))
     sweep = data.get("applicability", {})
     defaults = ApplicabilitySettings()
     return StudyConfig(
