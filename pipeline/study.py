@@ -152,6 +152,30 @@ def worker_pool(max_workers) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(max_workers=max_workers, initializer=_die_with_parent, initargs=(os.getpid(),))
 
 
+POOL_EXIT_SECONDS = 10.0
+"""How long a finished pool's workers may take to exit before they are killed."""
+
+
+def shutdown_pool(pool, wait=True, timeout=POOL_EXIT_SECONDS):
+    """Shut a process pool down; with ``wait``, its workers are gone when this returns.
+
+    ``ProcessPoolExecutor.shutdown(wait=True)`` waits forever if a worker is killed while it holds
+    the task queue's lock (the others then never read their exit sentinel); here stragglers are
+    killed after ``timeout`` seconds instead.
+    """
+    processes = list((getattr(pool, "_processes", None) or {}).values())  # private, only to bound the wait
+    pool.shutdown(wait=False, cancel_futures=True)
+    if not wait:
+        return
+    deadline = time.monotonic() + timeout
+    for process in processes:
+        process.join(max(0.0, deadline - time.monotonic()))
+    for process in processes:
+        if process.is_alive():
+            process.kill()
+            process.join(1.0)
+
+
 def _is_lost_worker(error) -> bool:
     """A worker process died under the task (OOM killer, kill -9): the task may be retried."""
     return isinstance(error, BrokenProcessPool) or type(error).__name__ == "KilledWorker"
@@ -193,7 +217,7 @@ def _executor(workers, scheduler, dask_workers):
         return (lambda *a: InProcess(a), lambda futures: list(futures), lambda finished: None)
     pool = worker_pool(workers or os.cpu_count())
     return (lambda *a: pool.submit(compute_cells, *a), as_completed,
-            lambda finished: pool.shutdown(wait=finished, cancel_futures=True))
+            lambda finished: shutdown_pool(pool, wait=finished))
 
 
 def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, describe=str):

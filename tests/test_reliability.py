@@ -508,3 +508,20 @@ def test_short_record_that_processing_cannot_handle_is_skipped_not_a_traceback(n
         assert_one_line_error(captured.err, "short.AT2", "cannot be processed")
     else:
         assert status == 0 and len(pd.read_csv(tmp_path / "out" / "records.csv")) == 2
+
+
+def _block_forever(_):
+    time.sleep(3600)
+
+
+def test_pool_shutdown_is_bounded_when_a_worker_never_exits():
+    """A worker stuck forever (as when another was killed holding the queue lock) is killed, not awaited."""
+    from pipeline.study import shutdown_pool, worker_pool
+
+    pool = worker_pool(1)
+    pool.submit(_block_forever, 0)
+    time.sleep(0.5)
+    workers = list(pool._processes.values())
+    started = time.monotonic()
+    shutdown_pool(pool, wait=True, timeout=1.0)
+    assert time.monotonic() - started < 5 and not any(p.is_alive() for p in workers)
