@@ -1,7 +1,5 @@
 """Issue 13's list of ~30 probes, one row each: every one must end with one line on stderr and the
-documented exit status (README, ``rockfrag --help``), never a traceback. Rows whose fix belongs to
-the calibration part of the issue carry ``OTHERS``: expected to fail until that work is merged, then
-they must pass (xfail is not strict; remove the mark once they pass)."""
+documented exit status (README, ``rockfrag --help``), never a traceback."""
 
 from __future__ import annotations
 
@@ -14,10 +12,6 @@ import pytest
 from pipeline import cli
 from pipeline.checkpoints import SUFFIX
 from tests.reliability_helpers import error_lines, small_study_text, write_at2
-
-OTHERS = pytest.mark.xfail(strict=False, reason="fixed by the calibration helper's part of issue 13; must pass "
-                                                "once merged")
-
 
 def run_cli(argv) -> tuple[int, str, str]:
     out, err = io.StringIO(), io.StringIO()
@@ -93,7 +87,7 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
                                             "--output", p / "o", *RUN], 2, ["threshhold"], ()),
     ("calibrate text cell in theta", lambda p: ["calibrate", _write(p / "t.csv", "time [s],theta [rad],other\n" + "".join(
         f"{0.01 * i},{'x' if i == 5 else 1e-4 * i},{i}\n" for i in range(30))), "--record", p / "records" / "good.AT2",
-        "--output", p / "o", "--grid-only", "--n-k", "2", "--n-xi", "2"], 2, ["theta"], (OTHERS,)),
+        "--output", p / "o", "--grid-only", "--n-k", "2", "--n-xi", "2"], 2, ["theta"], ()),
     # 3. tracebacks with rc 1
     ("output is a file", lambda p: _write(p / "f", "x") and ["records", "--set", p / "records", "--output", p / "f"],
      2, ["is a file"], ()),
@@ -127,7 +121,7 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
      ()),
     ("calibrate all-zero reference", lambda p: ["calibrate", zero_reference(p), "--record", p / "records" / "good.AT2",
                                                 "--output", p / "o", "--grid-only", "--n-k", "2", "--n-xi", "2"],
-     2, ["zero.csv"], (OTHERS,)),
+     2, ["zero.csv"], ()),
     ("calibrate --n-k 0", lambda p: ["calibrate", p / "reference.csv", "--record", p / "records" / "good.AT2",
                                      "--output", p / "o", "--grid-only", "--n-k", "0"], 2, ["n-k"], ()),
     ("applicability --n-g 0", lambda p: ["applicability", p / "study.toml", "--output", p / "o", "--n-g", "0",
