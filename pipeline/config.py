@@ -22,11 +22,16 @@ import numpy as np
 
 from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError
+from pipeline.measures import MEASURES
 from pipeline.models import MODELS, SWITCH_RULES
 from pipeline.soils import SOILS, SoilClass
-from pipeline.units import STANDARD_GRAVITY
 
-MEASURE_UNITS = {"pga": ("g", STANDARD_GRAVITY), "sa": ("g", STANDARD_GRAVITY), "pgv": ("m/s", 1.0)}
+MEASURE_UNITS = {name: (m.display_unit, m.display_factor) for name, m in MEASURES.items() if m.scalable}
+"""Measures a study can scale records to: name -> (display unit, SI value of one display unit)."""
+
+LEVELS_RELATIVE_TO = ("", "uplift")
+"""``[intensity] levels.relative_to``: "" = levels in the measure's unit, the same for every block;
+"uplift" = multiples of each block's uplift intensity (pipeline.study.uplift_intensity)."""
 
 
 @dataclass(frozen=True)
@@ -52,6 +57,18 @@ class StudyConfig:
     confidence: float
     source: str
     raw: dict
+    levels_relative_to: str = ""  # "" (absolute levels) or "uplift" (multiples of each block's uplift intensity)
+    capacity_resolution: float = 0.02  # relative bracket of the adaptive overturning capacities; 0 = off
+    period_range: tuple[float, float] | None = None  # AvgSa periods [s]; None = 0.2 T .. 3 T
+
+    @property
+    def relative_levels(self) -> bool:
+        return self.levels_relative_to == "uplift"
+
+    @property
+    def measure_options(self) -> dict:
+        """Options every ``pipeline.measures.Measure`` call of the study takes."""
+        return {"period": self.period, "damping": self.damping, "period_range": self.period_range}
 
     @property
     def level_unit(self) -> str:
@@ -59,7 +76,10 @@ class StudyConfig:
 
     @property
     def levels_si(self) -> np.ndarray:
-        """Intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV)."""
+        """Absolute intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV); with relative levels
+        the dimensionless multiples themselves (per-block intensities: pipeline.study.level_intensities)."""
+        if self.relative_levels:
+            return np.asarray(self.levels, dtype=float)
         return np.asarray(self.levels) * MEASURE_UNITS[self.measure][1]
 
     def as_json(self) -> str:
@@ -94,7 +114,11 @@ def _number(data, key, where, source, low, high, default=None, low_open=False):
 
 
 def _levels(spec, source, unit):
+    """Levels as given (display unit, or multiples when relative): a list, or {start, stop, count,
+    spacing} or {values}, each optionally with ``relative_to``."""
     where = "intensity.levels"
+    if isinstance(spec, dict) and "values" in spec:
+        spec = spec["values"]
     if isinstance(spec, list):
         if not spec:
             raise ConfigError(where, "empty list", source)
@@ -137,7 +161,7 @@ ALLOWED_KEYS = {
     "": {"study", "intensity", "soils", "models", "solver", "blocks", "soils_custom", "damage_states",
          "hazard", "fragility"},
     "study": {"name", "record_sets", "processing", "output"},
-    "intensity": {"measure", "period", "damping", "levels"},
+    "intensity": {"measure", "period", "damping", "levels", "capacity_resolution", "period_range"},
     "solver": {"switch", "tail", "overturn_angle"},
     "hazard": {"file", "design_life"},
     "fragility": {"bootstrap", "seed", "confidence"},
@@ -216,7 +240,31 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         seed=int(_number(data.get("fragility", {}), "seed", "fragility", source, 0, 2**32, default=0)),
         confidence=_number(data.get("fragility", {}), "confidence", "fragility", source, 0.0, 1.0, default=0.9,
                            low_open=True),
-        source=source, raw=data)
+        source=source, raw=data, **_intensity_extras(intensity, source))
+
+
+def _intensity_extras(intensity, source) -> dict:
+    """The per-block level, adaptive-capacity and AvgSa settings of ``[intensity]``."""
+    levels = intensity.get("levels", {})
+    relative_to = levels.get("relative_to", "") if isinstance(levels, dict) else ""
+    if relative_to not in LEVELS_RELATIVE_TO:
+        raise ConfigError("intensity.levels.relative_to", f"{relative_to!r}; allowed: \"\" (absolute levels) "
+                          "or \"uplift\" (multiples of each block's uplift intensity)", source)
+    if isinstance(levels, dict):
+        unknown = set(levels) - {"start", "stop", "count", "spacing", "values", "relative_to"}
+        if unknown:
+            raise ConfigError(f"intensity.levels.{sorted(unknown)[0]}", "unknown key; allowed: start, stop, "
+                              "count, spacing, values, relative_to", source)
+    resolution = _number(intensity, "capacity_resolution", "intensity", source, 0.0, 0.5, default=0.02)
+    period_range = intensity.get("period_range")
+    if period_range is not None:
+        if (not isinstance(period_range, list) or len(period_range) != 2
+                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in period_range)
+                or not 0.01 <= period_range[0] < period_range[1] <= 20.0):
+            raise ConfigError("intensity.period_range", f"{period_range!r}; allowed [low, high] in s with "
+                              "0.01 <= low < high <= 20", source)
+        period_range = (float(period_range[0]), float(period_range[1]))
+    return {"levels_relative_to": relative_to, "capacity_resolution": resolution, "period_range": period_range}
 
 
 def load_study(path=None, overrides: dict | None = None) -> StudyConfig:
