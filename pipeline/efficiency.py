@@ -100,12 +100,12 @@ def sufficiency_p_value(log_capacity, covariate, use_log) -> float:
 
 
 def rank_ascending(values) -> np.ndarray:
-    """1 for the smallest value along the last axis, 2 for the next, ...; NaN stays NaN (unranked)."""
+    """1 for the smallest value along the last axis, 2 for the next, ...; equal values (to 1e-9,
+    e.g. PGA and PGA/(g tan alpha) within one block) share the lower rank; NaN stays NaN."""
     values = np.asarray(values, float)
-    order = np.argsort(np.where(np.isnan(values), np.inf, values), axis=-1, kind="stable")
-    ranks = np.empty_like(values)
-    np.put_along_axis(ranks, order, np.arange(1, values.shape[-1] + 1, dtype=float) * np.ones_like(values), axis=-1)
-    return np.where(np.isnan(values), np.nan, ranks)
+    filled = np.where(np.isnan(values), np.inf, values)
+    smaller = filled[..., None, :] < filled[..., :, None] * (1.0 - 1e-9)
+    return np.where(np.isnan(values), np.nan, 1.0 + smaller.sum(axis=-1))
 
 
 def efficiency_from_capacities(capacity: xr.DataArray, covariates: dict) -> xr.Dataset:

@@ -88,6 +88,7 @@ def test_capacity_is_the_scale_factor_times_the_records_measure():
 
 def test_rank_leaves_missing_dispersions_unranked():
     np.testing.assert_array_equal(rank_ascending([0.4, np.nan, 0.1]), [2.0, np.nan, 1.0])
+    np.testing.assert_array_equal(rank_ascending([0.3, 0.1, 0.3 * (1 + 1e-12), 0.5]), [2.0, 1.0, 2.0, 4.0])
 
 
 def test_outputs_and_a4_figure(tmp_path):

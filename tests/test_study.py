@@ -89,7 +89,7 @@ def test_invalid_study_names_field_and_file(tmp_path, text, field):
 
 def test_default_study_matches_the_issue():
     config = load_study()
-    assert len(config.levels) == 40 and config.measure == "pga"
+    assert len(config.levels) == 28 and config.measure == "pga"
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
     assert config.models == ("housner", "ssi") and len(config.blocks) == 3
     paper = config.blocks[0]
