@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numba import njit
@@ -70,6 +71,7 @@ def significant_duration(acceleration, dt, start=0.05, end=0.95) -> float:
     return float(np.interp(end, husid, time) - np.interp(start, husid, time))
 
 
+@lru_cache(maxsize=4096)
 def oscillator_coefficients(period, damping, dt):
     """Exact recurrence for x = [u, v] of u'' + 2 zeta w u' + w^2 u = -a_g, a_g linear in a step.
 
@@ -84,7 +86,11 @@ def oscillator_coefficients(period, damping, dt):
     augmented[:2, 2] = forcing * dt
     augmented[2, 3] = 1.0  # the ramp: input grows by (a[k+1]-a[k]) over the step
     exponential = expm(augmented)
-    return exponential[:2, :2], exponential[:2, 2], exponential[:2, 3]
+    # cached (records share dt and periods): hand out read-only arrays
+    parts = exponential[:2, :2].copy(), exponential[:2, 2].copy(), exponential[:2, 3].copy()
+    for part in parts:
+        part.flags.writeable = False
+    return parts
 
 
 @njit(cache=True)
@@ -137,7 +143,7 @@ def response_spectrum(acceleration, dt, periods=DEFAULT_PERIODS, damping=0.05):
         raise ValueError("periods must be positive [s]")
     if not 0 <= damping < 1:
         raise ValueError(f"damping ratio {damping} out of range; allowed 0 <= damping < 1")
-    coefficients = [oscillator_coefficients(period, damping, dt) for period in periods]
+    coefficients = [oscillator_coefficients(float(period), float(damping), float(dt)) for period in periods]
     phi = np.array([c[0] for c in coefficients])
     gamma0 = np.array([c[1] for c in coefficients])
     gamma1 = np.array([c[2] for c in coefficients])
