@@ -31,6 +31,7 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
+from pipeline.cube import write_netcdf
 from pipeline.measures import MEASURES
 from pipeline.outputs import atomic_path
 
@@ -239,10 +240,7 @@ def write_efficiency(dataset: xr.Dataset, output) -> tuple[Path, Path]:
     """``efficiency.nc`` and ``efficiency.csv`` in ``output``."""
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)
-    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
-                if var.dtype.kind == "f"}
-    with atomic_path(output / "efficiency.nc") as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    write_netcdf(dataset, output / "efficiency.nc")
     with atomic_path(output / "efficiency.csv") as temporary:
         efficiency_table(dataset).to_csv(temporary, index=False, float_format="%.6g")
     return output / "efficiency.nc", output / "efficiency.csv"

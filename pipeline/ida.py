@@ -25,8 +25,7 @@ import math
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import OUTCOME_OVERTURNED
-from pipeline.outputs import atomic_path
+from pipeline.cube import OUTCOME_OVERTURNED, write_netcdf
 
 FRACTILES = (0.16, 0.50, 0.84)
 RESPONSE_LEVELS = np.round(np.concatenate([np.linspace(0.05, 1.0, 20), np.linspace(1.5, 5.0, 8)]), 4)
@@ -175,10 +174,8 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
 
 
 def write_ida(dataset: xr.Dataset, path) -> None:
-    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
-                if var.dtype.kind == "f"}
-    with atomic_path(path) as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    """``ida.nc``: the one netCDF writer of the package (pipeline.cube.write_netcdf)."""
+    write_netcdf(dataset, path)
 
 
 def fill(overturns, lower, upper, tolerance=0.02, max_runs=200):
