@@ -25,7 +25,8 @@ from reference import reference_response  # noqa: E402
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.config import load_study  # noqa: E402
 from pipeline.ida import hunt_and_fill  # noqa: E402
-from pipeline.models import simulate, simulate_batch  # noqa: E402
+from pipeline.models import get_model, simulate, simulate_batch  # noqa: E402
+from pipeline.soils import soil_block_stiffness  # noqa: E402
 from pipeline.processing import process_record  # noqa: E402
 from pipeline.records import load_records  # noqa: E402
 
@@ -74,6 +75,40 @@ def solver_throughput(records):
               f"{scipy_ms / kernel_ms:7.0f}x")
 
 
+def per_run_cost(records):
+    """ms and integration steps per run of each model on each default soil, the default study's blocks."""
+    print("\n1b. Per-run cost, one core: the default blocks and soils, far-field set at 1.5 and 3 x uplift PGA")
+    config = load_study()
+    print(f"   {'model':20} {'block':16}" + "".join(f"{s.name:>16}" for s in config.soils))
+    cases = [("housner", {}), ("ssi", {}), ("winkler", {"bed": "continuous"}), ("winkler", {"bed": "two-spring"})]
+    for model, options in cases:
+        label = model + (f" ({options['bed']})" if options else "")
+        for block in config.blocks:
+            cells = []
+            soils = config.soils[:1] if get_model(model).is_rigid_base else config.soils
+            for soil in soils:
+                k = soil_block_stiffness(soil, block)
+                simulate_batch(model, records[0].acceleration[:50], records[0].dt, [1.0], [(block, k, 0.05)], **options)
+                start = time.perf_counter()
+                runs = steps = 0
+                for record in records:
+                    scales = np.array([1.5, 3.0]) * block.uplift_acceleration() / np.max(np.abs(record.acceleration))
+                    out = simulate_batch(model, record.acceleration, record.dt, scales, [(block, k, 0.05)], **options)
+                    runs += out.size
+                    steps += out["n_steps"].sum()
+                elapsed = time.perf_counter() - start
+                omega_over_p = np.sqrt(k / block.mass) / block.p()
+                cells.append(f"{elapsed / runs * 1e3:6.2f} ms {steps / runs / 1e3:5.1f}k")
+                if get_model(model).is_rigid_base:
+                    cells[-1] += " (all soils)"
+            print(f"   {label:20} {block.name:16}" + "".join(f"{c:>16}" for c in cells))
+    omega = [f"{s.name} {np.sqrt(soil_block_stiffness(s, b) / b.mass) / b.p():.0f}" for b in config.blocks[:1]
+             for s in config.soils]
+    print(f"   (ms per run and integration steps per run; omega_v/p of the paper block: {', '.join(omega)}.")
+    print("    Steps end on every sample, so soft beds cost about one step per sample; stiff beds are bounded by")
+    print("    the explicit integrator's stability, h < 3.3/omega_v.)")
+
+
 def run_study_subprocess(args, output):
     command = [sys.executable, "-m", "pipeline", "run", *args, "--output", str(output), "--no-progress"]
     start = time.perf_counter()
@@ -90,7 +125,8 @@ def study_timing():
     with tempfile.TemporaryDirectory() as folder:
         elapsed, peak_mb = run_study_subprocess([], Path(folder) / "default")
     config = load_study()
-    runs = sum(1 if m == "housner" else len(config.soils) for m in config.models) * len(config.blocks) * 44 * len(config.levels)
+    runs = sum(1 if get_model(m).is_rigid_base else len(config.soils) for m in config.models) \
+        * len(config.blocks) * 44 * len(config.levels)
     print(f"   {runs} solver runs in {elapsed:.1f} s wall ({runs / elapsed:.0f} runs/s); "
           f"peak RSS of the largest process {peak_mb:.0f} MB")
     print("\n3. Scaling: 8 far-field records, default levels/soils/blocks/models")
@@ -125,5 +161,6 @@ def hunt_and_fill_savings(records):
 if __name__ == "__main__":
     records = far_field()
     solver_throughput(records)
+    per_run_cost(records)
     study_timing()
     hunt_and_fill_savings(records)

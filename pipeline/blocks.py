@@ -13,15 +13,11 @@ from dataclasses import dataclass, field
 
 from pipeline.errors import ConfigError
 from pipeline.units import STANDARD_GRAVITY
+from pipeline.validation import Number
 
 
 def _check(name, value, low, high, unit, low_open=True):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ConfigError(name, f"{value!r} is not a finite number [{unit}]")
-    if (value <= low if low_open else value < low) or value > high:
-        raise ConfigError(name, f"{value} [{unit}] out of range; allowed {'>' if low_open else '>='} "
-                          f"{low:g} and <= {high:g}")
-    return float(value)
+    return Number(low, high, low_open=low_open, unit=unit).check(value, name, None)
 
 
 @dataclass(frozen=True)

@@ -18,71 +18,179 @@ EXIT_USER_ERROR = 2
 EXIT_PARTIAL = 1
 
 
-def _add_record_arguments(parser):
-    parser.add_argument("--set", dest="record_set", action="append", metavar="NAME",
-                        help="record set from records/MANIFEST.csv (far-field, near-field-pulse, "
-                             "near-field-no-pulse, near-field, peer-original, bolu, all), a record id, "
-                             "or a folder/file of your own records; repeatable (default: all)")
-    parser.add_argument("--units", default=None,
-                        help="acceleration units of your own files when the format does not state "
-                             "them (g, m/s^2, cm/s^2, gal)")
-    parser.add_argument("--processing", type=Path, default=None, metavar="TOML",
-                        help="processing recipe (default: pipeline/processing.toml)")
-    parser.add_argument("--output", type=Path, default=Path("reports"), metavar="DIR",
-                        help="output folder (default: reports)")
-    parser.add_argument("--no-progress", action="store_true", help="hide progress bars")
+# ---------------------------------------------------------------- argument types (checked at parse time)
+
+def _number_type(low, *, low_open=True, high=None, high_open=False, whole=False):
+    """An argparse type: a (whole) number in a range, else a one-line usage error."""
+    wanted = "a whole number" if whole else "a number"
+    limits = [f"{'>' if low_open else '>='} {low:g}"] + ([f"{'<' if high_open else '<='} {high:g}"]
+                                                         if high is not None else [])
+
+    def convert(text):
+        try:
+            value = int(text) if whole else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not {wanted}") from None
+        too_low = value <= low if low_open else value < low
+        too_high = high is not None and (value >= high if high_open else value > high)
+        if too_low or too_high or value != value:
+            raise argparse.ArgumentTypeError(f"{text} must be {' and '.join(limits)}")
+        return value
+
+    convert.__name__ = "whole number" if whole else "number"
+    return convert
 
 
-def _load(args):
-    from pipeline.processing import load_recipe
-    from pipeline.records import load_records
+POSITIVE = _number_type(0)
+POOL_SIZE = _number_type(1, low_open=False, whole=True)
+GRID_SIZE = _number_type(2, low_open=False, whole=True)
 
-    recipe = load_recipe(args.processing)
-    records, failures = load_records(args.record_set or ["all"], units=args.units)
-    for failure in failures:
-        print(f"rockfrag: skipped {failure}", file=sys.stderr)
-    return records, failures, recipe
 
+def _name(text):
+    if not text.strip():
+        raise argparse.ArgumentTypeError("empty; name a record set, a record id, a folder or a file")
+    return text
+
+
+# ---------------------------------------------------------------- shared options, defined once
+
+def _parent():
+    return argparse.ArgumentParser(add_help=False)
+
+
+def _study_option(positional=True):
+    parent = _parent()
+    if positional:
+        parent.add_argument("study", nargs="?", type=Path, default=None,
+                            help="study TOML file (default: the shipped pipeline/defaults.toml)")
+    else:
+        parent.add_argument("--study", type=Path, default=None, metavar="TOML",
+                            help="study TOML file (default: the shipped pipeline/defaults.toml)")
+    return parent
+
+
+def _record_set_option():
+    parent = _parent()
+    parent.add_argument("--set", dest="record_set", action="append", type=_name, metavar="NAME",
+                        help="record set (far-field, near-field-pulse, near-field-no-pulse, near-field, "
+                             "peer-original, bolu, all), a record id, or a folder/file of your own records; "
+                             "repeatable (default: the study's study.record_sets)")
+    return parent
+
+
+def _reading_options():
+    parent = _parent()
+    parent.add_argument("--units", default=None,
+                        help="acceleration units of your own files that do not state them: g, m/s^2, cm/s^2, "
+                             "gal (default: the study's study.units)")
+    parent.add_argument("--dt", type=POSITIVE, default=None, metavar="SECONDS",
+                        help="time step of one-column text records [s] (default: the study's study.dt)")
+    parent.add_argument("--processing", type=Path, default=None, metavar="TOML",
+                        help="processing recipe (default: the study's study.processing, else "
+                             "pipeline/processing.toml)")
+    return parent
+
+
+def _output_option():
+    parent = _parent()
+    parent.add_argument("--output", type=Path, default=None, metavar="DIR",
+                        help="output folder (default: the study's study.output, reports/)")
+    parent.add_argument("--no-progress", action="store_true", help="hide progress bars")
+    return parent
+
+
+def _workers_option(scheduler):
+    parent = _parent()
+    parent.add_argument("--workers", type=POOL_SIZE, default=None, metavar="N",
+                        help="worker processes (N >= 1; 1 runs in this process; default: all cores)")
+    parent.add_argument("--serial", dest="workers", action="store_const", const=1,
+                        help="same as --workers 1")
+    if scheduler:
+        parent.add_argument("--scheduler", default=None, metavar="local|ADDRESS",
+                            help="run the study on dask: 'local' starts a LocalCluster of --workers processes, "
+                                 "an address such as tcp://host:8786 uses a running cluster")
+    return parent
+
+
+# ---------------------------------------------------------------- from arguments to a study
+
+def _study_config(args, applicability=None):
+    """The study (file or shipped default) with the command-line options that override its keys.
+
+    One rule for every command: an option left out takes the study's value (``--set``:
+    study.record_sets, ``--output``: study.output, ``--processing``: study.processing, ``--units`` and
+    ``--dt``: study.units and study.dt); without a study file, the shipped defaults.
+    """
+    from pipeline.config import load_study
+
+    study = {}
+    if getattr(args, "record_set", None):
+        study["record_sets"] = list(args.record_set)
+    for option, key in (("processing", "processing"), ("units", "units"), ("dt", "dt")):
+        value = getattr(args, option, None)
+        if value is not None:
+            study[key] = str(value) if isinstance(value, Path) else value
+    overrides = {"study": study} if study else {}
+    if applicability:
+        overrides["applicability"] = applicability
+    config = load_study(args.study, overrides or None)
+    return config, Path(args.output) if args.output else config.output
+
+
+def _executor_options(args) -> dict:
+    """run_study's executor arguments: a process pool of --workers, or dask with --scheduler."""
+    scheduler = getattr(args, "scheduler", None)
+    if scheduler is None:
+        return {"workers": args.workers}
+    if scheduler == "local":
+        import os
+
+        return {"dask_workers": args.workers or os.cpu_count()}
+    if args.workers is not None:
+        raise PipelineError(f"--workers {args.workers} with --scheduler {scheduler}: a running cluster has its "
+                            "own workers; use --workers with --scheduler local or without --scheduler")
+    return {"scheduler": scheduler}
+
+
+def _log(message):
+    print(message, file=sys.stderr)
+
+
+# ---------------------------------------------------------------- commands
 
 def command_records(args) -> int:
-    from pipeline.records_report import TABLE_COLUMNS, records_stage
-
-    records, failures, recipe = _load(args)
-    if not records:
-        raise PipelineError("no record could be read; nothing to do")
-    table, pngs = records_stage(records, recipe, args.output, plot=args.plot,
-                                progress=not args.no_progress)
     import pandas as pd
 
+    from pipeline.processing import load_recipe
+    from pipeline.records import load_records
+    from pipeline.records_report import TABLE_COLUMNS, records_stage
+
+    config, output = _study_config(args)
+    recipe = load_recipe(config.processing or None)
+    records, failures = load_records(list(config.record_sets), units=config.record_units or None,
+                                     dt=config.record_dt)
+    for failure in failures:
+        _log(f"rockfrag: skipped {failure}")
+    if not records:
+        raise PipelineError("no record could be read; nothing to do")
+    table, pngs = records_stage(records, recipe, output, plot=args.plot, progress=not args.no_progress)
     shown = table[["id", "event", "station", "component", *TABLE_COLUMNS]].rename(columns=TABLE_COLUMNS)
     with pd.option_context("display.max_rows", None, "display.width", 200, "display.max_colwidth", 28):
         print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-    print(f"\nwrote {args.output / 'records.csv'} ({len(table)} records)")
+    print(f"\nwrote {output / 'records.csv'} ({len(table)} records)")
     if pngs:
-        print(f"wrote {len(pngs)} figures in {args.output / 'records'}/")
+        print(f"wrote {len(pngs)} figures in {output / 'records'}/")
     flagged = table[table["qa_flags"].astype(bool)]
     if len(flagged):
         print(f"QA: {len(flagged)} record(s) flagged (kept): {', '.join(flagged['id'])}; see qa_flags")
     return EXIT_PARTIAL if failures else 0
 
 
-def _study_config(args):
-    from pipeline.config import load_study
-
-    overrides = {}
-    if getattr(args, "record_set", None):
-        overrides.setdefault("study", {})["record_sets"] = args.record_set
-    config = load_study(args.study, overrides or None)
-    return config, Path(args.output) if args.output else config.output
-
-
 def command_run(args) -> int:
     from pipeline.study import run_study
 
     config, output = _study_config(args)
-    dataset, stats = run_study(config, output=output, workers=1 if args.serial else None,
-                               scheduler=args.scheduler, dask_workers=args.workers,
-                               progress=not args.no_progress)
+    dataset, stats = run_study(config, output=output, progress=not args.no_progress, **_executor_options(args))
     runs = stats["runs_computed"]
     rate = f", {runs / stats['seconds']:.0f} runs/s" if runs else ""
     print(f"wrote {output / 'cube.nc'} ({stats['seconds']:.1f} s{rate}; "
@@ -91,22 +199,19 @@ def command_run(args) -> int:
 
 
 def command_fragility(args) -> int:
-    """The whole pipeline: study cube, IDA, fragility and risk, report."""
+    """The whole pipeline: study cube, IDA, fragility and risk, applicability, report."""
     import time
 
     from pipeline.fragility import fragility_stage
     from pipeline.ida import ida_stage
     from pipeline.report import report_stage
-    from pipeline.study import run_study
-
-    from pipeline.study import study_records
+    from pipeline.study import run_study, study_records
 
     started = time.perf_counter()
     config, output = _study_config(args)
-    loaded = study_records(config, log=lambda message: print(message, file=sys.stderr))
-    cube, stats = run_study(config, output=output, workers=1 if args.serial else None,
-                            scheduler=args.scheduler, dask_workers=args.workers, progress=not args.no_progress,
-                            loaded=loaded)
+    executor = _executor_options(args)
+    loaded = study_records(config, log=_log)
+    cube, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded, **executor)
     print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
@@ -122,8 +227,8 @@ def command_fragility(args) -> int:
     if not args.skip_applicability:
         from pipeline.applicability import applicability_stage
 
-        applicability = applicability_stage(config, output, workers=1 if args.serial else None,
-                                            progress=not args.no_progress, loaded=loaded)
+        applicability = applicability_stage(config, output, workers=args.workers, progress=not args.no_progress,
+                                            loaded=loaded)
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
                              applicability, loaded)
     print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
@@ -131,47 +236,42 @@ def command_fragility(args) -> int:
     return EXIT_PARTIAL if stats["failures"] else 0
 
 
-def _block_from_study(name, study):
-    from pipeline.config import load_study
-
-    config = load_study(study)
-    blocks = {b.name: b for b in config.blocks}
-    if name not in blocks:
-        raise PipelineError(f"unknown block {name!r}; blocks of the study: {', '.join(blocks)}")
-    return blocks[name], config
-
-
-def _ground_motion(args):
+def _ground_motion(args, config):
     from pipeline.processing import load_recipe, process_record
     from pipeline.records import load_records
 
-    records, failures = load_records(args.record, units=args.units)
+    records, failures = load_records(args.record, units=config.record_units or None, dt=config.record_dt)
     if failures:
         raise failures[0]
     if len(records) != 1:
         raise PipelineError(f"--record {args.record!r} selects {len(records)} records; name exactly one")
-    record = records[0] if args.raw else process_record(records[0], load_recipe(args.processing))
-    if not args.scale > 0:
-        raise PipelineError(f"--scale {args.scale}: must be > 0")
+    record = records[0] if args.raw else process_record(records[0], load_recipe(config.processing or None))
     return record, record.acceleration * args.scale
 
 
 def command_calibrate(args) -> int:
     from pipeline.calibrate import calibrate, load_reference, write_outputs
 
-    block, config = _block_from_study(args.block, args.study)
+    config, output = _study_config(args)
+    blocks = {b.name: b for b in config.blocks}
+    if args.block not in blocks:
+        raise PipelineError(f"unknown block {args.block!r}; blocks of the study: {', '.join(blocks)}")
+    block = blocks[args.block]
     ref_time, ref_rotation = load_reference(args.reference, args.time_unit, args.angle_unit)
-    record, ag = _ground_motion(args)
+    record, ag = _ground_motion(args, config)
     soil_g = args.soil_g
     if soil_g is None and args.soil:
         soils = {s.name: s for s in config.soils}
         if args.soil not in soils:
             raise PipelineError(f"unknown soil {args.soil!r}; soils of the study: {', '.join(soils)}")
         soil_g = soils[args.soil].shear_modulus
+    for option, (low, high) in (("--k-range", args.k_range), ("--xi-range", args.xi_range)):
+        if not low < high:
+            raise PipelineError(f"{option} {low:g} {high:g}: MIN must be below MAX")
     result = calibrate(ref_time, ref_rotation, ag, record.dt, block, k_range=tuple(args.k_range),
                        xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi, soil_shear_modulus=soil_g,
                        switch=config.switch, local=not args.grid_only)
-    files = write_outputs(result, ref_time, ref_rotation, ag, record.dt, block, args.output, config.switch)
+    files = write_outputs(result, ref_time, ref_rotation, ag, record.dt, block, output, config.switch)
     print(f"grid optimum : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation {result.correlation_grid:.4f}")
     print(f"local optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation {result.correlation:.4f}")
     print(f"RMS error {result.rms_error:.3g} rad; peak angle {result.peak_model:.4g} rad vs reference "
@@ -184,109 +284,98 @@ def command_calibrate(args) -> int:
     return 0
 
 
-def command_applicability(args) -> int:
-    import numpy as np
+APPLICABILITY_OPTIONS = ("g_range", "n_g", "levels", "block_moduli", "tolerance")
+"""Options of ``rockfrag applicability`` that override the study's ``[applicability]`` keys of the same name."""
 
-    from pipeline.applicability import run_applicability, write_applicability
+
+def command_applicability(args) -> int:
+    from pipeline.applicability import applicability_stage
     from pipeline.study import study_records
 
-    config, output = _study_config(args)
-    if args.g_range[0] <= 0 or args.g_range[1] <= args.g_range[0]:
-        raise PipelineError(f"--g-range {args.g_range}: need 0 < G_min < G_max [Pa]")
-    records, _, _ = study_records(config, log=lambda message: print(message, file=sys.stderr))
-    dataset = run_applicability(records, config.blocks, shear_moduli=np.geomspace(*args.g_range, args.n_g),
-                                block_moduli=tuple(args.block_moduli), level_factors=tuple(args.levels),
-                                tolerance=args.tolerance, workers=1 if args.serial else None,
-                                progress=not args.no_progress)
-    paths = write_applicability(dataset, output)
+    overrides = {key: getattr(args, key) for key in APPLICABILITY_OPTIONS if getattr(args, key) is not None}
+    config, output = _study_config(args, overrides)
+    loaded = study_records(config, log=_log)
+    dataset = applicability_stage(config, output, workers=args.workers, progress=not args.no_progress,
+                                  loaded=loaded)
     table = (dataset.threshold_shear_modulus / 1e6).to_dataframe()["threshold_shear_modulus"].unstack()
-    print(f"G_s [MPa] above which Housner is within {args.tolerance:.0%} of SSI (rows: block, E_b [Pa]; "
-          "columns: PGA / uplift PGA; NaN: not within tolerance even at the stiffest G_s):")
+    print(f"G_s [MPa] above which Housner is within {config.applicability.tolerance:.0%} of each model (rows: "
+          "model, block, E_b [Pa]; columns: PGA / uplift PGA; NaN: not within tolerance even at the stiffest G_s):")
     print(table.round(0).to_string())
-    for path in paths:
-        print(f"wrote {path}")
     return 0
 
+
+# ---------------------------------------------------------------- the parser
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="rockfrag",
         description="Seismic fragility of unanchored rocking structures (Housner and SSI-rocking "
-                    "models) from real strong-motion records.")
+                    "models) from real strong-motion records. Options left out take the study's value "
+                    "(the shipped pipeline/defaults.toml when no study file is given).")
     parser.add_argument("--version", action="version", version=f"rockfrag {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    study, record_set, reading, output = _study_option(), _record_set_option(), _reading_options(), _output_option()
+    pool, dask = _workers_option(scheduler=False), _workers_option(scheduler=True)
 
-    records = commands.add_parser("records", help="list records with intensity measures "
-                                  "(writes records.csv; --plot writes a PNG per record)")
-    _add_record_arguments(records)
+    records = commands.add_parser("records", parents=[study, record_set, reading, output],
+                                  help="list records with intensity measures (writes records.csv; --plot writes "
+                                       "a PNG per record)")
     records.add_argument("--plot", action="store_true",
                          help="write raw-vs-processed acceleration/velocity/displacement and the 5%% "
                               "response spectrum of every record as PNG")
     records.set_defaults(handler=command_records)
 
-    for name, handler, text in (("run", command_run, "run a study into the cube (cube.nc)"),
-                                ("fragility", command_fragility,
-                                 "run the whole pipeline: cube, IDA, fragility, report")):
-        sub = commands.add_parser(name, help=text)
-        sub.add_argument("study", nargs="?", type=Path, default=None,
-                         help="study TOML file (default: the shipped pipeline/defaults.toml)")
-        sub.add_argument("--set", dest="record_set", action="append", metavar="NAME",
-                         help="record set(s), overriding the study's study.record_sets")
-        sub.add_argument("--output", type=Path, default=None, metavar="DIR",
-                         help="output folder (default: the study's study.output, reports/)")
-        sub.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                         help="run on an existing dask.distributed cluster, e.g. tcp://host:8786")
-        sub.add_argument("--workers", type=int, default=None, metavar="N",
-                         help="start a local dask cluster with N worker processes")
-        sub.add_argument("--serial", action="store_true", help="run in this process (debugging)")
-        sub.add_argument("--no-progress", action="store_true", help="hide progress bars")
-        if name == "fragility":
-            sub.add_argument("--skip-applicability", action="store_true",
-                             help="skip the soil-stiffness sweep of `rockfrag applicability` (saves minutes)")
-        sub.set_defaults(handler=handler)
-    calibrate = commands.add_parser("calibrate", help="fit the SSI stiffness k and damping xi to a reference "
-                                    "rotation history (paper eq. 17)")
+    run = commands.add_parser("run", parents=[study, record_set, reading, output, dask],
+                              help="run a study into the cube (cube.nc)")
+    run.set_defaults(handler=command_run)
+    fragility = commands.add_parser("fragility", parents=[study, record_set, reading, output, dask],
+                                    help="run the whole pipeline: cube, IDA, fragility, applicability, report")
+    fragility.add_argument("--skip-applicability", action="store_true",
+                           help="skip the soil-stiffness sweep of `rockfrag applicability` (saves minutes)")
+    fragility.set_defaults(handler=command_fragility)
+
+    calibrate = commands.add_parser("calibrate", parents=[_study_option(positional=False), reading, output],
+                                    help="fit the SSI stiffness k and damping xi to a reference rotation history "
+                                         "(paper eq. 17)")
     calibrate.add_argument("reference", type=Path, help="table of time and rotation (CSV or any table pandas "
                            "reads); units from --time-unit/--angle-unit or headers such as 'time [s]', 'theta [deg]'")
-    calibrate.add_argument("--record", required=True, help="the ground motion: a record id (e.g. DUZCE/BOL090) "
-                           "or a file")
-    calibrate.add_argument("--scale", type=float, default=1.0, help="factor applied to the record (default 1)")
+    calibrate.add_argument("--record", required=True, type=_name,
+                           help="the ground motion: a record id (e.g. DUZCE/BOL090) or a file")
+    calibrate.add_argument("--scale", type=POSITIVE, default=1.0, help="factor applied to the record (default 1)")
     calibrate.add_argument("--raw", action="store_true", help="use the record as published (no processing)")
-    calibrate.add_argument("--processing", type=Path, default=None, metavar="TOML", help="processing recipe")
-    calibrate.add_argument("--units", default=None, help="acceleration units of a record file that does not state them")
     calibrate.add_argument("--block", default="paper", help="block name from the study (default: paper)")
-    calibrate.add_argument("--study", type=Path, default=None, help="study TOML holding the block (default: shipped)")
     calibrate.add_argument("--soil", default=None, help="soil of the study, for the implied A/H of eq. 19")
-    calibrate.add_argument("--soil-g", type=float, default=None, metavar="PA", help="soil shear modulus G_s [Pa] "
-                           "for the implied A/H (overrides --soil)")
-    calibrate.add_argument("--k-range", type=float, nargs=2, default=[1e8, 9e8], metavar=("MIN", "MAX"),
+    calibrate.add_argument("--soil-g", type=POSITIVE, default=None, metavar="PA",
+                           help="soil shear modulus G_s [Pa] for the implied A/H (overrides --soil)")
+    calibrate.add_argument("--k-range", type=POSITIVE, nargs=2, default=[1e8, 9e8], metavar=("MIN", "MAX"),
                            help="stiffness grid [N/m] (default 1e8 9e8 = the paper's 1e5-9e5 kN/m)")
-    calibrate.add_argument("--xi-range", type=float, nargs=2, default=[0.01, 0.07], metavar=("MIN", "MAX"),
+    calibrate.add_argument("--xi-range", type=_number_type(0, high=1, high_open=True), nargs=2,
+                           default=[0.01, 0.07], metavar=("MIN", "MAX"),
                            help="damping-ratio grid [-] (default 0.01 0.07)")
-    calibrate.add_argument("--n-k", type=int, default=25, help="grid points in k (log-spaced)")
-    calibrate.add_argument("--n-xi", type=int, default=7, help="grid points in xi")
+    calibrate.add_argument("--n-k", type=GRID_SIZE, default=25, help="grid points in k (log-spaced, >= 2)")
+    calibrate.add_argument("--n-xi", type=GRID_SIZE, default=7, help="grid points in xi (>= 2)")
     calibrate.add_argument("--grid-only", action="store_true", help="skip the local optimisation")
-    calibrate.add_argument("--time-unit", choices=["s", "ms"], default=None)
-    calibrate.add_argument("--angle-unit", choices=["rad", "mrad", "deg"], default=None)
-    calibrate.add_argument("--output", type=Path, default=Path("reports"), metavar="DIR")
+    calibrate.add_argument("--time-unit", default=None, help="time unit of the reference (default: from its "
+                           "header, else s)")
+    calibrate.add_argument("--angle-unit", default=None, help="angle unit of the reference (default: from its "
+                           "header, else rad)")
     calibrate.set_defaults(handler=command_calibrate)
 
-    applicability = commands.add_parser("applicability", help="sweep the soil shear modulus and compare "
-                                        "Housner with SSI-rocking (writes applicability.nc and a figure)")
-    applicability.add_argument("study", nargs="?", type=Path, default=None, help="study TOML (blocks, records)")
-    applicability.add_argument("--set", dest="record_set", action="append", metavar="NAME",
-                               help="record set(s), overriding the study's")
-    applicability.add_argument("--g-range", type=float, nargs=2, default=[10e6, 100e9], metavar=("MIN", "MAX"),
-                               help="soil shear modulus range [Pa] (default 1e7 1e11)")
-    applicability.add_argument("--n-g", type=int, default=13, help="moduli in the sweep (log-spaced)")
-    applicability.add_argument("--levels", type=float, nargs="+", default=[1.5, 2.5, 4.0],
-                               help="PGA levels as multiples of each block's uplift PGA g tan(alpha)")
-    applicability.add_argument("--block-moduli", type=float, nargs="+", default=[30e9, 210e9], metavar="PA",
-                               help="block Young's moduli E_b to compare [Pa] (default concrete and steel)")
-    applicability.add_argument("--tolerance", type=float, default=0.10, help="allowed |SSI/Housner - 1|")
-    applicability.add_argument("--output", type=Path, default=None, metavar="DIR")
-    applicability.add_argument("--serial", action="store_true", help="run in this process")
-    applicability.add_argument("--no-progress", action="store_true")
+    applicability = commands.add_parser(
+        "applicability", parents=[study, record_set, reading, output, pool],
+        help="sweep the soil shear modulus and compare Housner with SSI-rocking (writes applicability.nc and a "
+             "figure; the same sweep as the fragility stage, from the study's [applicability] table)")
+    applicability.add_argument("--g-range", type=POSITIVE, nargs=2, default=None, metavar=("MIN", "MAX"),
+                               help="soil shear modulus range [Pa] (study default 1e7 1e11)")
+    applicability.add_argument("--n-g", type=GRID_SIZE, default=None, help="moduli in the sweep (log-spaced; "
+                               "study default 13)")
+    applicability.add_argument("--levels", type=POSITIVE, nargs="+", default=None,
+                               help="PGA levels as multiples of each block's uplift PGA g tan(alpha) "
+                                    "(study default 1.5 2.5 4)")
+    applicability.add_argument("--block-moduli", type=POSITIVE, nargs="+", default=None, metavar="PA",
+                               help="block Young's moduli E_b to compare [Pa] (study default 3e10 2.1e11)")
+    applicability.add_argument("--tolerance", type=POSITIVE, default=None,
+                               help="allowed |SSI/Housner - 1| (study default 0.1)")
     applicability.set_defaults(handler=command_applicability)
     return parser
 

@@ -1,15 +1,25 @@
 """pipeline.config - study definition: shipped defaults plus a user TOML file, validated once.
 
 Input : ``pipeline/defaults.toml`` and optionally a user study file with the same layout (a table or
-        key in the user file replaces the default one; ``[blocks]`` and ``[soils_custom]`` entries are
-        added to / replace the defaults by name).
-Output: a frozen ``StudyConfig`` with SI values; errors name the file, the field, the value and the
-        allowed range.
+        key in the user file replaces the default one; ``[soils_custom.NAME]``, ``[blocks_custom.NAME]``
+        and ``[damage_states.NAME]`` entries are added to / replace the defaults by name).
+Output: a frozen ``StudyConfig`` with SI values.
+
+Validation happens here, once, before anything runs: every key at every level is checked against
+``SCHEMA`` (unknown keys, TOML types, ranges), then the cross-references (soil, block and model names,
+damage-state EDPs, the hazard file). Each mistake is one ``ConfigError`` naming the study file and
+the field as the user wrote it (``soils_custom.loam.poison_ratio``, ``intensity.levels.start``).
+
+Blocks: ``blocks = ["paper", "mine"]`` selects which blocks run, among the shipped presets and the
+user's ``[blocks_custom.NAME]`` tables. A user file may instead define ``[blocks.NAME]`` tables (TOML
+cannot hold both forms under one key): then exactly those blocks run, and the presets do not.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
+import difflib
 import hashlib
 import json
 import math
@@ -23,15 +33,216 @@ import numpy as np
 from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.measures import MEASURES
-from pipeline.models import MODELS, SWITCH_RULES
-from pipeline.soils import SOILS, SoilClass
+from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
+from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
+from pipeline.validation import Number, shown as _shown
 
 MEASURE_UNITS = {name: (m.display_unit, m.display_factor) for name, m in MEASURES.items() if m.scalable}
-"""Measures a study can scale records to: name -> (display unit, SI value of one display unit)."""
+"""Measures a study can scale records to (pipeline.measures registry): name -> (display unit, SI value
+of one display unit)."""
+SCALING_MEASURES = tuple(MEASURE_UNITS)
+LEVEL_REFERENCES = ("", "uplift")
+"""``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
+uplift intensity."""
 
-LEVELS_RELATIVE_TO = ("", "uplift")
-"""``[intensity] levels.relative_to``: "" = levels in the measure's unit, the same for every block;
-"uplift" = multiples of each block's uplift intensity (pipeline.study.uplift_intensity)."""
+
+# ---------------------------------------------------------------- the schema
+
+@dataclass(frozen=True)
+class Text:
+    """A string, optionally one of ``choices``."""
+
+    choices: tuple[str, ...] = ()
+    nonempty: bool = False
+
+    def check(self, value, field, source):
+        allowed = f"; allowed: {', '.join(repr(c) for c in self.choices)}" if self.choices else ""
+        if not isinstance(value, str):
+            raise ConfigError(field, f"{_shown(value)}; must be a string{allowed}", source)
+        if self.choices and value not in self.choices:
+            raise ConfigError(field, f"{value!r} unknown{allowed}", source)
+        if self.nonempty and not value.strip():
+            raise ConfigError(field, "empty; must be a non-empty string", source)
+        return value
+
+
+@dataclass(frozen=True)
+class Names:
+    """A non-empty list of non-empty strings (names of soils, models, blocks, record sets)."""
+
+    example: str
+
+    def check(self, value, field, source):
+        if not isinstance(value, list):
+            raise ConfigError(field, f"{_shown(value)}; must be a list of names, e.g. {self.example}", source)
+        if not value:
+            raise ConfigError(field, f"empty list; name at least one, e.g. {self.example}", source)
+        for index, item in enumerate(value):
+            if not isinstance(item, str):
+                raise ConfigError(f"{field}[{index}]", f"{_shown(item)}; must be a name (a string)", source)
+            if not item.strip():
+                raise ConfigError(f"{field}[{index}]", "empty name", source)
+        return value
+
+
+@dataclass(frozen=True)
+class Numbers:
+    """A non-empty list of numbers, each checked by ``item``."""
+
+    item: Number
+
+    def check(self, value, field, source):
+        if not isinstance(value, list) or not value:
+            raise ConfigError(field, f"{_shown(value)}; must be a non-empty list of {self.item.describe()}", source)
+        return [self.item.check(v, f"{field}[{i}]", source) for i, v in enumerate(value)]
+
+
+@dataclass(frozen=True)
+class Table:
+    """A TOML table with a fixed set of keys (any other key is an error listing the allowed ones)."""
+
+    fields: dict
+
+    def check(self, value, field, source):
+        if not isinstance(value, dict):
+            raise ConfigError(field or "study", f"{_shown(value)}; must be a table ([{field}] or {{ ... }})",
+                              source)
+        for key, item in value.items():
+            where = f"{field}.{key}" if field else key
+            if key not in self.fields:
+                dotted = (f" (a table name with a dot must be quoted: [{field.rsplit('.', 1)[0]}.\"{field.rsplit('.', 1)[1]}"
+                          f".{key}\"])" if isinstance(item, dict) and field.count(".") == 1 else "")
+                raise ConfigError(where, _unknown_key(key, self.fields, top_level=not field) + dotted, source)
+            self.fields[key].check(item, where, source)
+        return value
+
+
+@dataclass(frozen=True)
+class NamedTables:
+    """``[PREFIX.NAME]`` tables: any name, each a ``Table``."""
+
+    table: Table
+
+    def check(self, value, field, source):
+        if not isinstance(value, dict):
+            raise ConfigError(field, f"{_shown(value)}; must be tables [{field}.NAME]", source)
+        for name, item in value.items():
+            if not isinstance(item, dict):
+                raise ConfigError(f"{field}.{name}", f"{_shown(item)}; must be a table [{field}.{name}] with keys "
+                                  f"{', '.join(sorted(self.table.fields))}", source)
+            self.table.check(item, f"{field}.{name}", source)
+        return value
+
+
+@dataclass(frozen=True)
+class Either:
+    """A list (the first spec) or tables (the second), chosen by the value's TOML type."""
+
+    as_list: Names
+    as_tables: NamedTables
+
+    def check(self, value, field, source):
+        return (self.as_list if isinstance(value, list) else self.as_tables).check(value, field, source)
+
+
+@dataclass(frozen=True)
+class Checked:
+    """A value checked by its own function (``[intensity] levels``: see ``_levels``)."""
+
+    function: object
+
+    def check(self, value, field, source):
+        return self.function(value, field, source)
+
+
+def _unknown_key(key, allowed, top_level=False) -> str:
+    close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.75)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    if not top_level and key in SCHEMA.fields:
+        hint += " (top-level keys such as soils/models must come before the first [table])"
+    return f"unknown key{hint}; allowed: {', '.join(sorted(allowed))}"
+
+
+TEXT = Text()
+SOIL_TABLE = Table({**SOIL_RANGES, "why": TEXT})
+# Types only: the ranges of a block are Block's own (pipeline/blocks.py), reported with the user's field.
+BLOCK_TABLE = Table({key: Number() for key in ("b", "h", "R", "alpha", "mass", "E_b", "footprint_area",
+                                                "soil_depth")} | {"why": TEXT})
+LEVEL_TABLE_KEYS = ("start", "stop", "count", "spacing", "values", "relative_to")
+
+
+def _damage_state_table() -> Table:
+    from pipeline.fragility import DamageState
+
+    keys = [f.name for f in dataclasses.fields(DamageState) if f.name != "name"]
+    return Table({key: Number(0, low_open=True) if key == "threshold" else TEXT for key in keys})
+
+
+SCHEMA = Table({
+    "soils": Names('["sand", "rock"]'),
+    "models": Names('["housner", "ssi"]'),
+    "blocks": Either(Names('["paper", "slender-cabinet"]'), NamedTables(BLOCK_TABLE)),
+    "soils_custom": NamedTables(SOIL_TABLE),
+    "blocks_custom": NamedTables(BLOCK_TABLE),
+    "damage_states": NamedTables(_damage_state_table()),
+    "study": Table({"name": Text(nonempty=True), "record_sets": Names('["far-field"]'), "processing": TEXT,
+                    "output": Text(nonempty=True),
+                    "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"),
+                    # report metadata, read by pipeline.report
+                    "title": TEXT, "project": TEXT, "author": TEXT}),
+    "intensity": Table({"measure": Text(SCALING_MEASURES), "period": Number(0.01, 20.0, unit="s"),
+                        "damping": Number(0.0, 0.5), "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True)),
+                        "capacity_resolution": Number(0.0, 0.5),
+                        "period_range": Numbers(Number(0.01, 20.0, unit="s"))}),
+    "solver": Table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
+                     "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
+                     "bed": Text(tuple(BED_TYPES))}),
+    "hazard": Table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
+    "fragility": Table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
+                        "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
+    "applicability": Table({
+        "g_range": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
+        "n_g": Number(2, 200, integer=True),
+        "levels": Numbers(Number(0, 100, low_open=True)),
+        "block_moduli": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
+        "tolerance": Number(0, 10, low_open=True),
+    }),
+})
+"""Every key a study file may hold, with its type and range."""
+
+
+def validate(data: dict, source: str) -> None:
+    """Check keys, TOML types and ranges of a (possibly partial) study dict, as the user wrote it."""
+    SCHEMA.check(data, "", source)
+    blocks = data.get("blocks")
+    for table, tables in (("blocks", blocks if isinstance(blocks, dict) else {}),
+                          ("blocks_custom", data.get("blocks_custom", {}))):
+        for name, spec in tables.items():
+            _block(table, name, spec, source)  # Block's own ranges, with the user's field names
+    for name, spec in data.get("soils_custom", {}).items():
+        _soil(name, spec, source)
+    applicability = data.get("applicability", {})
+    g_range = applicability.get("g_range")
+    if g_range is not None and (len(g_range) != 2 or g_range[1] <= g_range[0]):
+        raise ConfigError("applicability.g_range", f"{g_range}; must be [G_min, G_max] with G_min < G_max [Pa]",
+                          source)
+
+
+# ---------------------------------------------------------------- the study
+
+@dataclass(frozen=True)
+class ApplicabilitySettings:
+    """The soil-stiffness sweep of ``rockfrag applicability`` (``[applicability]``; one definition)."""
+
+    g_range: tuple[float, float] = (10e6, 100e9)
+    n_g: int = 13
+    levels: tuple[float, ...] = (1.5, 2.5, 4.0)
+    block_moduli: tuple[float, ...] = (30e9, 210e9)
+    tolerance: float = 0.10
+
+    @property
+    def shear_moduli(self) -> np.ndarray:
+        return np.geomspace(self.g_range[0], self.g_range[1], self.n_g)
 
 
 @dataclass(frozen=True)
@@ -57,9 +268,17 @@ class StudyConfig:
     confidence: float
     source: str
     raw: dict
+    bed: str = "continuous"
     levels_relative_to: str = ""  # "" (absolute levels) or "uplift" (multiples of each block's uplift intensity)
     capacity_resolution: float = 0.02  # relative bracket of the adaptive overturning capacities; 0 = off
     period_range: tuple[float, float] | None = None  # AvgSa periods [s]; None = 0.2 T .. 3 T
+    record_units: str = ""
+    record_dt: float | None = None  # time step of one-column text records [s]; None: from the files
+    applicability: ApplicabilitySettings = ApplicabilitySettings()
+
+    @property
+    def level_unit(self) -> str:
+        return MEASURE_UNITS[self.measure][0]
 
     @property
     def relative_levels(self) -> bool:
@@ -69,10 +288,6 @@ class StudyConfig:
     def measure_options(self) -> dict:
         """Options every ``pipeline.measures.Measure`` call of the study takes."""
         return {"period": self.period, "damping": self.damping, "period_range": self.period_range}
-
-    @property
-    def level_unit(self) -> str:
-        return MEASURE_UNITS[self.measure][0]
 
     @property
     def levels_si(self) -> np.ndarray:
@@ -93,195 +308,226 @@ class StudyConfig:
 def _merge(default: dict, user: dict) -> dict:
     merged = copy.deepcopy(default)
     for key, value in user.items():
-        if key in ("blocks", "soils_custom") and isinstance(value, dict):
+        if key in ("blocks_custom", "soils_custom", "damage_states") and isinstance(value, dict):
             merged.setdefault(key, {}).update(value)
-        elif isinstance(value, dict) and isinstance(merged.get(key), dict) and key != "levels":
+        elif isinstance(value, dict) and isinstance(merged.get(key), dict) and key not in ("levels", "blocks"):
             merged[key] = _merge(merged[key], value)
         else:
             merged[key] = value
     return merged
 
 
-def _number(data, key, where, source, low, high, default=None, low_open=False):
-    value = data.get(key, default)
-    if value is None:
-        raise ConfigError(f"{where}.{key}", "missing", source)
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ConfigError(f"{where}.{key}", f"{value!r} is not a number; allowed {low} to {high}", source)
-    if (value <= low if low_open else value < low) or value > high:
-        raise ConfigError(f"{where}.{key}", f"{value} out of range; allowed {low} to {high}", source)
-    return float(value)
+def _blocks_as_selector(data: dict) -> dict:
+    """``[blocks.NAME]`` tables -> ``blocks = [NAME, ...]`` plus ``[blocks_custom.NAME]`` (a copy)."""
+    if not isinstance(data.get("blocks"), dict):
+        return data
+    data = dict(data)
+    tables = data.pop("blocks")
+    data["blocks_custom"] = {**data.get("blocks_custom", {}), **tables}
+    data["blocks"] = list(tables)
+    return data
 
 
-def _levels(spec, source, unit):
-    """Levels as given (display unit, or multiples when relative): a list, or {start, stop, count,
-    spacing} or {values}, each optionally with ``relative_to``."""
+def _user_blocks(default: dict, user: dict) -> dict:
+    """The user's file with its block choice made explicit: defining blocks without a selector runs them only."""
+    user = _blocks_as_selector(user)
+    if "blocks" not in user and user.get("blocks_custom"):
+        user["blocks"] = list(user["blocks_custom"])
+    return user
+
+
+def _levels(spec, source, check_only=False):
+    """``[intensity] levels``: a list, or ``{start, stop, count, spacing, relative_to}`` (levels in g or m/s,
+    or multiples of each block's uplift intensity with ``relative_to = "uplift"``).
+
+    Returns (levels, relative_to); with ``check_only`` the spec unchanged.
+    """
     where = "intensity.levels"
-    if isinstance(spec, dict) and "values" in spec:
-        spec = spec["values"]
+    level = Number(0, 1e3, low_open=True)
+    relative_to = ""
     if isinstance(spec, list):
         if not spec:
-            raise ConfigError(where, "empty list", source)
-        values = [_number({"v": v}, "v", where, source, 0, 1e3, low_open=True) for v in spec]
+            raise ConfigError(where, "empty list; give at least one level", source)
+        values = [level.check(v, f"{where}[{i}]", source) for i, v in enumerate(spec)]
     elif isinstance(spec, dict):
-        start = _number(spec, "start", where, source, 0, 1e3, low_open=True)
-        stop = _number(spec, "stop", where, source, 0, 1e3, low_open=True)
-        count = spec.get("count", 40)
-        if not isinstance(count, int) or not 1 <= count <= 1000:
-            raise ConfigError(f"{where}.count", f"{count!r}; allowed a whole number 1 to 1000", source)
-        if stop <= start:
-            raise ConfigError(where, f"stop {stop} must exceed start {start} [{unit}]", source)
-        spacing = spec.get("spacing", "log")
-        if spacing not in ("log", "linear"):
-            raise ConfigError(f"{where}.spacing", f"{spacing!r}; allowed 'log' or 'linear'", source)
-        values = (np.geomspace if spacing == "log" else np.linspace)(start, stop, count).tolist()
+        for key in spec:
+            if key not in LEVEL_TABLE_KEYS:
+                raise ConfigError(f"{where}.{key}", _unknown_key(key, LEVEL_TABLE_KEYS), source)
+        relative_to = Text(LEVEL_REFERENCES).check(spec.get("relative_to", ""), f"{where}.relative_to", source)
+        if "values" in spec:  # { values = [...], relative_to = "uplift" }: listed multiples or levels
+            values = Numbers(level).check(spec["values"], f"{where}.values", source)
+        else:
+            for key in ("start", "stop"):
+                if key not in spec:
+                    raise ConfigError(f"{where}.{key}", f"missing; must be {level.describe()}", source)
+            start = level.check(spec["start"], f"{where}.start", source)
+            stop = level.check(spec["stop"], f"{where}.stop", source)
+            count = Number(1, 1000, integer=True).check(spec.get("count", 40), f"{where}.count", source)
+            if stop <= start:
+                raise ConfigError(where, f"stop {stop:g} must exceed start {start:g}", source)
+            spacing = Text(("log", "linear")).check(spec.get("spacing", "log"), f"{where}.spacing", source)
+            values = (np.geomspace if spacing == "log" else np.linspace)(start, stop, count).tolist()
     else:
-        raise ConfigError(where, "expected a list of levels or {start, stop, count, spacing}", source)
+        raise ConfigError(where, f"{_shown(spec)}; must be a list of levels or "
+                          "{ start, stop, count, spacing }", source)
     if sorted(values) != values or len(set(values)) != len(values):
         raise ConfigError(where, "levels must increase strictly", source)
-    return tuple(float(v) for v in values)
+    if check_only:
+        return spec
+    return tuple(float(v) for v in values), relative_to
 
 
-def _block(name, data, source):
-    known = {"b", "h", "R", "alpha", "mass", "E_b", "footprint_area", "soil_depth", "why"}
-    unknown = set(data) - known
-    if unknown:
-        raise ConfigError(f"blocks.{name}.{sorted(unknown)[0]}", f"unknown key; allowed: {', '.join(sorted(known))}",
-                          source)
+def _block(table, name, data, source) -> Block:
     try:
         return Block(name=name, b=data.get("b"), h=data.get("h"), R=data.get("R"), alpha=data.get("alpha"),
                      mass=data.get("mass", 1e5), E_b=data.get("E_b", 30e9),
                      footprint_area=data.get("footprint_area"), soil_depth=data.get("soil_depth", 2.0),
                      description=data.get("why", ""))
+    except ConfigError as error:  # Block names fields "block NAME.key"; the user wrote "blocks.NAME.key"
+        key = error.field.rsplit(".", 1)[1] if error.field.startswith(f"block {name}.") else None
+        field = f"{table}.{name}.{key}" if key else f"{table}.{name}"
+        raise ConfigError(field, error.reason, source) from None
+
+
+def _soil(name, data, source) -> SoilClass:
+    try:
+        return SoilClass(name, float(data["shear_modulus"]), float(data.get("poisson_ratio", 0.3)),
+                         float(data.get("density", 2000.0)), float(data.get("damping_ratio", 0.05)),
+                         data.get("why", "user soil"))
+    except KeyError:
+        raise ConfigError(f"soils_custom.{name}.shear_modulus", "missing; must be a number > 0 [Pa]",
+                          source) from None
+    except ConfigError as error:
+        raise ConfigError(f"soils_custom.{name}.{error.field.rsplit('.', 1)[1]}", error.reason, source) from None
+
+
+def _select(kind, names, available, source):
+    unknown = [n for n in names if n not in available]
+    if unknown:
+        raise ConfigError(kind, f"unknown {kind[:-1]} {unknown[0]!r}; available: {', '.join(available)}", source)
+    if len(set(names)) != len(names):
+        raise ConfigError(kind, f"{[n for n in names if names.count(n) > 1][0]!r} named twice", source)
+    return tuple(available[n] for n in names)
+
+
+def _check_damage_states(data, source):
+    """The study's damage states as the fragility stage will read them (its own EDP list)."""
+    from pipeline.fragility import damage_states_from_config
+
+    try:
+        damage_states_from_config(data)
     except ConfigError as error:
         raise ConfigError(error.field, error.reason, source) from None
 
 
-ALLOWED_KEYS = {
-    "": {"study", "intensity", "soils", "models", "solver", "blocks", "soils_custom", "damage_states",
-         "hazard", "fragility"},
-    "study": {"name", "record_sets", "processing", "output"},
-    "intensity": {"measure", "period", "damping", "levels", "capacity_resolution", "period_range"},
-    "solver": {"switch", "tail", "overturn_angle"},
-    "hazard": {"file", "design_life"},
-    "fragility": {"bootstrap", "seed", "confidence"},
-}
+def _check_hazard(path, source):
+    """The hazard curve loads (file exists, two numeric columns, decreasing frequency)."""
+    from pipeline.risk import load_hazard
+
+    if path and Path(path).is_dir():
+        raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
+    try:
+        load_hazard(path or None)
+    except ConfigError as error:
+        raise ConfigError(error.field, f"{error.source}: {error.reason}", source) from None
+    except (ValueError, UnicodeDecodeError, OSError) as error:
+        reason = str(error).splitlines()[0] if str(error) else type(error).__name__
+        raise ConfigError("hazard.file", f"{path}: not a table of numbers (intensity, annual frequency) "
+                          f"({reason})", source) from None
 
 
-def _check_keys(data, source):
-    for table, allowed in ALLOWED_KEYS.items():
-        section = data if table == "" else data.get(table, {})
-        if not isinstance(section, dict):
-            raise ConfigError(table, "expected a table", source)
-        for key in section:
-            if key not in allowed:
-                where = f"{table}.{key}" if table else key
-                hint = " (top-level keys such as soils/models must come before the first [table])" \
-                    if key in ALLOWED_KEYS[""] else ""
-                raise ConfigError(where, f"unknown key; allowed: {', '.join(sorted(allowed))}{hint}", source)
+def _period_range(value, source) -> tuple[float, float] | None:
+    """``[intensity] period_range`` (AvgSa periods, s): [low, high] with low < high, or None."""
+    if value is None:
+        return None
+    if len(value) != 2 or not value[0] < value[1]:
+        raise ConfigError("intensity.period_range", f"{value!r}; must be [low, high] in s with low < high", source)
+    return float(value[0]), float(value[1])
 
 
 def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
-    _check_keys(data, source)
+    """Validate a complete study dict (defaults already merged) and build the ``StudyConfig``."""
+    validate(data, source)
+    data = _blocks_as_selector(data)
     study = data.get("study", {})
     intensity = data.get("intensity", {})
     solver = data.get("solver", {})
+    hazard = data.get("hazard", {})
+    fragility = data.get("fragility", {})
     measure = intensity.get("measure", "pga")
-    if measure not in MEASURE_UNITS:
-        raise ConfigError("intensity.measure", f"{measure!r}; allowed: {', '.join(MEASURE_UNITS)}", source)
-    unit = MEASURE_UNITS[measure][0]
-    record_sets = study.get("record_sets", ["far-field"])
-    if isinstance(record_sets, str):
-        record_sets = [record_sets]
-    if not record_sets:
-        raise ConfigError("study.record_sets", "empty; name at least one record set", source)
 
-    custom = {}
-    for name, soil in data.get("soils_custom", {}).items():
-        try:
-            custom[name] = SoilClass(name, _number(soil, "shear_modulus", f"soils_custom.{name}", source, 0, 1e13, low_open=True),
-                                     float(soil.get("poisson_ratio", 0.3)), float(soil.get("density", 2000.0)),
-                                     float(soil.get("damping_ratio", 0.05)), soil.get("why", "user soil"))
-        except ConfigError as error:
-            raise ConfigError(error.field, error.reason, source) from None
-    available = {**SOILS, **custom}
-    soils = []
-    for name in data.get("soils", list(SOILS)):
-        if name not in available:
-            raise ConfigError("soils", f"unknown soil {name!r}; available: {', '.join(available)}", source)
-        soils.append(available[name])
-    models = data.get("models", ["housner", "ssi"])
-    for name in models:
-        if name not in MODELS:
-            raise ConfigError("models", f"unknown model {name!r}; available: {', '.join(MODELS)}", source)
-    blocks = [_block(name, spec, source) for name, spec in data.get("blocks", {}).items()]
-    if not blocks:
-        raise ConfigError("blocks", "no block defined", source)
-    switch = solver.get("switch", "consistent")
-    if switch not in SWITCH_RULES:
-        raise ConfigError("solver.switch", f"{switch!r}; allowed: {', '.join(SWITCH_RULES)}", source)
-    if not soils or not models:
-        raise ConfigError("soils" if not soils else "models", "empty list", source)
+    custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
+    soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
+    models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
+    library = {name: _block("blocks_custom", name, spec, source) for name, spec in data.get("blocks_custom", {}).items()}
+    if "blocks" not in data:
+        raise ConfigError("blocks", "no block defined; add [blocks.NAME] tables", source)
+    blocks = _select("blocks", data["blocks"], library, source)
+    levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
+    _check_damage_states(data, source)
+    _check_hazard(hazard.get("file", ""), source)
+    sweep = data.get("applicability", {})
+    defaults = ApplicabilitySettings()
     return StudyConfig(
-        name=str(study.get("name", "study")), record_sets=tuple(str(s) for s in record_sets),
-        processing=str(study.get("processing", "")), output=Path(study.get("output", "reports")),
-        measure=measure,
-        period=_number(intensity, "period", "intensity", source, 0.01, 20.0, default=1.0),
-        damping=_number(intensity, "damping", "intensity", source, 0.0, 0.5, default=0.05),
-        levels=_levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source, unit),
-        soils=tuple(soils), blocks=tuple(blocks), models=tuple(models), switch=switch,
-        tail=_number(solver, "tail", "solver", source, 0.0, 600.0, default=10.0),
-        overturn_angle=_number(solver, "overturn_angle", "solver", source, 0.0, math.pi / 2,
-                               default=math.pi / 2, low_open=True),
-        hazard_file=str(data.get("hazard", {}).get("file", "")),
-        design_life=_number(data.get("hazard", {}), "design_life", "hazard", source, 0.0, 10000.0, default=50.0,
-                            low_open=True),
-        bootstrap=int(_number(data.get("fragility", {}), "bootstrap", "fragility", source, 0, 100000, default=100)),
-        seed=int(_number(data.get("fragility", {}), "seed", "fragility", source, 0, 2**32, default=0)),
-        confidence=_number(data.get("fragility", {}), "confidence", "fragility", source, 0.0, 1.0, default=0.9,
-                           low_open=True),
-        source=source, raw=data, **_intensity_extras(intensity, source))
+        name=study.get("name", "study"), record_sets=tuple(study.get("record_sets", ["far-field"])),
+        processing=study.get("processing", ""), output=Path(study.get("output", "reports")),
+        measure=measure, period=float(intensity.get("period", 1.0)), damping=float(intensity.get("damping", 0.05)),
+        levels=levels, levels_relative_to=relative_to,
+        capacity_resolution=float(intensity.get("capacity_resolution", 0.02)),
+        period_range=_period_range(intensity.get("period_range"), source),
+        soils=soils, blocks=blocks, models=models,
+        switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
+        tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
+        hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)),
+        bootstrap=int(fragility.get("bootstrap", 100)), seed=int(fragility.get("seed", 0)),
+        confidence=float(fragility.get("confidence", 0.9)),
+        record_units=study.get("units", ""), record_dt=study.get("dt"),
+        applicability=ApplicabilitySettings(
+            g_range=tuple(float(g) for g in sweep.get("g_range", defaults.g_range)),
+            n_g=int(sweep.get("n_g", defaults.n_g)),
+            levels=tuple(float(v) for v in sweep.get("levels", defaults.levels)),
+            block_moduli=tuple(float(v) for v in sweep.get("block_moduli", defaults.block_moduli)),
+            tolerance=float(sweep.get("tolerance", defaults.tolerance))),
+        source=source, raw=data)
 
 
-def _intensity_extras(intensity, source) -> dict:
-    """The per-block level, adaptive-capacity and AvgSa settings of ``[intensity]``."""
-    levels = intensity.get("levels", {})
-    relative_to = levels.get("relative_to", "") if isinstance(levels, dict) else ""
-    if relative_to not in LEVELS_RELATIVE_TO:
-        raise ConfigError("intensity.levels.relative_to", f"{relative_to!r}; allowed: \"\" (absolute levels) "
-                          "or \"uplift\" (multiples of each block's uplift intensity)", source)
-    if isinstance(levels, dict):
-        unknown = set(levels) - {"start", "stop", "count", "spacing", "values", "relative_to"}
-        if unknown:
-            raise ConfigError(f"intensity.levels.{sorted(unknown)[0]}", "unknown key; allowed: start, stop, "
-                              "count, spacing, values, relative_to", source)
-    resolution = _number(intensity, "capacity_resolution", "intensity", source, 0.0, 0.5, default=0.02)
-    period_range = intensity.get("period_range")
-    if period_range is not None:
-        if (not isinstance(period_range, list) or len(period_range) != 2
-                or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in period_range)
-                or not 0.01 <= period_range[0] < period_range[1] <= 20.0):
-            raise ConfigError("intensity.period_range", f"{period_range!r}; allowed [low, high] in s with "
-                              "0.01 <= low < high <= 20", source)
-        period_range = (float(period_range[0]), float(period_range[1]))
-    return {"levels_relative_to": relative_to, "capacity_resolution": resolution, "period_range": period_range}
+def read_study_file(path) -> dict:
+    """A user study file as a dict; unreadable, binary or non-TOML files are one ``ConfigError``."""
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise PipelineError(f"{path}: study file not found") from None
+    except IsADirectoryError:
+        raise ConfigError("study file", "is a folder; expected a TOML file", str(path)) from None
+    except UnicodeDecodeError:
+        raise ConfigError("study file", "not a text file (binary content); expected a TOML study file",
+                          str(path)) from None
+    except OSError as error:
+        raise ConfigError("study file", f"cannot read it ({error.strerror})", str(path)) from None
+    if "\x00" in text:
+        raise ConfigError("study file", "not a text file (binary content); expected a TOML study file", str(path))
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ConfigError("study", f"not valid TOML ({error})", str(path)) from None
 
 
 def load_study(path=None, overrides: dict | None = None) -> StudyConfig:
-    """Defaults merged with a user study file (and a dict of overrides, e.g. from the CLI)."""
+    """Defaults merged with a user study file (and a dict of overrides, e.g. from the CLI).
+
+    The user file is validated on its own first, so errors name its fields as written; the override
+    dict is validated the same way (source "command line").
+    """
     default = tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text())
     source = "pipeline/defaults.toml"
-    merged = default
+    merged = _blocks_as_selector(default)
     if path is not None:
-        path = Path(path)
-        try:
-            user = tomllib.loads(path.read_text())
-        except FileNotFoundError:
-            raise PipelineError(f"{path}: study file not found") from None
-        except tomllib.TOMLDecodeError as error:
-            raise ConfigError("study", f"not valid TOML ({error})", str(path)) from None
-        merged = _merge(default, user)
+        user = read_study_file(path)
         source = str(path)
+        validate(user, source)
+        merged = _merge(merged, _user_blocks(default, user))
     if overrides:
-        merged = _merge(merged, overrides)
+        validate(overrides, "command line")
+        merged = _merge(merged, _user_blocks(default, overrides))
     return study_from_dict(merged, source)

@@ -10,50 +10,90 @@ Output: an ``xarray.Dataset`` following CF-1.12 (every variable with ``units`` a
 from __future__ import annotations
 
 import json
-import math
 
 import numpy as np
 import xarray as xr
 
 from pipeline import __version__
 from pipeline.measures import MEASURES
-from pipeline.models import kernels
+from pipeline.models import get_model
+from pipeline.models.base import Outcome
 from pipeline.outputs import atomic_path
 
-OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = 0, 1, 2, 3
-OUTCOME_MEANINGS = "no_uplift rocking overturned solver_failed"
+# Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
+OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = (int(o) for o in Outcome)
+OUTCOME_MEANINGS = " ".join(o.flag_meaning for o in Outcome)
 
 DIMS = ("record", "im_level", "soil", "block", "model")
 
+
+def _always(model):
+    return True
+
+
+def _foundation(model):
+    return model.needs_foundation
+
+
+def _pulls(model):
+    return model.can_pull
+
+
+def _bed(model):
+    return model.uses_bed
+
+
+# Cube variable: (summary field of pipeline.models.fields, units, long name, which models it applies to;
+# NaN elsewhere). Derived variables (outcome, peak_angle_ratio, support_tension) are added below.
 VARIABLES = {
-    # name: (summary index or None, units, long_name)
-    "peak_angle": (kernels.S_PEAK, "rad", "peak absolute rocking angle"),
-    "time_of_peak": (kernels.S_TIME_OF_PEAK, "s", "time of the peak rocking angle"),
-    "n_impacts": (kernels.S_N_IMPACTS, "1", "number of impacts (pivot switches at theta = 0)"),
-    "time_of_uplift": (kernels.S_TIME_OF_UPLIFT, "s", "time of first uplift (NaN: never uplifted)"),
-    "peak_settlement": (kernels.S_PEAK_Y, "m", "peak settlement of the active pivot (SSI; NaN for rigid base)"),
-    "min_support_force": (kernels.S_MIN_SUPPORT, "N", "minimum vertical foundation force (negative: tension)"),
+    "peak_angle": ("peak_angle", "rad", "peak absolute rocking angle", _always),
+    "time_of_peak": ("time_of_peak", "s", "time of the peak rocking angle", _always),
+    "n_impacts": ("n_impacts", "1", "number of impacts (pivot switches; winkler: a lifted corner landing)",
+                  _always),
+    "time_of_uplift": ("time_of_uplift", "s", "time of first uplift (NaN: never uplifted)", _always),
+    "peak_uplift": ("peak_corner_uplift", "m", "peak height of a base corner above the ground", _always),
+    "peak_settlement": ("peak_settlement", "m",
+                        "peak settlement of the active pivot (ssi) or of the base centre (winkler)", _foundation),
+    "min_support_force": ("min_support_force", "N",
+                          "minimum vertical foundation force (negative: the foundation pulled on the block)",
+                          _foundation),
+    "time_of_tension": ("time_of_tension", "s",
+                        "first time the paper's spring pulled on the block (NaN: never)", _pulls),
+    "n_flights": ("n_flights", "1", "times the whole base left the ground", _bed),
+    "airborne_time": ("airborne_time", "s", "total time with the whole base off the ground", _bed),
+    "peak_friction_demand": ("peak_friction_demand", "1",
+                             "peak |H|/N, the base friction coefficient needed to prevent sliding "
+                             "(while N >= 0.1 m g)", _bed),
 }
 
 
 def summaries_to_variables(summaries, blocks, model_names):
-    """Turn a summary array (record, level, soil, block, model, N_SUMMARY) into named arrays."""
-    out = {}
-    for name, (index, _, _) in VARIABLES.items():
-        out[name] = summaries[..., index].copy()
-    alpha = np.array([b.alpha for b in blocks])[None, None, None, :, None]
-    half_width = np.array([b.b for b in blocks])[None, None, None, :, None]
+    """Turn summary records (record, level, soil, block, model) into named arrays (NaN where not applicable)."""
+    models = [get_model(name) for name in model_names]
     mass = np.array([b.mass for b in blocks])[None, None, None, :, None]
-    status = summaries[..., kernels.S_STATUS].astype(np.int8)
-    out["outcome"] = status
-    out["peak_angle_ratio"] = out["peak_angle"] / alpha
-    out["peak_uplift"] = 2.0 * half_width * np.sin(np.minimum(out["peak_angle"], math.pi / 2))
-    out["time_of_uplift"] = np.where(out["time_of_uplift"] < 0, np.nan, out["time_of_uplift"])
+    alpha = np.array([b.alpha for b in blocks])[None, None, None, :, None]
+    out = {}
+    for name, (field, _, _, applies) in VARIABLES.items():
+        mask = np.array([applies(model) for model in models])[None, None, None, None, :]
+        out[name] = np.where(mask, summaries[field], np.nan)
     out["min_support_force"] = out["min_support_force"] * mass
-    rigid = np.array([name == "housner" for name in model_names])[None, None, None, None, :]
-    out["peak_settlement"] = np.where(rigid, np.nan, out["peak_settlement"])
-    out["min_support_force"] = np.where(rigid, np.nan, out["min_support_force"])
+    out["outcome"] = np.nan_to_num(summaries["status"], nan=int(Outcome.FAILED)).astype(np.int8)
+    out["peak_angle_ratio"] = out["peak_angle"] / alpha
+    pulls = np.array([model.can_pull for model in models])[None, None, None, None, :]
+    tension = np.where(out["min_support_force"] < 0, 1, 0).astype(np.int8)
+    out["support_tension"] = np.where(pulls, tension, -1).astype(np.int8)
     return out
+
+
+DERIVED_ATTRIBUTES = {
+    "outcome": {"long_name": "outcome of the run", "units": "1",
+                "flag_values": np.array([int(o) for o in Outcome], dtype=np.int8), "flag_meanings": OUTCOME_MEANINGS},
+    "peak_angle_ratio": {"long_name": "peak rocking angle over slenderness alpha", "units": "1"},
+    "support_tension": {"long_name": "the paper's spring pulled on the block during the run "
+                                     "(results after time_of_tension are not physical)", "units": "1",
+                        "flag_values": np.array([-1, 0, 1], dtype=np.int8),
+                        "flag_meanings": "not_applicable no_tension tension"},
+}
 
 
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
@@ -62,7 +102,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
     processed record [SI]; scale_factors : (n_record, n_level, n_block) (or (n_record, n_level));
-    summaries : (n_record, n_level, n_soil, n_block, n_model, N_SUMMARY); stiffness : (n_soil, n_block)
+    summaries : summary records (n_record, n_level, n_soil, n_block, n_model); stiffness : (n_soil, n_block)
     interface stiffness [N/m]; provenance : dict of JSON-able facts; intensity : (n_block, n_level)
     physical intensity of every level [SI] (default: the absolute levels); capacities : (4, n_record,
     n_soil, n_block, n_model) adaptive overturning capacity, bracket and extra runs as scale factors
@@ -91,18 +131,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     intensity = np.asarray(intensity, float)
     data_vars = {}
     for name, array in values.items():
-        if name == "outcome":
-            data_vars[name] = (DIMS, array, {
-                "long_name": "outcome of the run", "units": "1",
-                "flag_values": np.array([0, 1, 2, 3], dtype=np.int8), "flag_meanings": OUTCOME_MEANINGS})
-        elif name == "peak_angle_ratio":
-            data_vars[name] = (DIMS, array, {"long_name": "peak rocking angle over slenderness alpha",
-                                             "units": "1"})
-        elif name == "peak_uplift":
-            data_vars[name] = (DIMS, array, {"long_name": "peak uplift of the lifted corner, 2 b sin(theta_max)",
-                                             "units": "m"})
+        if name in DERIVED_ATTRIBUTES:
+            data_vars[name] = (DIMS, array, dict(DERIVED_ATTRIBUTES[name]))
         else:
-            _, units, long_name = VARIABLES[name]
+            _, units, long_name, _ = VARIABLES[name]
             data_vars[name] = (DIMS, array, {"long_name": long_name, "units": units})
     data_vars["scale_factor"] = (("record", "im_level", "block"), scale_factors,
                                  {"long_name": "factor applied to the processed record", "units": "1"})
@@ -123,6 +155,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "soil": ("soil", [s.name for s in config.soils], {"long_name": "soil class"}),
         "block": ("block", [b.name for b in config.blocks], {"long_name": "block"}),
         "model": ("model", model_names, {"long_name": "rocking model"}),
+        "model_label": ("model", [get_model(name).label for name in model_names], {"long_name": "rocking model"}),
         "record_event": ("record", [str(r.metadata.get("event", "")) for r in records], {"long_name": "earthquake"}),
         "record_station": ("record", [str(r.metadata.get("station", "")) for r in records], {"long_name": "station"}),
         "record_component": ("record", [str(r.metadata.get("component", "")) for r in records],
@@ -164,7 +197,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "processing": json.dumps(provenance.get("processing", {})),
         "processing_steps": json.dumps(provenance.get("processing_steps", {})),
         "references": "Housner (1963); SSI-rocking model from the Lagrangian of the paper "
-                      "'A Simplified Mechanical Model for Rocking Structures on Compliant Foundations'",
+                      "'A Simplified Mechanical Model for Rocking Structures on Compliant Foundations'; "
+                      "tensionless Winkler bed (Psycharis & Jennings 1983; Chopra & Yim 1985)",
+        "winkler_bed": config.bed,
     }
     return dataset
 

@@ -15,6 +15,16 @@ import math
 from dataclasses import dataclass
 
 from pipeline.errors import ConfigError
+from pipeline.validation import Number
+
+
+SOIL_RANGES = {
+    "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),
+    "poisson_ratio": Number(0, 0.5, high_open=True),
+    "density": Number(0, 1e5, low_open=True, unit="kg/m^3"),
+    "damping_ratio": Number(0, 1, high_open=True),
+}
+"""Allowed values of a soil's numbers (also the study file's ``[soils_custom.NAME]`` ranges)."""
 
 
 @dataclass(frozen=True)
@@ -29,14 +39,8 @@ class SoilClass:
     description: str = ""
 
     def __post_init__(self):
-        if not (self.shear_modulus > 0 and math.isfinite(self.shear_modulus)):
-            raise ConfigError(f"soil {self.name}.shear_modulus", f"{self.shear_modulus} [Pa]; allowed > 0")
-        if not 0 <= self.poisson_ratio < 0.5:
-            raise ConfigError(f"soil {self.name}.poisson_ratio", f"{self.poisson_ratio}; allowed 0 to < 0.5")
-        if not self.density > 0:
-            raise ConfigError(f"soil {self.name}.density", f"{self.density} [kg/m^3]; allowed > 0")
-        if not 0 <= self.damping_ratio < 1:
-            raise ConfigError(f"soil {self.name}.damping_ratio", f"{self.damping_ratio}; allowed 0 to < 1")
+        for key, allowed in SOIL_RANGES.items():
+            allowed.check(getattr(self, key), f"soil {self.name}.{key}", None)
 
     @property
     def constrained_modulus(self) -> float:

@@ -38,7 +38,9 @@ from pipeline.cube import build_cube, write_netcdf
 from pipeline.errors import PipelineError
 from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
 from pipeline.measures import MEASURES, pga
-from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, kernels, simulate_batch
+from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, simulate_batch
+from pipeline.models.base import Outcome
+from pipeline.models.fields import new_summaries
 from pipeline.outputs import atomic_path
 from pipeline.processing import load_recipe, process_record
 from pipeline.records import load_records
@@ -102,16 +104,15 @@ def capacity_key(key, resolution) -> str:
     return f"{key}-capacity-{resolution:g}"
 
 
-def cell_capacity(acceleration, dt, scales, summary, job, switch, t_end, overturn_angle, resolution):
+def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolution):
     """[capacity, lower, upper, extra runs] of one cell as scale factors (see capacity_from_stripes)."""
     _, model, block, k, xi = job
 
     def overturns(scale):
-        result = simulate_batch(model, acceleration, dt, [scale], [(block, k, xi)], switch=switch,
-                                t_end=t_end, overturn_angle=overturn_angle)
-        return int(result[0, 0, kernels.S_STATUS]) == kernels.STATUS_OVERTURNED
+        result = simulate_batch(model, acceleration, dt, [scale], [(block, k, xi)], t_end=t_end, **options)
+        return int(result[0, 0]["status"]) == int(Outcome.OVERTURNED)
 
-    overturned = summary[:, kernels.S_STATUS].astype(int) == kernels.STATUS_OVERTURNED
+    overturned = summary["status"].astype(int) == int(Outcome.OVERTURNED)
     return np.array(capacity_from_stripes(scales, overturned, overturns, tolerance=resolution), dtype=float)
 
 
@@ -125,15 +126,14 @@ def cells_for_record(record, config, recipe, block_scales=None) -> list[Cell]:
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
-              "solver": {"switch": config.switch, "tail": config.tail, "overturn": config.overturn_angle,
-                         "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
+              "solver": {**solver_options(config), "tail": config.tail, "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
     cells = []
     for block_index, block in enumerate(config.blocks):
         block_spec = {k: v for k, v in asdict(block).items() if k not in ("name", "description")}
         if block_scales is not None:
             block_spec["scales"] = [float(f"{v:.12g}") for v in block_scales[:, block_index]]
         for model in config.models:
-            if not get_model(model).needs_foundation:
+            if get_model(model).is_rigid_base:
                 cells.append(Cell(_hash({**common, "block": block_spec, "model": model}), block_index, None, model))
                 continue
             for soil_index, soil in enumerate(config.soils):
@@ -143,11 +143,17 @@ def cells_for_record(record, config, recipe, block_scales=None) -> list[Cell]:
     return cells
 
 
-def compute_cells(acceleration, dt, scales, jobs, switch, tail, overturn_angle, capacity_resolution=0.0):
+def solver_options(config) -> dict:
+    """The study's solver settings as ``simulate_batch`` keywords (pipeline.models.SolverOptions)."""
+    return {"switch": config.switch, "bed": config.bed, "overturn_angle": config.overturn_angle}
+
+
+def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0):
     """Pure task function (runs in a worker): summaries for each job.
 
-    jobs : list of (key, model, block, k, xi). Returns {key: ndarray (n_scale, N_SUMMARY)} and, when
-    ``capacity_resolution`` > 0, {capacity_key(key): [capacity, lower, upper, runs]} (scale factors).
+    jobs : list of (key, model, block, k, xi); options : ``solver_options``.
+    Returns {key: summary records (n_scale,)} and, when ``capacity_resolution`` > 0,
+    {capacity_key(key): [capacity, lower, upper, runs]} (scale factors).
     """
     results = {}
     t_end = (acceleration.size - 1) * dt + tail
@@ -156,13 +162,13 @@ def compute_cells(acceleration, dt, scales, jobs, switch, tail, overturn_angle, 
         by_model.setdefault(model, []).append((key, block, k, xi))
     for model, group in by_model.items():
         summaries = simulate_batch(model, acceleration, dt, scales, [(b, k, xi) for _, b, k, xi in group],
-                                   switch=switch, t_end=t_end, overturn_angle=overturn_angle)
+                                   t_end=t_end, **options)
         for (key, *_), summary in zip(group, summaries):
             results[key] = summary
     if capacity_resolution > 0:
         for job in jobs:
             results[capacity_key(job[0], capacity_resolution)] = cell_capacity(
-                acceleration, dt, scales, results[job[0]], job, switch, t_end, overturn_angle, capacity_resolution)
+                acceleration, dt, scales, results[job[0]], job, options, t_end, capacity_resolution)
     return results
 
 
@@ -188,13 +194,13 @@ class CheckpointStore:
                 np.save(handle, array)
 
 
-def _warm_up():
+def _warm_up(models):
     """Compile (or load from the on-disk cache) the kernels once before starting workers."""
     from pipeline.blocks import Block
 
     block = Block(name="warm-up", R=1.0, alpha=0.2, mass=1.0)
-    simulate_batch("housner", np.zeros(3), 0.01, [1.0], [(block, None, None)])
-    simulate_batch("ssi", np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
+    for model in models:
+        simulate_batch(model, np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
 
 
 def _executor(workers, scheduler, dask_workers):
@@ -242,7 +248,8 @@ def study_records(config, log=print):
     so ``rockfrag fragility`` reads and processes them once.
     """
     recipe = load_recipe(config.processing or None)
-    raw_records, failures = load_records(list(config.record_sets))
+    raw_records, failures = load_records(list(config.record_sets), units=config.record_units or None,
+                                         dt=config.record_dt)
     for failure in failures:
         log(f"rockfrag: skipped {failure}")
     if not raw_records:
@@ -287,14 +294,14 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
         f"cells from checkpoints, {runs_total} runs to do")
 
     if tasks:
-        _warm_up()
+        _warm_up(config.models)
         submit, completed, shutdown = _executor(workers, scheduler, dask_workers)
         try:
             futures = {}
             for index, block_index, jobs in tasks:
                 record = records[index]
                 future = submit(record.acceleration, record.dt, scale_factors[index, :, block_index], jobs,
-                                config.switch, config.tail, config.overturn_angle, resolution)
+                                solver_options(config), config.tail, resolution)
                 futures[future] = jobs
             with tqdm(total=runs_total, unit="run", desc="study", disable=not progress, smoothing=0.1) as bar:
                 for future in completed(list(futures)):
@@ -304,14 +311,13 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
         finally:
             shutdown()
 
-    summaries = np.full((len(records), n_levels, len(config.soils), len(config.blocks), len(config.models),
-                         kernels.N_SUMMARY), np.nan)
+    summaries = new_summaries((len(records), n_levels, len(config.soils), len(config.blocks), len(config.models)))
     for r, cells in enumerate(all_cells):
         for cell in cells:
             model_index = config.models.index(cell.model)
             result = store.load(cell.key)
             if cell.soil_index is None:
-                summaries[r, :, :, cell.block_index, model_index] = result[:, None, :]
+                summaries[r, :, :, cell.block_index, model_index] = result[:, None]
             else:
                 summaries[r, :, cell.soil_index, cell.block_index, model_index] = result
     capacities, capacity_stats = gather_capacities(all_cells, store, config, intensity, resolution)

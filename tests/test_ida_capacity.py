@@ -10,7 +10,7 @@ import xarray as xr
 from pipeline.blocks import Block
 from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from pipeline.ida import capacity_from_stripes, ida_dataset, uniform_stripe_runs
-from pipeline.models import kernels, simulate_batch
+from pipeline.models import simulate_batch
 
 SLENDER = Block(name="slender", b=0.3, h=1.5, mass=2000.0)
 
@@ -70,7 +70,7 @@ def test_adaptive_capacity_matches_a_brute_force_fine_grid(bolu_records, record_
 
     def status(scales):
         summary = simulate_batch("housner", acceleration, dt, scales, [(SLENDER, None, None)])
-        return summary[0, :, kernels.S_STATUS].astype(int) == kernels.STATUS_OVERTURNED
+        return summary[0]["status"].astype(int) == OUTCOME_OVERTURNED
 
     def overturns(scale):
         return bool(status([scale])[0])

@@ -73,8 +73,8 @@ def small_cube(small_study, tmp_path_factory):
     ('models = ["newmark"]\n', "models"),
     ('[solver]\nswitch = "sticky"\n', "solver.switch"),
     ('[solver]\noverturn_angle = 2.0\n', "solver.overturn_angle"),
-    ('[blocks.bad]\nb = -1.0\nh = 2.0\n', "block bad.b"),
-    ('[blocks.bad]\nb = 1.0\nh = 2.0\nR = 3.0\nalpha = 0.3\n', "block bad"),
+    ('[blocks.bad]\nb = -1.0\nh = 2.0\n', "blocks.bad.b"),
+    ('[blocks.bad]\nb = 1.0\nh = 2.0\nR = 3.0\nalpha = 0.3\n', "blocks.bad"),
     ('[blocks.bad]\nb = 1.0\nh = 2.0\ncolour = "red"\n', "blocks.bad.colour"),
     ('[intensity]\nlevels = [0.1]\nsoils = ["sand"]\n', "intensity.soils"),
 ])
@@ -91,7 +91,7 @@ def test_default_study_matches_the_issue():
     config = load_study()
     assert len(config.levels) == 28 and config.measure == "pga"
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
-    assert config.models == ("housner", "ssi") and len(config.blocks) == 3
+    assert config.models == ("housner", "ssi", "winkler") and len(config.blocks) == 3
     paper = config.blocks[0]
     assert paper.R == 9.39 and paper.alpha == 0.44
     # levels are multiples of each block's uplift intensity: from below uplift to far above it

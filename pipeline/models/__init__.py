@@ -1,32 +1,39 @@
-"""pipeline.models - stage 5: rocking solvers (Housner and SSI-rocking).
+"""pipeline.models - stage 5: rocking solvers (Housner, the paper's SSI model, the Winkler bed).
 
-Input : a model name, ground acceleration [m/s^2] sampled at dt [s], a ``Block`` and, for SSI,
-        the interface stiffness k [N/m] and damping ratio xi [-].
-Output: a ``RockingResult`` (histories, peak angle, impacts, overturning), or for many scale
-        factors at once a summary array from ``simulate_batch``.
+Input : a model name, ground acceleration [m/s^2] sampled at dt [s], a ``Block`` and, for models
+        with a foundation, the interface stiffness k [N/m] and damping ratio xi [-].
+Output: a ``RockingResult`` (histories, peak angle, impacts, overturning, foundation checks), or for
+        many scale factors and cases at once summary records (``fields.SUMMARY_DTYPE``) from
+        ``simulate_batch`` and ``simulate_histories``.
 
-Models are a registry: ``MODELS[name]``; a new model is one module and one ``register`` call.
+Models are a registry: ``MODELS[name]``; a new model is one module and one ``register`` call (the
+contract is in pipeline/models/base.py). Callers ask the model object what it needs
+(``needs_foundation``, ``is_rigid_base``, ``uses_bed`` ...) instead of comparing names.
 """
 
 from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
 from pipeline.blocks import Block
 from pipeline.errors import SolverError
-from pipeline.models import kernels
-from pipeline.models.base import MESSAGES, RockingModel, RockingResult, Status
+from pipeline.models import fields, kernels
+from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
+from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
 from pipeline.units import STANDARD_GRAVITY
 
 MODELS: dict[str, RockingModel] = {}
 
-SWITCH_RULES = {"consistent": kernels.SWITCH_CONSISTENT, "continuous": kernels.SWITCH_CONTINUOUS}
+SWITCH_RULES = {"consistent": fields.SWITCH_CONSISTENT, "continuous": fields.SWITCH_CONTINUOUS}
+BED_TYPES = {"continuous": fields.BED_CONTINUOUS, "two-spring": fields.BED_TWO_SPRING}
 
 DEFAULT_RTOL = 1e-6  # relative error per step; peak angles agree with scipy at 1e-10 to ~1e-6
 DEFAULT_ATOL = 1e-7  # absolute error per step, as a fraction of alpha, alpha*p, y_static, y_static*omega
+DEFAULT_XI = 0.05
 DEFAULT_ZENO_FRACTION = 1e-6  # excursions below this fraction of alpha end the rocking
 DEFAULT_TAIL = 10.0  # s of free vibration after the record
 MAX_EVENTS = 200_000
@@ -40,24 +47,40 @@ def register(model: RockingModel) -> None:
 def get_model(name: str) -> RockingModel:
     try:
         return MODELS[name]
-    except KeyError:
+    except (KeyError, TypeError):
         raise SolverError(f"unknown model {name!r}; valid models are: {', '.join(MODELS)}") from None
 
 
-def parameter_vector(model: RockingModel, block: Block, *, k=None, xi=None, switch="consistent",
-                     restitution=None, g=STANDARD_GRAVITY, overturn_angle=math.pi / 2,
-                     rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL) -> tuple[np.ndarray, float]:
-    """Kernel parameter vector and the initial (static) settlement y0 [m]; validates the inputs."""
-    if switch not in SWITCH_RULES:
-        raise SolverError(f"switch {switch!r} unknown; valid: {', '.join(SWITCH_RULES)}")
-    if not 0 < overturn_angle <= math.pi / 2:
-        raise SolverError(f"overturn_angle {overturn_angle} [rad] out of range; allowed 0 < angle <= pi/2")
-    if not g > 0:
-        raise SolverError(f"g = {g} [m/s^2]; must be > 0")
-    if restitution is None:
-        restitution = model.default_restitution(block)
-    if not 0 <= restitution <= 1:
-        raise SolverError(f"restitution {restitution} out of range; allowed 0 to 1")
+@dataclass(frozen=True)
+class SolverOptions:
+    """Settings shared by every case of a call (validated once)."""
+
+    switch: str = "consistent"        # ssi pivot-switch rule: consistent | continuous
+    bed: str = "continuous"           # winkler bed: continuous | two-spring
+    restitution: float | None = None  # pivot models; None = the model's default for the block
+    g: float = STANDARD_GRAVITY
+    overturn_angle: float = math.pi / 2
+    rtol: float = DEFAULT_RTOL
+    atol: float = DEFAULT_ATOL
+
+    def __post_init__(self):
+        if self.switch not in SWITCH_RULES:
+            raise SolverError(f"switch {self.switch!r} unknown; valid: {', '.join(SWITCH_RULES)}")
+        if self.bed not in BED_TYPES:
+            raise SolverError(f"bed {self.bed!r} unknown; valid: {', '.join(BED_TYPES)}")
+        if not 0 < self.overturn_angle <= math.pi / 2:
+            raise SolverError(f"overturn_angle {self.overturn_angle} [rad] out of range; allowed 0 < angle <= pi/2")
+        if not self.g > 0:
+            raise SolverError(f"g = {self.g} [m/s^2]; must be > 0")
+        if self.restitution is not None and not 0 <= self.restitution <= 1:
+            raise SolverError(f"restitution {self.restitution} out of range; allowed 0 to 1")
+        if not (0 < self.rtol < 1 and 0 < self.atol < 1):
+            raise SolverError(f"rtol {self.rtol}, atol {self.atol}: each must be in (0, 1)")
+
+
+def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options=SolverOptions()):
+    """The kernel's parameter record and initial state [theta, theta', y, y'] (static) for one case."""
+    params = fields.new_params(1)[0]
     omega = 0.0
     xi_value = 0.0
     y0 = 0.0
@@ -66,26 +89,42 @@ def parameter_vector(model: RockingModel, block: Block, *, k=None, xi=None, swit
             raise SolverError(f"model {model.name!r} needs the interface stiffness k [N/m]")
         if not (k > 0 and math.isfinite(k)):
             raise SolverError(f"k = {k} [N/m] out of range; allowed finite > 0")
-        xi_value = 0.05 if xi is None else xi
+        xi_value = DEFAULT_XI if xi is None else xi
         if not 0 <= xi_value < 1:
             raise SolverError(f"xi = {xi_value} out of range; allowed 0 <= xi < 1")
         omega = math.sqrt(k / block.mass)
-        y0 = g / omega**2  # static equilibrium: never drop the block onto an unloaded spring
-    params = np.zeros(kernels.N_PARAMS)
-    params[kernels.P_R] = block.R
-    params[kernels.P_ALPHA] = block.alpha
-    params[kernels.P_G] = g
-    params[kernels.P_KAPPA] = model.kappa
-    params[kernels.P_OMEGA] = omega
-    params[kernels.P_XI] = xi_value
-    params[kernels.P_RESTITUTION] = restitution
-    params[kernels.P_SWITCH] = SWITCH_RULES[switch]
-    params[kernels.P_OVERTURN] = overturn_angle
-    params[kernels.P_RTOL] = rtol
-    params[kernels.P_ATOL] = atol
-    params[kernels.P_ZENO] = DEFAULT_ZENO_FRACTION * block.alpha
-    params[kernels.P_MAX_EVENTS] = MAX_EVENTS
-    return params, y0
+        y0 = options.g / omega**2  # static equilibrium: never drop the block onto an unloaded bed
+    restitution = options.restitution
+    if restitution is None:
+        restitution = model.default_restitution(block)
+    params["R"] = block.R
+    params["alpha"] = block.alpha
+    params["b"] = block.b
+    params["h"] = block.h
+    params["g"] = options.g
+    params["kappa"] = model.kappa
+    params["omega"] = omega
+    params["xi"] = xi_value
+    params["restitution"] = restitution
+    params["switch"] = SWITCH_RULES[options.switch]
+    params["bed"] = BED_TYPES[options.bed]
+    params["overturn"] = options.overturn_angle
+    params["rtol"] = options.rtol
+    params["atol"] = options.atol
+    params["zeno"] = DEFAULT_ZENO_FRACTION * block.alpha
+    params["max_events"] = MAX_EVENTS
+    return params, np.array([0.0, 0.0, y0, 0.0])
+
+
+def parameter_table(model: RockingModel, cases, options: SolverOptions):
+    """Parameter records (n_case,) and initial states (n_case, 4) for (block, k, xi) cases."""
+    if len(cases) == 0:
+        raise SolverError("no (block, k, xi) case given")
+    table = fields.new_params(len(cases))
+    states = np.empty((len(cases), 4))
+    for row, (block, k, xi) in enumerate(cases):
+        table[row], states[row] = parameter_record(model, block, k, xi, options)
+    return table, states
 
 
 def _ground(ag, dt):
@@ -99,76 +138,82 @@ def _ground(ag, dt):
     return ag
 
 
-def simulate(model, ag, dt, block, *, k=None, xi=None, switch="consistent", restitution=None,
-             theta0=0.0, thetadot0=0.0, t_end=None, g=STANDARD_GRAVITY, overturn_angle=math.pi / 2,
-             rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL) -> RockingResult:
+def _time_window(ag, dt, t_end):
+    """(ground motion cut to t_end, number of tail samples): the record plus DEFAULT_TAIL by default."""
+    if t_end is None:
+        t_end = (ag.size - 1) * dt + DEFAULT_TAIL
+    if not (t_end >= 0 and math.isfinite(t_end)):
+        raise SolverError(f"t_end = {t_end} [s]; must be >= 0")
+    n_total = max(2, int(round(t_end / dt)) + 1)
+    if n_total < ag.size:
+        ag = ag[:n_total]
+    return ag, max(0, n_total - ag.size)
+
+
+def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0, t_end=None,
+             **options) -> RockingResult:
     """Rocking response of ``block`` to ground acceleration ``ag`` [m/s^2] sampled at ``dt`` [s].
 
     Parameters
     ----------
     model : str
-        ``housner``, ``ssi`` or ``ssi-paper`` (see ``MODELS``).
+        ``housner``, ``ssi`` (the paper's model), ``ssi-paper`` (its printed equations) or ``winkler``
+        (tensionless bed); see ``MODELS``.
     k, xi : float
-        Interface stiffness [N/m] and damping ratio [-] (SSI models; xi defaults to 0.05).
-    switch : str
-        SSI pivot-switch rule, ``consistent`` (default) or ``continuous``.
-    restitution : float, optional
-        Factor on theta' at each impact; Housner default 1 - 1.5 sin^2(alpha), SSI default 1.
+        Interface stiffness [N/m] (winkler: the bed's total vertical stiffness K) and damping ratio
+        [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m)).
     theta0, thetadot0 : float
         Initial rotation [rad] and rate [rad/s] (free rocking).
     t_end : float, optional
         End time [s]; zero ground motion after the record. Default: record + 10 s.
-    overturn_angle : float
-        |theta| at which the block has overturned [rad] (default pi/2, terminal).
+    **options
+        ``SolverOptions`` fields: ``switch`` (ssi: consistent | continuous), ``bed`` (winkler:
+        continuous | two-spring), ``restitution`` (pivot models; Housner default 1 - 1.5 sin^2 alpha),
+        ``g``, ``overturn_angle`` [rad] (default pi/2, terminal), ``rtol``, ``atol``.
     """
     spec = get_model(model)
-    ag = _ground(ag, dt)
-    params, y0 = parameter_vector(spec, block, k=k, xi=xi, switch=switch, restitution=restitution,
-                                  g=g, overturn_angle=overturn_angle, rtol=rtol, atol=atol)
-    record_end = (ag.size - 1) * dt
-    if t_end is None:
-        t_end = record_end + DEFAULT_TAIL
-    if t_end < 0:
-        raise SolverError(f"t_end = {t_end} [s]; must be >= 0")
-    n_total = max(2, int(round(t_end / dt)) + 1)
-    n_tail = max(0, n_total - ag.size)
-    if n_total < ag.size:
-        ag = ag[:n_total]
+    settings = SolverOptions(**options)
+    ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
+    table, states = parameter_table(spec, [(block, k, xi)], settings)
+    state = states[0]
+    state[0], state[1] = float(theta0), float(thetadot0)
     history = np.empty((ag.size + n_tail, 4))
     impacts = np.empty(IMPACT_CAPACITY)
-    summary = np.zeros(kernels.N_SUMMARY)
-    kernels.simulate_kernel(spec.kernel_code, ag, float(dt), n_tail, params, float(theta0),
-                            float(thetadot0), y0, 0.0, history, impacts, summary)
-    return _result(spec, block, params, dt, summary, history, impacts)
+    summaries = new_summaries(1)
+    kernels.single_kernel(spec.kernel_code, ag, float(dt), n_tail, table, state, history, impacts, summaries)
+    return _result(spec, block, dt, summaries[0], history, impacts)
 
 
-def _result(spec, block, params, dt, summary, history, impacts):
-    status = Status(int(summary[kernels.S_STATUS]))
-    n_impacts = int(summary[kernels.S_N_IMPACTS])
-    min_support = summary[kernels.S_MIN_SUPPORT] * block.mass
+def _result(spec, block, dt, summary, history, impacts):
+    status = Outcome(int(summary["status"]))
+    n_impacts = int(summary["n_impacts"])
+    min_support = float(summary["min_support_force"]) * block.mass
     message = MESSAGES[status]
-    if spec.needs_foundation and min_support < 0:
+    if spec.can_pull and min_support < 0:
         message += f"; the foundation spring went into tension (min support force {min_support:.3g} N)"
-        warnings.warn(f"{spec.name}: foundation spring in tension (min support force {min_support:.3g} N): "
-                      "the block would jump; results past that moment are not physical", stacklevel=3)
-    time_of_uplift = summary[kernels.S_TIME_OF_UPLIFT]
+        warnings.warn(f"{spec.name}: foundation spring in tension from t = {float(summary['time_of_tension']):.3f} s "
+                      f"(min support force {min_support:.3g} N = {min_support / (block.mass * 9.80665):.2g} W): "
+                      "real ground cannot pull; results past that moment are not physical "
+                      "(the 'winkler' model has a tensionless bed)", stacklevel=3)
     return RockingResult(
         model=spec.name, t=np.arange(history.shape[0]) * dt, theta=history[:, 0].copy(),
         theta_dot=history[:, 1].copy(), y=history[:, 2].copy(), y_dot=history[:, 3].copy(),
-        peak_angle=float(summary[kernels.S_PEAK]),
-        peak_angle_ratio=float(summary[kernels.S_PEAK] / block.alpha),
-        time_of_peak=float(summary[kernels.S_TIME_OF_PEAK]),
-        uplifted=bool(summary[kernels.S_UPLIFTED]), overturned=status == Status.OVERTURNED,
+        peak_angle=float(summary["peak_angle"]),
+        peak_angle_ratio=float(summary["peak_angle"] / block.alpha),
+        time_of_peak=float(summary["time_of_peak"]),
+        uplifted=bool(summary["uplifted"]), overturned=status == Outcome.OVERTURNED,
         n_impacts=n_impacts, impact_times=impacts[:min(n_impacts, impacts.size)].copy(),
-        time_of_uplift=float(time_of_uplift) if time_of_uplift >= 0 else math.nan,
-        peak_settlement=float(summary[kernels.S_PEAK_Y]) if spec.needs_foundation else 0.0,
-        min_support_force=float(min_support) if spec.needs_foundation else block.mass * params[kernels.P_G],
-        status=status, message=message, n_steps=int(summary[kernels.S_N_STEPS]))
+        time_of_uplift=float(summary["time_of_uplift"]),
+        peak_settlement=float(summary["peak_settlement"]) if spec.needs_foundation else 0.0,
+        min_support_force=min_support,
+        time_of_tension=float(summary["time_of_tension"]),
+        n_flights=int(summary["n_flights"]), airborne_time=float(summary["airborne_time"]),
+        peak_uplift=float(summary["peak_corner_uplift"]),
+        peak_friction_demand=float(summary["peak_friction_demand"]),
+        status=status, message=message, n_steps=int(summary["n_steps"]))
 
 
-def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, switch="consistent",
-                   restitution=None, t_end=None, g=STANDARD_GRAVITY, overturn_angle=math.pi / 2,
-                   rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL) -> np.ndarray:
+def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, t_end=None, **options) -> np.ndarray:
     """Run one record at many scale factors for many (block, k, xi) cases in one compiled call.
 
     Parameters
@@ -176,65 +221,49 @@ def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, switch="con
     scales : array_like, shape (n_scale,)
         Factors applied to ``ag``.
     blocks_and_foundations : list of (Block, k, xi)
-        k and xi are ignored (may be None) for Housner.
+        k and xi are ignored (may be None) for rigid-base models.
+    **options
+        ``SolverOptions`` fields (see ``simulate``).
 
     Returns
     -------
-    ndarray, shape (n_case, n_scale, kernels.N_SUMMARY)
-        Summary vectors (see ``kernels.S_*``; status codes as ``Status``).
+    ndarray of ``fields.SUMMARY_DTYPE`` records, shape (n_case, n_scale)
+        ``summaries["peak_angle"]`` etc.; ``status`` holds ``Outcome`` codes.
     """
     spec = get_model(model)
-    ag = _ground(ag, dt)
-    rows, y0s = [], []
-    for block, k, xi in blocks_and_foundations:
-        params, y0 = parameter_vector(spec, block, k=k, xi=xi, switch=switch, restitution=restitution,
-                                      g=g, overturn_angle=overturn_angle, rtol=rtol, atol=atol)
-        rows.append(params)
-        y0s.append(y0)
-    record_end = (ag.size - 1) * dt
-    n_tail = max(0, int(round(((record_end + DEFAULT_TAIL) if t_end is None else t_end) / dt)) + 1 - ag.size)
+    ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
+    table, states = parameter_table(spec, blocks_and_foundations, SolverOptions(**options))
     scales = np.ascontiguousarray(scales, dtype=np.float64)
-    summaries = np.zeros((len(rows), scales.size, kernels.N_SUMMARY))
-    kernels.batch_kernel(spec.kernel_code, ag, float(dt), n_tail, scales, np.array(rows),
-                         np.array(y0s), summaries)
+    summaries = new_summaries((len(table), scales.size))
+    kernels.batch_kernel(spec.kernel_code, ag, float(dt), n_tail, scales, table, states, summaries)
     return summaries
 
 
-def simulate_histories(model, ag, dt, cases, *, switch="consistent", restitution=None, t_end=None,
-                       g=STANDARD_GRAVITY, overturn_angle=math.pi / 2, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL):
+def simulate_histories(model, ag, dt, cases, *, t_end=None, **options):
     """Rotation histories of one ground motion for many (block, k, xi) cases in one compiled call.
 
     Returns
     -------
     t : ndarray (n,) [s]; theta : ndarray (n_case, n) [rad] (NaN after overturning);
-    y : ndarray (n_case, n) [m]; summaries : ndarray (n_case, kernels.N_SUMMARY).
+    y : ndarray (n_case, n) [m]; summaries : ``SUMMARY_DTYPE`` records (n_case,).
     """
     spec = get_model(model)
-    ag = _ground(ag, dt)
-    rows, y0s = [], []
-    for block, k, xi in cases:
-        params, y0 = parameter_vector(spec, block, k=k, xi=xi, switch=switch, restitution=restitution, g=g,
-                                      overturn_angle=overturn_angle, rtol=rtol, atol=atol)
-        rows.append(params)
-        y0s.append(y0)
-    record_end = (ag.size - 1) * dt
-    n_total = max(2, int(round(((record_end + DEFAULT_TAIL) if t_end is None else t_end) / dt)) + 1)
-    n_tail = max(0, n_total - ag.size)
-    if n_total < ag.size:
-        ag = ag[:n_total]
-    histories = np.empty((len(rows), ag.size + n_tail, 4))
-    summaries = np.zeros((len(rows), kernels.N_SUMMARY))
-    kernels.history_batch_kernel(spec.kernel_code, ag, float(dt), n_tail, np.array(rows), np.array(y0s),
-                                 histories, summaries)
+    ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
+    table, states = parameter_table(spec, cases, SolverOptions(**options))
+    histories = np.empty((len(table), ag.size + n_tail, 4))
+    summaries = new_summaries(len(table))
+    kernels.history_batch_kernel(spec.kernel_code, ag, float(dt), n_tail, table, states, histories, summaries)
     return np.arange(ag.size + n_tail) * dt, histories[:, :, 0], histories[:, :, 2], summaries
 
 
 from pipeline.models import housner as _housner  # noqa: E402  (registration at import)
 from pipeline.models import ssi as _ssi  # noqa: E402
+from pipeline.models import winkler as _winkler  # noqa: E402
 
 register(_housner.MODEL)
 register(_ssi.MODEL)
 register(_ssi.PAPER_MODEL)
+register(_winkler.MODEL)
 
-__all__ = ["MODELS", "RockingResult", "Status", "get_model", "register", "simulate", "simulate_batch",
-           "simulate_histories"]
+__all__ = ["BED_TYPES", "MODELS", "Outcome", "RockingResult", "SUMMARY_DTYPE", "SUMMARY_FIELDS", "SWITCH_RULES",
+           "SolverOptions", "get_model", "register", "simulate", "simulate_batch", "simulate_histories"]

@@ -1,14 +1,28 @@
-"""pipeline.models.base - the model contract and the result object.
+"""pipeline.models.base - the model contract, the outcome enum and the result object.
 
-Input : nothing (definitions). Output: ``RockingModel`` (what a model registers), ``RockingResult``
-(what ``simulate`` returns) and ``Status``.
+Input : nothing (definitions). Output: ``RockingModel`` (what a model registers), ``Outcome`` (the one
+spelling of a run's outcome, used by the kernels, the cube's flag variable, IDA and fragility) and
+``RockingResult`` (what ``simulate`` returns).
 
-Contract for a new model (one module, one ``register`` call):
-1. It names a compiled kernel code (``kernels.HOUSNER`` or ``kernels.SSI``) and the inertia factor
-   kappa of its rotational equation; the kernel owns the time loop, events and status.
-2. ``needs_foundation`` says whether k [N/m] and xi [-] are required.
-3. ``default_restitution(block)`` gives the velocity factor applied at each impact.
-4. A result with status OVERTURNED is an outcome, not an error.
+The contract for a model (as scipy's ``integrate/_ivp/base.py`` states its own), one module and one
+``register`` call:
+
+1. The module defines its physics as small compiled functions of plain arrays and a
+   ``fields.PARAMS_DTYPE`` record, and names its kernel code (``fields.HOUSNER``, ``SSI``,
+   ``WINKLER``); ``kernels.rhs`` dispatches on that code (a new kernel code is one branch there).
+2. Pivot models (``kernel_code`` HOUSNER or SSI) rest until the uplift condition, rock on one corner
+   and switch pivot at theta = 0 through an impact rule; bed models (WINKLER) have no rest phase and
+   no impact rule: their contact law does everything.
+3. ``needs_foundation``: the model needs the interface stiffness k [N/m] and damping ratio xi [-];
+   ``is_rigid_base``: its result does not depend on the soil (computed once per block).
+4. ``uses_restitution``, ``uses_switch``, ``uses_bed``: which solver options apply; a caller asks
+   these instead of comparing model names.
+5. ``uplift_is_rigid_threshold``: uplift happens exactly when |ag| = g tan(alpha) (at rest), so under
+   PGA scaling the uplift fragility is a known step.
+6. ``can_pull``: the foundation force can become negative (the paper's spring); the kernel reports
+   ``min_support_force`` and ``time_of_tension`` so that runs past that moment can be flagged.
+7. A run that overturns is an outcome (``Outcome.OVERTURNED``), not an error; ``Outcome.FAILED``
+   means the integration stopped (step or event guard).
 """
 
 from __future__ import annotations
@@ -20,18 +34,22 @@ from typing import Callable
 import numpy as np
 
 
-class Status(enum.IntEnum):
+class Outcome(enum.IntEnum):
     NO_UPLIFT = 0
     ROCKING = 1
     OVERTURNED = 2
     FAILED = 3
 
+    @property
+    def flag_meaning(self) -> str:
+        return {0: "no_uplift", 1: "rocking", 2: "overturned", 3: "solver_failed"}[int(self)]
+
 
 MESSAGES = {
-    Status.NO_UPLIFT: "the block never uplifted",
-    Status.ROCKING: "the block rocked and did not overturn",
-    Status.OVERTURNED: "the block overturned (|theta| reached the overturning angle)",
-    Status.FAILED: "integration stopped: too many events or steps (chatter or bad parameters)",
+    Outcome.NO_UPLIFT: "the block never uplifted",
+    Outcome.ROCKING: "the block rocked and did not overturn",
+    Outcome.OVERTURNED: "the block overturned (|theta| reached the overturning angle)",
+    Outcome.FAILED: "integration stopped: too many events or steps (chatter or bad parameters)",
 }
 
 
@@ -39,10 +57,17 @@ MESSAGES = {
 class RockingModel:
     name: str
     kernel_code: int
-    kappa: float  # theta'' = (kappa/R)(...): 3/4 from I_O = 4/3 m R^2
+    kappa: float  # m R^2 / I_O of the pivot equation: 3/4 from I_O = 4/3 m R^2; p^2 = kappa g / R
     needs_foundation: bool
     default_restitution: Callable
     description: str
+    label: str = ""
+    is_rigid_base: bool = False
+    uses_restitution: bool = False
+    uses_switch: bool = False
+    uses_bed: bool = False
+    uplift_is_rigid_threshold: bool = True
+    can_pull: bool = False
 
 
 @dataclass
@@ -52,11 +77,14 @@ class RockingResult:
     Attributes
     ----------
     t : ndarray (n,) [s]; theta, theta_dot : ndarray (n,) [rad], [rad/s], NaN after overturning.
-    y, y_dot : ndarray (n,) [m], [m/s] pivot settlement and its rate (SSI; zeros for Housner).
+    y, y_dot : ndarray (n,) [m], [m/s] settlement (positive down) of the active pivot (ssi) or of the
+        base centre (winkler); zeros for Housner.
     peak_angle [rad], peak_angle_ratio = peak_angle / alpha [-], time_of_peak [s],
     uplifted, overturned (bool), n_impacts, impact_times [s], time_of_uplift [s] (NaN if none),
-    peak_settlement [m] (SSI), min_support_force [N] (SSI; negative = tension, warned),
-    status (Status) and message.
+    peak_settlement [m], min_support_force [N] (negative: the foundation pulled, ssi only),
+    time_of_tension [s] (first time it pulled; NaN if never), n_flights, airborne_time [s],
+    peak_uplift [m] (highest corner above the ground), peak_friction_demand [-] (winkler),
+    status (Outcome) and message.
     """
 
     model: str
@@ -75,11 +103,16 @@ class RockingResult:
     time_of_uplift: float
     peak_settlement: float
     min_support_force: float
-    status: Status
+    status: Outcome
     message: str
     n_steps: int = 0
+    time_of_tension: float = float("nan")
+    n_flights: int = 0
+    airborne_time: float = 0.0
+    peak_uplift: float = 0.0
+    peak_friction_demand: float = 0.0
     extra: dict = field(default_factory=dict)
 
     @property
     def success(self) -> bool:
-        return self.status != Status.FAILED
+        return self.status != Outcome.FAILED

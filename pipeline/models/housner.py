@@ -1,16 +1,33 @@
 """pipeline.models.housner - Housner's rigid-base rocking block (paper eqs. 1-6).
 
-Input : block (R, alpha), ground acceleration. Output: registered model ``housner``.
+Input : block (R, alpha), ground acceleration. Output: registered model ``housner`` and its
+compiled right-hand side ``housner_rhs``.
 
 theta'' = -p^2 [sin(sigma alpha - theta) + (ag/g) cos(sigma alpha - theta)], p^2 = 3g/(4R), sigma
 the active pivot. At rest until |ag| > g tan(alpha); at each impact (theta = 0) theta' <- r theta'
 with r = 1 - 1.5 sin^2(alpha) by default (angular momentum about the new corner), pivot switches.
 """
 
-from pipeline.models import kernels
+import math
+
 from pipeline.models.base import RockingModel
+from pipeline.models.fields import HOUSNER
+from pipeline.models.jit import njit
+
+
+@njit(cache=True)
+def housner_rhs(sigma, x, accel, params, out):
+    """dx/dt while rocking on pivot sigma: theta'' = -(kappa/R)(g sin A + ag cos A), A = sigma alpha - theta."""
+    angle = sigma * params["alpha"] - x[0]
+    out[0] = x[1]
+    out[1] = -params["kappa"] * (params["g"] * math.sin(angle) + accel * math.cos(angle)) / params["R"]
+    out[2] = 0.0
+    out[3] = 0.0
+
 
 MODEL = RockingModel(
-    name="housner", kernel_code=kernels.HOUSNER, kappa=0.75, needs_foundation=False,
+    name="housner", kernel_code=HOUSNER, kappa=0.75, needs_foundation=False, is_rigid_base=True,
+    uses_restitution=True, uplift_is_rigid_threshold=True,
     default_restitution=lambda block: block.housner_restitution(),
+    label="Housner (rigid base)",
     description="rigid base (Housner 1963); impacts dissipate with r = 1 - 1.5 sin^2(alpha)")

@@ -35,15 +35,66 @@ Housner's restitution emerges); ``continuous`` keeps theta' and y' (what ODE45 o
 equations does; tends to Housner with r = 1).
 """
 
-from pipeline.models import kernels
+import math
+
 from pipeline.models.base import RockingModel
+from pipeline.models.fields import SSI
+from pipeline.models.jit import njit
+
+
+@njit(cache=True)
+def ssi_rest_rhs(x, params, out):
+    """Both corners down: only the vertical spring-dashpot moves."""
+    omega = params["omega"]
+    out[0] = 0.0
+    out[1] = 0.0
+    out[2] = x[3]
+    out[3] = params["g"] - omega * omega * x[2] - 2.0 * params["xi"] * omega * x[3]
+
+
+@njit(cache=True)
+def ssi_rhs(sigma, x, accel, params, out):
+    """dx/dt while rocking on pivot sigma (the equations in the module docstring)."""
+    radius = params["R"]
+    g = params["g"]
+    omega = params["omega"]
+    kappa = params["kappa"]
+    angle = sigma * params["alpha"] - x[0]  # A = sigma*alpha - theta
+    sin_a = math.sin(angle)
+    cos_a = math.cos(angle)
+    free = g - omega * omega * x[2] - 2.0 * params["xi"] * omega * x[3] - radius * cos_a * x[1] * x[1]
+    moment = -g * sin_a - accel * cos_a
+    y_acc = (free + kappa * sin_a * moment) / (1.0 - kappa * sin_a * sin_a)
+    out[0] = x[1]
+    out[1] = kappa / radius * (sin_a * y_acc + moment)
+    out[2] = x[3]
+    out[3] = y_acc
+
+
+@njit(cache=True)
+def ssi_support(x, params):
+    """Force of the spring-dashpot on the block per unit mass [m/s^2] (negative: it pulls)."""
+    omega = params["omega"]
+    return omega * omega * x[2] + 2.0 * params["xi"] * omega * x[3]
+
+
+@njit(cache=True)
+def ssi_pivot_switch(x, params):
+    """``consistent`` switch: theta' and the centre-of-mass velocity stay continuous, so y' jumps."""
+    x[3] = x[3] + 2.0 * params["R"] * math.sin(params["alpha"]) * abs(x[1])
+
 
 MODEL = RockingModel(
-    name="ssi", kernel_code=kernels.SSI, kappa=0.75, needs_foundation=True,
+    name="ssi", kernel_code=SSI, kappa=0.75, needs_foundation=True, uses_switch=True,
+    uses_restitution=True, uplift_is_rigid_threshold=True, can_pull=True,
     default_restitution=lambda block: 1.0,
-    description="2-DOF rocking on a vertical spring-dashpot, derived from the Lagrangian")
+    label="SSI, paper's model (spring can pull)",
+    description="the paper's 2-DOF model: one vertical spring-dashpot under the active pivot, derived from "
+                "the Lagrangian; the spring can pull on the block")
 
 PAPER_MODEL = RockingModel(
-    name="ssi-paper", kernel_code=kernels.SSI, kappa=3.0 / 7.0, needs_foundation=True,
+    name="ssi-paper", kernel_code=SSI, kappa=3.0 / 7.0, needs_foundation=True, uses_switch=True,
+    uses_restitution=True, uplift_is_rigid_threshold=True, can_pull=True,
     default_restitution=lambda block: 1.0,
+    label="SSI, paper's printed equations",
     description="the paper's printed eqs. 15-16 (3/7 factors; typos fixed); does not tend to Housner")

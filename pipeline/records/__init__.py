@@ -5,19 +5,19 @@ Input : a record set name from the catalogue (``far-field``, ``near-field-pulse`
 Output: ``Record`` objects (an ``obspy.Trace`` of ground acceleration [m/s^2] plus catalogue
         metadata) and, for a batch, the list of ``RecordError`` for files that could not be read.
 
-Formats are a registry: ``FORMATS[name] = RecordFormat(is_format, read_format)``. Built-ins are
-registered at the bottom of this module; third parties add theirs through the entry-point group
-``pipeline.record_formats`` (an object with ``is_format``/``read_format``), merged once. Formats
-that obspy reads itself (MiniSEED, SAC, KNET, ...) go through ``obspy.read`` with the units the
-user states.
+Formats: rockfrag's own readers (PEER AT2, text/CSV) sit in ``FORMATS[name] = RecordFormat(is_format,
+read_format)``, registered at the bottom of this module and tried in that order; their readers take
+the user's ``units`` and ``dt``. Every other format goes through ``obspy.read``, which detects its
+built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and third-party ones through obspy's own
+entry-point group ``obspy.plugin.waveform``: that is the one extension mechanism (the former
+``pipeline.record_formats`` group is gone). Units: from the file where it states them (PEER AT2: g;
+K-NET/KiK-net: the header's scale factor in gal; text: a header such as ``acc [g]``), else the user's.
 """
 
 from __future__ import annotations
 
-import functools
 import os
 from dataclasses import dataclass, field
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Callable, NamedTuple
 
@@ -25,6 +25,7 @@ import numpy as np
 
 from pipeline.errors import ManifestError, RecordError
 from pipeline.records import peer_at2
+from pipeline.records import text as text_records
 from pipeline.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
 from pipeline.units import acceleration_factor
 
@@ -32,12 +33,13 @@ RECORDS_DIR = Path(os.environ.get("ROCKFRAG_RECORDS", Path(__file__).resolve().p
 """Folder holding the shipped records and ``MANIFEST.csv`` (override with $ROCKFRAG_RECORDS)."""
 
 RECORD_SUFFIXES = {".at2"}
-"""File endings picked up when a folder is given (other formats: name the files)."""
+"""File endings picked up when a folder is given, plus text records (``text.TEXT_SUFFIXES`` whose content
+is one or two numeric columns); other formats: name the files."""
 
 
 class RecordFormat(NamedTuple):
     is_format: Callable  # (path) -> bool, never raises
-    read_format: Callable  # (path) -> obspy.Stream with acceleration in m/s^2
+    read_format: Callable  # (path, units=None, dt=None) -> obspy.Stream with acceleration in m/s^2
 
 
 FORMATS: dict[str, RecordFormat] = {}
@@ -48,22 +50,13 @@ def register_format(name: str, is_format: Callable, read_format: Callable) -> No
     FORMATS[name] = RecordFormat(is_format, read_format)
 
 
-@functools.lru_cache(maxsize=1)
-def _load_plugin_formats() -> None:
-    for entry in entry_points(group="pipeline.record_formats"):
-        plugin = entry.load()
-        register_format(entry.name, plugin.is_format, plugin.read_format)
-
-
 def list_formats() -> list[str]:
     """Names of the record formats this installation reads itself (plus obspy's formats)."""
-    _load_plugin_formats()
     return list(FORMATS)
 
 
 def detect_format(path) -> str | None:
     """Name of the first registered format that recognises ``path``, or None."""
-    _load_plugin_formats()
     for name, fmt in FORMATS.items():
         if fmt.is_format(path):
             return name
@@ -107,7 +100,7 @@ class Record:
         return Record(self.id, trace, dict(self.metadata))
 
 
-def read_record(path, format: str | None = None, units: str | None = None):
+def read_record(path, format: str | None = None, units: str | None = None, dt: float | None = None):
     """Read one acceleration record into an ``obspy.Trace`` in m/s^2.
 
     Parameters
@@ -118,7 +111,10 @@ def read_record(path, format: str | None = None, units: str | None = None):
         A registered format name (see ``list_formats()``) or an obspy format name; detected if omitted.
     units : str, optional
         Acceleration units of the file's samples (``g``, ``m/s^2``, ``cm/s^2``, ``gal``). Required for
-        formats that do not state them (obspy formats); ignored for PEER AT2, whose header states g.
+        formats that do not state them (text without a unit in its header, MiniSEED, SAC, ...); ignored
+        for PEER AT2 (g) and K-NET/KiK-net (the header's scale factor in gal), whose headers state them.
+    dt : float, optional
+        Time step [s] of one-column text records (files with a time column or a header state theirs).
 
     Raises
     ------
@@ -128,10 +124,9 @@ def read_record(path, format: str | None = None, units: str | None = None):
     path = Path(path)
     if not path.is_file():
         raise RecordError(path, "file not found")
-    _load_plugin_formats()
     name = format if format in FORMATS else (None if format else detect_format(path))
     if name is not None:
-        stream = FORMATS[name].read_format(path)
+        stream = FORMATS[name].read_format(path, units=units, dt=dt)
         return stream[0]
     return _read_with_obspy(path, format, units)
 
@@ -148,6 +143,11 @@ def _read_with_obspy(path, format, units):
         raise RecordError(path, f"holds {len(stream)} traces; expected one horizontal acceleration "
                           "component per file")
     trace = stream[0]
+    if trace.stats._format == "KNET":
+        # obspy's calib is the header's scale factor with gal -> m/s^2 applied; NIED's counts carry a
+        # constant offset (the header's Max. Acc. is taken after removing the mean)
+        units = "m/s^2"
+        trace.data = np.asarray(trace.data, dtype=np.float64) - np.mean(trace.data)
     if units is None:
         units = trace.stats.get("units")
     if units is None:
@@ -190,9 +190,9 @@ def _load_entry(entry: CatalogueEntry) -> Record:
     return Record(entry.id, trace, entry.metadata())
 
 
-def _load_user_file(path: Path, units) -> Record:
-    trace = read_record(path, units=units)
-    header = trace.stats.get("peer_at2", {})
+def _load_user_file(path: Path, units, dt=None) -> Record:
+    trace = read_record(path, units=units, dt=dt)
+    header = trace.stats.get("peer_at2") or trace.stats.get("text_record") or {}
     metadata = {"id": path.stem, "file": str(path), "event": header.get("event", ""),
                 "year": None, "magnitude": None, "station": header.get("station", trace.stats.station),
                 "component": header.get("component", trace.stats.channel), "sets": "user",
@@ -201,7 +201,8 @@ def _load_user_file(path: Path, units) -> Record:
     return Record(path.stem, trace, metadata)
 
 
-def load_records(selection, records_dir=None, units: str | None = None, verify_checksums=True):
+def load_records(selection, records_dir=None, units: str | None = None, verify_checksums=True,
+                 dt: float | None = None):
     """Load a record set by name, a folder of files, or a list of these.
 
     Parameters
@@ -210,6 +211,8 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
         Set names (``record_sets()``), record ids, folders or files.
     units : str, optional
         Acceleration units for user files in formats that do not state them.
+    dt : float, optional
+        Time step [s] of the user's one-column text records.
     verify_checksums : bool
         Check catalogue files against their sha256 (a changed file is reported by name).
 
@@ -245,13 +248,15 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
                 else:
                     add(_load_entry, entry.id, entry)
         elif Path(text).is_dir():
-            files = sorted(p for p in Path(text).rglob("*") if p.suffix.lower() in RECORD_SUFFIXES)
+            files = sorted(p for p in Path(text).rglob("*")
+                           if p.suffix.lower() in RECORD_SUFFIXES or text_records.is_text_record(p))
             if not files:
-                raise RecordError(text, f"folder holds no record files ({', '.join(RECORD_SUFFIXES)})")
+                raise RecordError(text, f"folder holds no record files ({', '.join(sorted(RECORD_SUFFIXES))}, "
+                                  "or text/CSV of one or two numeric columns)")
             for path in files:
-                add(lambda p: _load_user_file(p, units), str(path), path)
+                add(lambda p: _load_user_file(p, units, dt), str(path), path)
         elif Path(text).is_file():
-            add(lambda p: _load_user_file(p, units), text, Path(text))
+            add(lambda p: _load_user_file(p, units, dt), text, Path(text))
         else:
             raise ManifestError(f"unknown record selection {text!r}: not a record set "
                                 f"({', '.join(sorted(sets))}), a record id, a folder or a file")
@@ -259,3 +264,4 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
 
 
 register_format("PEER_AT2", peer_at2.is_peer_at2, peer_at2.read_peer_at2)
+register_format("TEXT", text_records.is_text_record, text_records.read_text_record)

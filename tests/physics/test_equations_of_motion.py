@@ -12,6 +12,7 @@ import pytest
 import sympy as sp
 
 from pipeline.models import kernels
+from pipeline.models.fields import HOUSNER, SSI, new_params
 
 
 def _lagrange_accelerations():
@@ -75,10 +76,10 @@ def test_kernel_rhs_is_euler_lagrange(sigma):
         state = np.array([sigma * rng.uniform(0, alpha), rng.normal(0, 1.0),
                           rng.uniform(-0.01, 0.05), rng.normal(0, 0.1)])
         accel = rng.normal(0, 5.0)
-        params = np.zeros(kernels.N_PARAMS)
-        params[[kernels.P_R, kernels.P_ALPHA, kernels.P_G, kernels.P_KAPPA, kernels.P_OMEGA, kernels.P_XI]] = \
-            [radius, alpha, g, 0.75, omega, xi]
-        kernels.rhs(kernels.SSI, kernels.ROCKING, sigma, state, accel, params, out)
+        params = new_params(1)[0]
+        for name, value in zip(("R", "alpha", "g", "kappa", "omega", "xi"), (radius, alpha, g, 0.75, omega, xi)):
+            params[name] = value
+        kernels.rhs(SSI, kernels.ROCKING, sigma, state, accel, params, out)
         arguments = (state[0], state[1], state[2], state[3], m, radius, alpha, g, k, c, accel, sigma)
         expected_theta = theta_dd(*arguments)
         expected_y = y_dd(*arguments)
@@ -89,11 +90,12 @@ def test_kernel_rhs_is_euler_lagrange(sigma):
 
 def test_stiff_limit_of_rhs_is_housner_eq1():
     """With y'' = 0 imposed (rigid base), the theta equation is Housner's eq. 1."""
-    params = np.zeros(kernels.N_PARAMS)
+    params = new_params(1)[0]
     radius, alpha, g = 3.0, 0.3, 9.80665
-    params[[kernels.P_R, kernels.P_ALPHA, kernels.P_G, kernels.P_KAPPA]] = [radius, alpha, g, 0.75]
+    for name, value in zip(("R", "alpha", "g", "kappa"), (radius, alpha, g, 0.75)):
+        params[name] = value
     out = np.empty(4)
     state = np.array([0.1, 0.2, 0.0, 0.0])
-    kernels.rhs(kernels.HOUSNER, kernels.ROCKING, 1.0, state, 1.5, params, out)
+    kernels.rhs(HOUSNER, kernels.ROCKING, 1.0, state, 1.5, params, out)
     p2 = 3 * g / (4 * radius)
     assert out[1] == pytest.approx(-p2 * (np.sin(alpha - 0.1) + 1.5 / g * np.cos(alpha - 0.1)), rel=1e-14)

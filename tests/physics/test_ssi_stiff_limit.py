@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from pipeline.blocks import Block
-from pipeline.models import Status, simulate
+from pipeline.models import Outcome, simulate
 
 G = 9.80665
 BLOCK = Block(name="test", R=1.0, alpha=0.2, mass=1000.0)
@@ -86,7 +86,7 @@ def test_static_start_and_uplift_threshold():
     k = stiffness(40)
     threshold = G * math.tan(BLOCK.alpha)
     below = simulate("ssi", np.full(300, 0.999 * threshold), 0.01, BLOCK, k=k, xi=0.05)
-    assert below.status == Status.NO_UPLIFT
+    assert below.status == Outcome.NO_UPLIFT
     y_static = BLOCK.mass * G / k
     np.testing.assert_allclose(below.y, y_static, rtol=1e-12)  # starts and stays at equilibrium
     above = simulate("ssi", np.full(300, -1.001 * threshold), 0.01, BLOCK, k=k, xi=0.05)

@@ -1,0 +1,99 @@
+"""pipeline.models.fields - the named fields that cross the compiled-kernel boundary.
+
+Input : nothing (definitions). Output: ``PARAMS_DTYPE`` (what a kernel is told about one case),
+``SUMMARY_FIELDS``/``SUMMARY_DTYPE`` (what it reports about one run), the model codes and the
+event kinds. Both records are NumPy structured dtypes: numba reads and writes their fields by name
+(``params["alpha"]``, ``summary["peak_angle"]``), so no slot index leaks out of the kernels, and the
+cube's variables are generated from ``SUMMARY_FIELDS`` (pipeline.cube).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# Kernel codes: which right-hand side and which time loop a model uses (pipeline.models.kernels).
+HOUSNER = 0   # rigid base, pivot rocking with a restitution rule
+SSI = 1       # one vertical spring-dashpot under the active pivot (the paper's model)
+WINKLER = 2   # tensionless viscoelastic Winkler bed (continuous or two springs)
+
+# Pivot-switch rules of the SSI model at theta = 0.
+SWITCH_CONSISTENT = 0
+SWITCH_CONTINUOUS = 1
+
+# Bed types of the Winkler model.
+BED_CONTINUOUS = 0
+BED_TWO_SPRING = 1
+
+# Event kinds located inside a step.
+EVENT_NONE = -1
+EVENT_IMPACT = 0        # theta crosses 0 (pivot switch for pivot models; counted for winkler)
+EVENT_OVERTURN = 1      # |theta| reaches the overturning angle
+EVENT_UPLIFT = 2        # rest -> rocking (pivot models)
+EVENT_SETTLE = 3        # a start that does not lift: back to rest (pivot models)
+EVENT_CONTACT = 4       # a bed contact point opens or closes (winkler)
+
+PARAMS_DTYPE = np.dtype([
+    ("R", "f8"),            # semi-diagonal [m]
+    ("alpha", "f8"),        # slenderness [rad]
+    ("b", "f8"),            # half-width [m]
+    ("h", "f8"),            # half-height [m]
+    ("g", "f8"),            # gravity [m/s^2]
+    ("kappa", "f8"),        # m R^2 / I_O of the pivot equation [-]; p^2 = kappa g / R
+    ("omega", "f8"),        # sqrt(K/m) of the foundation [rad/s]; 0 for a rigid base
+    ("xi", "f8"),           # damping ratio of the vertical foundation mode [-]
+    ("restitution", "f8"),  # factor on theta' at each impact (pivot models)
+    ("switch", "f8"),       # SWITCH_* (SSI)
+    ("bed", "f8"),          # BED_* (winkler)
+    ("overturn", "f8"),     # |theta| of overturning [rad]
+    ("rtol", "f8"),         # relative error per step [-]
+    ("atol", "f8"),         # absolute error per step as a fraction of each state's scale [-]
+    ("zeno", "f8"),         # excursions below this angle end the rocking [rad] (pivot models)
+    ("max_events", "f8"),   # chatter guard
+])
+
+
+@dataclass(frozen=True)
+class SummaryField:
+    name: str
+    units: str
+    long_name: str
+    per_mass: bool = False  # stored per unit mass in the kernel; the cube multiplies by the mass
+
+
+SUMMARY_FIELDS = (
+    SummaryField("status", "1", "outcome of the run (pipeline.models.base.Outcome)"),
+    SummaryField("peak_angle", "rad", "peak absolute rocking angle"),
+    SummaryField("time_of_peak", "s", "time of the peak rocking angle"),
+    SummaryField("n_impacts", "1", "number of impacts (theta crossing 0 while rocking)"),
+    SummaryField("uplifted", "1", "1 if some point of the base left the ground"),
+    SummaryField("peak_settlement", "m", "peak settlement of the active pivot (ssi) or base centre (winkler)"),
+    SummaryField("min_support_force", "N", "minimum vertical foundation force (negative: the spring pulls)",
+                 per_mass=True),
+    SummaryField("time_of_tension", "s", "first time the foundation force was negative (NaN: never)"),
+    SummaryField("t_end", "s", "time reached by the integration"),
+    SummaryField("n_steps", "1", "accepted integration steps"),
+    SummaryField("time_of_uplift", "s", "time of first uplift (NaN: never uplifted)"),
+    SummaryField("time_of_overturn", "s", "time of overturning (NaN: did not overturn)"),
+    SummaryField("n_flights", "1", "times the whole base left the ground (winkler)"),
+    SummaryField("airborne_time", "s", "total time with the whole base off the ground (winkler)"),
+    SummaryField("peak_corner_uplift", "m", "peak height of a base corner above the ground surface"),
+    SummaryField("peak_friction_demand", "1",
+                 "peak horizontal over vertical base force needed to prevent sliding (winkler)"),
+)
+
+SUMMARY_DTYPE = np.dtype([(field.name, "f8") for field in SUMMARY_FIELDS])
+
+
+def new_params(shape=()) -> np.ndarray:
+    """A zeroed parameter record (or array of records)."""
+    return np.zeros(shape, dtype=PARAMS_DTYPE)
+
+
+def new_summaries(shape=()) -> np.ndarray:
+    """Summary records filled with NaN (a cell never computed reads as NaN)."""
+    out = np.empty(shape, dtype=SUMMARY_DTYPE)
+    for name in SUMMARY_DTYPE.names:
+        out[name] = np.nan
+    return out

@@ -1,0 +1,221 @@
+"""pipeline.models.winkler - a rigid block on a tensionless viscoelastic Winkler bed.
+
+Input : block (b, h, m), the bed's total vertical stiffness K [N/m] (eq. 19, as for ``ssi``), its
+        damping ratio xi [-] relative to the vertical mode (total dashpot C = 2 xi sqrt(K m)) and the
+        bed type: ``continuous`` (K spread uniformly over the footprint width 2b) or ``two-spring``
+        (K/2 and C/2 at each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model).
+Output: registered model ``winkler`` and its compiled physics: ``bed_force``, ``accelerations``,
+        ``winkler_rhs``, ``contact_indicator``, ``corner_height``, ``friction_demand``.
+
+Why: the paper's model puts one linear spring-dashpot under the active pivot, and that spring pulls
+the block down whenever it rebounds, which real ground cannot do. Here every point of the base
+carries pressure = max(0, k delta + c delta') while it is in the ground (delta > 0) and nothing
+otherwise: the contact opens by itself, the block tilts elastically before it uplifts, it can leave
+the ground entirely (flight), and impacts dissipate through the bed's dashpots - no restitution
+coefficient is needed.
+
+Coordinates: theta (> 0 tilts towards +x: the +b corner presses in) and y, the settlement of the
+base centre (positive down; static y = m g / K). No sliding: the base centre follows the ground
+horizontally. When the block rocks on a corner that corner therefore slips by b (1 - cos theta), a
+second-order effect; ``friction_demand`` reports |H|/N, the friction coefficient needed to hold the
+base, so a user sees where the no-sliding assumption is strained.
+
+Base point s in [-b, b]: penetration delta(s) = y + s sin(theta), rate y' + s cos(theta) theta'.
+With j = J/m = (b^2 + 4 h^2)/3 (inertia about the base centre over m), F and M the bed's vertical
+force and its moment about the base centre (per unit mass), the Lagrangian
+
+    T = m/2 [(xg' + h cos(th) th')^2 + (y' + h sin(th) th')^2] + I_c th'^2 / 2,
+    V = m g (h cos(th) - y) + bed energy,   Q_y = -F m,  Q_th = -cos(th) M m
+
+gives (tests/physics/test_winkler*.py checks this with sympy)
+
+    j th'' + h sin(th) y'' = g h sin(th) - h cos(th) ag - cos(th) M
+    h sin(th) th'' + y''   = g - F - h cos(th) th'^2.
+"""
+
+from __future__ import annotations
+
+import math
+
+from pipeline.models.base import RockingModel
+from pipeline.models.fields import BED_TWO_SPRING, WINKLER
+from pipeline.models.jit import njit
+
+# contact indicators located as events: penetration and contact force at each corner
+N_CONTACT_INDICATORS = 4
+
+
+@njit(cache=True)
+def _clip(low, high, c0, c1):
+    """Restrict [low, high] to where c0 + c1 s > 0."""
+    if c1 > 0.0:
+        low = max(low, -c0 / c1)
+    elif c1 < 0.0:
+        high = min(high, -c0 / c1)
+    elif c0 <= 0.0:
+        high = low
+    return low, high
+
+
+@njit(cache=True)
+def bed_force(x, params):
+    """Vertical force F and its moment M about the base centre, both per unit mass, for state x.
+
+    F [m/s^2] pushes the block up; M [m^2/s^2] is int q(s) s ds (positive when the +b side carries more).
+    """
+    return bed_force_at(x, params, math.sin(x[0]), math.cos(x[0]))
+
+
+@njit(cache=True)
+def bed_force_at(x, params, sin_t, cos_t):
+    """``bed_force`` with sin(theta) and cos(theta) already known."""
+    b = params["b"]
+    omega = params["omega"]
+    stiffness = omega * omega           # K/m
+    damping = 2.0 * params["xi"] * omega  # C/m
+    if params["bed"] == BED_TWO_SPRING:
+        force = 0.0
+        moment = 0.0
+        for side in (-1.0, 1.0):
+            s = side * b
+            delta = x[2] + s * sin_t
+            if delta > 0.0:
+                f = 0.5 * (stiffness * delta + damping * (x[3] + s * cos_t * x[1]))
+                if f > 0.0:
+                    force += f
+                    moment += s * f
+        return force, moment
+    # continuous bed: q(s) = p0 + p1 s on the interval where both delta(s) > 0 and q(s) > 0
+    k_l = stiffness / (2.0 * b)
+    c_l = damping / (2.0 * b)
+    p0 = k_l * x[2] + c_l * x[3]
+    p1 = k_l * sin_t + c_l * cos_t * x[1]
+    low, high = _clip(-b, b, x[2], sin_t)
+    low, high = _clip(low, high, p0, p1)
+    if high <= low:
+        return 0.0, 0.0
+    d1 = high - low
+    d2 = (high * high - low * low) / 2.0
+    d3 = (high * high * high - low * low * low) / 3.0
+    return max(p0 * d1 + p1 * d2, 0.0), p0 * d2 + p1 * d3
+
+
+@njit(cache=True)
+def accelerations(theta, theta_dot, y, y_dot, ag, force, moment, h, j, g):
+    """(theta'', y'') from the two equations of motion (module docstring); force, moment per mass."""
+    return accelerations_at(math.sin(theta), math.cos(theta), theta_dot, ag, force, moment, h, j, g)
+
+
+@njit(cache=True)
+def accelerations_at(sin_t, cos_t, theta_dot, ag, force, moment, h, j, g):
+    """``accelerations`` with sin(theta) and cos(theta) already known."""
+    vertical = g - force - h * cos_t * theta_dot * theta_dot
+    rotational = g * h * sin_t - h * cos_t * ag - cos_t * moment
+    determinant = j - h * h * sin_t * sin_t
+    theta_acc = (rotational - h * sin_t * vertical) / determinant
+    y_acc = (j * vertical - h * sin_t * rotational) / determinant
+    return theta_acc, y_acc
+
+
+@njit(cache=True)
+def winkler_rhs(x, accel, params, out):
+    """dx/dt for x = [theta, theta', y, y']."""
+    h = params["h"]
+    b = params["b"]
+    sin_t = math.sin(x[0])
+    cos_t = math.cos(x[0])
+    force, moment = bed_force_at(x, params, sin_t, cos_t)
+    theta_acc, y_acc = accelerations_at(sin_t, cos_t, x[1], accel, force, moment, h,
+                                        (b * b + 4.0 * h * h) / 3.0, params["g"])
+    out[0] = x[1]
+    out[1] = theta_acc
+    out[2] = x[3]
+    out[3] = y_acc
+
+
+@njit(cache=True)
+def contact_indicator(index, x, params):
+    """Event functions whose sign changes are contact changes.
+
+    0, 1: penetration of the -b and +b corner [m]; 2, 3: the bed's pressure law k delta + c delta'
+    at the -b and +b corner (per unit stiffness, [m]), where the contact force switches on or off.
+    """
+    side = -1.0 if index % 2 == 0 else 1.0
+    s = side * params["b"]
+    delta = x[2] + s * math.sin(x[0])
+    if index < 2:
+        return delta
+    omega = params["omega"]
+    return delta + 2.0 * params["xi"] / omega * (x[3] + s * math.cos(x[0]) * x[1])
+
+
+@njit(cache=True)
+def settled_beyond_reach(x, params, peak_angle):
+    """True when, with the ground at rest and the base in full contact, the block can no longer reach its
+    recorded peak angle nor lift a corner: its energy above the settled state is below a quarter of the
+    elastic energy of either (small-tilt stiffness of the bed, K_r - m g h). The bed only dissipates, so
+    the rest of the response cannot change the peak angle, uplift or flights; the batch kernels (which
+    keep no history) stop there."""
+    b = params["b"]
+    h = params["h"]
+    g = params["g"]
+    omega = params["omega"]
+    stiffness = omega * omega  # K/m
+    tilt_stiffness = stiffness * b * b * (1.0 if params["bed"] == BED_TWO_SPRING else 1.0 / 3.0) - g * h
+    if tilt_stiffness <= 0.0:
+        return False  # the bed cannot even hold the block upright elastically
+    y_static = g / stiffness
+    sin_t = math.sin(x[0])
+    cos_t = math.cos(x[0])
+    j = (b * b + 4.0 * h * h) / 3.0
+    kinetic = 0.5 * ((h * cos_t * x[1]) ** 2 + (x[3] + h * sin_t * x[1]) ** 2 + (j - h * h) * x[1] * x[1])
+    # bed energy in full contact (the caller checks it): two springs K/2, or
+    # int_{-b}^{b} 1/2 (K/2b) (y + s sin)^2 ds = K/2 (y^2 + b^2 sin^2 / 3) for the continuous bed
+    if params["bed"] == BED_TWO_SPRING:
+        bed = 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t)
+    else:
+        bed = 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t / 3.0)
+    excess = kinetic + g * (h * cos_t - x[2]) + bed - (g * (h - y_static) + 0.5 * stiffness * y_static * y_static)
+    lift_angle = y_static / b  # a corner lifts at about this tilt (settled base)
+    reach = 0.25 * 0.5 * tilt_stiffness * min(peak_angle, lift_angle) ** 2
+    return excess < reach
+
+
+@njit(cache=True)
+def contact_indicators(x, params, out):
+    """All four ``contact_indicator`` values at once (one sin and cos)."""
+    b = params["b"]
+    sin_t = math.sin(x[0])
+    rate = 2.0 * params["xi"] / params["omega"] * b * math.cos(x[0]) * x[1]
+    base_rate = 2.0 * params["xi"] / params["omega"] * x[3]
+    out[0] = x[2] - b * sin_t
+    out[1] = x[2] + b * sin_t
+    out[2] = out[0] + base_rate - rate
+    out[3] = out[1] + base_rate + rate
+
+
+@njit(cache=True)
+def corner_height(index, x, params):
+    """Height of corner 0 (-b) or 1 (+b) above the ground surface [m] (negative: in the ground)."""
+    s = -params["b"] if index == 0 else params["b"]
+    return -(x[2] + s * math.sin(x[0]))
+
+
+@njit(cache=True)
+def friction_demand(x, dx, accel, force, params):
+    """|H| / N: friction coefficient needed to hold the base centre against sliding.
+
+    H/m = ag + d^2/dt^2 (h sin theta) = ag + h cos(theta) theta'' - h sin(theta) theta'^2; N/m = force.
+    """
+    h = params["h"]
+    horizontal = accel + h * math.cos(x[0]) * dx[1] - h * math.sin(x[0]) * x[1] * x[1]
+    return abs(horizontal) / force
+
+
+MODEL = RockingModel(
+    name="winkler", kernel_code=WINKLER, kappa=0.75, needs_foundation=True, uses_bed=True,
+    uplift_is_rigid_threshold=False,
+    default_restitution=lambda block: 1.0,
+    label="Winkler bed, tensionless",
+    description="rigid block on a tensionless viscoelastic Winkler bed (continuous or two springs); "
+                "the bed never pulls, impacts dissipate through its dashpots")
