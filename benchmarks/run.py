@@ -1,6 +1,6 @@
 """``make bench``: solver throughput against the scipy reference, the default study's wall time and
-memory, scaling from 1 to all cores, and the runs hunt-and-fill saves. Prints a report; never part
-of the tests.
+memory, scaling from 1 to all cores, the runs hunt-and-fill saves, and the calibration search's time.
+Prints a report; never part of the tests.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "physics"))
 warnings.simplefilter("ignore")
 
+import calibration  # noqa: E402  (benchmarks/calibration.py)
 from reference import reference_response  # noqa: E402
 
 from pipeline.blocks import Block  # noqa: E402
@@ -164,3 +165,14 @@ if __name__ == "__main__":
     per_run_cost(records)
     study_timing()
     hunt_and_fill_savings(records)
+
+    from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/ is on sys.path)
+
+    winkler_against_opensees()
+    print("\n5. ", end="")
+    calibration.run()
+
+    import fragility as fragility_benchmark  # benchmarks/fragility.py (this folder is on sys.path)
+
+    print("\n6. ", end="")
+    fragility_benchmark.run(print=print)

@@ -209,6 +209,9 @@ def command_fragility(args) -> int:
 
     started = time.perf_counter()
     config, output = _study_config(args)
+    from pipeline.risk import study_hazard
+
+    study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
     executor = _executor_options(args)
     loaded = study_records(config, log=_log)
     cube, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded, **executor)
@@ -220,7 +223,7 @@ def command_fragility(args) -> int:
 
         efficiency_stage(cube, loaded[0], config, output)
         print(f"wrote {output / 'efficiency.nc'} and {output / 'efficiency.csv'}")
-    fragility, risk = fragility_stage(cube, ida, config, output)
+    fragility, risk = fragility_stage(cube, ida, config, output, progress=not args.no_progress)
     for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
         print(f"wrote {output / name}")
     applicability = None
@@ -250,15 +253,18 @@ def _ground_motion(args, config):
 
 
 def command_calibrate(args) -> int:
-    from pipeline.calibrate import calibrate, load_reference, write_outputs
+    from pipeline.calibrate import calibrate, check_reference, load_reference, write_outputs
 
     config, output = _study_config(args)
     blocks = {b.name: b for b in config.blocks}
     if args.block not in blocks:
         raise PipelineError(f"unknown block {args.block!r}; blocks of the study: {', '.join(blocks)}")
     block = blocks[args.block]
-    ref_time, ref_rotation = load_reference(args.reference, args.time_unit, args.angle_unit)
+    reference = load_reference(args.reference, args.time_unit, args.angle_unit)
+    print(reference.describe_units())
     record, ag = _ground_motion(args, config)
+    check_reference(reference.time, reference.rotation, (len(ag) - 1) * record.dt, record.dt,
+                    source=str(args.reference), time_unit=reference.time_unit)
     soil_g = args.soil_g
     if soil_g is None and args.soil:
         soils = {s.name: s for s in config.soils}
@@ -268,12 +274,16 @@ def command_calibrate(args) -> int:
     for option, (low, high) in (("--k-range", args.k_range), ("--xi-range", args.xi_range)):
         if not low < high:
             raise PipelineError(f"{option} {low:g} {high:g}: MIN must be below MAX")
-    result = calibrate(ref_time, ref_rotation, ag, record.dt, block, k_range=tuple(args.k_range),
-                       xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi, soil_shear_modulus=soil_g,
-                       switch=config.switch, local=not args.grid_only)
-    files = write_outputs(result, ref_time, ref_rotation, ag, record.dt, block, output, config.switch)
-    print(f"grid optimum : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation {result.correlation_grid:.4f}")
-    print(f"local optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation {result.correlation:.4f}")
+    result = calibrate(reference.time, reference.rotation, ag, record.dt, block, model=args.model,
+                       k_range=tuple(args.k_range), xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi,
+                       soil_shear_modulus=soil_g, switch=config.switch, local=not args.grid_only,
+                       log=lambda line: print(line, file=sys.stderr))
+    files = write_outputs(result, reference.time, reference.rotation, ag, record.dt, block, output, config.switch)
+    print(f"grid optimum  : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation (eq. 17) "
+          f"{result.correlation_grid:.4f}")
+    if not args.grid_only:
+        print(f"global optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation (eq. 17) "
+              f"{result.correlation:.4f} ({result.n_simulations} simulations, {result.seconds:.1f} s)")
     print(f"RMS error {result.rms_error:.3g} rad; peak angle {result.peak_model:.4g} rad vs reference "
           f"{result.peak_reference:.4g} rad ({result.peak_error:+.1%})")
     if result.area_over_depth is not None:
@@ -352,13 +362,15 @@ def build_parser() -> argparse.ArgumentParser:
     calibrate.add_argument("--xi-range", type=_number_type(0, high=1, high_open=True), nargs=2,
                            default=[0.01, 0.07], metavar=("MIN", "MAX"),
                            help="damping-ratio grid [-] (default 0.01 0.07)")
-    calibrate.add_argument("--n-k", type=GRID_SIZE, default=25, help="grid points in k (log-spaced, >= 2)")
-    calibrate.add_argument("--n-xi", type=GRID_SIZE, default=7, help="grid points in xi (>= 2)")
-    calibrate.add_argument("--grid-only", action="store_true", help="skip the local optimisation")
-    calibrate.add_argument("--time-unit", default=None, help="time unit of the reference (default: from its "
-                           "header, else s)")
-    calibrate.add_argument("--angle-unit", default=None, help="angle unit of the reference (default: from its "
-                           "header, else rad)")
+    calibrate.add_argument("--n-k", type=GRID_SIZE, default=25, help="coarse grid points in k (log-spaced, >= 2)")
+    calibrate.add_argument("--n-xi", type=GRID_SIZE, default=7, help="coarse grid points in xi (>= 2)")
+    calibrate.add_argument("--grid-only", action="store_true", help="the coarse grid only (the paper's procedure)")
+    calibrate.add_argument("--time-unit", default=None, help="time unit of the reference: s, ms, us, min (default: "
+                           "from its header, else s)")
+    calibrate.add_argument("--angle-unit", default=None, help="angle unit of the reference: rad, mrad, deg "
+                           "(default: from its header, else rad)")
+    calibrate.add_argument("--model", default="ssi", help="the model to calibrate: any with a foundation, e.g. "
+                           "ssi, ssi-paper, winkler (default ssi)")
     calibrate.set_defaults(handler=command_calibrate)
 
     applicability = commands.add_parser(

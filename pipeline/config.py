@@ -420,14 +420,17 @@ def _check_damage_states(data, source):
         raise ConfigError(error.field, error.reason, source) from None
 
 
-def _check_hazard(path, source):
-    """The hazard curve loads (file exists, two numeric columns, decreasing frequency)."""
+def _check_hazard(path, source, measure="pga", period=None):
+    """The hazard curve loads (file exists, numeric, decreasing frequency) and is for the study's
+    intensity measure (and Sa period). No file and a measure other than PGA: no risk, nothing to check."""
     from pipeline.risk import load_hazard
 
     if path and Path(path).is_dir():
         raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
+    if not path and measure != "pga":
+        return
     try:
-        load_hazard(path or None)
+        load_hazard(path or None, measure, period if measure == "sa" else None)
     except ConfigError as error:
         raise ConfigError(error.field, f"{error.source}: {error.reason}", source) from None
     except (ValueError, UnicodeDecodeError, OSError) as error:
@@ -465,7 +468,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     blocks = _select("blocks", data["blocks"], library, source)
     levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
     _check_damage_states(data, source)
-    _check_hazard(hazard.get("file", ""), source)
+    _check_hazard(hazard.get("file", ""), source, measure, float(intensity.get("period", 1.0)))
     sweep = data.get("applicability", {})
     defaults = ApplicabilitySettings()
     return StudyConfig(

@@ -1,32 +1,64 @@
 """pipeline.fragility - stage 8: the cube -> lognormal fragility functions per soil and damage state.
 
-Input : the study cube (outcome, peak_angle_ratio over record x im_level x soil x block x model),
-        the damage states (registry below, plus ``[damage_states.NAME]`` tables of the study file).
-Output: ``reports/fragility.nc`` (median, beta, bootstrap confidence bounds, records, fit method and
-        goodness of fit per soil x block x model x damage state; empirical exceedance fractions per
-        level; the three-outcome probabilities) and CSV exports, including a pelicun fragility file.
+Input : the study cube (outcome, peak_angle_ratio over record x im_level x soil x block x model; the
+        intensity of each level per block, see ``intensity_levels``), the damage states (registry below,
+        plus ``[damage_states.NAME]`` tables of the study file).
+Output: ``reports/fragility.nc`` (median, beta, bootstrap bounds, fit method, ``status``, the
+        ``extrapolated`` flag, goodness of fit, the non-crossing rule's deviance cost and the studied
+        range per soil x block x model x damage state; empirical fractions per level; the three-outcome
+        probabilities), ``fragility.csv`` and a pelicun damage-model CSV (``pelicun_table``).
 
-Fits: maximum likelihood on the binomial counts over intensity levels (Baker 2015, Earthquake
-Spectra 31(1)); for overturning also from the IDA capacities (first overturning level per record),
-right-censored at the highest level for records that never overturn. Confidence bounds come from
-resampling records (seeded). Ordered damage states must not cross: where independent fits would
-cross inside the studied intensity range, the states are refitted jointly with a shared beta.
+Fits (Baker 2015, Earthquake Spectra 31(1); the numerics on arrays are in ``pipeline.lognormal_fit``):
+binomial maximum likelihood on the counts per level, a probit regression solved by vectorised Fisher
+scoring; for overturning also from the IDA
+capacities, right-censored at the highest level. Every row says what it is (``STATUS``):
+- uplift under PGA scaling of a model whose uplift is the rigid-body threshold is the exact step
+  g tan(alpha) (``deterministic-threshold``, beta = 0), not a fit;
+- perfectly separated counts have no lognormal MLE: a step between the two bracketing levels,
+  beta = 0, status ``separated`` and a warning (never a silent small beta);
+- a median outside the studied range is flagged ``extrapolated``; a state no record reached is
+  ``not-reached`` (median NaN).
+Ordered states must not cross where the data can tell (from the lowest level at which the more severe
+state has exceedances up to the highest level); states that do are refitted with a shared beta and
+the deviance this costs is reported. Bootstrap bounds resample records and refit each row with the
+same estimator as its point estimate (the shared fit for shared-beta rows). Fewer than
+``SMALL_SAMPLE`` records give a warning on every row.
 """
 
 from __future__ import annotations
 
+import json
+import sys
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 import xarray as xr
-from scipy.optimize import minimize
-from scipy.special import log_ndtr, ndtr
-from scipy.stats import chi2
 
 from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from pipeline.errors import ConfigError
+from pipeline.lognormal_fit import (CROSSING_TOLERANCE, curves_cross, deviance, fit_binomial,  # noqa: F401
+                                    fit_censored_capacities, fit_independent, fit_shared_beta, goodness_of_fit,
+                                    lognormal_cdf, separation)
 from pipeline.outputs import atomic_path
+from pipeline.units import STANDARD_GRAVITY
+
+STATUS = {
+    "fitted": "lognormal fitted by maximum likelihood; median inside the studied range",
+    "extrapolated": "lognormal fitted, but the median lies outside the studied range",
+    "not-reached": "no record reached the state at any level; no curve",
+    "below-range": "most records reached the state already at the lowest level: the median is below the range",
+    "above-range": "a few records reached the state, only at the highest level: the median is above the range",
+    "deterministic-threshold": "an exact step at g tan(alpha) (uplift under PGA scaling), beta = 0",
+    "separated": "perfectly separated counts: a step between two levels, beta = 0 (not identifiable)",
+}
+"""The ``status`` of a fragility row and what it means (the report prints these)."""
+
+SMALL_SAMPLE = 10
+"""Fewer records than this give a warning on every fitted row."""
+
+RIGID_UPLIFT_MODELS = ("housner", "ssi", "ssi-paper")
+"""Fallback when a model object does not say ``uplift_is_rigid_threshold``."""
 
 
 @dataclass(frozen=True)
@@ -40,9 +72,6 @@ class DamageState:
 
 
 DAMAGE_STATES: dict[str, DamageState] = {}
-
-DETERMINISTIC_BETA = 0.05
-"""Fitted dispersions below this mark a deterministic threshold (a step), not a lognormal curve."""
 
 
 def register_damage_state(state: DamageState) -> None:
@@ -84,177 +113,303 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
     return reached.astype(float).where(outcome != OUTCOME_FAILED)
 
 
-# ---------------------------------------------------------------- maximum-likelihood fits
+# ---------------------------------------------------------------- intensity levels of a cube
 
-def _negative_log_likelihood(params, log_im, exceed, total):
-    log_median, log_beta = params
-    z = (log_im - log_median) / np.exp(log_beta)
-    return -np.sum(exceed * log_ndtr(z) + (total - exceed) * log_ndtr(-z))
+def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
+    """The physical intensity of every (block, im_level) in the study's display unit, and the unit.
 
-
-def fit_binomial(im, exceed, total, beta_start=0.4):
-    """Lognormal fragility (median [IM units], beta [-]) by MLE on counts per level (Baker 2015).
-
-    NaN, NaN when the data cannot identify a curve (no exceedance, or exceedance everywhere).
+    Works for both cube layouts: one physical ``im_level`` coordinate shared by all blocks, or a
+    dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate (in the
+    display unit, e.g. ``intensity`` [g], or in SI, e.g. ``im_level_si`` [m/s^2]; found by its dims and
+    units). Returns (n_block, n_level).
     """
-    im, exceed, total = (np.asarray(a, float) for a in (im, exceed, total))
-    keep = total > 0
-    im, exceed, total = im[keep], exceed[keep], total[keep]
-    if exceed.sum() == 0 or np.all(exceed == total):
-        return np.nan, np.nan
-    fraction = exceed / total
-    start = np.interp(0.5, np.maximum.accumulate(fraction), np.log(im)) if fraction.max() >= 0.5 \
-        else np.log(im[-1]) + 0.5
-    result = minimize(_negative_log_likelihood, x0=[start, np.log(beta_start)], args=(np.log(im), exceed, total),
-                      method="L-BFGS-B", bounds=[(np.log(im[0]) - 5, np.log(im[-1]) + 5), (np.log(0.01), np.log(5.0))])
-    return float(np.exp(result.x[0])), float(np.exp(result.x[1]))
+    from pipeline.config import MEASURE_UNITS  # config imports this module (DamageState) at load
+
+    n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
+    display, factor = MEASURE_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
+    per_block = [name for name, coord in cube.coords.items() if set(coord.dims) == {"block", "im_level"}]
+    for name in sorted(per_block, key=lambda n: n not in ("intensity", "im_intensity")):
+        units = cube[name].attrs.get("units", "")
+        values = cube[name].transpose("block", "im_level").values.astype(float)
+        if units == display:
+            return values, units
+        if (units in ("m/s^2", "m s-2", "m/s", "m s-1") or name == "im_level_si") and display:
+            return values / factor, display
+    levels = cube.im_level.values.astype(float)
+    return np.broadcast_to(levels, (n_block, n_level)).copy(), cube.im_level.attrs.get("units", "")
 
 
-def fit_censored_capacities(capacities, censor_at):
-    """Lognormal fit of per-record capacities, right-censored at ``censor_at`` where NaN."""
-    capacities = np.asarray(capacities, float)
-    observed = capacities[np.isfinite(capacities)]
-    n_censored = np.sum(~np.isfinite(capacities))
-    if observed.size < 2:
-        return np.nan, np.nan
-    log_observed = np.log(observed)
+def uplift_is_rigid_threshold(model_name: str) -> bool:
+    """Does the model's uplift happen exactly at g tan(alpha) under PGA scaling? Asks the model."""
+    from pipeline.models import get_model
 
-    def negative(params):
-        log_median, log_beta = params
-        beta = np.exp(log_beta)
-        z = (log_observed - log_median) / beta
-        z_censor = (np.log(censor_at) - log_median) / beta
-        return -(np.sum(-0.5 * z**2 - np.log(beta)) + n_censored * log_ndtr(-z_censor))
-
-    start = [log_observed.mean(), np.log(max(log_observed.std(), 0.05))]
-    result = minimize(negative, x0=start, method="L-BFGS-B",
-                      bounds=[(log_observed.min() - 5, log_observed.max() + 10), (np.log(0.01), np.log(5.0))])
-    return float(np.exp(result.x[0])), float(np.exp(result.x[1]))
+    try:
+        model = get_model(model_name)
+    except Exception:  # a cube of a model this installation does not know: fall back on its name
+        return model_name in RIGID_UPLIFT_MODELS
+    return bool(getattr(model, "uplift_is_rigid_threshold", model_name in RIGID_UPLIFT_MODELS))
 
 
-def fit_shared_beta(im, exceed_by_state, total_by_state):
-    """Joint MLE of one median per state and a common beta (non-crossing by construction)."""
-    log_im = np.log(np.asarray(im, float))
-    n = len(exceed_by_state)
-    starts = [fit_binomial(im, e, t) for e, t in zip(exceed_by_state, total_by_state)]
-
-    def negative(params):
-        log_beta = params[-1]
-        return sum(_negative_log_likelihood([params[i], log_beta], log_im, exceed_by_state[i], total_by_state[i])
-                   for i in range(n))
-
-    x0 = [np.log(m) for m, _ in starts] + [np.log(np.nanmean([b for _, b in starts]))]
-    bounds = [(log_im[0] - 5, log_im[-1] + 5)] * n + [(np.log(0.01), np.log(5.0))]
-    result = minimize(negative, x0=x0, method="L-BFGS-B", bounds=bounds)
-    medians = np.maximum.accumulate(np.exp(result.x[:n]))  # ordered severity, ordered medians
-    return medians, float(np.exp(result.x[-1]))
+def uplift_threshold(cube: xr.Dataset, unit: str) -> np.ndarray | None:
+    """g tan(alpha) per block in the study's intensity unit, or None when the cube cannot tell."""
+    factor = {"g": STANDARD_GRAVITY, "m/s^2": 1.0, "m s-2": 1.0}.get(unit)
+    if factor is None:
+        return None
+    if "block_uplift_acceleration" in cube.coords:
+        return cube.block_uplift_acceleration.values / factor
+    if "block_alpha" in cube.coords:
+        return STANDARD_GRAVITY * np.tan(cube.block_alpha.values) / factor
+    return None
 
 
-def lognormal_cdf(im, median, beta):
-    return ndtr(np.log(np.asarray(im, float) / median) / beta)
+# ---------------------------------------------------------------- one soil x block x model cell
+
+@dataclass
+class RowFit:
+    """The fit of one damage state in one cell, and what it is."""
+
+    median: float = np.nan
+    beta: float = np.nan
+    method: str = "none"
+    status: str = "not-reached"
+    warnings: tuple = ()
+    deviance_cost: float = 0.0
+
+    def warn(self, message):
+        self.warnings = (*self.warnings, message)
 
 
-def goodness_of_fit(im, exceed, total, median, beta):
-    """(deviance p-value, max |fitted - empirical|) of a fitted curve against the counts."""
-    if not np.isfinite(median):
-        return np.nan, np.nan
-    keep = total > 0
-    im, exceed, total = im[keep], exceed[keep], total[keep]
-    p = np.clip(lognormal_cdf(im, median, beta), 1e-12, 1 - 1e-12)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        term1 = np.where(exceed > 0, exceed * np.log(exceed / (total * p)), 0.0)
-        term2 = np.where(total - exceed > 0, (total - exceed) * np.log((total - exceed) / (total * (1 - p))), 0.0)
-    deviance = 2 * np.sum(term1 + term2)
-    dof = max(1, int(keep.sum()) - 2)
-    return float(chi2.sf(deviance, dof)), float(np.max(np.abs(p - exceed / total)))
+def _crosses_where_data_tell(levels, exceed_severe, lower_fit, upper_fit):
+    """Do two fitted curves cross between the lowest level at which the more severe state has
+    exceedances and the highest level? (Below it both are zero by the data; tails there are arithmetic.)"""
+    reached = np.flatnonzero(exceed_severe > 0)
+    if reached.size == 0:
+        return False
+    grid = np.geomspace(levels[reached[0]], levels[-1], 200) if levels[-1] > levels[reached[0]] else levels[-1:]
+    return curves_cross(grid, [lower_fit, upper_fit])
 
 
-def curves_cross(im_grid, fits):
-    """True if any less severe state's curve falls below a more severe one on the grid."""
-    curves = [lognormal_cdf(im_grid, m, b) for m, b in fits if np.isfinite(m)]
-    return any(np.any(lower < upper - 1e-9) for lower, upper in zip(curves, curves[1:]))
+def _shared_fit(levels, exceed, total, group):
+    medians, beta = fit_shared_beta(levels, exceed[group], total[group])
+    return [(float(m), float(beta)) for m in medians]
+
+
+def noncrossing_groups(levels, exceed, total, fits, usable):
+    """Merge adjacent fitted states into shared-beta groups until no two curves cross where the data
+    can tell. Returns (groups, fits) with the refitted (median, beta) of grouped states."""
+    groups = [[s] for s in usable]
+    fits = dict(fits)
+    changed = True
+    while changed and len(groups) > 1:
+        changed = False
+        for g in range(len(groups) - 1):
+            lower, upper = groups[g][-1], groups[g + 1][0]
+            if _crosses_where_data_tell(levels, exceed[upper], fits[lower], fits[upper]):
+                merged = groups[g] + groups[g + 1]
+                for s, fit in zip(merged, _shared_fit(levels, exceed, total, merged)):
+                    fits[s] = fit
+                groups[g:g + 2] = [merged]
+                changed = True
+                break
+    return groups, fits
+
+
+def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit=""):
+    """Fit every damage state of one cell. exceed, total : (n_state, n_level) counts per level.
+
+    threshold : the exact uplift intensity g tan(alpha) when uplift is a rigid threshold under this
+    scaling, else None. Returns (rows, groups): a RowFit per state and the estimator groups (lists of
+    state indices; more than one state = a shared-beta fit), which the bootstrap reuses.
+    """
+    medians, betas = fit_independent(levels, exceed, total)
+    rows = []
+    span = f"{levels[0]:.3g}-{levels[-1]:.3g} {unit}".strip()
+    for s, state in enumerate(states):
+        row = RowFit()
+        has_data = total[s] > 0
+        if state.edp == "uplifted" and threshold is not None:
+            row.median, row.beta, row.method, row.status = float(threshold), 0.0, "exact-g-tan-alpha", \
+                "deterministic-threshold"
+            step = (levels > threshold).astype(float)
+            clear = has_data & (np.abs(levels / threshold - 1) > 1e-6)
+            disagree = int(np.sum(clear & (exceed[s] != step * total[s])))
+            if disagree:
+                row.warn(f"at {disagree} levels the runs disagree with the exact g tan(alpha) step")
+        elif not (exceed[s][has_data] > 0).any():
+            row.warn(f"not reached by any record within the studied range {span}")
+        elif np.isnan(medians[s]) and exceed[s][has_data][0] >= 0.5 * total[s][has_data][0]:
+            row.status = "below-range"
+            row.warn(f"reached by most records already at the lowest level; the median lies below "
+                     f"{levels[0]:.3g} {unit}")
+        elif np.isnan(medians[s]):
+            row.status = "above-range"
+            row.warn(f"reached only at the highest level by {int(exceed[s][has_data][-1])} of "
+                     f"{int(total[s][has_data][-1])} records; the median lies above {levels[-1]:.3g} {unit}")
+        elif betas[s] == 0:
+            row.median, row.beta, row.method, row.status = medians[s], 0.0, "step-between-levels", "separated"
+            row.warn("perfectly separated counts: no lognormal MLE exists; reported as a step at "
+                     f"{medians[s]:.3g} {unit} with beta = 0")
+        else:
+            row.median, row.beta, row.method, row.status = medians[s], betas[s], "mle-binomial", "fitted"
+        rows.append(row)
+    usable = [s for s, row in enumerate(rows) if row.method == "mle-binomial"]
+    groups, fits = noncrossing_groups(levels, exceed, total, {s: (rows[s].median, rows[s].beta) for s in usable},
+                                      usable)
+    for group in groups:
+        if len(group) < 2:
+            continue
+        for s in group:
+            row = rows[s]
+            independent = deviance(levels, exceed[s], total[s], row.median, row.beta)
+            row.median, row.beta = fits[s]
+            row.method = "mle-binomial-shared-beta"
+            row.deviance_cost = deviance(levels, exceed[s], total[s], row.median, row.beta) - independent
+    grouped = {s for group in groups for s in group}
+    groups = [group for group in groups] + [[s] for s in range(len(states)) if s not in grouped]
+    for row in rows:
+        if row.method.startswith("mle") and not levels[0] <= row.median <= levels[-1]:
+            row.status = "extrapolated"
+            row.warn(f"median {row.median:.3g} {unit} outside the studied range {span} (extrapolated)")
+        if n_records is not None and n_records < SMALL_SAMPLE and row.method != "exact-g-tan-alpha" \
+                and np.isfinite(row.median):
+            row.warn(f"only {n_records} records (fewer than {SMALL_SAMPLE}): beta and the bounds are rough")
+    return rows, groups
+
+
+def bootstrap_cell(levels, exceed, total, rows, groups):
+    """Refit resampled counts with each row's own estimator. exceed, total : (n_boot, n_state, n_level).
+
+    Returns medians, betas of shape (n_boot, n_state) (NaN where a sample cannot identify the curve).
+    """
+    n_boot, n_state = exceed.shape[:2]
+    medians, betas = np.full((n_boot, n_state), np.nan), np.full((n_boot, n_state), np.nan)
+    independent = [g[0] for g in groups if len(g) == 1 and rows[g[0]].method in ("mle-binomial", "step-between-levels")]
+    if independent:  # all independently fitted states of the cell in one batch, warm-started at the point
+        start_median = np.tile([rows[s].median for s in independent], (n_boot, 1))
+        start_beta = np.tile([rows[s].beta if rows[s].beta > 0 else 0.4 for s in independent], (n_boot, 1))
+        medians[:, independent], betas[:, independent] = fit_independent(
+            levels, exceed[:, independent], total[:, independent], start=(start_median, start_beta))
+    for group in groups:
+        first = rows[group[0]]
+        if len(group) == 1 and first.method == "exact-g-tan-alpha":
+            medians[:, group[0]], betas[:, group[0]] = first.median, 0.0
+        elif len(group) > 1:
+            e, t = exceed[:, group], total[:, group]
+            separated, *_ = separation(e, t)
+            identifiable = ((e > 0) & (t > 0)).any(-1) & ((e < t) & (t > 0)).any(-1) & ~separated
+            regular = identifiable.all(-1)
+            if regular.any():
+                start = (np.tile([rows[s].median for s in group], (int(regular.sum()), 1)),
+                         np.full(int(regular.sum()), first.beta))
+                m, b = fit_shared_beta(levels, e[regular], t[regular], start=start)
+                medians[np.ix_(regular, group)] = m
+                betas[np.ix_(regular, group)] = b[:, None]
+    return medians, betas
 
 
 # ---------------------------------------------------------------- the whole cube
 
-def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, seed=0,
-                      confidence=0.90) -> xr.Dataset:
-    """Fit every soil x block x model x damage state of a cube (see module docstring)."""
-    states = states or list(DAMAGE_STATES.values())
+ROW_VARIABLES = {
+    "median": ("median intensity of the lognormal fragility", None),
+    "beta": ("lognormal dispersion beta (0 = a step)", "1"),
+    "median_low": ("lower bootstrap bound of the median (records resampled)", None),
+    "median_high": ("upper bootstrap bound of the median (records resampled)", None),
+    "beta_low": ("lower bootstrap bound of beta", "1"),
+    "beta_high": ("upper bootstrap bound of beta", "1"),
+    "gof_p_value": ("goodness of fit: deviance chi-square p-value of the binomial fit", "1"),
+    "gof_max_error": ("goodness of fit: max |fitted - empirical| exceedance fraction", "1"),
+    "noncrossing_deviance_cost": ("binomial deviance added by the shared-beta (non-crossing) refit", "1"),
+    "capacity_median": ("median of the IDA overturning capacities (censored lognormal MLE)", None),
+    "capacity_beta": ("dispersion of the IDA overturning capacities (censored lognormal MLE)", "1"),
+}
+
+
+def record_resamples(n_records, n_bootstrap, seed):
+    """(n_bootstrap, n_records) multiplicities of each record in each bootstrap sample (seeded)."""
     rng = np.random.default_rng(seed)
-    levels = cube.im_level.values
-    unit = cube.im_level.attrs.get("units", "")
+    picks = rng.integers(0, n_records, (n_bootstrap, n_records))
+    weights = np.zeros((n_bootstrap, n_records))
+    np.add.at(weights, (np.repeat(np.arange(n_bootstrap), n_records), picks.ravel()), 1.0)
+    return weights
+
+
+def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, seed=0,
+                      confidence=0.90, progress=False) -> xr.Dataset:
+    """Fit every soil x block x model x damage state of a cube (see module docstring)."""
+    from tqdm.auto import tqdm
+
+    states = states or list(DAMAGE_STATES.values())
+    intensity, unit = intensity_levels(cube)
+    measure = cube.attrs.get("intensity_measure", "")
+    thresholds = uplift_threshold(cube, unit) if measure == "pga" else None
     group_dims = ("soil", "block", "model")
+    models = [str(m) for m in cube.model.values]
+    rigid = {m: uplift_is_rigid_threshold(m) for m in models}
     shape = tuple(cube.sizes[d] for d in group_dims) + (len(states),)
-    names = ["median", "beta", "median_low", "median_high", "beta_low", "beta_high", "gof_p_value",
-             "gof_max_error", "capacity_median", "capacity_beta"]
-    out = {name: np.full(shape, np.nan) for name in names}
-    method = np.full(shape, "mle-binomial", dtype=object)
+    out = {name: np.full(shape, np.nan) for name in ROW_VARIABLES}
+    text = {name: np.full(shape, "", dtype=object) for name in ("fit_method", "status", "fit_warning")}
+    extrapolated = np.zeros(shape, np.int8)
     exceed_all = np.stack([exceedance(cube, s).transpose("record", "im_level", *group_dims).values
                            for s in states], axis=-1)  # (record, level, soil, block, model, state)
-    fraction = np.nanmean(exceed_all, axis=0)
-    grid = np.geomspace(levels[0], levels[-1], 200)
+    valid = np.isfinite(exceed_all)
+    reached = np.nan_to_num(exceed_all)
+    with np.errstate(invalid="ignore"):
+        fraction = reached.sum(0) / valid.sum(0)
     n_records = cube.sizes["record"]
+    weights = record_resamples(n_records, n_bootstrap, seed)
     first_overturn = None
     if ida is not None:
         first_overturn = ida.first_overturn_im.transpose("record", *group_dims).values
     tail = (1 - confidence) / 2
-    for index in np.ndindex(*shape[:-1]):
-        data = exceed_all[(slice(None), slice(None), *index)]  # (record, level, state)
-        valid = np.isfinite(data)
-        exceed = np.nansum(data, axis=0)
-        total = valid.sum(axis=0).astype(float)
-        fits = [fit_binomial(levels, exceed[:, s], total[:, s]) for s in range(len(states))]
-        labels = ["mle-binomial" if np.isfinite(m) else "not-identifiable" for m, _ in fits]
-        # A state reached at one intensity by every record (uplift under PGA scaling: g tan(alpha))
-        # is a step, not a lognormal: keep it as a deterministic threshold, outside the ordering.
-        for s, (median, beta) in enumerate(fits):
-            if np.isfinite(beta) and beta < DETERMINISTIC_BETA:
-                labels[s] = "deterministic-threshold"
-        usable = [s for s in range(len(states)) if labels[s] == "mle-binomial"]
-        if curves_cross(grid, [fits[s] for s in usable]):
-            medians, beta = fit_shared_beta(levels, [exceed[:, s] for s in usable], [total[:, s] for s in usable])
-            for s, median in zip(usable, medians):
-                fits[s] = (median, beta)
-                labels[s] = "mle-binomial-shared-beta"
-        boot = np.full((n_bootstrap, len(states), 2), np.nan)
-        for b in range(n_bootstrap):
-            pick = rng.integers(0, n_records, n_records)
-            sample = data[pick]
-            e = np.nansum(sample, axis=0)
-            t = np.isfinite(sample).sum(axis=0).astype(float)
-            for s in range(len(states)):
-                if np.isfinite(fits[s][0]):
-                    boot[b, s] = fit_binomial(levels, e[:, s], t[:, s])
-        for s, state in enumerate(states):
-            median, beta = fits[s]
+    cells = list(np.ndindex(*shape[:-1]))
+    for index in tqdm(cells, desc="fragility fits + bootstrap", unit="cell", disable=not progress):
+        soil, block, model = index
+        levels = intensity[block]
+        data = (slice(None), slice(None), *index)
+        exceed = reached[data].sum(0).T  # (state, level)
+        total = valid[data].sum(0).T.astype(float)
+        threshold = thresholds[block] if thresholds is not None and rigid[models[model]] else None
+        rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, unit)
+        if n_bootstrap:
+            boot_exceed = np.einsum("br,rls->bsl", weights, reached[data])
+            boot_total = np.einsum("br,rls->bsl", weights, valid[data].astype(float))
+            boot_median, boot_beta = bootstrap_cell(levels, boot_exceed, boot_total, rows, groups)
+        for s, (state, row) in enumerate(zip(states, rows)):
             key = (*index, s)
-            out["median"][key], out["beta"][key] = median, beta
-            method[key] = labels[s]
-            if np.isfinite(median) and np.isfinite(boot[:, s, 0]).any():
-                out["median_low"][key], out["median_high"][key] = np.nanquantile(boot[:, s, 0], [tail, 1 - tail])
-                out["beta_low"][key], out["beta_high"][key] = np.nanquantile(boot[:, s, 1], [tail, 1 - tail])
+            out["median"][key], out["beta"][key] = row.median, row.beta
+            out["noncrossing_deviance_cost"][key] = row.deviance_cost if np.isfinite(row.median) else np.nan
+            text["fit_method"][key], text["status"][key] = row.method, row.status
+            text["fit_warning"][key] = "; ".join(row.warnings)
+            extrapolated[key] = row.status == "extrapolated"
+            if n_bootstrap and np.isfinite(row.median) and np.isfinite(boot_median[:, s]).any():
+                out["median_low"][key], out["median_high"][key] = np.nanquantile(boot_median[:, s], [tail, 1 - tail])
+                out["beta_low"][key], out["beta_high"][key] = np.nanquantile(boot_beta[:, s], [tail, 1 - tail])
             out["gof_p_value"][key], out["gof_max_error"][key] = goodness_of_fit(
-                levels, exceed[:, s], total[:, s], median, beta)
+                levels, exceed[s], total[s], row.median, row.beta)
             if state.edp == "overturned" and first_overturn is not None:
                 out["capacity_median"][key], out["capacity_beta"][key] = fit_censored_capacities(
                     first_overturn[(slice(None), *index)], levels[-1])
 
     dims = (*group_dims, "damage_state")
-    attrs = {
-        "median": ("median intensity of the lognormal fragility (binomial MLE)", unit),
-        "beta": ("lognormal dispersion beta (binomial MLE)", "1"),
-        "median_low": (f"lower {confidence:.0%} bootstrap bound of the median (records resampled)", unit),
-        "median_high": (f"upper {confidence:.0%} bootstrap bound of the median (records resampled)", unit),
-        "beta_low": (f"lower {confidence:.0%} bootstrap bound of beta", "1"),
-        "beta_high": (f"upper {confidence:.0%} bootstrap bound of beta", "1"),
-        "gof_p_value": ("goodness of fit: deviance chi-square p-value of the binomial fit", "1"),
-        "gof_max_error": ("goodness of fit: max |fitted - empirical| exceedance fraction", "1"),
-        "capacity_median": ("median of the IDA overturning capacities (censored lognormal MLE)", unit),
-        "capacity_beta": ("dispersion of the IDA overturning capacities (censored lognormal MLE)", "1"),
-    }
-    data_vars = {name: (dims, out[name], {"long_name": attrs[name][0], "units": attrs[name][1]}) for name in names}
-    data_vars["fit_method"] = (dims, method.astype(str), {"long_name": "how the curve was fitted"})
+    data_vars = {}
+    for name, (long_name, units) in ROW_VARIABLES.items():
+        if name in ("median_low", "median_high", "beta_low", "beta_high"):
+            long_name = f"{confidence:.0%} two-sided interval: {long_name}"
+        data_vars[name] = (dims, out[name], {"long_name": long_name, "units": unit if units is None else units})
+    data_vars["fit_method"] = (dims, text["fit_method"].astype(str), {
+        "long_name": "estimator: mle-binomial | mle-binomial-shared-beta | exact-g-tan-alpha | "
+                     "step-between-levels | none"})
+    data_vars["status"] = (dims, text["status"].astype(str), {
+        "long_name": "what the row is: " + " | ".join(STATUS),
+        "description": json.dumps(STATUS)})
+    data_vars["extrapolated"] = (dims, extrapolated, {
+        "long_name": "1 where the fitted median lies outside the studied intensity range of its block",
+        "units": "1", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "inside_range extrapolated"})
+    data_vars["fit_warning"] = (dims, text["fit_warning"].astype(str), {"long_name": "warnings about the fit"})
+    data_vars["studied_im_min"] = (("block",), intensity[:, 0], {
+        "long_name": "lowest intensity level studied for the block", "units": unit})
+    data_vars["studied_im_max"] = (("block",), intensity[:, -1], {
+        "long_name": "highest intensity level studied for the block", "units": unit})
     data_vars["n_records"] = ((), n_records, {"long_name": "number of records", "units": "1"})
     data_vars["empirical_fraction"] = (("im_level", *dims), fraction, {
         "long_name": "fraction of records reaching the damage state", "units": "1"})
@@ -263,15 +418,43 @@ def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, 
     coords = {d: cube[d] for d in group_dims}
     coords.update({"im_level": cube.im_level, "damage_state": [s.name for s in states],
                    "damage_state_description": ("damage_state", [s.description for s in states]),
-                   "outcome_class": ["no_uplift", "rocking", "overturned"]})
+                   "outcome_class": ["no_uplift", "rocking", "overturned"],
+                   "intensity": (("block", "im_level"), intensity, {
+                       "long_name": f"intensity of each level ({measure})", "units": unit})})
     dataset = xr.Dataset(data_vars, coords=coords)
+    warnings = warning_summary(dataset)
     dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag lognormal fragility functions",
                      "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", ""),
-                     "intensity_measure": cube.attrs.get("intensity_measure", ""),
+                     "intensity_measure": measure, "intensity_unit": unit,
                      "bootstrap_samples": n_bootstrap, "bootstrap_seed": seed,
+                     "fit_warnings": json.dumps(warnings),
                      "references": "Baker (2015) Efficient analytical fragility function fitting using "
                                    "dynamic structural analysis. Earthquake Spectra 31(1)"}
     return dataset
+
+
+def warning_summary(dataset: xr.Dataset) -> list[str]:
+    """Short lines for the console: how many rows are extrapolated, separated, not reached, small."""
+    status = dataset.status.values.ravel()
+    warnings = dataset.fit_warning.values.ravel()
+    total = status.size
+    lines = []
+    for name, what in (("extrapolated", "medians outside the studied range (flagged `extrapolated`)"),
+                       ("separated", "perfectly separated states reported as steps with beta = 0"),
+                       ("not-reached", "states no record reached (no curve, 'not reached')"),
+                       ("below-range", "states with the median below the lowest level (no curve)"),
+                       ("above-range", "states reached only at the highest level (median above the range, no curve)")):
+        count = int(np.sum(status == name))
+        if count:
+            lines.append(f"{count} of {total} fragility rows: {what}")
+    small = int(np.sum(["fewer than" in w for w in warnings]))
+    if small:
+        lines.append(f"only {int(dataset.n_records)} records (fewer than {SMALL_SAMPLE}): beta and the bounds "
+                     f"of {small} rows are rough")
+    disagree = int(np.sum(["disagree" in w for w in warnings]))
+    if disagree:
+        lines.append(f"{disagree} uplift rows: runs disagree with the exact g tan(alpha) step (see fit_warning)")
+    return lines
 
 
 def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
@@ -291,42 +474,75 @@ def write_fragility(dataset: xr.Dataset, path) -> None:
         dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
 
 
+TABLE_COLUMNS = ["median", "beta", "status", "extrapolated", "fit_method", "median_low", "median_high", "beta_low",
+                 "beta_high", "gof_p_value", "gof_max_error", "noncrossing_deviance_cost", "capacity_median",
+                 "capacity_beta", "fit_warning"]
+
+
 def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:
-    """One row per soil x block x model x damage state."""
-    columns = ["median", "beta", "median_low", "median_high", "beta_low", "beta_high", "gof_p_value",
-               "gof_max_error", "capacity_median", "capacity_beta", "fit_method"]
-    table = dataset[columns].to_dataframe().reset_index()
-    table["im_units"] = dataset.im_level.attrs.get("units", "")
+    """One row per soil x block x model x damage state, with the studied range of the block."""
+    table = dataset[TABLE_COLUMNS].to_dataframe().reset_index()
+    studied = dataset[["studied_im_min", "studied_im_max"]].to_dataframe().reset_index()
+    table = table.merge(studied.rename(columns={"studied_im_min": "im_lowest", "studied_im_max": "im_highest"}),
+                        on="block")
+    table["im_units"] = dataset.attrs.get("intensity_unit", "")
     table["n_records"] = int(dataset.n_records)
-    keep = ["soil", "block", "model", "damage_state", *columns, "im_units", "n_records"]
+    keep = ["soil", "block", "model", "damage_state", *TABLE_COLUMNS[:-1], "im_lowest", "im_highest", "im_units",
+            "n_records", "fit_warning"]
     return table[keep]
 
+
+# ---------------------------------------------------------------- pelicun damage-model export
 
 PELICUN_DEMAND = {"pga": ("Peak Ground Acceleration", "g"), "sa": ("Spectral Acceleration", "g"),
                   "pgv": ("Peak Ground Velocity", "mps")}
 
 
-def pelicun_table(dataset: xr.Dataset) -> pd.DataFrame:
-    """pelicun fragility CSV: one component per soil/block/model, LS1..LSn = damage states."""
-    demand_type, demand_unit = PELICUN_DEMAND.get(dataset.attrs.get("intensity_measure", "pga"), ("", ""))
-    rows = []
+def pelicun_id(block: str, soil: str, model: str) -> str:
+    """A component ID pelicun can parse: it splits IDs on '-', so names keep '_' instead."""
+    return ".".join(["ROCK", *(str(part).replace("-", "_").replace(" ", "_") for part in (block, soil, model))])
+
+
+def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFrame:
+    """pelicun damage-model CSV: one component per soil/block/model, LS1..LSn = the damage states in
+    order of severity. ``Demand-Directional = 1``: the demand is the scaled component itself, so pelicun
+    must not apply its non-directional factor (1.2 x the larger of two directions) to it. A state no
+    record reached leaves its LS empty and marks the component ``Incomplete`` (pelicun then skips it);
+    the ``Comment`` column says what each LS is, the studied range and which medians are extrapolated."""
+    measure = dataset.attrs.get("intensity_measure", "pga")
+    demand_type, demand_unit = PELICUN_DEMAND.get(measure, ("", ""))
+    if measure == "sa" and period:
+        demand_type = f"{demand_type}|{period:g}"
+    unit = dataset.attrs.get("intensity_unit", "")
+    rows, seen = [], {}
     for soil in dataset.soil.values:
         for block in dataset.block.values:
             for model in dataset.model.values:
-                row = {"ID": f"ROCK.{block}.{soil}.{model}", "Incomplete": 0, "Demand-Type": demand_type,
-                       "Demand-Unit": demand_unit, "Demand-Offset": 0, "Demand-Directional": 0}
+                component = pelicun_id(block, soil, model)
+                if component in seen:
+                    raise ConfigError("blocks/soils/models", f"names {seen[component]} and {(block, soil, model)} "
+                                      f"give the same pelicun ID {component}; rename one")
+                seen[component] = (block, soil, model)
                 cell = dataset.sel(soil=soil, block=block, model=model)
-                level = 0
-                for state in dataset.damage_state.values:
+                low, high = float(cell.studied_im_min), float(cell.studied_im_max)
+                row = {"ID": component, "Incomplete": 0, "Demand-Type": demand_type, "Demand-Unit": demand_unit,
+                       "Demand-Offset": 0, "Demand-Directional": 1}
+                notes = [f"rockfrag {measure} fragility, studied range {low:.4g}-{high:.4g} {unit}"]
+                for level, state in enumerate(dataset.damage_state.values, start=1):
                     median = float(cell["median"].sel(damage_state=state))
+                    beta = float(cell["beta"].sel(damage_state=state))
+                    status = str(cell["status"].sel(damage_state=state).values)
+                    notes.append(f"LS{level} {state}: {status}")
                     if not np.isfinite(median):
                         row["Incomplete"] = 1
+                        row.update({f"LS{level}-Family": "", f"LS{level}-Theta_0": np.nan,
+                                    f"LS{level}-Theta_1": np.nan, f"LS{level}-DamageStateWeights": ""})
                         continue
-                    level += 1
-                    row[f"LS{level}-Family"] = "lognormal"
+                    row[f"LS{level}-Family"] = "deterministic" if beta == 0 else "lognormal"
                     row[f"LS{level}-Theta_0"] = median
-                    row[f"LS{level}-Theta_1"] = float(cell["beta"].sel(damage_state=state))
+                    row[f"LS{level}-Theta_1"] = np.nan if beta == 0 else beta
                     row[f"LS{level}-DamageStateWeights"] = ""
+                row["Comment"] = "; ".join(notes)
                 rows.append(row)
     return pd.DataFrame(rows)
 
@@ -336,17 +552,25 @@ def write_csv(table: pd.DataFrame, path) -> None:
         table.to_csv(temporary, index=False, float_format="%.6g")
 
 
-def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output):
-    """Fit, add the risk, and write fragility.nc, fragility.csv, fragility_pelicun.csv and risk.csv."""
+def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=None, log=None):
+    """Fit, add the risk, and write fragility.nc, fragility.csv and fragility_pelicun.csv.
+
+    The hazard curve is read (and checked against the study's intensity measure) before any fit.
+    Fit warnings are printed to ``log`` (stderr by default) and kept in the dataset.
+    """
     from pathlib import Path
 
-    from pipeline.risk import load_hazard, risk_dataset
+    from pipeline.risk import risk_dataset, study_hazard
 
+    log = log or (lambda message: print(message, file=sys.stderr))
+    progress = sys.stderr.isatty() if progress is None else progress
     output = Path(output)
+    hazard = study_hazard(config)
     states = damage_states_from_config(config.raw)
     dataset = fragility_dataset(cube, states=states, ida=ida, n_bootstrap=config.bootstrap, seed=config.seed,
-                                confidence=config.confidence)
-    hazard = load_hazard(config.hazard_file or None)
+                                confidence=config.confidence, progress=progress)
+    for line in json.loads(dataset.attrs["fit_warnings"]):
+        log(f"fragility warning: {line}")
     risk = risk_dataset(dataset, hazard, config.design_life)
     combined = dataset.merge(risk)
     combined.attrs.update(dataset.attrs)
@@ -355,5 +579,5 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output):
     table = fragility_table(dataset)
     table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])
     write_csv(table, output / "fragility.csv")
-    write_csv(pelicun_table(dataset), output / "fragility_pelicun.csv")
+    write_csv(pelicun_table(dataset, getattr(config, "period", None)), output / "fragility_pelicun.csv")
     return combined, risk

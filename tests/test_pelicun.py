@@ -1,0 +1,67 @@
+"""Round trip through pelicun: our fragility_pelicun.csv loads with pelicun's own API (Assessment ->
+demand.load_sample -> asset.load_cmp_model -> damage.load_model_parameters -> damage.calculate), and
+P(DS >= k) over a demand sample agrees with our lognormals within Monte-Carlo noise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.stats import norm
+
+pelicun = pytest.importorskip("pelicun", reason="pelicun is not installed (pip install -e '.[test]')")
+
+from pipeline.fragility import fragility_dataset, lognormal_cdf, pelicun_table  # noqa: E402
+from tests.test_fragility import synthetic_cube  # noqa: E402
+
+N_DEMANDS = 20000
+
+
+@pytest.fixture(scope="module")
+def round_trip(tmp_path_factory):
+    from pelicun.assessment import Assessment
+
+    folder = tmp_path_factory.mktemp("pelicun")
+    fragility = fragility_dataset(synthetic_cube(n_records=200), n_bootstrap=0)
+    table = pelicun_table(fragility)
+    table.to_csv(folder / "fragility_pelicun.csv", index=False)
+    rng = np.random.default_rng(0)
+    pga = np.exp(rng.uniform(np.log(0.05), np.log(3.0), N_DEMANDS))
+    demand = pd.DataFrame({"1-PGA-1-1": pga})
+    with open(folder / "demand.csv", "w") as handle:  # pelicun's sample layout: a Units row under the header
+        handle.write(",1-PGA-1-1\nUnits,g\n")
+        demand.to_csv(handle, header=False)
+    component = table.ID.iloc[0]
+    assessment = Assessment({"PrintLog": False, "Seed": 1, "Verbose": False})
+    assessment.demand.load_sample(str(folder / "demand.csv"))
+    assessment.stories = 1
+    marginals = pd.DataFrame({"Units": ["ea"], "Location": ["1"], "Direction": ["1"], "Theta_0": ["1"],
+                              "Blocks": [None]}, index=[component])
+    assessment.asset.load_cmp_model({"marginals": marginals})
+    assessment.asset.generate_cmp_sample(N_DEMANDS)
+    assessment.damage.load_model_parameters([str(folder / "fragility_pelicun.csv")],
+                                            set(assessment.asset.list_unique_component_ids()))
+    assessment.damage.calculate()
+    sample = assessment.damage.ds_model.sample
+    damage_state = np.argmax(sample.to_numpy(), axis=1)  # one-hot quantity per damage state
+    return fragility.isel(soil=0, block=0, model=0), pga, damage_state
+
+
+def test_pelicun_damage_states_match_our_lognormals(round_trip):
+    cell, pga, damage_state = round_trip
+    for k, state in enumerate(cell.damage_state.values, start=1):
+        median, beta = float(cell["median"].sel(damage_state=state)), float(cell.beta.sel(damage_state=state))
+        expected = lognormal_cdf(pga, median, beta).mean()
+        observed = np.mean(damage_state >= k)
+        noise = np.sqrt(expected * (1 - expected) / pga.size)
+        assert observed == pytest.approx(expected, abs=4 * noise + 1e-3), state
+
+
+def test_directional_demand_is_not_scaled_by_pelicun(round_trip):
+    """With Demand-Directional = 0 pelicun would multiply PGA by 1.2: P(DS) some points too high."""
+    cell, pga, damage_state = round_trip
+    median, beta = float(cell["median"].sel(damage_state="overturning")), float(cell.beta.sel(damage_state="overturning"))
+    scaled = norm.cdf(np.log(1.2 * pga / median) / beta).mean()
+    unscaled = norm.cdf(np.log(pga / median) / beta).mean()
+    observed = np.mean(damage_state >= 4)
+    assert abs(observed - unscaled) < abs(observed - scaled) / 4
