@@ -187,10 +187,14 @@ def command_records(args) -> int:
 
 
 def command_run(args) -> int:
-    from pipeline.study import run_study
+    from pipeline.showcase import showcase_stage
+    from pipeline.study import run_study, study_records
 
     config, output = _study_config(args)
-    dataset, stats = run_study(config, output=output, progress=not args.no_progress, **_executor_options(args))
+    loaded = study_records(config, log=_log)
+    dataset, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded,
+                               **_executor_options(args))
+    showcase_stage(config, output, loaded)
     runs = stats["runs_computed"]
     rate = f", {runs / stats['seconds']:.0f} runs/s" if runs else ""
     print(f"wrote {output / 'cube.nc'} ({stats['seconds']:.1f} s{rate}; "
@@ -205,6 +209,7 @@ def command_fragility(args) -> int:
     from pipeline.fragility import fragility_stage
     from pipeline.ida import ida_stage
     from pipeline.report import report_stage
+    from pipeline.showcase import showcase_stage
     from pipeline.study import run_study, study_records
 
     started = time.perf_counter()
@@ -216,6 +221,7 @@ def command_fragility(args) -> int:
     loaded = study_records(config, log=_log)
     cube, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded, **executor)
     print(f"wrote {output / 'cube.nc'} ({stats['cells_reused']} of {stats['cells']} cells from checkpoints)")
+    showcase_stage(config, output, loaded)
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
     if "capacity_scale_factor" in cube:  # measure ranking from the adaptive capacities (no solver runs)
@@ -233,8 +239,9 @@ def command_fragility(args) -> int:
         applicability = applicability_stage(config, output, workers=args.workers, progress=not args.no_progress,
                                             loaded=loaded)
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
-                             applicability, loaded)
-    print(f"wrote {pdf} ({len(pngs)} pages) and {len(pngs)} figures in {output / 'figures'}/")
+                             applicability, progress=not args.no_progress)
+    print(f"wrote {pdf} ({len(pngs)} numbered pages), {output / 'report.html'} and {len(pngs)} page images "
+          f"in {output / 'figures'}/")
     print(f"done in {time.perf_counter() - started:.0f} s")
     return EXIT_PARTIAL if stats["failures"] else 0
 

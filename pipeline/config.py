@@ -200,6 +200,8 @@ SCHEMA = Table({
     "hazard": Table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
     "fragility": Table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                         "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
+    "report": Table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
+                     "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True)}),
     "applicability": Table({
         "g_range": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
         "n_g": Number(2, 200, integer=True),

@@ -1,101 +1,355 @@
-"""Report: the whole pipeline on a small study produces the PDF and every PNG, none empty."""
+"""Report: one numbered A4 document with its HTML twin, written only from result files; the pages show
+only what the study ran; the limitations come from the run; the README's outputs table is true."""
 
 from __future__ import annotations
 
 import re
+import warnings
 
 import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
 import pytest
+import xarray as xr
 
 from pipeline.cli import main
 
+from .test_readme import outputs_table
 from .test_study import SMALL
+
+A4_LANDSCAPE_POINTS = (842, 595)  # 297 x 210 mm
+REPORT_TABLE = """
+[report]
+title = "Rocking fragility of the yard equipment"
+project = "Harbour crane upgrade"
+author = "A. Engineer"
+"""
 
 
 @pytest.fixture(scope="module")
 def pipeline_output(tmp_path_factory):
     folder = tmp_path_factory.mktemp("pipeline")
     study = folder / "study.toml"
-    study.write_text(SMALL + "\n[fragility]\nbootstrap = 5\n")
-    status = main(["fragility", str(study), "--output", str(folder / "reports"), "--no-progress", "--serial"])
+    study.write_text(SMALL + "\n[fragility]\nbootstrap = 5\n" + REPORT_TABLE)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        status = main(["fragility", str(study), "--output", str(folder / "reports"), "--no-progress", "--serial"])
     assert status == 0
-    return folder / "reports", study
+    return folder / "reports", study, caught
 
 
-def expected_figures(n_blocks, n_ssi_models=1):
-    # summary, records table, spectra, Bolu processing, Bolu comparison, IDA per block,
-    # per block: fragility by soil (per SSI model) + by model + outcomes, applicability
-    return 5 + n_blocks + n_blocks * (n_ssi_models + 2) + 1 + 1  # + the applicability sweep
+def _datasets(output):
+    opened = {}
+    for name in ("cube", "ida", "fragility", "showcase"):
+        with xr.open_dataset(output / f"{name}.nc") as dataset:
+            opened[name] = dataset.load()
+    return opened
 
 
 @pytest.mark.slow
-def test_every_output_file_is_written(pipeline_output):
-    output, _ = pipeline_output
-    for name in ("cube.nc", "ida.nc", "fragility.nc", "fragility.csv", "fragility_pelicun.csv", "report.pdf",
-                 "applicability.nc", "applicability-sweep.png"):
-        assert (output / name).stat().st_size > 0, name
-    pngs = sorted((output / "figures").glob("*.png"))
-    assert len(pngs) == expected_figures(3)
-    pdf = (output / "report.pdf").read_bytes()
-    pages = len(re.findall(rb"/Type\s*/Page[^s]", pdf))
-    assert pages == len(pngs)
+def test_outputs_table_matches_what_fragility_writes(pipeline_output):
+    output, _, _ = pipeline_output
+    claimed, not_claimed = [], []
+    for cell, writer in outputs_table().items():
+        cell = re.sub(r"\{(\w+),\w+\}", r"\1", cell)  # calibration.{json,csv} -> calibration.json
+        names = [name.strip("` ").rstrip("/") for name in cell.split(",")]
+        (claimed if "rockfrag fragility" in writer else not_claimed).extend(names)
+    assert "cube.nc" in claimed and "records.csv" in not_claimed
+    for name in claimed:
+        found = list(output.glob(name))
+        assert found and all(p.is_dir() or p.stat().st_size > 0 for p in found), f"README: fragility writes {name}"
+    for name in not_claimed:
+        assert not list(output.glob(name)), f"README says only another command writes {name}"
     assert not list(output.glob(".*.part"))
 
 
 @pytest.mark.slow
-def test_no_figure_is_empty(pipeline_output):
-    import xarray as xr
+def test_one_numbered_a4_document_with_an_html_twin(pipeline_output):
+    output, _, _ = pipeline_output
+    pdf = (output / "report.pdf").read_bytes()
+    pages = len(re.findall(rb"/Type\s*/Page[^s]", pdf))
+    boxes = {tuple(round(float(v)) for v in box.split()[2:])
+             for box in re.findall(rb"/MediaBox\s*\[\s*([\d.\s]+)\]", pdf)}
+    assert boxes == {A4_LANDSCAPE_POINTS}, boxes
+    pngs = sorted((output / "figures").glob("*.png"))
+    assert pages == len(pngs) >= 15
+    html = (output / "report.html").read_text()
+    sections = re.findall(r"<section id='page-(\d+)'>", html)
+    assert [int(n) for n in sections] == list(range(1, pages + 1))
+    assert html.count(f"of {pages}</span>") == pages  # "page N of M" on every page
+    for target in re.findall(r"href='#page-(\d+)'", html):  # the contents links every page it lists
+        assert 1 <= int(target) <= pages
+    assert len(set(re.findall(r"href='#page-(\d+)'", html))) == pages - 1  # all but the contents itself
+    assert html.count("data:image/png;base64,") >= pages - 12  # figure pages embedded, text pages as HTML
+    assert "src='http" not in html and "href='http" not in html  # self-contained
 
+
+@pytest.mark.slow
+def test_title_project_author_and_sections_from_the_study(pipeline_output):
+    output, _, _ = pipeline_output
+    html = (output / "report.html").read_text()
+    for text in ("Rocking fragility of the yard equipment", "Harbour crane upgrade", "A. Engineer"):
+        assert text in html
+    order = [html.index(f"<h2>{title}") for title in ("Contents", "Summary", "Methods", "Limitations",
+                                                       "Intensity measures", "IDA curves")]
+    assert order == sorted(order)
+    assert "θmax/α ≥ 0.5" in html  # damage states by their registry description, not ids
+    assert "rocking-0.5:" not in html.split("Methods")[0]
+
+
+@pytest.mark.slow
+def test_no_figure_warning_and_no_open_figures(pipeline_output):
+    _, _, caught = pipeline_output
+    assert not [w for w in caught if "More than 20 figures" in str(w.message)]
+    assert plt.get_fignums() == []
+
+
+@pytest.mark.slow
+def test_report_reads_results_and_never_simulates(pipeline_output, monkeypatch, tmp_path):
+    import shutil
+
+    import pipeline.models as models
     from pipeline.config import load_study
-    from pipeline.report import build_figures
-    from pipeline.soils import soil_block_stiffness
+    from pipeline.report import report_stage
 
-    output, study = pipeline_output
-    config = load_study(study)
-    cube = xr.open_dataset(output / "cube.nc")
-    ida = xr.open_dataset(output / "ida.nc")
-    fragility = xr.open_dataset(output / "fragility.nc")
-    from pipeline.records import load_records
-    from pipeline.processing import process_record
-    from pipeline.measures import intensity_measures
+    output, study, _ = pipeline_output
 
-    raw, _ = load_records("bolu")
-    records = [process_record(r) for r in raw]
-    measures = [intensity_measures(r.acceleration, r.dt, sa_periods=(1.0,)) for r in records]
-    figures = build_figures(config, cube, ida, fragility, fragility, records, measures, raw[1], records[1], 1.0,
-                            soil_block_stiffness)
-    for item in figures:
-        axes = item.figure.get_axes()
-        drawn = sum(len(a.lines) + len(a.collections) + len(a.tables) + len(a.patches) for a in axes)
-        assert drawn > 0, item.name
-        assert item.figure._suptitle is not None or any(a.get_title() for a in axes), item.name
-        plotted = [a for a in axes if a.lines or a.collections]
-        if plotted:  # shared axes label only the outer panels: at least one label of each kind
-            assert any(a.get_xlabel() for a in plotted) and any(a.get_ylabel() for a in plotted), item.name
-            assert all("[" in a.get_xlabel() for a in plotted if a.get_xlabel()), item.name  # units
-        plt.close(item.figure)
+    def forbidden(*args, **kwargs):
+        raise AssertionError("the report ran a solver")
+
+    for name in ("simulate", "simulate_batch", "simulate_histories"):
+        monkeypatch.setattr(models, name, forbidden)
+    copy = tmp_path / "copy"
+    shutil.copytree(output, copy)
+    opened = _datasets(copy)
+    first, _ = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
+                            progress=False)
+    second, _ = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
+                             progress=False)
+    assert first.read_bytes() == second.read_bytes()  # no creation dates: the same results, the same file
+    assert plt.get_fignums() == []
 
 
-def test_pdf_is_deterministic(tmp_path):
-    from pipeline.report import Figure, write_report
+def _results(output, study, **changes):
+    from pipeline.config import load_study
+    from pipeline.report import Results
 
-    def one():
-        figure, axis = plt.subplots()
-        axis.plot([0, 1], [0, 1])
-        return [Figure("line", figure, "a line")]
-
-    first, _ = write_report(one(), tmp_path / "a")
-    second, _ = write_report(one(), tmp_path / "b")
-    assert first.read_bytes() == second.read_bytes()
+    opened = _datasets(output)
+    values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
+                  output=output, showcase=opened["showcase"])
+    values.update(changes)
+    return Results(**values)
 
 
-def test_record_table_is_paginated(all_records):
-    from pipeline.report import ROWS_PER_TABLE_PAGE, records_tables
+@pytest.mark.slow
+def test_pages_cover_only_the_study(pipeline_output):
+    from pipeline.report import plan
 
-    measures = [{"pga_m_s2": 1.0, "pgv_m_s": 1.0, "arias_m_s": 1.0, "d5_95_s": 1.0, "sa_1s_m_s2": 1.0}] * len(all_records)
-    pages = records_tables(all_records, measures)
-    assert len(pages) == -(-len(all_records) // ROWS_PER_TABLE_PAGE)
-    rows = [len(page.figure.axes[0].tables[0].get_celld()) // 8 - 1 for page in pages]  # minus the header
-    assert sum(rows) == len(all_records)
-    for page in pages:
-        plt.close(page.figure)
+    output, study, _ = pipeline_output
+    results = _results(output, study)
+    names = [page.name for page in plan(results)]
+    blocks = list(results.cube.block.values)
+    assert sorted(n[4:] for n in names if n.startswith("ida-")) == sorted(blocks)
+    assert "showcase-response" in names  # the study has Bolu
+    without = [page.section for page in plan(_results(output, study, showcase=results.showcase.drop_vars(
+        [v for v in results.showcase.variables if "record" not in results.showcase[v].dims and v != "period"])))]
+    assert "Showcase record" not in without
+    # one 'fragility by soil' page per foundation model, none for the rigid base
+    assert not [n for n in names if n.startswith("fragility-soils-") and n.endswith("-housner")]
+
+
+@pytest.mark.slow
+def test_figure_pages_rigid_base_once_legend_outside_shared_scales(pipeline_output):
+    from pipeline.report import figures
+    from pipeline.report.adapters import models_of
+    from pipeline.report.layout import PAGE_SIZE
+
+    output, study, _ = pipeline_output
+    results = _results(output, study)
+    block = str(results.cube.block.values[0])
+    page = figures.ida_page(results.ida, block, "")
+    titles = [a.get_title() for a in page.axes if a.get_visible()]
+    rigid = [m for m in models_of(results.cube) if m.rigid_base]
+    founded = [m for m in models_of(results.cube) if not m.rigid_base]
+    assert len(titles) == len(rigid) + len(founded) * results.cube.sizes["soil"]
+    assert sum("housner" in t.lower() for t in titles) == 1
+    assert tuple(page.get_size_inches()) == PAGE_SIZE
+    _assert_legend_outside(page)
+    plt.close(page)
+
+    page = figures.showcase_response_page(results.showcase, "")
+    theta_axes = [a for a in page.axes if a.get_ylabel().startswith("θ [")]
+    assert len(theta_axes) == results.cube.sizes["soil"]
+    assert len({a.get_ylim() for a in theta_axes}) == 1  # one scale for the compared panels
+    start, end = theta_axes[0].get_xlim()
+    window = (float(results.showcase.attrs["strong_motion_start_s"]), float(results.showcase.attrs["strong_motion_end_s"]))
+    assert window[0] - 5 <= start <= window[0] and window[1] <= end <= window[1] + 10
+    assert end - start < float(results.showcase.time.values[-1])  # cropped, not the whole record
+    _assert_legend_outside(page)
+    lines = [line for a in theta_axes for line in a.lines]
+    styles = {(line.get_color(), str(line.get_linestyle())) for line in lines}
+    assert len(styles) == results.cube.sizes["model"]  # models in distinct colours and line styles
+    plt.close(page)
+
+    page = figures.fragility_by_soil_page(results.fragility, block, founded[0], "")
+    _assert_legend_outside(page)
+    labels = [t.get_text() for legend in page.legends for t in legend.get_texts()]
+    assert sum("housner" in label.lower() for label in labels) == 1  # the rigid base listed once
+    plt.close(page)
+
+
+def _assert_legend_outside(figure):
+    figure.canvas.draw()
+    right = max(a.get_window_extent().x1 for a in figure.axes if a.get_visible())
+    assert figure.legends, "no legend"
+    for legend in figure.legends:
+        assert legend.get_window_extent().x0 >= right
+
+
+def _fake_cube(tension, friction=None):
+    """A cube of 10 records x 2 levels x 2 soils x 1 block x 2 models with given tension flags."""
+    shape = (10, 2, 2, 1, 2)
+    coords = {"record": [f"r{i}" for i in range(10)], "im_level": [0.1, 0.2], "soil": ["clay", "rock"],
+              "block": ["b"], "model": ["housner", "ssi"]}
+    data = {"outcome": (list(coords), np.ones(shape, dtype=np.int8)),
+            "support_tension": (list(coords), tension)}
+    if friction is not None:
+        data["peak_friction_demand"] = (list(coords), friction)
+    return xr.Dataset(data, coords=coords)
+
+
+def test_limitations_state_the_tension_fraction_per_soil_and_block():
+    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+
+    tension = np.full((10, 2, 2, 1, 2), np.nan)
+    tension[..., 1] = 0.0
+    tension[:3, :, 0, 0, 1] = 1.0  # 3 of 10 records pulled on clay at both levels
+    tension[:1, 0, 1, 0, 1] = 1.0  # 1 of 20 runs on rock
+    cube = _fake_cube(tension)
+    fraction = run_fraction(cube, tension_flag(cube), model_info("ssi"))
+    assert float(fraction.sel(soil="clay", block="b")) == pytest.approx(0.3)
+    assert float(fraction.sel(soil="rock", block="b")) == pytest.approx(0.05)
+    assert run_fraction(cube, tension_flag(cube), model_info("housner")) is None  # not computed: NaN
+
+
+def test_tension_flag_not_applicable_is_not_counted():
+    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+
+    flags = np.full((10, 2, 2, 1, 2), -1, dtype=np.int8)  # -1: the model cannot pull (tensionless, rigid)
+    flags[..., 1] = 0
+    flags[:2, :, 1, 0, 1] = 1
+    cube = _fake_cube(flags)
+    assert run_fraction(cube, tension_flag(cube), model_info("housner")) is None
+    fraction = run_fraction(cube, tension_flag(cube), model_info("ssi"))
+    assert float(fraction.sel(soil="rock", block="b")) == pytest.approx(0.2) and float(fraction.sel(soil="clay", block="b")) == 0.0
+
+
+def test_tension_falls_back_to_negative_support_force():
+    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+
+    force = np.full((10, 2, 2, 1, 2), 1000.0)
+    force[:5, :, 1, 0, 1] = -1.0
+    cube = _fake_cube(np.zeros_like(force)).drop_vars("support_tension")
+    cube["min_support_force"] = (list(cube.outcome.dims), force)
+    fraction = run_fraction(cube, tension_flag(cube), model_info("ssi"))
+    assert float(fraction.sel(soil="rock", block="b")) == pytest.approx(0.5)
+    assert float(fraction.sel(soil="clay", block="b")) == 0.0
+
+
+def test_sliding_fraction_above_the_friction_coefficient():
+    from pipeline.report.adapters import friction_flag, model_info, run_fraction
+
+    demand = np.full((10, 2, 2, 1, 2), 0.2)
+    demand[:4, 1, 0, 0, 1] = 0.7  # 4 of 20 runs on clay need more than mu = 0.5
+    cube = _fake_cube(np.zeros_like(demand), demand)
+    fraction = run_fraction(cube, friction_flag(cube, 0.5), model_info("ssi"))
+    assert float(fraction.sel(soil="clay", block="b")) == pytest.approx(0.2)
+    assert float(fraction.sel(soil="rock", block="b")) == 0.0
+    assert friction_flag(cube.drop_vars("peak_friction_demand"), 0.5) is None
+
+
+def _fake_fragility(medians, levels=(0.1, 1.0)):
+    coords = {"soil": ["clay"], "block": ["b"], "model": ["ssi"], "damage_state": ["a", "b", "c"],
+              "im_level": list(levels)}
+    return xr.Dataset({"median": (("soil", "block", "model", "damage_state"), np.array(medians).reshape(1, 1, 1, 3))},
+                      coords=coords)
+
+
+def test_extrapolated_medians_from_the_studied_range(tmp_path):
+    from pipeline.report.adapters import extrapolation
+
+    table = extrapolation(_fake_fragility([0.5, 2.0, np.nan]), tmp_path)
+    assert list(table.status) == ["within", "above-range", "no fit"]
+    per_block = _fake_fragility([0.5, 2.0, 0.05])
+    per_block["intensity"] = (("block", "im_level"), [[0.01, 3.0]])  # the per-block levels of the new layout
+    assert list(extrapolation(per_block, tmp_path).status) == ["within", "within", "within"]
+
+
+def test_extrapolated_medians_from_the_fragility_csv_status_column(tmp_path):
+    from pipeline.report.adapters import extrapolation
+
+    pd.DataFrame({"soil": ["clay"] * 3, "block": ["b"] * 3, "model": ["ssi"] * 3, "damage_state": ["a", "b", "c"],
+                  "status": ["ok", "extrapolated-above", "ok"]}).to_csv(tmp_path / "fragility.csv", index=False)
+    table = extrapolation(_fake_fragility([0.5, 0.6, 0.7]), tmp_path)
+    assert list(table.status) == ["within", "above-range", "within"]
+
+
+def test_text_pages_split_long_tables_with_their_header():
+    from pipeline.report.text import heading, paginate, paragraph, table
+
+    items = [heading("h"), paragraph("p"), table(["a", "b"], [[str(i), str(i)] for i in range(100)])]
+    pages = paginate(items, capacity=30)
+    rows = [row for page in pages for item in page if item.kind == "table" for row in item.rows]
+    assert len(rows) == 100 and len(pages) == 4
+    assert all(page[0].kind != "heading" or len(page) > 1 for page in pages)
+
+
+def test_showcase_record_is_bolu_or_the_named_one():
+    from pipeline.config import study_from_dict
+    from pipeline.showcase import showcase_record_id
+    import tomllib
+    from importlib.resources import files
+
+    defaults = tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text())
+    config = study_from_dict(defaults)
+    assert showcase_record_id(config, ["DUZCE/BOL090", "X/Y"]) == "DUZCE/BOL090"
+    assert showcase_record_id(config, ["X/Y"]) is None
+    named = study_from_dict({**defaults, "report": {**defaults["report"], "showcase_record": "X/Y"}})
+    assert showcase_record_id(named, ["A/B"]) == "X/Y"
+
+
+@pytest.mark.slow
+def test_showcase_file_has_units_and_one_case_per_rigid_model(pipeline_output):
+    output, study, _ = pipeline_output
+    showcase = _datasets(output)["showcase"]
+    for name, variable in showcase.data_vars.items():
+        assert variable.attrs.get("units") and variable.attrs.get("long_name"), name
+    models = list(map(str, showcase.case_model.values))
+    soils = list(map(str, showcase.case_soil.values))
+    assert models.count("housner") == 1 and soils[models.index("housner")] == ""
+    assert models.count("ssi") == 2
+    assert np.nanmax(np.abs(showcase.theta.values)) > 0  # the block rocks under Bolu
+
+
+def test_efficiency_page_when_the_module_and_file_exist(monkeypatch, tmp_path):
+    import sys
+    import types
+
+    from pipeline.report import _efficiency_plotter
+    from pipeline.report.layout import PAGE_SIZE
+    from pipeline.report.sections import Results
+
+    module = types.ModuleType("pipeline.efficiency")
+
+    def plot_efficiency(dataset):
+        figure, axis = plt.subplots(figsize=(4, 3))
+        axis.plot(dataset.x.values, dataset.x.values)
+        return figure
+
+    module.plot_efficiency = plot_efficiency
+    monkeypatch.setitem(sys.modules, "pipeline.efficiency", module)
+    results = Results(None, None, None, None, tmp_path, efficiency=xr.Dataset({"x": ("i", [1.0, 2.0])}))
+    figure = _efficiency_plotter(results)()
+    assert tuple(figure.get_size_inches()) == PAGE_SIZE
+    plt.close(figure)
+    assert _efficiency_plotter(Results(None, None, None, None, tmp_path)) is None  # no efficiency.nc: no page

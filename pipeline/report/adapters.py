@@ -1,0 +1,198 @@
+"""pipeline.report.adapters - what the report asks of the result files, whatever their layout.
+
+Input : the study's datasets (cube, ida, fragility + risk) and the model registry.
+Output: small answers the pages draw: model labels and roles (rigid base or on a foundation), the
+        intensity levels of a block (per-block ``intensity`` coordinate when present, else ``im_level``),
+        the axis label of the intensity measure, human labels of the damage states, whether a fitted
+        median is extrapolated, and run fractions of the limitation checks.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from pipeline.models import base as _model_base
+from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
+
+Outcome = getattr(_model_base, "Outcome", getattr(_model_base, "Status", None))  # the cube's outcome codes
+OUTCOME_ROCKING, OUTCOME_FAILED = int(Outcome.ROCKING), int(Outcome.FAILED)
+
+
+@dataclass(frozen=True)
+class ModelInfo:
+    name: str
+    label: str
+    rigid_base: bool
+    description: str
+    can_pull: bool | None = None  # None: the registry does not say
+    uses_bed: bool = False  # a bed of springs (solver.bed), not the pivot-switch rule
+
+
+def model_info(name: str) -> ModelInfo:
+    """Label and role of a model from the registry (a model no longer registered keeps its name)."""
+    from pipeline.models import MODELS
+
+    model = MODELS.get(name)
+    if model is None:
+        return ModelInfo(name, name, False, "")
+    rigid = bool(getattr(model, "is_rigid_base", not model.needs_foundation))
+    description = getattr(model, "description", "")
+    label = getattr(model, "label", None) or f"{name}: {description.split(';')[0]}"
+    return ModelInfo(name, label, rigid, description, getattr(model, "can_pull", None),
+                     bool(getattr(model, "uses_bed", False)))
+
+
+def models_of(dataset) -> list[ModelInfo]:
+    """Models of a dataset: rigid-base models first (the reference), then the others in study order."""
+    infos = [model_info(str(m)) for m in dataset.model.values]
+    return [m for m in infos if m.rigid_base] + [m for m in infos if not m.rigid_base]
+
+
+def model_styles(models) -> dict:
+    """Line style per model: rigid base black dashed, the others distinct colours and dash patterns."""
+    styles, index = {}, 0
+    for model in models:
+        if model.rigid_base:
+            styles[model.name] = dict(RIGID_STYLE)
+        else:
+            styles[model.name] = dict(MODEL_STYLES[index % len(MODEL_STYLES)])
+            index += 1
+    return styles
+
+
+def short_label(model: ModelInfo) -> str:
+    """A label short enough for a legend: the registry label, or the name for long descriptions."""
+    return model.label if len(model.label) <= 45 else model.name
+
+
+def cell(dataset, model: ModelInfo, block, soil=None):
+    """The results of one model and block; a rigid-base model on the first soil (all soils are equal)."""
+    if "soil" in dataset.dims and (model.rigid_base or soil is None):
+        soil = dataset.soil.values[0]
+    selection = {"model": model.name, "block": block}
+    if "soil" in dataset.dims:
+        selection["soil"] = soil
+    return dataset.sel(selection)
+
+
+def block_levels(dataset, block) -> np.ndarray:
+    """Intensity levels of a block: the per-block ``intensity`` coordinate, or the shared ``im_level``."""
+    if "intensity" in dataset.variables and "block" in dataset["intensity"].dims:
+        return np.asarray(dataset["intensity"].sel(block=block).values, dtype=float)
+    return np.asarray(dataset.im_level.values, dtype=float)
+
+
+def measure_label(dataset) -> str:
+    """Axis label of the intensity measure with units, e.g. 'PGA [g]'."""
+    source = dataset["intensity"] if "intensity" in dataset.variables else dataset.im_level
+    unit = source.attrs.get("units", dataset.im_level.attrs.get("units", ""))
+    measure = str(dataset.attrs.get("intensity_measure", "")).lower()
+    long_name = str(dataset.im_level.attrs.get("long_name", ""))
+    short = {"pga": "PGA", "pgv": "PGV"}.get(measure) or next(
+        (text for phrase, text in (("peak ground acceleration", "PGA"), ("peak ground velocity", "PGV"))
+         if phrase in long_name), None)
+    if short is None:
+        found = re.search(r"Sa\([^)]*\)", long_name)
+        short = found.group(0) if found else (measure.upper() or "intensity")
+    return f"{short} [{unit}]"
+
+
+def state_labels(fragility) -> dict:
+    """Human label of each damage state: the registry's description with its symbols."""
+    from pipeline.fragility import DAMAGE_STATES
+
+    labels = {}
+    descriptions = (fragility["damage_state_description"].values if "damage_state_description" in fragility.coords
+                    else [""] * fragility.sizes["damage_state"])
+    for name, description in zip(fragility.damage_state.values, descriptions):
+        description = str(description) or getattr(DAMAGE_STATES.get(str(name)), "description", "") or str(name)
+        text = pretty(description)
+        labels[str(name)] = text[0].upper() + text[1:] if text[:1].isascii() else text
+    return labels
+
+
+def extrapolation(fragility, output=None) -> pd.DataFrame:
+    """One row per fitted median: soil, block, model, damage_state, median, status
+    (``within``, ``above-range``, ``below-range``). ``fragility.csv``'s ``status`` or ``extrapolated``
+    column is used when present; otherwise the median is compared with the block's studied levels."""
+    table = fragility["median"].to_dataframe().reset_index()[["soil", "block", "model", "damage_state", "median"]]
+    csv = Path(output) / "fragility.csv" if output is not None else None
+    if csv is not None and csv.is_file():
+        written = pd.read_csv(csv)
+        keys = ["soil", "block", "model", "damage_state"]
+        if "status" in written.columns:
+            merged = table.merge(written[keys + ["status"]], on=keys, how="left")
+            merged["status"] = merged["status"].fillna("").astype(str)
+            merged["status"] = [_status_word(s, m) for s, m in zip(merged["status"], merged["median"])]
+            return merged
+        if "extrapolated" in written.columns:
+            merged = table.merge(written[keys + ["extrapolated"]], on=keys, how="left")
+            merged["status"] = np.where(merged["extrapolated"].astype(str).str.lower().isin(["true", "1", "yes"]),
+                                        "extrapolated", "within")
+            return merged.drop(columns="extrapolated")
+    status = []
+    for row in table.itertuples():
+        levels = block_levels(fragility, row.block)
+        if not np.isfinite(row.median):
+            status.append("no fit")
+        elif row.median > levels.max():
+            status.append("above-range")
+        elif row.median < levels.min():
+            status.append("below-range")
+        else:
+            status.append("within")
+    table["status"] = status
+    return table
+
+
+def _status_word(status: str, median: float) -> str:
+    text = status.lower()
+    if not np.isfinite(median):
+        return "no fit"
+    if "extrapol" in text or "above" in text or "below" in text:
+        return "below-range" if "below" in text else ("above-range" if "above" in text else "extrapolated")
+    return "within"
+
+
+def run_fraction(cube, flag, model: ModelInfo):
+    """Fraction of a model's valid runs where ``flag`` (a boolean DataArray over the cube) holds,
+    per soil and block (soil collapsed for rigid-base models); None when the flag is all NaN."""
+    valid = cube.outcome.sel(model=model.name) != OUTCOME_FAILED
+    values = flag.sel(model=model.name)
+    known = values.notnull() & valid
+    if int(known.sum()) == 0:
+        return None
+    hits = (values.fillna(0).astype(bool) & known).sum(("record", "im_level"))
+    total = known.sum(("record", "im_level"))
+    return (hits / total.where(total > 0)).transpose("soil", "block")
+
+
+def tension_flag(cube):
+    """1 where the foundation pulled on the block, 0 where not, NaN where not computed."""
+    if "support_tension" in cube:  # flags -1 not applicable, 0 no tension, 1 tension (or NaN)
+        flag = cube.support_tension
+        return flag.where(flag >= 0)
+    if "min_support_force" in cube:
+        force = cube.min_support_force
+        return (force < 0).where(force.notnull())
+    return None
+
+
+def friction_flag(cube, coefficient):
+    """1 where holding the base without sliding needed more than ``coefficient``, NaN where unknown."""
+    if "peak_friction_demand" not in cube:
+        return None
+    demand = cube.peak_friction_demand
+    return (demand > coefficient).where(demand.notnull())
+
+
+def uplift_intensity(cube, block) -> float:
+    """Intensity at which the block starts to rock, in the unit of its levels (g tan(alpha) for PGA)."""
+    if "block_uplift_intensity" in cube.variables:
+        return float(cube.block_uplift_intensity.sel(block=block))
+    return float(cube.block_uplift_acceleration.sel(block=block)) / 9.80665

@@ -1,0 +1,370 @@
+"""pipeline.report.figures - the figure pages of the report, each drawn on one A4-landscape page.
+
+Input : the opened result datasets (cube, ida, fragility, showcase, applicability) and labels from the
+        registries (pipeline.report.adapters). Output: matplotlib figures of the page size (layout.new_page)
+        with axis labels in units, one legend outside the data, and a caption. Nothing is simulated.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pipeline.report.adapters import (OUTCOME_ROCKING, block_levels, cell, measure_label, model_styles, models_of,
+                                      short_label, state_labels, uplift_intensity)
+from pipeline.report.layout import GRID, FRACTILE_STYLES, log_axis, new_page, outside_legend, panels, soil_colour
+
+G = 9.80665
+IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (the flatline)
+WINDOW_BEFORE, WINDOW_AFTER = 3.0, 8.0  # s around the strong-motion window on the time axes
+
+
+def _grid(n):
+    """(rows, columns) for n panels on a landscape page."""
+    columns = n if n <= 3 else 2 if n == 4 else 3
+    return math.ceil(n / columns), columns
+
+
+def spectra_page(showcase, caption):
+    figure = new_page("Response spectra of the record set", caption)
+    axis = panels(figure)[0, 0]
+    periods = showcase.period.values
+    spectra = showcase.record_spectrum.values / G
+    for row in spectra:
+        axis.loglog(periods, row, color="0.75", lw=0.6)
+    axis.plot([], [], color="0.75", lw=0.6, label=f"each record ({spectra.shape[0]})")
+    for q, style in FRACTILE_STYLES.items():
+        axis.loglog(periods, np.quantile(spectra, q, axis=0), label=f"{q:.0%} fractile", **style)
+    axis.set_xlabel("period T [s]")
+    axis.set_ylabel("spectral acceleration Sa(T, 5%) [g]")
+    axis.grid(alpha=0.3, which="both")
+    outside_legend(figure, [axis])
+    return figure
+
+
+def showcase_ground_page(showcase, caption):
+    title = (f"{showcase.attrs.get('showcase_event', '')}, {showcase.attrs.get('showcase_station', '')} "
+             f"{showcase.attrs.get('showcase_component', '')} ({showcase.attrs['showcase_record']}): raw and processed")
+    figure = new_page(title, caption)
+    axes = panels(figure, 3, 1, sharex=True, gridspec_kw=dict(hspace=0.12))[:, 0]
+    time = showcase.time_ground.values
+    for axis, quantity, unit, factor in zip(axes, ("acceleration", "velocity", "displacement"),
+                                            ("g", "m/s", "m"), (1 / G, 1.0, 1.0)):
+        axis.plot(time, showcase[f"ground_{quantity}_raw"].values * factor, color="0.55", lw=0.8,
+                  label="raw (as published)")
+        axis.plot(time, showcase[f"ground_{quantity}_processed"].values * factor, color="#1f77b4", lw=0.9,
+                  label="processed")
+        axis.set_ylabel(f"{quantity} [{unit}]")
+        axis.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(time[0], time[-1])
+    outside_legend(figure, axes)
+    return figure
+
+
+def _time_window(showcase):
+    start = float(showcase.attrs.get("strong_motion_start_s", 0.0)) - WINDOW_BEFORE
+    end = float(showcase.attrs.get("strong_motion_end_s", showcase.time.values[-1])) + WINDOW_AFTER
+    return max(start, 0.0), min(end, float(showcase.time.values[-1]))
+
+
+def showcase_response_page(showcase, caption):
+    """Ground motion on top, then per soil theta(t) (left) and the foundation's settlement (right);
+    one y-scale per column, time cropped to the strong motion."""
+    import xarray as xr
+
+    block = showcase.attrs["showcase_block"]
+    figure = new_page(f"{showcase.attrs['showcase_record']}, block '{block}' (R = "
+                      f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
+                      "rad): rocking on each soil", caption)
+    soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
+    models = models_of(xr.Dataset(coords={"model": list(dict.fromkeys(map(str, showcase.case_model.values)))}))
+    styles = model_styles(models)
+    start, end = _time_window(showcase)
+    margins = dict(left=0.075, right=GRID["right"], wspace=0.22)
+    ground = figure.add_gridspec(1, 1, top=GRID["top"], bottom=0.79, **margins).subplots()
+    ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35", lw=0.7)
+    ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
+                   color="0.9", zorder=0, label="5-95% Arias window")
+    ground.set_ylabel("ground [g]")
+    ground.set_xlim(start, end)
+    ground.grid(alpha=0.3)
+    ground.tick_params(labelbottom=False)
+    grid = figure.add_gridspec(len(soils), 2, top=0.74, bottom=GRID["bottom"], hspace=0.12, **margins)
+    peak = np.nanmax(np.abs(showcase.theta.values)) if np.isfinite(showcase.theta.values).any() else 0.0
+    scale, unit = (1000.0, "mrad") if peak < 0.1 else (1.0, "rad")
+    theta_axes, settle_axes = [], []
+    for row, soil in enumerate(soils):
+        theta_axis = figure.add_subplot(grid[row, 0], sharex=ground, sharey=theta_axes[0] if theta_axes else None)
+        settle_axis = figure.add_subplot(grid[row, 1], sharex=ground, sharey=settle_axes[0] if settle_axes else None)
+        theta_axes.append(theta_axis)
+        settle_axes.append(settle_axis)
+        for model in models:
+            mask = (showcase.case_model.values == model.name) & (
+                (showcase.case_soil.values == "") if model.rigid_base else (showcase.case_soil.values == soil))
+            if not mask.any():
+                continue
+            index = int(np.flatnonzero(mask)[0])
+            theta_axis.plot(showcase.time.values, showcase.theta.values[index] * scale, label=short_label(model),
+                            **styles[model.name])
+            if not model.rigid_base:
+                settle_axis.plot(showcase.time.values, showcase.settlement.values[index] * 1000,
+                                 **styles[model.name])
+        theta_axis.set_ylabel(f"θ [{unit}]")
+        settle_axis.set_ylabel("Δy [mm]")
+        theta_axis.text(0.01, 0.92, soil, transform=theta_axis.transAxes, fontsize=9, weight="bold", va="top",
+                        bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
+        for axis in (theta_axis, settle_axis):
+            axis.grid(alpha=0.3)
+            axis.tick_params(labelbottom=row == len(soils) - 1)
+    theta_axes[0].set_title("rocking angle θ (the rigid base is the same on every soil)", fontsize=9)
+    settle_axes[0].set_title("settlement Δy from the static position (down +; each model's reference point)",
+                             fontsize=9)
+    theta_axes[-1].set_xlabel("time [s]")
+    settle_axes[-1].set_xlabel("time [s]")
+    outside_legend(figure, [ground, *theta_axes])
+    return figure
+
+
+def _finite_capped(values):
+    return np.where(np.isfinite(values), np.minimum(values, IDA_CAP), IDA_CAP)
+
+
+def ida_page(ida, block, caption):
+    """One panel per rigid-base model and per foundation model x soil, filling the page in reading order."""
+    models = models_of(ida)
+    soils = list(map(str, ida.soil.values))
+    drawn = [(m, None) for m in models if m.rigid_base]
+    drawn += [(m, soil) for m in models if not m.rigid_base for soil in soils]
+    columns = min(len(drawn), 3 if len(drawn) <= 6 else 4)
+    rows = math.ceil(len(drawn) / columns)
+    figure = new_page(f"IDA curves: block '{block}'", caption)
+    axes = panels(figure, rows, columns, sharex=True, sharey=True, gridspec_kw=dict(hspace=0.3))
+    levels = block_levels(ida, block)
+    for axis, (model, soil) in zip(axes.flat, drawn):
+        picked = cell(ida, model, block, soil)
+        for curve in picked.edp.transpose("record", "im_level").values:
+            axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
+        for q in ida.fractile.values:
+            style = FRACTILE_STYLES.get(round(float(q), 2), dict(color="C4", lw=1.2))
+            axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
+                      label=f"{float(q):.0%} fractile", **style)
+        axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
+        axis.set_title(short_label(model) if soil is None else f"{model.name} on {soil}", fontsize=9)
+        axis.grid(alpha=0.3)
+        axis.set_xlim(0, IDA_CAP * 1.05)
+    axes.flat[0].plot([], [], color="0.65", lw=0.5, label="one record")
+    axes.flat[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
+    for index, axis in enumerate(axes.flat):
+        if index >= len(drawn):
+            axis.set_visible(False)
+            continue
+        row, column = divmod(index, columns)
+        if column == 0:
+            axis.set_ylabel(measure_label(ida))
+        if index + columns >= len(drawn):  # nothing drawn below: label the x axis here
+            axis.set_xlabel("θmax/α [-]")
+            axis.tick_params(labelbottom=True)
+    outside_legend(figure, [axes.flat[0]])
+    return figure
+
+
+def _fragility_series(axis, fragility, levels, picked, state, style, label):
+    from pipeline.fragility import lognormal_cdf
+
+    values = picked.sel(damage_state=state)
+    grid = np.geomspace(levels[0], levels[-1], 200)
+    median, beta = float(values["median"]), float(values["beta"])
+    colour = style.get("color")
+    axis.plot(levels, values.empirical_fraction.values, "o", ms=3, color=colour, alpha=0.75,
+              zorder=style.get("zorder", 2))
+    if np.isfinite(median) and np.isfinite(beta):
+        axis.plot(grid, lognormal_cdf(grid, median, beta), label=label, **style)
+        low, high = float(values.median_low), float(values.median_high)
+        if np.isfinite(low) and np.isfinite(high) and beta > 0.05:
+            axis.fill_between(grid, lognormal_cdf(grid, high, beta), lognormal_cdf(grid, low, beta),
+                              color=colour, alpha=0.12, lw=0)
+    else:
+        axis.plot([], [], label=label, **style)  # listed once in the legend; the page caption explains gaps
+
+
+def _state_axes(figure, fragility, n_rows=1):
+    states = [str(s) for s in fragility.damage_state.values]
+    if n_rows == 1:
+        rows, columns = _grid(len(states))
+    else:
+        rows, columns = n_rows, len(states)
+    axes = panels(figure, rows, columns, sharex=True, sharey=True,
+                  gridspec_kw=dict(hspace=0.45 if n_rows > 1 else 0.32))
+    for axis in axes.flat[len(states) * (1 if n_rows == 1 else n_rows):]:
+        axis.set_visible(False)
+    return states, axes
+
+
+def _finish_fragility_axes(axes, fragility, levels):
+    for axis in axes.flat:
+        if not axis.get_visible():
+            continue
+        log_axis(axis)
+        axis.set_xlim(levels[0], levels[-1])
+        axis.set_ylim(-0.02, 1.02)
+        axis.grid(alpha=0.3, which="both")
+    for axis in axes[:, 0]:
+        axis.set_ylabel("P(damage state | IM) [-]")
+    for axis in axes[-1]:
+        axis.set_xlabel(measure_label(fragility))
+
+
+def fragility_by_soil_page(fragility, block, model, caption):
+    """Panels per damage state; the soils in colours, rigid-base models once as the black dashed reference."""
+    models = models_of(fragility)
+    styles = model_styles(models)
+    figure = new_page(f"Fragility by soil: block '{block}', {short_label(model)}", caption)
+    states, axes = _state_axes(figure, fragility)
+    labels = state_labels(fragility)
+    levels = block_levels(fragility, block)
+    for axis, state in zip(axes.flat, states):
+        for index, soil in enumerate(map(str, fragility.soil.values)):
+            style = dict(styles[model.name], color=soil_colour(soil, index))
+            _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state, style,
+                              f"{model.name} on {soil}")
+        for reference in (m for m in models if m.rigid_base):
+            _fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
+                              styles[reference.name], short_label(reference))
+        axis.set_title(labels[state], fontsize=10)
+    _finish_fragility_axes(axes, fragility, levels)
+    outside_legend(figure, list(axes.flat))
+    return figure
+
+
+def fragility_by_model_page(fragility, block, soils, caption):
+    """Rows: the softest and stiffest soil; columns: damage states; models in their own colours and styles."""
+    models = models_of(fragility)
+    styles = model_styles(models)
+    figure = new_page(f"Fragility by model: block '{block}'", caption)
+    states, axes = _state_axes(figure, fragility, n_rows=len(soils))
+    labels = state_labels(fragility)
+    levels = block_levels(fragility, block)
+    for row, soil in enumerate(soils):
+        for column, state in enumerate(states):
+            axis = axes[row, column]
+            for model in models:
+                _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
+                                  styles[model.name], short_label(model))
+            axis.set_title(f"{labels[state]}\non {soil}", fontsize=9)
+    _finish_fragility_axes(axes, fragility, levels)
+    outside_legend(figure, list(axes.flat))
+    return figure
+
+
+def outcomes_page(fragility, block, caption):
+    """One panel per model: P(uplift) solid and P(overturning) dashed per soil; the gap is rocking."""
+    models = models_of(fragility)
+    rows, columns = _grid(len(models))
+    figure = new_page(f"Outcomes by intensity: block '{block}'", caption)
+    axes = panels(figure, rows, columns, sharex=True, sharey=True)
+    for axis in axes.flat[len(models):]:
+        axis.set_visible(False)
+    levels = block_levels(fragility, block)
+    probability = fragility.outcome_probability
+    for axis, model in zip(axes.flat, models):
+        soils = [None] if model.rigid_base else list(map(str, fragility.soil.values))
+        for index, soil in enumerate(soils):
+            picked = cell(probability.to_dataset(name="p"), model, block, soil)["p"]
+            colour = "black" if soil is None else soil_colour(soil, index)
+            uplift = 1 - picked.sel(outcome_class="no_uplift").values
+            overturn = picked.sel(outcome_class="overturned").values
+            axis.plot(levels, uplift, color=colour, ls="-", lw=1.5,
+                      label="any soil (rigid base)" if soil is None else soil)
+            axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
+            if soil is None or len(soils) == 1:
+                axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
+        log_axis(axis)
+        axis.set_xlim(levels[0], levels[-1])
+        axis.set_ylim(-0.02, 1.02)
+        axis.set_title(short_label(model), fontsize=10)
+        axis.grid(alpha=0.3, which="both")
+    axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): rocking or overturning")
+    axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
+    axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
+    for axis in axes[:, 0]:
+        axis.set_ylabel("probability [-]")
+    for axis in axes[-1]:
+        axis.set_xlabel(measure_label(fragility))
+    for axis in axes.flat:
+        if axis.get_visible():
+            axis.tick_params(labelbottom=True)
+    outside_legend(figure, list(axes.flat))
+    return figure
+
+
+def applicability_page(cube, caption, limit=0.10):
+    """Median peak angle of each foundation model over the rigid-base reference against G_s, per block;
+    soils named on the top axis."""
+    models = models_of(cube)
+    reference = next(m for m in models if m.rigid_base)
+    founded = [m for m in models if not m.rigid_base]
+    styles = model_styles(models)
+    figure = new_page(f"Applicability of the rigid base: each foundation model over {reference.name}", caption)
+    axis = panels(figure, gridspec_kw=dict(top=0.85))[0, 0]
+    shear = cube.soil_shear_modulus.values / 1e6
+    order = np.argsort(shear)
+    markers = "os^Dv"
+    for b_index, block in enumerate(cube.block.values):
+        uplift = uplift_intensity(cube, block)
+        levels = block_levels(cube, block)
+        band = (levels >= 1.2 * uplift) & (levels <= 3.0 * uplift)
+        if not band.any():
+            continue
+        sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band))
+        rigid_angle = sub.peak_angle.sel(model=reference.name)
+        for model in founded:
+            survived = (sub.outcome.sel(model=[reference.name, model.name]) == OUTCOME_ROCKING).all("model")
+            ratio = (sub.peak_angle.sel(model=model.name).where(survived).median(["record", "im_level"]) /
+                     rigid_angle.where(survived).median(["record", "im_level"])).values
+            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], color=f"C{b_index % 10}",
+                      ls=styles[model.name]["ls"], lw=1.4, label=f"{block}, {model.name}")
+    axis.axhspan(1 - limit, 1 + limit, color="0.88", label=f"within ±{limit:.0%} of the rigid base", zorder=0)
+    axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, label="paper's limit: G_s = 300-1000 MPa", zorder=0)
+    axis.axhline(1.0, color="k", lw=0.8)
+    log_axis(axis)
+    axis.set_xlabel("soil shear modulus G_s [MPa]")
+    axis.set_ylabel(f"median θmax (model) / median θmax ({reference.name}) [-]")
+    axis.grid(alpha=0.3, which="both")
+    top = axis.secondary_xaxis("top")
+    top.set_xticks(shear, [str(s) for s in cube.soil.values], fontsize=8)
+    top.minorticks_off()
+    outside_legend(figure, [axis])
+    return figure
+
+
+def sweep_page(dataset, caption):
+    """The fine G_s sweep of `rockfrag applicability`, one panel per block."""
+    tolerance = float(dataset.attrs.get("tolerance", 0.1))
+    blocks = list(dataset.block.values)
+    rows, columns = _grid(len(blocks))
+    figure = new_page(f"Rigid-base error against soil stiffness (grey: ±{tolerance:.0%}; green: paper's "
+                      "300-1000 MPa)", caption)
+    axes = panels(figure, rows, columns, sharey=True, gridspec_kw=dict(hspace=0.4))
+    for axis in axes.flat[len(blocks):]:
+        axis.set_visible(False)
+    shear = dataset.shear_modulus.values / 1e6
+    dash = ["-", "--", ":", "-."]
+    for axis, block in zip(axes.flat, blocks):
+        for e_index, modulus in enumerate(dataset.block_modulus.values):
+            for l_index, level in enumerate(dataset.level.values):
+                ratio = dataset.peak_angle_ratio_ssi_housner.sel(block=block).values[e_index, l_index]
+                axis.plot(shear, ratio, color=f"C{l_index}", ls=dash[e_index % 4], marker=".",
+                              label=f"E_b = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
+        axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
+        axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
+        axis.axhline(1.0, color="k", lw=0.7)
+        axis.set_title(str(block), fontsize=10)
+        log_axis(axis)
+        axis.set_xlabel("soil shear modulus G_s [MPa]")
+        axis.grid(alpha=0.3, which="both")
+    for axis in axes[:, 0]:
+        axis.set_ylabel("median θmax SSI / Housner [-]")
+    outside_legend(figure, [axes.flat[0]])
+    return figure

@@ -1,0 +1,177 @@
+"""pipeline.report.text - text pages (contents, methods, limitations, tables) laid out on the page size.
+
+Input : a list of ``Item`` (heading, paragraph, bullet, table, note). Output: the items split over as
+many pages as they need (``paginate``, pure: the page count is known before anything is drawn), each
+page drawn as a figure (``draw_text_page``) and written as HTML (``items_html``).
+"""
+
+from __future__ import annotations
+
+import html
+import textwrap
+from dataclasses import dataclass, field
+
+from pipeline.report.layout import new_page
+
+TOP, BOTTOM = 0.925, 0.085  # figure fractions available to text
+LINE = 0.021  # one line of 9.5 pt text on the A4-landscape page [figure fraction]
+WRAP = 150  # characters per line of 9.5 pt text across the page
+CHAR = 0.0062  # width of one 8.5 pt table character [figure fraction], for column positions
+LEFT = 0.02
+
+
+@dataclass
+class Item:
+    """kind: heading | paragraph | bullet | table | note; text, or header + rows for a table."""
+
+    kind: str
+    text: str = ""
+    header: list = field(default_factory=list)
+    rows: list = field(default_factory=list)
+
+
+def heading(text):
+    return Item("heading", text)
+
+
+def paragraph(text):
+    return Item("paragraph", text)
+
+
+def bullet(text):
+    return Item("bullet", text)
+
+
+def note(text):
+    return Item("note", text)
+
+
+def table(header, rows):
+    return Item("table", header=[str(h) for h in header], rows=[[str(c) for c in row] for row in rows])
+
+
+def _lines(item) -> int:
+    if item.kind == "heading":
+        return 2
+    if item.kind == "table":
+        return len(item.rows) + 2
+    width = WRAP - (4 if item.kind == "bullet" else 0)
+    return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind == "paragraph" else 0)
+
+
+def paginate(items, capacity=None) -> list[list[Item]]:
+    """Split items into pages; a table longer than a page is split with its header repeated;
+    a heading never ends a page."""
+    capacity = capacity or int((TOP - BOTTOM) / LINE)
+    pages, current, used = [], [], 0
+    queue = list(items)
+    while queue:
+        item = queue.pop(0)
+        need = _lines(item)
+        if item.kind == "table" and need > capacity - used:
+            room = capacity - used - 2
+            if room < 3 and current:
+                pages.append(current)
+                current, used = [], 0
+                queue.insert(0, item)
+                continue
+            room = max(room, 3)
+            head = Item("table", header=item.header, rows=item.rows[:room])
+            tail = Item("table", header=item.header, rows=item.rows[room:])
+            current.append(head)
+            pages.append(current)
+            current, used = [], 0
+            if tail.rows:
+                queue.insert(0, tail)
+            continue
+        if used + need > capacity and current:
+            if current[-1].kind == "heading":  # keep a heading with what follows it
+                pages.append(current[:-1])
+                current, used = [current[-1]], _lines(current[-1])
+            else:
+                pages.append(current)
+                current, used = [], 0
+        current.append(item)
+        used += need
+    if current or not pages:
+        pages.append(current)
+    return pages
+
+
+def _column_positions(item) -> list[float]:
+    widths = [max(len(item.header[c]), *(len(row[c]) for row in item.rows)) if item.rows else len(item.header[c])
+              for c in range(len(item.header))]
+    positions, x = [], LEFT + 0.01
+    for width in widths:
+        positions.append(x)
+        x += (width + 2) * CHAR
+    return positions
+
+
+def draw_text_page(title, items, caption="", top=TOP, figure=None):
+    """One page figure with the items drawn top-down from ``top``."""
+    figure = figure or new_page(title, caption)
+    y = top
+    for item in items:
+        if item.kind == "heading":
+            y -= 0.4 * LINE
+            figure.text(LEFT, y, item.text, fontsize=11, weight="bold", va="top")
+            y -= 1.6 * LINE
+        elif item.kind == "table":
+            positions = _column_positions(item)
+            for x, text in zip(positions, item.header):
+                figure.text(x, y, text, fontsize=8.5, weight="bold", va="top")
+            y -= LINE
+            figure.add_artist(_rule(y + 0.25 * LINE, positions[-1] + (len(item.header[-1]) + 12) * CHAR))
+            for row in item.rows:
+                for x, text in zip(positions, row):
+                    figure.text(x, y, text, fontsize=8.5, va="top")
+                y -= LINE
+            y -= LINE
+        else:
+            indent = 0.02 if item.kind == "bullet" else 0.0
+            width = WRAP - (4 if item.kind == "bullet" else 0)
+            lines = textwrap.wrap(item.text, width) or [""]
+            for number, line in enumerate(lines):
+                if item.kind == "bullet" and number == 0:
+                    figure.text(LEFT + 0.006, y, "•", fontsize=9.5, va="top")
+                figure.text(LEFT + indent, y, line, fontsize=9.5 if item.kind != "note" else 8.5, va="top",
+                            style="italic" if item.kind == "note" else "normal")
+                y -= LINE
+            if item.kind == "paragraph":
+                y -= LINE
+    return figure
+
+
+def _rule(y, right):
+    import matplotlib.lines
+
+    return matplotlib.lines.Line2D([LEFT, min(right, 0.985)], [y, y], color="0.5", lw=0.6)
+
+
+def items_html(items) -> str:
+    """The same items as HTML (headings h3, paragraphs, bullet lists, tables)."""
+    parts, in_list = [], False
+    for item in items:
+        if item.kind == "bullet" and not in_list:
+            parts.append("<ul>")
+            in_list = True
+        elif item.kind != "bullet" and in_list:
+            parts.append("</ul>")
+            in_list = False
+        if item.kind == "heading":
+            parts.append(f"<h3>{html.escape(item.text)}</h3>")
+        elif item.kind == "bullet":
+            parts.append(f"<li>{html.escape(item.text)}</li>")
+        elif item.kind == "note":
+            parts.append(f"<p class='note'>{html.escape(item.text)}</p>")
+        elif item.kind == "table":
+            head = "".join(f"<th>{html.escape(h)}</th>" for h in item.header)
+            body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
+                           for row in item.rows)
+            parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+        else:
+            parts.append(f"<p>{html.escape(item.text)}</p>")
+    if in_list:
+        parts.append("</ul>")
+    return "\n".join(parts)

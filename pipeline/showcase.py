@@ -1,0 +1,250 @@
+"""pipeline.showcase - study-time data the report draws besides the cube: the record set's measures
+and spectra, and the response histories of one showcase record.
+
+Input : the study configuration and its processed records (``study.study_records``).
+Output: ``reports/showcase.nc`` holding
+        * per record (dim ``record``; ``period`` for spectra): PGA [m/s^2], PGV [m/s], Arias
+          intensity [m/s], D5-95 [s], Sa(1 s) [m/s^2] and the 5%-damped spectrum of each processed record;
+        * for the showcase record (dim ``time_ground``): raw and processed acceleration [m/s^2],
+          velocity [m/s] and displacement [m];
+        * for every model and soil of the showcase block (dims ``case``, ``time``): the rocking angle
+          theta(t) [rad] and the vertical displacement of the foundation y - y_static [m]; a rigid-base
+          model is one case (soil "").
+        The showcase record is ``[report] showcase_record`` or, when the study contains it, Duezce 1999
+        Bolu 090 (the paper's record); the block is ``[report] showcase_block`` or the study's first block.
+        The report only reads this file; it never runs a solver. Reused when its inputs are unchanged.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from pipeline import __version__
+from pipeline.errors import ConfigError, PipelineError
+from pipeline.measures import intensity_measures, response_spectrum
+from pipeline.models import get_model, simulate
+from pipeline.outputs import atomic_path
+from pipeline.processing import integrate, process_record
+from pipeline.soils import soil_block_stiffness
+
+PAPER_RECORD = "DUZCE/BOL090"
+SPECTRUM_PERIODS = np.geomspace(0.02, 10.0, 60)
+FILE_NAME = "showcase.nc"
+
+
+def report_settings(config) -> dict:
+    """The study's ``[report]`` table (title, project, author, showcase_record, showcase_block, ...)."""
+    settings = config.raw.get("report", {})
+    return settings if isinstance(settings, dict) else {}
+
+
+def is_rigid_base(model) -> bool:
+    """True when the model's result does not depend on the soil (e.g. Housner)."""
+    return bool(getattr(model, "is_rigid_base", not model.needs_foundation))
+
+
+def showcase_record_id(config, record_ids) -> str | None:
+    """The record the showcase pages draw, or None (no showcase pages)."""
+    named = str(report_settings(config).get("showcase_record", "") or "")
+    if named:
+        return named
+    return PAPER_RECORD if PAPER_RECORD in record_ids else None
+
+
+def showcase_block(config):
+    """The block of the showcase pages: ``[report] showcase_block`` or the study's first block."""
+    name = str(report_settings(config).get("showcase_block", "") or "")
+    if not name:
+        return config.blocks[0]
+    for block in config.blocks:
+        if block.name == name:
+            return block
+    raise ConfigError("report.showcase_block", f"unknown block {name!r}; blocks of the study: "
+                      f"{', '.join(b.name for b in config.blocks)}", config.source)
+
+
+def strong_motion_window(acceleration, dt, start=0.05, end=0.95) -> tuple[float, float]:
+    """Times [s] at which the Arias intensity reaches ``start`` and ``end`` of its final value."""
+    cumulative = np.cumsum(np.asarray(acceleration, dtype=float) ** 2)
+    if cumulative[-1] <= 0:
+        return 0.0, (cumulative.size - 1) * dt
+    fraction = cumulative / cumulative[-1]
+    return float(np.searchsorted(fraction, start) * dt), float(np.searchsorted(fraction, end) * dt)
+
+
+def record_set_variables(records) -> dict:
+    """Measures and 5%-damped spectra of the processed records (dims record, period)."""
+    measures = [intensity_measures(r.acceleration, r.dt, sa_periods=(1.0,)) for r in records]
+    spectra = np.array([response_spectrum(r.acceleration, r.dt, SPECTRUM_PERIODS)["sa"] for r in records])
+
+    def column(key):
+        return ("record", np.array([m[key] for m in measures]))
+
+    return {
+        "record_pga": (*column("pga_m_s2"), {"long_name": "PGA of the processed record", "units": "m/s^2"}),
+        "record_pgv": (*column("pgv_m_s"), {"long_name": "PGV of the processed record", "units": "m/s"}),
+        "record_arias": (*column("arias_m_s"), {"long_name": "Arias intensity of the processed record",
+                                                "units": "m/s"}),
+        "record_d5_95": (*column("d5_95_s"), {"long_name": "significant duration D5-95", "units": "s"}),
+        "record_sa_1s": (*column("sa_1s_m_s2"), {"long_name": "Sa(1 s, 5%) of the processed record",
+                                                 "units": "m/s^2"}),
+        "record_spectrum": (("record", "period"), spectra,
+                            {"long_name": "5%-damped spectral acceleration of the processed record",
+                             "units": "m/s^2"}),
+    }
+
+
+def _padded(series, n):
+    out = np.full(n, np.nan)
+    out[:series.size] = series
+    return out
+
+
+def ground_motion_variables(raw, processed) -> dict:
+    """Raw and processed acceleration, velocity and displacement on one time axis (dim time_ground)."""
+    n = max(raw.acceleration.size, processed.acceleration.size)
+    variables = {}
+    for stage, record in (("raw", raw), ("processed", processed)):
+        velocity, displacement = integrate(record.acceleration, record.dt)
+        for quantity, series, units in (("acceleration", record.acceleration, "m/s^2"),
+                                        ("velocity", velocity, "m/s"), ("displacement", displacement, "m")):
+            variables[f"ground_{quantity}_{stage}"] = (
+                "time_ground", _padded(np.asarray(series, dtype=float), n),
+                {"long_name": f"ground {quantity} of the showcase record, {stage}", "units": units})
+    return variables, np.arange(n) * processed.dt
+
+
+def response_cases(config, block):
+    """(model name, soil or None) for every case of the showcase: rigid-base models once."""
+    cases = []
+    for name in config.models:
+        if is_rigid_base(get_model(name)):
+            cases.append((name, None))
+        else:
+            cases.extend((name, soil) for soil in config.soils)
+    return cases
+
+
+def simulate_cases(config, block, record):
+    """theta(t), y(t) - y_static and the minimum support force of every showcase case."""
+    t_end = record.duration + config.tail
+    thetas, settlements, support = [], [], []
+    time = None
+    for name, soil in response_cases(config, block):
+        options = {}
+        if soil is not None:
+            options = dict(k=soil_block_stiffness(soil, block), xi=soil.damping_ratio)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # tension is recorded below, not warned about
+            result = simulate(name, record.acceleration, record.dt, block, switch=config.switch, t_end=t_end,
+                              overturn_angle=config.overturn_angle, **options)
+        time = result.t if time is None or result.t.size > time.size else time
+        thetas.append(result.theta)
+        if soil is None:
+            settlements.append(np.full(result.t.size, np.nan))
+            support.append(np.nan)
+        else:
+            settlements.append(result.y - result.y[0])
+            support.append(result.min_support_force)
+    n = time.size
+    return time, np.array([_padded(t, n) for t in thetas]), np.array([_padded(s, n) for s in settlements]), \
+        np.array(support, dtype=float)
+
+
+def showcase_dataset(config, records, recipe, load=None) -> xr.Dataset:
+    """Everything ``showcase.nc`` holds (see the module docstring); ``load`` reads a record by id."""
+    ids = [r.id for r in records]
+    data_vars = record_set_variables(records)
+    coords = {"record": ("record", ids, {"long_name": "record id"}),
+              "period": ("period", SPECTRUM_PERIODS, {"long_name": "oscillator period", "units": "s"})}
+    attrs = {"title": f"rockfrag study '{config.name}': showcase histories and record-set measures",
+             "source": f"rockfrag {__version__}", "config_hash": config.config_hash, "showcase_record": ""}
+    record_id = showcase_record_id(config, ids)
+    if record_id is not None:
+        from pipeline.records import load_records
+
+        raw_records, failures = (load or load_records)(record_id)
+        if failures or len(raw_records) != 1:
+            raise ConfigError("report.showcase_record", f"{record_id!r} must name exactly one readable record "
+                              f"({failures[0] if failures else f'{len(raw_records)} records found'})",
+                              config.source)
+        raw = raw_records[0]
+        processed = process_record(raw, recipe)
+        block = showcase_block(config)
+        ground, ground_time = ground_motion_variables(raw, processed)
+        time, theta, settlement, support = simulate_cases(config, block, processed)
+        cases = response_cases(config, block)
+        start, end = strong_motion_window(processed.acceleration, processed.dt)
+        data_vars.update(ground)
+        data_vars.update({
+            "theta": (("case", "time"), theta, {"long_name": "rocking angle theta (NaN after overturning)",
+                                                "units": "rad"}),
+            "settlement": (("case", "time"), settlement, {
+                "long_name": "vertical displacement of the foundation from its static position, y - y_static",
+                "units": "m"}),
+            "min_support_force": ("case", support, {"long_name": "minimum vertical foundation force "
+                                                               "(negative: the foundation pulled)", "units": "N"}),
+            "interface_stiffness": ("case", [np.nan if soil is None else soil_block_stiffness(soil, block)
+                                             for _, soil in cases],
+                                    {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"}),
+        })
+        coords.update({
+            "time_ground": ("time_ground", ground_time, {"long_name": "time", "units": "s"}),
+            "time": ("time", time, {"long_name": "time", "units": "s"}),
+            "case_model": ("case", [name for name, _ in cases], {"long_name": "rocking model"}),
+            "case_soil": ("case", ["" if soil is None else soil.name for _, soil in cases],
+                          {"long_name": "soil class (empty: rigid base)"}),
+        })
+        attrs.update({
+            "showcase_record": raw.id, "showcase_event": str(raw.metadata.get("event", "")),
+            "showcase_station": str(raw.metadata.get("station", "")),
+            "showcase_component": str(raw.metadata.get("component", "")),
+            "showcase_block": block.name, "block_R_m": block.R, "block_alpha_rad": block.alpha,
+            "strong_motion_start_s": start, "strong_motion_end_s": end,
+            "strong_motion_definition": "5% to 95% of the Arias intensity of the processed record",
+        })
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def input_hash(config, records, recipe) -> str:
+    """Hash of everything ``showcase.nc`` depends on."""
+    settings = report_settings(config)
+    payload = {"version": __version__, "recipe": recipe.as_dict(), "models": list(config.models),
+               "records": [r.metadata.get("sha256", r.id) for r in records],
+               "soils": [repr(s) for s in config.soils], "blocks": [repr(b) for b in config.blocks],
+               "showcase": [settings.get("showcase_record", ""), settings.get("showcase_block", "")],
+               "solver": [config.switch, config.tail, config.overturn_angle]}
+    return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def showcase_stage(config, output, loaded=None, log=print) -> xr.Dataset:
+    """Write ``showcase.nc`` (or reuse it when its inputs are unchanged); returns the dataset.
+
+    ``loaded`` may pass ``study.study_records(config)`` to avoid reading the records again.
+    """
+    from pipeline.study import study_records
+
+    path = Path(output) / FILE_NAME
+    records, _, recipe = loaded or study_records(config, log)
+    if not records:
+        raise PipelineError("no record to describe in showcase.nc")
+    key = input_hash(config, records, recipe)
+    if path.is_file():
+        with xr.open_dataset(path) as cached:
+            if cached.attrs.get("input_hash") == key:
+                log(f"reused {path} (inputs unchanged)")
+                return cached.load()
+    dataset = showcase_dataset(config, records, recipe)
+    dataset.attrs["input_hash"] = key
+    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
+                if var.dtype.kind == "f"}
+    with atomic_path(path) as temporary:
+        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    log(f"wrote {path}")
+    return dataset
