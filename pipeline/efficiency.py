@@ -198,14 +198,12 @@ def efficiency_table(dataset: xr.Dataset) -> pd.DataFrame:
 def plot_efficiency(dataset: xr.Dataset, figsize=(8.27, 11.69)):
     """One page: dispersion of each measure per block (bars, median over soils and models, whiskers
     their range), sufficiency p-values against magnitude and distance, and the pooled dispersion."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # not pyplot: the caller owns the figure, no global state
 
     measures = list(dataset.measure.values)
     blocks = list(dataset.block.values)
-    figure, axes = plt.subplots(3, 1, figsize=figsize, constrained_layout=True)
+    figure = Figure(figsize=figsize, layout="constrained")
+    axes = figure.subplots(3, 1)
     width = 0.8 / max(len(blocks), 1)
     x = np.arange(len(measures))
     for b, block in enumerate(blocks):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import xarray as xr
+import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 from pipeline.efficiency import (capacities_in_measures, efficiency_from_capacities, efficiency_table,
@@ -98,5 +99,5 @@ def test_outputs_and_a4_figure(tmp_path):
     assert reread.dispersion.attrs["units"] == "1" and "long_name" in reread.p_distance.attrs
     assert csv.read_text().splitlines()[0].startswith("soil,block,model,measure")
     figure = plot_efficiency(dataset)
-    assert isinstance(figure, Figure)
+    assert isinstance(figure, Figure) and plt.get_fignums() == []  # no pyplot state left behind
     np.testing.assert_allclose(figure.get_size_inches(), [8.27, 11.69])
