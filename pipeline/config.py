@@ -35,12 +35,12 @@ from pipeline.errors import ConfigError, PipelineError
 from pipeline.measures import MEASURES
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
-from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number, shown as _shown
 
-MEASURE_UNITS = {"pga": ("g", STANDARD_GRAVITY), "sa": ("g", STANDARD_GRAVITY), "pgv": ("m/s", 1.0)}
-SCALING_MEASURES = tuple(name for name in MEASURES if name in MEASURE_UNITS)
-"""Measures a study can scale to: computed by pipeline.measures and with a display unit here."""
+MEASURE_UNITS = {name: (m.display_unit, m.display_factor) for name, m in MEASURES.items() if m.scalable}
+"""Measures a study can scale records to (pipeline.measures registry): name -> (display unit, SI value
+of one display unit)."""
+SCALING_MEASURES = tuple(MEASURE_UNITS)
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
 uplift intensity."""
@@ -168,7 +168,7 @@ SOIL_TABLE = Table({**SOIL_RANGES, "why": TEXT})
 # Types only: the ranges of a block are Block's own (pipeline/blocks.py), reported with the user's field.
 BLOCK_TABLE = Table({key: Number() for key in ("b", "h", "R", "alpha", "mass", "E_b", "footprint_area",
                                                 "soil_depth")} | {"why": TEXT})
-LEVEL_TABLE_KEYS = ("start", "stop", "count", "spacing", "relative_to")
+LEVEL_TABLE_KEYS = ("start", "stop", "count", "spacing", "values", "relative_to")
 
 
 def _damage_state_table() -> Table:
@@ -191,7 +191,9 @@ SCHEMA = Table({
                     # report metadata, read by pipeline.report
                     "title": TEXT, "project": TEXT, "author": TEXT}),
     "intensity": Table({"measure": Text(SCALING_MEASURES), "period": Number(0.01, 20.0, unit="s"),
-                        "damping": Number(0.0, 0.5), "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True))}),
+                        "damping": Number(0.0, 0.5), "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True)),
+                        "capacity_resolution": Number(0.0, 0.5),
+                        "period_range": Numbers(Number(0.01, 20.0, unit="s"))}),
     "solver": Table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
                      "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
                      "bed": Text(tuple(BED_TYPES))}),
@@ -269,7 +271,9 @@ class StudyConfig:
     source: str
     raw: dict
     bed: str = "continuous"
-    levels_relative_to: str = ""
+    levels_relative_to: str = ""  # "" (absolute levels) or "uplift" (multiples of each block's uplift intensity)
+    capacity_resolution: float = 0.02  # relative bracket of the adaptive overturning capacities; 0 = off
+    period_range: tuple[float, float] | None = None  # AvgSa periods [s]; None = 0.2 T .. 3 T
     record_units: str = ""
     record_dt: float | None = None  # time step of one-column text records [s]; None: from the files
     applicability: ApplicabilitySettings = ApplicabilitySettings()
@@ -279,8 +283,20 @@ class StudyConfig:
         return MEASURE_UNITS[self.measure][0]
 
     @property
+    def relative_levels(self) -> bool:
+        return self.levels_relative_to == "uplift"
+
+    @property
+    def measure_options(self) -> dict:
+        """Options every ``pipeline.measures.Measure`` call of the study takes."""
+        return {"period": self.period, "damping": self.damping, "period_range": self.period_range}
+
+    @property
     def levels_si(self) -> np.ndarray:
-        """Intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV)."""
+        """Absolute intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV); with relative levels
+        the dimensionless multiples themselves (per-block intensities: pipeline.study.level_intensities)."""
+        if self.relative_levels:
+            return np.asarray(self.levels, dtype=float)
         return np.asarray(self.levels) * MEASURE_UNITS[self.measure][1]
 
     def as_json(self) -> str:
@@ -339,17 +355,20 @@ def _levels(spec, source, check_only=False):
         for key in spec:
             if key not in LEVEL_TABLE_KEYS:
                 raise ConfigError(f"{where}.{key}", _unknown_key(key, LEVEL_TABLE_KEYS), source)
-        for key in ("start", "stop"):
-            if key not in spec:
-                raise ConfigError(f"{where}.{key}", f"missing; must be {level.describe()}", source)
-        start = level.check(spec["start"], f"{where}.start", source)
-        stop = level.check(spec["stop"], f"{where}.stop", source)
-        count = Number(1, 1000, integer=True).check(spec.get("count", 40), f"{where}.count", source)
-        if stop <= start:
-            raise ConfigError(where, f"stop {stop:g} must exceed start {start:g}", source)
-        spacing = Text(("log", "linear")).check(spec.get("spacing", "log"), f"{where}.spacing", source)
         relative_to = Text(LEVEL_REFERENCES).check(spec.get("relative_to", ""), f"{where}.relative_to", source)
-        values = (np.geomspace if spacing == "log" else np.linspace)(start, stop, count).tolist()
+        if "values" in spec:  # { values = [...], relative_to = "uplift" }: listed multiples or levels
+            values = Numbers(level).check(spec["values"], f"{where}.values", source)
+        else:
+            for key in ("start", "stop"):
+                if key not in spec:
+                    raise ConfigError(f"{where}.{key}", f"missing; must be {level.describe()}", source)
+            start = level.check(spec["start"], f"{where}.start", source)
+            stop = level.check(spec["stop"], f"{where}.stop", source)
+            count = Number(1, 1000, integer=True).check(spec.get("count", 40), f"{where}.count", source)
+            if stop <= start:
+                raise ConfigError(where, f"stop {stop:g} must exceed start {start:g}", source)
+            spacing = Text(("log", "linear")).check(spec.get("spacing", "log"), f"{where}.spacing", source)
+            values = (np.geomspace if spacing == "log" else np.linspace)(start, stop, count).tolist()
     else:
         raise ConfigError(where, f"{_shown(spec)}; must be a list of levels or "
                           "{ start, stop, count, spacing }", source)
@@ -422,6 +441,15 @@ def _check_hazard(path, source, measure="pga", period=None):
                           f"({reason})", source) from None
 
 
+def _period_range(value, source) -> tuple[float, float] | None:
+    """``[intensity] period_range`` (AvgSa periods, s): [low, high] with low < high, or None."""
+    if value is None:
+        return None
+    if len(value) != 2 or not value[0] < value[1]:
+        raise ConfigError("intensity.period_range", f"{value!r}; must be [low, high] in s with low < high", source)
+    return float(value[0]), float(value[1])
+
+
 def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     """Validate a complete study dict (defaults already merged) and build the ``StudyConfig``."""
     validate(data, source)
@@ -450,6 +478,8 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         processing=study.get("processing", ""), output=Path(study.get("output", "reports")),
         measure=measure, period=float(intensity.get("period", 1.0)), damping=float(intensity.get("damping", 0.05)),
         levels=levels, levels_relative_to=relative_to,
+        capacity_resolution=float(intensity.get("capacity_resolution", 0.02)),
+        period_range=_period_range(intensity.get("period_range"), source),
         soils=soils, blocks=blocks, models=models,
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),

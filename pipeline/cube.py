@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from pipeline import __version__
+from pipeline.measures import MEASURES
 from pipeline.models import get_model
 from pipeline.models.base import Outcome
 from pipeline.outputs import atomic_path
@@ -95,19 +96,39 @@ DERIVED_ATTRIBUTES = {
 }
 
 
-def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance) -> xr.Dataset:
+def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
+               intensity=None, capacities=None, capacity_stats=None) -> xr.Dataset:
     """Assemble the labelled cube.
 
-    records : list of Record (metadata); record_im : (n_record,) IM of each processed record [SI];
-    scale_factors : (n_record, n_level); summaries : (n_record, n_level, n_soil, n_block, n_model, N_SUMMARY);
-    stiffness : (n_soil, n_block) interface stiffness [N/m]; provenance : dict of JSON-able facts.
+    records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
+    processed record [SI]; scale_factors : (n_record, n_level, n_block) (or (n_record, n_level));
+    summaries : summary records (n_record, n_level, n_soil, n_block, n_model); stiffness : (n_soil, n_block)
+    interface stiffness [N/m]; provenance : dict of JSON-able facts; intensity : (n_block, n_level)
+    physical intensity of every level [SI] (default: the absolute levels); capacities : (4, n_record,
+    n_soil, n_block, n_model) adaptive overturning capacity, bracket and extra runs as scale factors
+    (pipeline.study.gather_capacities) or None; capacity_stats : its run accounting.
+
+    Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
+    with ``levels.relative_to = "uplift"``, else the levels in the measure's unit. The physical
+    intensity is always the (block, im_level) coordinate ``intensity`` [display unit] with
+    ``intensity_si``; read those, not ``im_level``, for intensities.
     """
     model_names = list(config.models)
+    n_block = len(config.blocks)
     values = summaries_to_variables(summaries, config.blocks, model_names)
+    measure = MEASURES[config.measure]
     unit = config.level_unit
-    im_si_unit = "m/s" if config.measure == "pgv" else "m/s^2"
-    measure_name = {"pga": "peak ground acceleration", "pgv": "peak ground velocity",
-                    "sa": f"spectral acceleration Sa({config.period:g} s, {config.damping:.0%})"}[config.measure]
+    im_si_unit = measure.si_unit
+    measure_name = measure.describe(**config.measure_options)
+    record_im = np.asarray(record_im, float)
+    if record_im.ndim == 1:
+        record_im = np.repeat(record_im[:, None], n_block, axis=1)
+    scale_factors = np.asarray(scale_factors, float)
+    if scale_factors.ndim == 2:
+        scale_factors = np.repeat(scale_factors[:, :, None], n_block, axis=2)
+    if intensity is None:
+        intensity = np.broadcast_to(config.levels_si, (n_block, len(config.levels)))
+    intensity = np.asarray(intensity, float)
     data_vars = {}
     for name, array in values.items():
         if name in DERIVED_ATTRIBUTES:
@@ -115,16 +136,22 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         else:
             _, units, long_name, _ = VARIABLES[name]
             data_vars[name] = (DIMS, array, {"long_name": long_name, "units": units})
-    data_vars["scale_factor"] = (("record", "im_level"), scale_factors,
+    data_vars["scale_factor"] = (("record", "im_level", "block"), scale_factors,
                                  {"long_name": "factor applied to the processed record", "units": "1"})
+    if capacities is not None:
+        capacity_dims = ("record", "soil", "block", "model")
+        for index, (name, long_name) in enumerate((
+                ("capacity_scale_factor", "overturning capacity as a scale factor: midpoint of the adaptive "
+                                          "bracket (NaN: no overturning found)"),
+                ("capacity_scale_lower", "largest scale factor found to survive below the capacity"),
+                ("capacity_scale_upper", "smallest scale factor found to overturn"),
+                ("capacity_runs", "solver runs added to the stripes to refine the capacity"))):
+            data_vars[name] = (capacity_dims, capacities[index], {"long_name": long_name, "units": "1"})
     data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
                                         {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
     coords = {
         "record": ("record", [r.id for r in records], {"long_name": "record id (records/MANIFEST.csv)"}),
-        "im_level": ("im_level", np.asarray(config.levels),
-                     {"long_name": f"intensity level: {measure_name}", "units": unit}),
-        "im_level_si": ("im_level", config.levels_si, {"long_name": f"intensity level: {measure_name}",
-                                                       "units": im_si_unit}),
+        **_level_coordinates(config, measure_name, intensity),
         "soil": ("soil", [s.name for s in config.soils], {"long_name": "soil class"}),
         "block": ("block", [b.name for b in config.blocks], {"long_name": "block"}),
         "model": ("model", model_names, {"long_name": "rocking model"}),
@@ -135,8 +162,8 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                              {"long_name": "component"}),
         "record_pga": ("record", [float(np.max(np.abs(r.acceleration))) for r in records],
                        {"long_name": "PGA of the processed record", "units": "m/s^2"}),
-        "record_im": ("record", np.asarray(record_im), {"long_name": f"{measure_name} of the processed record",
-                                                        "units": im_si_unit}),
+        "record_im": (("record", "block"), record_im, {"long_name": f"{measure_name} of the processed record",
+                                                       "units": im_si_unit}),
         "soil_shear_modulus": ("soil", [s.shear_modulus for s in config.soils],
                                {"long_name": "soil shear modulus G_s", "units": "Pa"}),
         "soil_constrained_modulus": ("soil", [s.constrained_modulus for s in config.soils],
@@ -161,6 +188,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "source": f"rockfrag {__version__}",
         "rockfrag_version": __version__,
         "intensity_measure": config.measure,
+        "intensity_measure_long_name": measure_name,
+        "levels_relative_to": config.levels_relative_to,
+        **{key: value for key, value in (capacity_stats or {}).items()},
         "study_config": config.as_json(),
         "config_hash": config.config_hash,
         "record_checksums": json.dumps({r.id: r.metadata.get("sha256", "") for r in records}),
@@ -172,6 +202,29 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "winkler_bed": config.bed,
     }
     return dataset
+
+
+def _level_coordinates(config, measure_name, intensity) -> dict:
+    """``im_level`` (index: multiples of uplift or absolute levels) and the per-block intensities."""
+    measure = MEASURES[config.measure]
+    if config.relative_levels:
+        level = ("im_level", np.asarray(config.levels, float),
+                 {"long_name": f"intensity level: multiple of the block's uplift intensity ({measure_name})",
+                  "units": "1"})
+        uplift = intensity[:, 0] / float(config.levels[0])
+        extra = {"block_uplift_intensity": ("block", uplift / measure.display_factor, {
+            "long_name": f"{measure_name} at which the block starts to rock (pipeline.study.uplift_intensity)",
+            "units": config.level_unit})}
+    else:
+        level = ("im_level", np.asarray(config.levels, float),
+                 {"long_name": f"intensity level: {measure_name}", "units": config.level_unit})
+        extra = {"im_level_si": ("im_level", config.levels_si, {"long_name": f"intensity level: {measure_name}",
+                                                                 "units": measure.si_unit})}
+    return {"im_level": level, **extra,
+            "intensity": (("block", "im_level"), intensity / measure.display_factor,
+                          {"long_name": f"{measure_name} of the level for the block", "units": config.level_unit}),
+            "intensity_si": (("block", "im_level"), intensity,
+                             {"long_name": f"{measure_name} of the level for the block", "units": measure.si_unit})}
 
 
 def write_netcdf(dataset: xr.Dataset, path) -> None:

@@ -141,13 +141,12 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
 
 def uplift_is_rigid_threshold(model_name: str) -> bool:
     """Does the model's uplift happen exactly at g tan(alpha) under PGA scaling? Asks the model."""
-    from pipeline.models import get_model
+    from pipeline.models import MODELS
 
-    try:
-        model = get_model(model_name)
-    except Exception:  # a cube of a model this installation does not know: fall back on its name
+    model = MODELS.get(model_name)
+    if model is None:  # a cube of a model this installation does not know: fall back on its name
         return model_name in RIGID_UPLIFT_MODELS
-    return bool(getattr(model, "uplift_is_rigid_threshold", model_name in RIGID_UPLIFT_MODELS))
+    return model.uplift_is_rigid_threshold
 
 
 def uplift_threshold(cube: xr.Dataset, unit: str) -> np.ndarray | None:

@@ -10,7 +10,11 @@ Output: ``reports/ida.nc`` with, per soil, block and model:
         - ``im_fractile``: 16/50/84% fractiles of the intensity given response (from each record's
           first crossing of the response level);
         - ``first_overturn_im`` and ``last_resurrection_free_im``: per-record overturning capacity, as
-          the first overturning level and the level above which every level overturns.
+          the first overturning level and the level above which every level overturns;
+        - ``capacity``: per-record overturning capacity from the study's adaptive runs (the stripes
+          refined by bisection to the study's ``capacity_resolution``), with the runs it took and,
+          as attributes, the runs saved against uniform stripes of the same resolution.
+Intensities are per block: the cube's (block, im_level) coordinate ``intensity``.
 ``hunt_and_fill`` traces one record's overturning capacity adaptively (Vamvatsikos & Cornell 2004).
 """
 
@@ -21,8 +25,7 @@ import math
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import OUTCOME_OVERTURNED
-from pipeline.outputs import atomic_path
+from pipeline.cube import OUTCOME_OVERTURNED, write_netcdf
 
 FRACTILES = (0.16, 0.50, 0.84)
 RESPONSE_LEVELS = np.round(np.concatenate([np.linspace(0.05, 1.0, 20), np.linspace(1.5, 5.0, 8)]), 4)
@@ -76,16 +79,44 @@ def overturning_capacities(outcome, levels):
     return first, stable
 
 
+def block_intensities(cube: xr.Dataset) -> tuple[np.ndarray, str]:
+    """(n_block, n_level) intensity of every level for every block [display unit], and the unit.
+
+    Reads the (block, im_level) coordinate ``intensity`` (pipeline.cube); a cube without it (absolute
+    levels from an older layout) has the same levels ``im_level`` for every block.
+    """
+    if "intensity" in cube.coords or "intensity" in cube:
+        values = cube["intensity"].transpose("block", "im_level").values
+        return values, cube["intensity"].attrs.get("units", "")
+    levels = cube.im_level.values
+    return np.broadcast_to(levels, (cube.sizes["block"], levels.size)), cube.im_level.attrs.get("units", "")
+
+
+def adaptive_capacities(cube: xr.Dataset) -> xr.DataArray | None:
+    """Overturning capacity of every (record, soil, block, model) from the adaptive runs, in the
+    study's measure [display unit]: capacity scale factor x the record's measure. None without them."""
+    if "capacity_scale_factor" not in cube:
+        return None
+    factor = cube["intensity_si"].isel(im_level=0) / cube["intensity"].isel(im_level=0)
+    capacity = cube["capacity_scale_factor"] * cube["record_im"] / factor
+    unit = cube["intensity"].attrs.get("units", "")
+    capacity = capacity.transpose("record", "soil", "block", "model")
+    capacity.attrs = {"long_name": f"overturning capacity from adaptive runs, bracketed to "
+                                   f"{cube.attrs.get('capacity_resolution', float('nan')):.0%} "
+                                   "(NaN: no overturning found)", "units": unit}
+    return capacity
+
+
 def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
     """All IDA products of a cube (see the module docstring)."""
     edp = ida_edp(cube)
-    levels = cube.im_level.values
-    unit = cube.im_level.attrs.get("units", "")
+    intensities, unit = block_intensities(cube)
     edp_fractile = xr.DataArray(
         np.quantile(edp.values, FRACTILES, axis=0, method="inverted_cdf"),
         dims=("fractile", *edp.dims[1:]), coords={"fractile": list(FRACTILES), **{d: cube[d] for d in edp.dims[1:]}},
         attrs={"long_name": "fractile of theta_max/alpha given intensity (inf = overturned)", "units": "1"})
     stack_dims = ("soil", "block", "model")
+    block_axis = stack_dims.index("block")
     shape = tuple(cube.sizes[d] for d in stack_dims)
     first = np.full((cube.sizes["record"], *shape), np.nan)
     stable = np.full_like(first, np.nan)
@@ -93,6 +124,7 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
     edp_t = edp.transpose("record", "im_level", *stack_dims).values
     outcome_t = cube.outcome.transpose("record", "im_level", *stack_dims).values
     for index in np.ndindex(*shape):
+        levels = intensities[index[block_axis]]
         curves = edp_t[(slice(None), slice(None), *index)]
         first[(slice(None), *index)], stable[(slice(None), *index)] = overturning_capacities(
             outcome_t[(slice(None), slice(None), *index)], levels)
@@ -103,7 +135,10 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
             im_given_edp[(slice(None), j, *index)] = np.quantile(capacity, FRACTILES, method="inverted_cdf")
     im_given_edp[~np.isfinite(im_given_edp)] = np.nan
     coords = {d: cube[d] for d in ("record", "im_level", *stack_dims)}
-    dataset = xr.Dataset({
+    for name in ("intensity", "intensity_si"):
+        if name in cube.coords:
+            coords[name] = cube[name]
+    data_vars = {
         "edp": edp,
         "edp_fractile": edp_fractile,
         "im_fractile": (("fractile", "response_level", *stack_dims), im_given_edp,
@@ -117,21 +152,49 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
         "resurrected": (("record", *stack_dims), (stable > first).astype(np.int8),
                         {"long_name": "1 if the block survived a level above its first overturning level",
                          "units": "1"}),
-    }, coords={**coords, "fractile": list(FRACTILES),
-               "response_level": ("response_level", RESPONSE_LEVELS, {"long_name": "theta_max/alpha", "units": "1"})})
-    dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag IDA curves",
-                     "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", "")}
+    }
+    capacity = adaptive_capacities(cube)
+    attrs = {"Conventions": "CF-1.12", "title": "rockfrag IDA curves",
+             "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", "")}
+    if capacity is not None:
+        data_vars["capacity"] = capacity
+        data_vars["capacity_runs"] = cube["capacity_runs"]
+        for ida_key, cube_key in (("capacity_resolution", "capacity_resolution"),
+                                  ("capacity_refining_runs", "capacity_runs"),
+                                  ("capacity_stripe_runs", "grid_runs"),
+                                  ("capacity_uniform_stripe_runs", "uniform_runs"),
+                                  ("capacity_runs_saved_fraction", "runs_saved_fraction")):
+            if cube_key in cube.attrs:
+                attrs[ida_key] = cube.attrs[cube_key]
+    dataset = xr.Dataset(data_vars, coords={**coords, "fractile": list(FRACTILES),
+                         "response_level": ("response_level", RESPONSE_LEVELS,
+                                            {"long_name": "theta_max/alpha", "units": "1"})})
+    dataset.attrs = attrs
     return dataset
 
 
 def write_ida(dataset: xr.Dataset, path) -> None:
-    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
-                if var.dtype.kind == "f"}
-    with atomic_path(path) as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    """``ida.nc``: the one netCDF writer of the package (pipeline.cube.write_netcdf)."""
+    write_netcdf(dataset, path)
 
 
-def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_runs=200):
+def fill(overturns, lower, upper, tolerance=0.02, max_runs=200):
+    """Bisect a bracket (``lower`` survives, ``upper`` overturns) until (upper - lower) <= tolerance x upper.
+
+    Returns (lower, upper, runs).
+    """
+    runs = 0
+    while (upper - lower) > tolerance * upper and runs < max_runs:
+        middle = 0.5 * (lower + upper)
+        runs += 1
+        if overturns(middle):
+            upper = middle
+        else:
+            lower = middle
+    return lower, upper, runs
+
+
+def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_runs=200, lower=0.0):
     """Adaptive overturning capacity of one record (hunt up, then fill by bisection).
 
     Parameters
@@ -144,6 +207,8 @@ def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_ru
         First hunting increment and its growth factor per step (Vamvatsikos & Cornell).
     tolerance : float
         Relative width of the final bracket [-].
+    lower : float
+        An intensity known to survive (below ``start``).
 
     Returns
     -------
@@ -151,7 +216,7 @@ def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_ru
     intensity found by the hunt (NaN if none within ``max_runs``).
     """
     runs = 0
-    lower, im, increment = 0.0, start, step
+    im, increment = start, step
     while runs < max_runs:
         runs += 1
         if overturns(im):
@@ -162,14 +227,48 @@ def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_ru
         increment *= growth
     else:
         return math.nan, lower, math.nan, runs
-    while (upper - lower) > tolerance * upper and runs < max_runs:
-        middle = 0.5 * (lower + upper)
-        runs += 1
-        if overturns(middle):
-            upper = middle
-        else:
-            lower = middle
-    return 0.5 * (lower + upper), lower, upper, runs
+    lower, upper, fill_runs = fill(overturns, lower, upper, tolerance, max_runs - runs)
+    return 0.5 * (lower + upper), lower, upper, runs + fill_runs
+
+
+def capacity_from_stripes(scales, overturned, overturns, tolerance=0.02, max_runs=60):
+    """Overturning capacity of one record as a scale factor, refining the study's stripes.
+
+    The stripes already ran (``overturned[j]`` at ``scales[j]``, increasing) and are the hunt:
+    the first overturning stripe and the stripe below it bracket the first overturning intensity,
+    which ``fill`` then bisects to ``tolerance``. A record that survives every stripe is hunted on
+    upwards from the top stripe (``hunt_and_fill``); one that overturns at the lowest stripe is
+    bracketed downwards by halving. ``overturns(scale) -> bool`` runs the solver.
+
+    Returns (capacity, lower, upper, runs): capacity is the bracket midpoint (NaN if the record
+    never overturned within ``max_runs`` extra runs); runs counts the extra solver runs only.
+    """
+    scales = np.asarray(scales, float)
+    hits = np.flatnonzero(np.asarray(overturned, bool))
+    if hits.size == 0:
+        top = scales[-1]
+        step = top * (scales[-1] / scales[-2] - 1.0) if scales.size > 1 else 0.1 * top
+        return hunt_and_fill(overturns, top + step, step=step, growth=1.5, tolerance=tolerance,
+                             max_runs=max_runs, lower=top)
+    upper = scales[hits[0]]
+    runs = 0
+    if hits[0] > 0:
+        lower = scales[hits[0] - 1]
+    else:
+        lower = 0.5 * upper
+        while runs < max_runs:
+            runs += 1
+            if not overturns(lower):
+                break
+            upper, lower = lower, 0.5 * lower
+    lower, upper, fill_runs = fill(overturns, lower, upper, tolerance, max_runs - runs)
+    return 0.5 * (lower + upper), lower, upper, runs + fill_runs
+
+
+def uniform_stripe_runs(bottom, top, tolerance) -> int:
+    """Stripes per record a uniform (geometric) grid needs from ``bottom`` to ``top`` so that
+    neighbouring stripes are ``tolerance`` apart, i.e. the resolution ``capacity_from_stripes`` gives."""
+    return int(math.ceil(math.log(top / bottom) / math.log(1.0 + tolerance))) + 1
 
 
 def ida_stage(cube: xr.Dataset, output) -> xr.Dataset:

@@ -3,7 +3,13 @@
 Input : acceleration samples [m/s^2] (ndarray, shape (n,)) at a constant time step dt [s].
 Output: scalar intensity measures in SI units (PGA [m/s^2], PGV [m/s], PGD [m], Arias intensity
         [m/s], CAV [m/s], significant duration D5-95 [s]) and 5%-damped response spectra for an
-        array of periods (Sa [m/s^2], Sd [m]).
+        array of periods (Sa [m/s^2], Sd [m]); measures made for rocking (PGA/(g tan alpha) and
+        p PGV/(g tan alpha) per block, average spectral acceleration over a period range, the
+        period and amplitude of the dominant velocity pulse).
+
+``MEASURES`` registers every measure a study can scale records to or rank (pipeline.efficiency) as
+one ``Measure``: name, function, SI unit, display unit, long name and pelicun demand type. A new
+measure is one ``register_measure(Measure(...))`` call.
 
 All functions are pure. The oscillator uses the exact solution for ground acceleration that is
 linear between samples (Nigam & Jennings 1969); its recurrence coefficients come from the matrix
@@ -12,6 +18,11 @@ solution written compactly.
 """
 
 from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numba import njit
@@ -60,6 +71,7 @@ def significant_duration(acceleration, dt, start=0.05, end=0.95) -> float:
     return float(np.interp(end, husid, time) - np.interp(start, husid, time))
 
 
+@lru_cache(maxsize=4096)
 def oscillator_coefficients(period, damping, dt):
     """Exact recurrence for x = [u, v] of u'' + 2 zeta w u' + w^2 u = -a_g, a_g linear in a step.
 
@@ -74,7 +86,11 @@ def oscillator_coefficients(period, damping, dt):
     augmented[:2, 2] = forcing * dt
     augmented[2, 3] = 1.0  # the ramp: input grows by (a[k+1]-a[k]) over the step
     exponential = expm(augmented)
-    return exponential[:2, :2], exponential[:2, 2], exponential[:2, 3]
+    # cached (records share dt and periods): hand out read-only arrays
+    parts = exponential[:2, :2].copy(), exponential[:2, 2].copy(), exponential[:2, 3].copy()
+    for part in parts:
+        part.flags.writeable = False
+    return parts
 
 
 @njit(cache=True)
@@ -127,7 +143,7 @@ def response_spectrum(acceleration, dt, periods=DEFAULT_PERIODS, damping=0.05):
         raise ValueError("periods must be positive [s]")
     if not 0 <= damping < 1:
         raise ValueError(f"damping ratio {damping} out of range; allowed 0 <= damping < 1")
-    coefficients = [oscillator_coefficients(period, damping, dt) for period in periods]
+    coefficients = [oscillator_coefficients(float(period), float(damping), float(dt)) for period in periods]
     phi = np.array([c[0] for c in coefficients])
     gamma0 = np.array([c[1] for c in coefficients])
     gamma1 = np.array([c[2] for c in coefficients])
@@ -158,10 +174,136 @@ def intensity_measures(acceleration, dt, sa_periods=(0.2, 1.0, 2.0)) -> dict:
     return measures
 
 
-MEASURES = {
-    "pga": lambda a, dt, **options: pga(a),
-    "pgv": lambda a, dt, **options: pgv(a, dt),
-    "sa": lambda a, dt, period=1.0, damping=0.05, **options: spectral_acceleration(a, dt, period, damping),
-}
-"""Intensity measures a study can scale records to: name -> f(acceleration [m/s^2], dt [s], **options)
-returning SI values. A new scaling measure is one entry here plus its unit in config.MEASURE_UNITS."""
+def average_spectral_acceleration(acceleration, dt, low, high, damping=0.05, count=10) -> float:
+    """AvgSa [m/s^2]: geometric mean of Sa at ``count`` log-spaced periods from ``low`` to ``high`` [s]
+    (Eads et al. 2015; Kohrangi et al. 2016)."""
+    if not 0 < low < high:
+        raise ValueError(f"AvgSa period range {low}..{high} s; need 0 < low < high")
+    spectrum = response_spectrum(acceleration, dt, np.geomspace(low, high, count), damping)
+    return float(np.exp(np.mean(np.log(spectrum["sa"]))))
+
+
+def velocity_pulse(acceleration, dt) -> tuple[float, float, float]:
+    """The dominant velocity pulse: (period Tp [s], velocity amplitude v_p [m/s], acceleration
+    amplitude a_p [m/s^2]).
+
+    A deliberately simple, documented estimator (not Baker's 2007 wavelet extraction): the half
+    cycle of ground velocity that holds the PGV runs between the zero crossings on either side of
+    the peak; the pulse is taken as one full sine cycle of velocity v_p sin(w_p t), so
+    Tp = 2 x (half-cycle duration), v_p = PGV and a_p = w_p v_p = 2 pi v_p / Tp (the acceleration
+    amplitude of the equivalent cosine pulse of Makris & Vassiliou). Exact for such a pulse; for
+    recorded pulse-like motions Tp tracks the period of the largest velocity half cycle.
+    """
+    velocity = integrate(np.asarray(acceleration, dtype=float), dt)[0]
+    peak = int(np.argmax(np.abs(velocity)))
+    v_p = float(abs(velocity[peak]))
+    if v_p == 0.0:
+        return math.nan, 0.0, 0.0
+    sign = np.sign(velocity[peak])
+    same_side = sign * velocity > 0
+    start = peak
+    while start > 0 and same_side[start - 1]:
+        start -= 1
+    end = peak
+    while end < velocity.size - 1 and same_side[end + 1]:
+        end += 1
+    # crossings linearly interpolated between the last sample on each side and its neighbour
+    t_start = _zero_crossing(velocity, start - 1, start, dt) if start > 0 else 0.0
+    t_end = _zero_crossing(velocity, end, end + 1, dt) if end < velocity.size - 1 else end * dt
+    period = 2.0 * (t_end - t_start)
+    return float(period), v_p, float(2.0 * math.pi * v_p / period)
+
+
+def _zero_crossing(series, i, j, dt) -> float:
+    """Time at which the straight line from sample i to sample j crosses zero [s]."""
+    a, b = series[i], series[j]
+    return (i + a / (a - b) * (j - i)) * dt if a != b else i * dt
+
+
+# ------------------------------------------------------------------ the measure registry
+
+@dataclass(frozen=True)
+class Measure:
+    """One intensity measure.
+
+    ``function(acceleration [m/s^2], dt [s], block, options) -> value [si_unit]``; ``block`` is a
+    ``pipeline.blocks.Block`` for per-block measures (ignored otherwise); ``options`` holds the
+    study's ``period`` [s], ``damping`` [-] and ``period_range`` ((low, high) [s] or None).
+    ``scaling_exponent`` n: IM(lambda a) = lambda^n IM(a); a study scales records to measures with
+    n = 1 only, and a record's capacity re-expressed in the measure is scale x IM (n = 1).
+    ``display_factor`` is the SI value of one display unit (9.80665 for g).
+    """
+
+    name: str
+    function: Callable[..., float]
+    si_unit: str
+    display_unit: str
+    display_factor: float
+    long_name: str
+    pelicun_demand: tuple[str, str] | None = None  # (pelicun demand type, pelicun unit), None: none
+    per_block: bool = False
+    scaling_exponent: float = 1.0
+
+    @property
+    def scalable(self) -> bool:
+        return self.scaling_exponent == 1.0
+
+    def __call__(self, acceleration, dt, block=None, **options) -> float:
+        if self.per_block and block is None:
+            raise ValueError(f"measure {self.name!r} is defined per block; pass the block")
+        return float(self.function(acceleration, dt, block, _options(options)))
+
+    def describe(self, **options) -> str:
+        """Long name with the study's options filled in."""
+        options = _options(options)
+        low, high = avgsa_range(options)
+        return self.long_name.format(period=options["period"], damping=options["damping"], low=low, high=high)
+
+
+def _options(options) -> dict:
+    return {"period": 1.0, "damping": 0.05, "period_range": None, **options}
+
+
+def avgsa_range(options) -> tuple[float, float]:
+    """AvgSa period range [s]: the study's ``period_range``, else 0.2 T .. 3 T around ``period``."""
+    given = options.get("period_range")
+    if given:
+        return float(given[0]), float(given[1])
+    return 0.2 * options["period"], 3.0 * options["period"]
+
+
+MEASURES: dict[str, Measure] = {}
+"""Registered measures by name (``register_measure``)."""
+
+
+def register_measure(measure: Measure) -> None:
+    MEASURES[measure.name] = measure
+
+
+def _rocking_pga(a, dt, block, o):
+    return pga(a) / block.uplift_acceleration()
+
+
+def _rocking_pgv(a, dt, block, o):
+    return block.p() * pgv(a, dt) / block.uplift_acceleration()
+
+
+register_measure(Measure("pga", lambda a, dt, block, o: pga(a), "m/s^2", "g", STANDARD_GRAVITY,
+                         "peak ground acceleration", ("Peak Ground Acceleration", "g")))
+register_measure(Measure("pgv", lambda a, dt, block, o: pgv(a, dt), "m/s", "m/s", 1.0,
+                         "peak ground velocity", ("Peak Ground Velocity", "mps")))
+register_measure(Measure("sa", lambda a, dt, block, o: spectral_acceleration(a, dt, o["period"], o["damping"]),
+                         "m/s^2", "g", STANDARD_GRAVITY, "spectral acceleration Sa({period:g} s, {damping:.0%})",
+                         ("Spectral Acceleration", "g")))
+register_measure(Measure("avgsa", lambda a, dt, block, o: average_spectral_acceleration(
+    a, dt, *avgsa_range(o), damping=o["damping"]), "m/s^2", "g", STANDARD_GRAVITY,
+    "average spectral acceleration AvgSa({low:g}-{high:g} s, {damping:.0%})"))
+register_measure(Measure("pga_ratio", _rocking_pga, "1", "1", 1.0,
+                         "PGA over the block's uplift acceleration, PGA/(g tan alpha)", per_block=True))
+register_measure(Measure("pgv_ratio", _rocking_pgv, "1", "1", 1.0,
+                         "p PGV/(g tan alpha), p = sqrt(3g/4R) (Makris & Vassiliou)", per_block=True))
+register_measure(Measure("pulse_amplitude", lambda a, dt, block, o: velocity_pulse(a, dt)[2], "m/s^2", "g",
+                         STANDARD_GRAVITY, "acceleration amplitude a_p = 2 pi PGV/Tp of the dominant velocity pulse"))
+register_measure(Measure("pulse_period", lambda a, dt, block, o: velocity_pulse(a, dt)[0], "s", "s", 1.0,
+                         "period Tp of the dominant velocity pulse (a record property: does not scale)",
+                         scaling_exponent=0.0))

@@ -46,7 +46,7 @@ def report_settings(config) -> dict:
 
 def is_rigid_base(model) -> bool:
     """True when the model's result does not depend on the soil (e.g. Housner)."""
-    return bool(getattr(model, "is_rigid_base", not model.needs_foundation))
+    return model.is_rigid_base
 
 
 def showcase_record_id(config, record_ids) -> str | None:

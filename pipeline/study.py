@@ -3,8 +3,14 @@
 Input : a ``StudyConfig`` (pipeline.config).
 Output: ``reports/cube.nc`` (see pipeline.cube) and the ``xarray.Dataset``.
 
-Work unit: one record at all its scale factors for all the cells (block, soil, model) it still
-needs, run by the compiled batch solver. A cell's result is checkpointed as one small file named by
+Levels: absolute (the same intensities for every block) or, with ``[intensity] levels.relative_to =
+"uplift"``, multiples of each block's uplift intensity (``level_intensities``); scale factors are then
+per (record, level, block).
+
+Work unit: one record and one block at all its scale factors for all the cells (soil, model) it
+still needs, run by the compiled batch solver. The same task then refines each cell's overturning
+capacity adaptively (pipeline.ida.capacity_from_stripes, to ``capacity_resolution``) and returns it
+as a second checkpoint entry, so capacities come from runs, not from the grid. A cell's result is checkpointed as one small file named by
 a hash of everything it depends on (record checksum, processing recipe, intensity settings, levels,
 block, soil, model, solver settings, package version), so an interrupted study resumes where it
 stopped and a changed input recomputes only the cells it touches. Housner results do not depend on
@@ -41,9 +47,11 @@ from pipeline import __version__
 from pipeline.cube import build_cube, write_netcdf
 from pipeline.checkpoints import CheckpointStore
 from pipeline.errors import PipelineError, RecordError
+from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
 from pipeline.locking import output_lock
-from pipeline.measures import MEASURES
+from pipeline.measures import MEASURES, pga
 from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, simulate_batch
+from pipeline.models.base import Outcome
 from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
 from pipeline.processing import load_recipe, process_records
 from pipeline.records import load_records
@@ -60,17 +68,72 @@ class Cell:
     model: str
 
 
-def record_intensity(acceleration, dt, config) -> float:
-    """The study's intensity measure of a processed record [SI]."""
-    return MEASURES[config.measure](acceleration, dt, period=config.period, damping=config.damping)
+def record_intensity(acceleration, dt, config, block=None) -> float:
+    """The study's intensity measure of a processed record [SI] (for ``block`` if it is per block)."""
+    return MEASURES[config.measure](acceleration, dt, block, **config.measure_options)
+
+
+def record_intensities(records, config) -> np.ndarray:
+    """The study's measure of every record for every block, (n_record, n_block) [SI]; one value per
+    record repeated over the blocks unless the measure is defined per block."""
+    measure = MEASURES[config.measure]
+    values = np.empty((len(records), len(config.blocks)))
+    for r, record in enumerate(records):
+        if measure.per_block:
+            values[r] = [record_intensity(record.acceleration, record.dt, config, b) for b in config.blocks]
+        else:
+            values[r] = record_intensity(record.acceleration, record.dt, config)
+    return values
+
+
+def uplift_intensity(config, record_im, record_pga) -> np.ndarray:
+    """Each block's uplift intensity in the study's measure, (n_block,) [SI].
+
+    Under PGA scaling it is exactly g tan(alpha) (Housner's rigid-base threshold; compliant bases
+    uplift at about the same PGA); for PGA/(g tan alpha) it is 1. For any other measure it is the
+    record median of the measure's value when the record is scaled to PGA = g tan(alpha):
+    median_r(IM_r / PGA_r) g tan(alpha) (record_im (n_record, n_block), record_pga (n_record,) [SI]).
+    """
+    uplift_pga = np.array([block.uplift_acceleration() for block in config.blocks])
+    return np.median(record_im / np.asarray(record_pga)[:, None], axis=0) * uplift_pga
+
+
+def level_intensities(config, record_im, record_pga) -> np.ndarray:
+    """The physical intensity of every (block, level), (n_block, n_level) [SI]."""
+    if config.relative_levels:
+        return uplift_intensity(config, record_im, record_pga)[:, None] * np.asarray(config.levels)[None, :]
+    return np.broadcast_to(config.levels_si, (len(config.blocks), len(config.levels))).copy()
+
+
+def study_scale_factors(intensity, record_im) -> np.ndarray:
+    """Scale factor of every (record, level, block): the level's intensity over the record's."""
+    return intensity.T[None, :, :] / record_im[:, None, :]
+
+
+def capacity_key(key, resolution) -> str:
+    """Checkpoint key of a cell's adaptive overturning capacity."""
+    return f"{key}-capacity-{resolution:g}"
+
+
+def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolution):
+    """[capacity, lower, upper, extra runs] of one cell as scale factors (see capacity_from_stripes)."""
+    _, model, block, k, xi = job
+
+    def overturns(scale):
+        result = simulate_batch(model, acceleration, dt, [scale], [(block, k, xi)], t_end=t_end, **options)
+        return int(result[0, 0]["status"]) == int(Outcome.OVERTURNED)
+
+    overturned = summary["status"].astype(int) == int(Outcome.OVERTURNED)
+    return np.array(capacity_from_stripes(scales, overturned, overturns, tolerance=resolution), dtype=float)
 
 
 def _hash(payload) -> str:
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:40]
 
 
-def cells_for_record(record, config, recipe) -> list[Cell]:
-    """The cells of one record with their checkpoint keys."""
+def cells_for_record(record, config, recipe, block_scales=None) -> list[Cell]:
+    """The cells of one record with their checkpoint keys (``block_scales``: the record's scale
+    factors per block, (n_level, n_block), part of each cell's key)."""
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
@@ -78,6 +141,8 @@ def cells_for_record(record, config, recipe) -> list[Cell]:
     cells = []
     for block_index, block in enumerate(config.blocks):
         block_spec = {k: v for k, v in asdict(block).items() if k not in ("name", "description")}
+        if block_scales is not None:
+            block_spec["scales"] = [float(f"{v:.12g}") for v in block_scales[:, block_index]]
         for model in config.models:
             if get_model(model).is_rigid_base:
                 cells.append(Cell(_hash({**common, "block": block_spec, "model": model}), block_index, None, model))
@@ -94,11 +159,12 @@ def solver_options(config) -> dict:
     return {"switch": config.switch, "bed": config.bed, "overturn_angle": config.overturn_angle}
 
 
-def compute_cells(acceleration, dt, scales, jobs, options, tail):
+def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0):
     """Pure task function (runs in a worker): summaries for each job.
 
     jobs : list of (key, model, block, k, xi); options : ``solver_options``.
-    Returns {key: summary records (n_scale,)}.
+    Returns {key: summary records (n_scale,)} and, when ``capacity_resolution`` > 0,
+    {capacity_key(key): [capacity, lower, upper, runs]} (scale factors).
     """
     results = {}
     t_end = (acceleration.size - 1) * dt + tail
@@ -110,6 +176,10 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail):
                                    t_end=t_end, **options)
         for (key, *_), summary in zip(group, summaries):
             results[key] = summary
+    if capacity_resolution > 0:
+        for job in jobs:
+            results[capacity_key(job[0], capacity_resolution)] = cell_capacity(
+                acceleration, dt, scales, results[job[0]], job, options, t_end, capacity_resolution)
     return results
 
 
@@ -286,14 +356,15 @@ def _check_workers(workers, dask_workers):
 
 
 def _scalable(records, record_im, log):
-    """Split records into those with a positive finite intensity and RecordErrors for the rest."""
+    """Split records into those whose intensity (per block) is positive and finite, and RecordErrors
+    for the rest (record_im: (n_record, n_block) [SI])."""
     keep, failures = [], []
-    for index, (record, im) in enumerate(zip(records, record_im)):
-        if np.isfinite(im) and im > 0:
+    for index, (record, im) in enumerate(zip(records, np.atleast_2d(record_im.T).T)):
+        if np.all(np.isfinite(im)) and np.all(im > 0):
             keep.append(index)
         else:
             failure = RecordError(record.metadata.get("file") or record.id,
-                                  f"record {record.id}: intensity measure is {im:g}; it cannot be scaled")
+                                  f"record {record.id}: intensity measure is {np.min(im):g}; it cannot be scaled")
             log(f"rockfrag: skipped {failure}")
             failures.append(failure)
     return keep, failures
@@ -323,30 +394,29 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     started = time.perf_counter()
     records, failures, recipe = loaded or study_records(config, warn)
     failures = list(failures)
-    record_im = np.array([record_intensity(r.acceleration, r.dt, config) for r in records])
+    record_im = record_intensities(records, config)
     keep, unscalable = _scalable(records, record_im, warn)
     failures += unscalable
     if not keep:
-        raise PipelineError("no record has a positive intensity measure; nothing to run")
+        raise PipelineError(f"no record has a positive intensity measure {config.measure}; nothing to run")
     records, record_im = [records[i] for i in keep], record_im[keep]
-    scale_factors = config.levels_si[None, :] / record_im[:, None]
+    record_pga = np.array([pga(r.acceleration) for r in records])
+    intensity = level_intensities(config, record_im, record_pga)
+    scale_factors = study_scale_factors(intensity, record_im)
+    resolution = config.capacity_resolution
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
 
     n_levels = len(config.levels)
     store = CheckpointStore(output / ".checkpoints", log=warn)
-    all_cells = [cells_for_record(record, config, recipe) for record in records]
-    results = store.load_verified([c.key for cells in all_cells for c in cells], (n_levels,), SUMMARY_DTYPE)
-    tasks = []
-    for index, cells in enumerate(all_cells):
-        missing = [c for c in cells if c.key not in results]
-        if missing:
-            jobs = [(c.key, c.model, config.blocks[c.block_index],
-                     None if c.soil_index is None else stiffness[c.soil_index, c.block_index],
-                     None if c.soil_index is None else config.soils[c.soil_index].damping_ratio)
-                    for c in missing]
-            tasks.append((index, jobs))
+    all_cells = [cells_for_record(record, config, recipe, scale_factors[index])
+                 for index, record in enumerate(records)]
+    keys = [c.key for cells in all_cells for c in cells]
+    results = store.load_verified(keys, (n_levels,), SUMMARY_DTYPE)
+    if resolution > 0:
+        results.update(store.load_verified([capacity_key(k, resolution) for k in keys], (4,), np.float64))
+    tasks = block_tasks(all_cells, results, config, stiffness, resolution)
     n_cells = sum(len(c) for c in all_cells)
-    n_missing = sum(len(jobs) for _, jobs in tasks)
+    n_missing = sum(len(jobs) for _, _, jobs in tasks)
     runs_total = n_missing * n_levels
     log(f"study '{config.name}': {len(records)} records x {n_levels} levels x {len(config.soils)} soils x "
         f"{len(config.blocks)} blocks x {len(config.models)} models; {n_cells - n_missing} of {n_cells} "
@@ -360,16 +430,16 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                 for key, summary in computed.items():
                     store.save(key, summary)
                     results[key] = summary
-                bar.update(len(task[1]) * n_levels)
+                bar.update(len(task[2]) * n_levels)  # capacity runs are not counted ahead
 
             lost = run_tasks(tasks,
                              lambda task: (records[task[0]].acceleration, records[task[0]].dt,
-                                           scale_factors[task[0]], task[1], solver_options(config),
-                                           config.tail),
+                                           scale_factors[task[0], :, task[1]], task[2], solver_options(config),
+                                           config.tail, resolution),
                              lambda: _executor(workers, scheduler, dask_workers), keep_result,
-                             describe=lambda task: f"record {records[task[0]].id}")
+                             describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}")
     if lost:
-        lost_indices = {index for index, _ in lost}
+        lost_indices = {index for index, _, _ in lost}
         for index in sorted(lost_indices):
             record = records[index]
             failure = RecordError(record.metadata.get("file") or record.id,
@@ -381,6 +451,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         if not kept:
             raise PipelineError("every record's computation was lost (worker processes killed); "
                                 "finished cells are kept, rerun to continue")
+        # the levels stay those of the whole record set (relative levels use its median)
         records, record_im, scale_factors = [records[i] for i in kept], record_im[kept], scale_factors[kept]
         all_cells = [all_cells[i] for i in kept]
 
@@ -393,12 +464,64 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                 summaries[r, :, :, cell.block_index, model_index] = result[:, None]
             else:
                 summaries[r, :, cell.soil_index, cell.block_index, model_index] = result
+    capacities, capacity_stats = gather_capacities(all_cells, results, config, intensity, resolution)
+    if capacity_stats:
+        log(f"capacities to {resolution:.0%}: {capacity_stats['capacity_runs']} refining runs over "
+            f"{capacity_stats['grid_runs']} stripe runs; uniform stripes of the same resolution would need "
+            f"{capacity_stats['uniform_runs']} runs ({capacity_stats['runs_saved_fraction']:.0%} saved)")
     provenance = {"processing": recipe.as_dict(),
                   "processing_steps": {r.id: list(r.trace.stats.get("processing", [])) for r in records}}
-    dataset = build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance)
+    dataset = build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
+                         intensity=intensity, capacities=capacities, capacity_stats=capacity_stats)
     write_netcdf(dataset, output / "cube.nc")
     elapsed = time.perf_counter() - started
     statistics = {"runs_computed": runs_total, "cells_reused": n_cells - n_missing, "cells": n_cells,
                   "seconds": elapsed, "failures": [str(f) for f in failures],
-                  "checkpoints_quarantined": [str(p) for p in store.quarantined]}
+                  "checkpoints_quarantined": [str(p) for p in store.quarantined], **capacity_stats}
     return dataset, statistics
+
+
+def block_tasks(all_cells, available, config, stiffness, resolution) -> list:
+    """(record index, block index, jobs) for every record and block with cells still to run (not in
+    ``available``, the verified checkpoints); a job is (key, model, block, k, xi). Grouped by block
+    because scale factors are per block."""
+    tasks = []
+    for index, cells in enumerate(all_cells):
+        by_block = {}
+        for cell in cells:
+            done = cell.key in available and (resolution <= 0 or capacity_key(cell.key, resolution) in available)
+            if not done:
+                by_block.setdefault(cell.block_index, []).append(cell)
+        for block_index, missing in by_block.items():
+            jobs = [(c.key, c.model, config.blocks[c.block_index],
+                     None if c.soil_index is None else stiffness[c.soil_index, c.block_index],
+                     None if c.soil_index is None else config.soils[c.soil_index].damping_ratio)
+                    for c in missing]
+            tasks.append((index, block_index, jobs))
+    return tasks
+
+
+def gather_capacities(all_cells, available, config, intensity, resolution):
+    """Adaptive capacities as scale factors (4, record, soil, block, model): capacity, lower, upper,
+    extra runs; and the run accounting against uniform stripes of the same resolution (a dict,
+    empty when capacities are off)."""
+    shape = (4, len(all_cells), len(config.soils), len(config.blocks), len(config.models))
+    capacities = np.full(shape, np.nan)
+    if resolution <= 0:
+        return None, {}
+    extra = 0
+    for r, cells in enumerate(all_cells):
+        for cell in cells:
+            result = available[capacity_key(cell.key, resolution)]
+            soils = slice(None) if cell.soil_index is None else cell.soil_index
+            capacities[:, r, soils, cell.block_index, config.models.index(cell.model)] = result[:, None] \
+                if cell.soil_index is None else result
+            extra += int(result[3])
+    n_cells = sum(len(c) for c in all_cells)
+    n_levels = intensity.shape[1]
+    uniform = sum(uniform_stripe_runs(intensity[b, 0], intensity[b, -1], resolution)
+                  for cells in all_cells for b in (c.block_index for c in cells))
+    grid = n_cells * n_levels
+    return capacities, {"capacity_runs": extra, "grid_runs": grid, "uniform_runs": uniform,
+                        "capacity_resolution": resolution,
+                        "runs_saved_fraction": 1.0 - (grid + extra) / uniform if uniform else 0.0}

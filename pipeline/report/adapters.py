@@ -16,10 +16,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.models import base as _model_base
+from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
 
-Outcome = getattr(_model_base, "Outcome", getattr(_model_base, "Status", None))  # the cube's outcome codes
 OUTCOME_ROCKING, OUTCOME_FAILED = int(Outcome.ROCKING), int(Outcome.FAILED)
 
 
@@ -29,7 +28,7 @@ class ModelInfo:
     label: str
     rigid_base: bool
     description: str
-    can_pull: bool | None = None  # None: the registry does not say
+    can_pull: bool = False
     uses_bed: bool = False  # a bed of springs (solver.bed), not the pivot-switch rule
 
 
@@ -40,11 +39,8 @@ def model_info(name: str) -> ModelInfo:
     model = MODELS.get(name)
     if model is None:
         return ModelInfo(name, name, False, "")
-    rigid = bool(getattr(model, "is_rigid_base", not model.needs_foundation))
-    description = getattr(model, "description", "")
-    label = getattr(model, "label", None) or f"{name}: {description.split(';')[0]}"
-    return ModelInfo(name, label, rigid, description, getattr(model, "can_pull", None),
-                     bool(getattr(model, "uses_bed", False)))
+    label = model.label or f"{name}: {model.description.split(';')[0]}"
+    return ModelInfo(name, label, model.is_rigid_base, model.description, model.can_pull, model.uses_bed)
 
 
 def models_of(dataset) -> list[ModelInfo]:

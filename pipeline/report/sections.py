@@ -234,7 +234,7 @@ def limitations_items(results: Results):
             continue
         fraction = run_fraction(cube, flag, model)
         if fraction is None:
-            if model.can_pull is False:
+            if not model.can_pull:
                 items.append(paragraph(f"{model.label}: the foundation cannot pull (tensionless); the block "
                                        "lifts off instead."))
             continue

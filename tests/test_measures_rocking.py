@@ -1,0 +1,84 @@
+"""Measures made for rocking, and the measure registry, against hand calculations."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pipeline.blocks import Block
+from pipeline.config import MEASURE_UNITS
+from pipeline.measures import MEASURES, average_spectral_acceleration, velocity_pulse
+from pipeline.units import STANDARD_GRAVITY as G
+
+BLOCK = Block(name="cabinet", b=0.3, h=1.5, mass=2000.0)  # tan(alpha) = 0.2, R = sqrt(0.09 + 2.25)
+
+
+def cosine_pulse(amplitude, period, dt=0.001, lead=1.0, trail=3.0):
+    """One cycle of a_p cos(w_p t) after ``lead`` s of rest: velocity (a_p/w_p) sin(w_p t), one full cycle."""
+    t = np.arange(0.0, lead + period + trail, dt)
+    inside = (t >= lead) & (t < lead + period)
+    return np.where(inside, amplitude * np.cos(2 * np.pi * (t - lead) / period), 0.0)
+
+
+def test_pga_ratio_is_pga_over_g_tan_alpha():
+    acceleration = np.array([0.0, 0.5, -1.2, 0.3]) * G  # PGA 1.2 g
+    assert MEASURES["pga_ratio"](acceleration, 0.01, BLOCK) == pytest.approx(1.2 / 0.2, rel=1e-12)
+
+
+def test_pgv_ratio_of_a_cosine_pulse_by_hand():
+    a_p, period = 3.0, 0.8
+    acceleration = cosine_pulse(a_p, period, dt=0.0005)
+    pgv = a_p * period / (2 * np.pi)  # peak of (a_p/w_p) sin(w_p t)
+    p = math.sqrt(3 * G / (4 * math.hypot(0.3, 1.5)))
+    expected = p * pgv / (G * 0.2)
+    assert MEASURES["pgv_ratio"](acceleration, 0.0005, BLOCK) == pytest.approx(expected, rel=2e-3)
+
+
+def test_per_block_measure_refuses_to_run_without_a_block():
+    with pytest.raises(ValueError, match="per block"):
+        MEASURES["pga_ratio"](np.ones(4), 0.01)
+
+
+def test_velocity_pulse_recovers_period_and_amplitudes_of_a_cosine_pulse():
+    a_p, period = 2.5, 1.3
+    found_period, v_p, found_a_p = velocity_pulse(cosine_pulse(a_p, period), 0.001)
+    # the jump of the sampled pulse at its start shifts the crossings by a few samples (dt = 1 ms)
+    assert found_period == pytest.approx(period, abs=5e-3)
+    assert v_p == pytest.approx(a_p * period / (2 * np.pi), abs=a_p * 0.001)  # + a_p dt/2 from the jump
+    assert found_a_p == pytest.approx(a_p, rel=8e-3)
+
+
+def test_avgsa_of_a_step_is_twice_the_step_when_undamped():
+    """Undamped SDOF under a suddenly applied a0: absolute acceleration a0 (1 - cos wt), peak 2 a0 at
+    every period (the record is long enough to reach it at the longest period)."""
+    a0 = 1.7
+    acceleration = np.full(4000, a0)
+    value = average_spectral_acceleration(acceleration, 0.002, 0.1, 2.0, damping=0.0)
+    assert value == pytest.approx(2 * a0, rel=1e-3)
+
+
+def test_avgsa_lies_between_the_extreme_spectral_ordinates(bolu_records):
+    record = bolu_records["DUZCE/BOL090"]
+    value = MEASURES["avgsa"](record.acceleration, record.dt, period=1.0, damping=0.05)
+    sa = [MEASURES["sa"](record.acceleration, record.dt, period=t) for t in np.geomspace(0.2, 3.0, 10)]
+    assert min(sa) < value < max(sa)
+    assert value == pytest.approx(math.exp(np.mean(np.log(sa))), rel=1e-9)  # geometric mean, 0.2T..3T
+
+
+@pytest.mark.parametrize("name", sorted(MEASURES))
+def test_every_measure_scales_with_its_exponent(bolu_records, name):
+    record = bolu_records["DUZCE/BOL000"]
+    measure = MEASURES[name]
+    value = measure(record.acceleration, record.dt, BLOCK)
+    doubled = measure(2.0 * record.acceleration, record.dt, BLOCK)
+    assert doubled == pytest.approx(2.0**measure.scaling_exponent * value, rel=1e-9)
+
+
+def test_registry_describes_every_measure_and_feeds_the_config_units():
+    for name, measure in MEASURES.items():
+        assert measure.name == name and measure.si_unit and measure.display_unit and measure.describe()
+        assert (name in MEASURE_UNITS) == measure.scalable
+    assert MEASURE_UNITS["pga"] == ("g", G) and MEASURE_UNITS["pgv_ratio"] == ("1", 1.0)
+    assert "0.5" in MEASURES["avgsa"].describe(period=2.5, period_range=(0.5, 7.0))
