@@ -285,49 +285,63 @@ def _executor(workers, scheduler, dask_workers):
                 return compute_cells(*self._arguments)
 
         return (lambda *a: InProcess(a), lambda futures: list(futures), lambda finished: None)
-    pool = worker_pool(workers or os.cpu_count())
+    return _pool_executor(workers or os.cpu_count())
+
+
+def _pool_executor(n_workers):
+    pool = worker_pool(n_workers)
     return (lambda *a: pool.submit(compute_cells, *a), as_completed,
             lambda finished: shutdown_pool(pool, wait=finished))
 
 
-def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, describe=str):
+def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, describe=str, isolate=None):
     """Run ``tasks`` on executors from ``make_executor()``; returns the tasks lost ``attempts`` times.
 
     A task whose worker process died (BrokenProcessPool, dask KilledWorker) is run again in a fresh
-    executor; results already received are kept (``on_result(task, result)`` saw them). Any other
+    executor; results already received are kept (``on_result(task, result)`` saw them). A broken pool
+    fails every task it still held, so the tasks lost in the last attempt are run once more one by one
+    on ``isolate()`` executors (if given): only a task that kills its own worker is returned. Any other
     exception propagates, with a note naming the task (``describe(task)``).
     """
     pending = list(tasks)
     for _ in range(attempts):
         if not pending:
             break
-        submit, completed, shutdown = make_executor()
-        lost, finished = [], False
-        try:
-            futures = {}
-            for task in pending:
-                try:
-                    futures[submit(*submit_arguments(task))] = task
-                except Exception as error:  # the pool broke while tasks were being submitted
-                    if not _is_lost_worker(error):
-                        raise
-                    lost.append(task)
-            for future in completed(list(futures)):
-                try:
-                    result = future.result()
-                except Exception as error:
-                    if not _is_lost_worker(error):
-                        error.add_note(describe(futures[future]))
-                        raise
-                    lost.append(futures[future])
-                    continue
-                on_result(futures[future], result)
-            finished = True
-        finally:
-            # a broken pool is joined before the next one forks, so no thread of it is caught mid-way
-            shutdown(bool(lost) or finished)
-        pending = lost
+        pending = _run_round(pending, submit_arguments, make_executor(), on_result, describe)
+    if pending and isolate is not None and len(pending) > 1:
+        pending = [task for task in pending
+                   for task in _run_round([task], submit_arguments, isolate(), on_result, describe)]
     return pending
+
+
+def _run_round(pending, submit_arguments, executor, on_result, describe):
+    """Submit ``pending`` to one executor; the tasks lost with a dead worker."""
+    submit, completed, shutdown = executor
+    lost, finished = [], False
+    try:
+        futures = {}
+        for task in pending:
+            try:
+                futures[submit(*submit_arguments(task))] = task
+            except Exception as error:  # the pool broke while tasks were being submitted
+                if not _is_lost_worker(error):
+                    raise
+                lost.append(task)
+        for future in completed(list(futures)):
+            try:
+                result = future.result()
+            except Exception as error:
+                if not _is_lost_worker(error):
+                    error.add_note(describe(futures[future]))
+                    raise
+                lost.append(futures[future])
+                continue
+            on_result(futures[future], result)
+        finished = True
+    finally:
+        # a broken pool is joined before the next one forks, so no thread of it is caught mid-way
+        shutdown(bool(lost) or finished)
+    return lost
 
 
 def study_records(config, log=print):
@@ -437,7 +451,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                                            scale_factors[task[0], :, task[1]], task[2], solver_options(config),
                                            config.tail, resolution),
                              lambda: _executor(workers, scheduler, dask_workers), keep_result,
-                             describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}")
+                             describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}",
+                             isolate=None if scheduler or dask_workers else lambda: _pool_executor(1))
     if lost:
         lost_indices = {index for index, _, _ in lost}
         for index in sorted(lost_indices):
