@@ -227,6 +227,7 @@ def applicability_stage(config, output, workers=None, progress=True, log=print, 
     records, _, recipe = loaded or study_records(config, log)
     sweep = config.applicability  # the study's [applicability] table: one definition for every caller
     models = [name for name in config.models if not get_model(name).is_rigid_base] or list(DEFAULT_MODELS)
+    models.sort(key=lambda name: get_model(name).can_pull)  # the admissible (tensionless) models first
     options = {"switch": config.switch, "bed": config.bed}
     key = hashlib.sha256(json.dumps({
         "version": __version__, "recipe": recipe.as_dict(), "blocks": [repr(b) for b in config.blocks],
