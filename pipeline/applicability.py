@@ -93,9 +93,9 @@ def run_applicability(records, blocks, *, shear_moduli=DEFAULT_SHEAR_MODULI, blo
     """
     models = [name for name in models if not get_model(name).is_rigid_base]
     options = dict(options or {})
-    from concurrent.futures import ProcessPoolExecutor
-
     from tqdm import tqdm
+
+    from pipeline.study import shutdown_pool, worker_pool
 
     shear_moduli = np.asarray(shear_moduli, float)
     arguments = [(r.acceleration, r.dt, float(np.max(np.abs(r.acceleration))), list(blocks), list(block_moduli),
@@ -103,9 +103,12 @@ def run_applicability(records, blocks, *, shear_moduli=DEFAULT_SHEAR_MODULI, blo
     if workers == 1:
         results = [_record_task(*a) for a in tqdm(arguments, desc="applicability", disable=not progress)]
     else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
+        pool = worker_pool(workers)  # its workers die with this process
+        try:
             futures = [pool.submit(_record_task, *a) for a in arguments]
             results = [f.result() for f in tqdm(futures, desc="applicability", unit="rec", disable=not progress)]
+        finally:
+            shutdown_pool(pool)
     peak_h = np.array([r[0] for r in results])
     over_h = np.array([r[1] for r in results])
     peak_s = np.array([r[2] for r in results])
