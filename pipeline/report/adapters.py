@@ -66,6 +66,11 @@ def short_label(model: ModelInfo) -> str:
     return model.label if len(model.label) <= 45 else model.name
 
 
+def panel_label(model: ModelInfo) -> str:
+    """The registry label without its parenthesis, for panel titles: "SSI, paper's model", "Housner"."""
+    return model.label.split(" (")[0]
+
+
 def cell(dataset, model: ModelInfo, block, soil=None):
     """The results of one model and block; a rigid-base model on the first soil (all soils are equal)."""
     if "soil" in dataset.dims and (model.rigid_base or soil is None):

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from pipeline.report.adapters import (OUTCOME_ROCKING, block_levels, cell, measure_label, model_styles, models_of,
-                                      short_label, state_labels, uplift_intensity)
+                                      panel_label, short_label, state_labels, uplift_intensity)
 from pipeline.report.layout import GRID, FRACTILE_STYLES, log_axis, new_page, outside_legend, panels, soil_colour
 
 G = 9.80665
@@ -151,7 +151,7 @@ def ida_page(ida, block, caption):
             axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
                       label=f"{float(q):.0%} fractile", **style)
         axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
-        axis.set_title(short_label(model) if soil is None else f"{model.name} on {soil}", fontsize=9)
+        axis.set_title(short_label(model) if soil is None else f"{panel_label(model)}\non {soil}", fontsize=9)
         axis.grid(alpha=0.3)
         axis.set_xlim(0, IDA_CAP * 1.05)
     axes.flat[0].plot([], [], color="0.65", lw=0.5, label="one record")
@@ -228,7 +228,7 @@ def fragility_by_soil_page(fragility, block, model, caption):
         for index, soil in enumerate(map(str, fragility.soil.values)):
             style = dict(styles[model.name], color=soil_colour(soil, index))
             _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state, style,
-                              f"{model.name} on {soil}")
+                              f"{panel_label(model)} on {soil}")
         for reference in (m for m in models if m.rigid_base):
             _fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
                               styles[reference.name], short_label(reference))
