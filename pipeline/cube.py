@@ -18,6 +18,7 @@ from pipeline import __version__
 from pipeline.measures import MEASURES
 from pipeline.models import get_model
 from pipeline.models.base import Outcome
+from pipeline.models.fields import FIELDS_BY_NAME
 from pipeline.outputs import atomic_path
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
@@ -43,27 +44,21 @@ def _bed(model):
     return model.uses_bed
 
 
-# Cube variable: (summary field of pipeline.models.fields, units, long name, which models it applies to;
-# NaN elsewhere). Derived variables (outcome, peak_angle_ratio, support_tension) are added below.
+# Cube variable: (summary field of pipeline.models.fields, which models it applies to; NaN elsewhere).
+# Units and long names come from the field; derived variables (outcome, peak_angle_ratio,
+# support_tension) are added below.
 VARIABLES = {
-    "peak_angle": ("peak_angle", "rad", "peak absolute rocking angle", _always),
-    "time_of_peak": ("time_of_peak", "s", "time of the peak rocking angle", _always),
-    "n_impacts": ("n_impacts", "1", "number of impacts (pivot switches; winkler: a lifted corner landing)",
-                  _always),
-    "time_of_uplift": ("time_of_uplift", "s", "time of first uplift (NaN: never uplifted)", _always),
-    "peak_uplift": ("peak_corner_uplift", "m", "peak height of a base corner above the ground", _always),
-    "peak_settlement": ("peak_settlement", "m",
-                        "peak settlement of the active pivot (ssi) or of the base centre (winkler)", _foundation),
-    "min_support_force": ("min_support_force", "N",
-                          "minimum vertical foundation force (negative: the foundation pulled on the block)",
-                          _foundation),
-    "time_of_tension": ("time_of_tension", "s",
-                        "first time the paper's spring pulled on the block (NaN: never)", _pulls),
-    "n_flights": ("n_flights", "1", "times the whole base left the ground", _bed),
-    "airborne_time": ("airborne_time", "s", "total time with the whole base off the ground", _bed),
-    "peak_friction_demand": ("peak_friction_demand", "1",
-                             "peak |H|/N, the base friction coefficient needed to prevent sliding "
-                             "(while N >= 0.1 m g)", _bed),
+    "peak_angle": ("peak_angle", _always),
+    "time_of_peak": ("time_of_peak", _always),
+    "n_impacts": ("n_impacts", _always),
+    "time_of_uplift": ("time_of_uplift", _always),
+    "peak_uplift": ("peak_corner_uplift", _always),
+    "peak_settlement": ("peak_settlement", _foundation),
+    "min_support_force": ("min_support_force", _foundation),
+    "time_of_tension": ("time_of_tension", _pulls),
+    "n_flights": ("n_flights", _bed),
+    "airborne_time": ("airborne_time", _bed),
+    "peak_friction_demand": ("peak_friction_demand", _bed),
 }
 
 
@@ -73,10 +68,10 @@ def summaries_to_variables(summaries, blocks, model_names):
     mass = np.array([b.mass for b in blocks])[None, None, None, :, None]
     alpha = np.array([b.alpha for b in blocks])[None, None, None, :, None]
     out = {}
-    for name, (field, _, _, applies) in VARIABLES.items():
+    for name, (field, applies) in VARIABLES.items():
         mask = np.array([applies(model) for model in models])[None, None, None, None, :]
-        out[name] = np.where(mask, summaries[field], np.nan)
-    out["min_support_force"] = out["min_support_force"] * mass
+        values = summaries[field] * mass if FIELDS_BY_NAME[field].per_mass else summaries[field]
+        out[name] = np.where(mask, values, np.nan)
     out["outcome"] = np.nan_to_num(summaries["status"], nan=int(Outcome.FAILED)).astype(np.int8)
     out["peak_angle_ratio"] = out["peak_angle"] / alpha
     pulls = np.array([model.can_pull for model in models])[None, None, None, None, :]
@@ -134,8 +129,8 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         if name in DERIVED_ATTRIBUTES:
             data_vars[name] = (DIMS, array, dict(DERIVED_ATTRIBUTES[name]))
         else:
-            _, units, long_name, _ = VARIABLES[name]
-            data_vars[name] = (DIMS, array, {"long_name": long_name, "units": units})
+            field = FIELDS_BY_NAME[VARIABLES[name][0]]
+            data_vars[name] = (DIMS, array, {"long_name": field.long_name, "units": field.units})
     data_vars["scale_factor"] = (("record", "im_level", "block"), scale_factors,
                                  {"long_name": "factor applied to the processed record", "units": "1"})
     if capacities is not None:

@@ -66,22 +66,25 @@ SUMMARY_FIELDS = (
     SummaryField("status", "1", "outcome of the run (pipeline.models.base.Outcome)"),
     SummaryField("peak_angle", "rad", "peak absolute rocking angle"),
     SummaryField("time_of_peak", "s", "time of the peak rocking angle"),
-    SummaryField("n_impacts", "1", "number of impacts (theta crossing 0 while rocking)"),
+    SummaryField("n_impacts", "1", "number of impacts (pivot switches; winkler: a lifted corner landing)"),
     SummaryField("uplifted", "1", "1 if some point of the base left the ground"),
-    SummaryField("peak_settlement", "m", "peak settlement of the active pivot (ssi) or base centre (winkler)"),
-    SummaryField("min_support_force", "N", "minimum vertical foundation force (negative: the spring pulls)",
+    SummaryField("peak_settlement", "m",
+                 "peak settlement of the active pivot (ssi) or of the base centre (winkler)"),
+    SummaryField("min_support_force", "N",
+                 "minimum vertical foundation force (negative: the foundation pulled on the block)",
                  per_mass=True),
-    SummaryField("time_of_tension", "s", "first time the foundation force was negative (NaN: never)"),
+    SummaryField("time_of_tension", "s", "first time the paper's spring pulled on the block (NaN: never)"),
     SummaryField("t_end", "s", "time reached by the integration"),
     SummaryField("n_steps", "1", "accepted integration steps"),
     SummaryField("time_of_uplift", "s", "time of first uplift (NaN: never uplifted)"),
     SummaryField("time_of_overturn", "s", "time of overturning (NaN: did not overturn)"),
-    SummaryField("n_flights", "1", "times the whole base left the ground (winkler)"),
-    SummaryField("airborne_time", "s", "total time with the whole base off the ground (winkler)"),
-    SummaryField("peak_corner_uplift", "m", "peak height of a base corner above the ground surface"),
+    SummaryField("n_flights", "1", "times the whole base left the ground"),
+    SummaryField("airborne_time", "s", "total time with the whole base off the ground"),
+    SummaryField("peak_corner_uplift", "m", "peak height of a base corner above the ground"),
     SummaryField("peak_friction_demand", "1",
-                 "peak horizontal over vertical base force needed to prevent sliding (winkler)"),
+                 "peak |H|/N, the base friction coefficient needed to prevent sliding (while N >= 0.1 m g)"),
 )
+FIELDS_BY_NAME = {field.name: field for field in SUMMARY_FIELDS}
 
 SUMMARY_DTYPE = np.dtype([(field.name, "f8") for field in SUMMARY_FIELDS])
 
