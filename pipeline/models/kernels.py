@@ -64,6 +64,12 @@ MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
 
+# rows of the work array (``workspace``): the Dormand-Prince stages k2..k7 (row 5 is f(t + h, x_new),
+# which the dense output and the next step reuse), then the interpolated state of the event functions
+ROW_F1 = 5
+ROW_EVENT = 6
+WORK_ROWS = 7
+
 # Dormand-Prince 5(4) tableau
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
 A21 = 1.0 / 5.0
@@ -99,6 +105,12 @@ def ground(motion, t):
 
 
 @njit(cache=True)
+def interval_of(t, dt):
+    """Index of the sample interval that starts at or just before t (t within 1e-9 dt of a sample: that one)."""
+    return int(math.floor(t / dt + 1e-9))
+
+
+@njit(cache=True)
 def rhs(code, phase, sigma, x, accel, params, out):
     """dx/dt for state x = [theta, theta_dot, y, y_dot] given ground acceleration ``accel``."""
     if code == WINKLER:
@@ -119,7 +131,7 @@ def rhs(code, phase, sigma, x, accel, params, out):
 def dopri_step(code, phase, sigma, t, x, f0, h, motion, params, k, x_new, err):
     """One Dormand-Prince step from (t, x), f0 = f(t, x); fills x_new, k[5] = f(t+h, x_new), err.
 
-    k : (6, 4) work array for the stages k2..k7.
+    k : (WORK_ROWS, 4) work array: the stages k2..k7 in rows 0-5.
     """
     k2, k3, k4, k5, k6, k7 = k[0], k[1], k[2], k[3], k[4], k[5]
     tmp = err  # err is written last: use it as the stage buffer meanwhile
@@ -185,6 +197,12 @@ def adaptive_step(code, phase, sigma, t, x, f0, h, motion, params, scale, k, x_n
         h = h * max(MIN_FACTOR, SAFETY * norm ** ERROR_EXPONENT)
 
 
+@njit(cache=True)
+def workspace():
+    """Work arrays of one response: (k, f0, x_new, err, scale); the loops never allocate after this."""
+    return np.empty((WORK_ROWS, 4)), np.empty(4), np.empty(4), np.empty(4), np.empty(4)
+
+
 # ---------------------------------------------------------------------------------------------
 # dense output and event location
 # ---------------------------------------------------------------------------------------------
@@ -217,13 +235,15 @@ def support(code, params, x):
 
 
 @njit(cache=True)
-def event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s, motion, t0):
-    """The event function of ``kind`` on the step's interpolant at fraction s (sign change = event)."""
+def event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s, motion, t0, state):
+    """The event function of ``kind`` on the step's interpolant at fraction s (sign change = event).
+
+    state : (4,) scratch array (the interpolated state; passed in so the hot event loops never allocate).
+    """
     if kind == EVENT_IMPACT:
         return sigma * hermite(x0, f0, x1, f1, h, s, 0)
     if kind == EVENT_OVERTURN:
         return abs(hermite(x0, f0, x1, f1, h, s, 0)) - params["overturn"]
-    state = np.empty(4)
     for i in range(4):
         state[i] = hermite(x0, f0, x1, f1, h, s, i)
     if kind == EVENT_CONTACT:
@@ -234,11 +254,11 @@ def event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s, motion, 
 
 
 @njit(cache=True)
-def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0):
+def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0, state):
     """Fraction s in (0, 1] of the step where the event function changes sign (Illinois method)."""
     s_low, s_high = 0.0, 1.0
-    v_low = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_low, motion, t0)
-    v_high = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_high, motion, t0)
+    v_low = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_low, motion, t0, state)
+    v_high = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_high, motion, t0, state)
     side = 0
     for _ in range(100):
         if v_high == v_low:
@@ -246,7 +266,7 @@ def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0):
         s_mid = (s_low * v_high - s_high * v_low) / (v_high - v_low)
         if not (s_low < s_mid < s_high):
             s_mid = 0.5 * (s_low + s_high)
-        v_mid = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_mid, motion, t0)
+        v_mid = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_mid, motion, t0, state)
         if (v_mid > 0) == (v_high > 0):
             s_high, v_high = s_mid, v_mid
             if side == 1:
@@ -263,21 +283,21 @@ def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0):
 
 
 @njit(cache=True)
-def refine_event(kind, index, code, phase, sigma, t, x, f0, h, s_guess, motion, params, k, x_new, err):
+def refine_event(kind, index, code, phase, sigma, t, x, f0, h, s_guess, motion, params, k, x_new, err, state):
     """Take the step to the event found on the interpolant, then sharpen the event time on the real
     solution (Illinois method on the step length: the cubic interpolant alone is only 4th-order
     accurate, which long steps would feel). On entry x_new, k[5] hold the full step; on return they hold
     the step to the event (on its far side or at it). Returns the step length taken."""
     f1 = k[5]
-    g_low = event_value(kind, index, code, sigma, params, x, f0, x, f0, h, 0.0, motion, t)
-    g_high = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h, 1.0, motion, t)
+    g_low = event_value(kind, index, code, sigma, params, x, f0, x, f0, h, 0.0, motion, t, state)
+    g_high = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h, 1.0, motion, t, state)
     h_low, h_high = 0.0, h
     tolerance = EVENT_VALUE_FRACTION * max(abs(g_low), abs(g_high))
     h_event = s_guess * h
     side = 0
     for _ in range(EVENT_REFINEMENTS):
         dopri_step(code, phase, sigma, t, x, f0, h_event, motion, params, k, x_new, err)
-        g_event = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h_event, 1.0, motion, t)
+        g_event = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h_event, 1.0, motion, t, state)
         if (g_event > 0.0) == (g_high > 0.0):
             h_high, g_high = h_event, g_event
             if side == 1:
@@ -333,12 +353,6 @@ def state_scales(code, params, y_static, scale):
     scale[2] = max(y_static, STATE_SCALE_FLOOR)
     scale[3] = max(y_static * params["omega"], STATE_SCALE_FLOOR)
     return p2
-
-
-@njit(cache=True)
-def interval_of(t, dt):
-    """Index of the sample interval that starts at or just before t (t within 1e-9 dt of a sample: that one)."""
-    return int(math.floor(t / dt + 1e-9))
 
 
 @njit(cache=True)
@@ -419,26 +433,26 @@ def rest_until_uplift(motion, t, t_seg_end, threshold):
 
 
 @njit(cache=True)
-def pivot_event(code, phase, sigma, params, x, f0, x_new, k7, h, motion, t):
+def pivot_event(code, phase, sigma, params, x, f0, x_new, k7, h, motion, t, state):
     """The earliest event inside an accepted step of a pivot model: (kind, fraction s)."""
     kind = EVENT_NONE
     s_event = 2.0
     if phase == ROCKING:
         if sigma * x[0] > 0.0 and sigma * x_new[0] <= 0.0:
             kind = EVENT_IMPACT
-            s_event = locate(EVENT_IMPACT, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t)
+            s_event = locate(EVENT_IMPACT, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t, state)
         if abs(x_new[0]) >= params["overturn"]:
-            s_hit = locate(EVENT_OVERTURN, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t)
+            s_hit = locate(EVENT_OVERTURN, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t, state)
             if s_hit < s_event:
                 kind, s_event = EVENT_OVERTURN, s_hit
         if kind == EVENT_NONE and sigma * x[0] == 0.0 and sigma * x_new[0] < 0.0:
             kind, s_event = EVENT_SETTLE, 1.0
     else:
-        v_start = event_value(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, 0.0, motion, t)
-        v_end = event_value(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, 1.0, motion, t)
+        v_start = event_value(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, 0.0, motion, t, state)
+        v_end = event_value(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, 1.0, motion, t, state)
         if v_start <= 0.0 and v_end > 0.0:
             kind = EVENT_UPLIFT
-            s_event = locate(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t)
+            s_event = locate(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t, state)
     return kind, s_event
 
 
@@ -473,14 +487,12 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     tan_alpha = math.tan(alpha)
     omega = params["omega"]
     y_static = params["g"] / (omega * omega) if code != HOUSNER else 0.0
-    scale = np.empty(4)
+    k, f0, x_new, err, scale = workspace()
     p2 = state_scales(code, params, y_static, scale)
     zeno_speed = math.sqrt(2.0 * p2 * math.sin(alpha) * params["zeno"])
-    k = np.empty((6, 4))
-    f0 = np.empty(4)
-    x_new = np.empty(4)
-    err = np.empty(4)
-    k7 = k[5]
+    k7 = k[ROW_F1]
+    state = k[ROW_EVENT]
+    f0_current = False  # f0 = f(t, x) is known (first same as last: k7 of the step just taken)
 
     phase = REST
     sigma = 0.0
@@ -513,6 +525,7 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
                 sigma = -1.0 if accel > 0 else 1.0
                 x[0] = 0.0
                 x[1] = 0.0
+                f0_current = False
                 if summary["uplifted"] == 0.0:
                     summary["uplifted"] = 1.0
                     summary["time_of_uplift"] = t
@@ -531,19 +544,22 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
                     t = t_seg_end  # (a crossing at the very end starts at the next interval's top)
                     start_now = False
                 next_row = hold_rows(history, next_row, dt, t, x)
+                f0_current = False
                 continue
         h = min(h, t_seg_end - t)
-        rhs(code, phase, sigma, x, ground(motion, t), params, f0)
+        if not f0_current:
+            rhs(code, phase, sigma, x, ground(motion, t), params, f0)
         zeno_guard = phase == ROCKING and x[0] == 0.0 and sigma * x[1] > 0.0
         h, norm = adaptive_step(code, phase, sigma, t, x, f0, h, motion, params, scale, k, x_new, err, zeno_guard)
         summary["n_steps"] += 1.0
         if summary["n_steps"] > MAX_STEPS:
             failed = True
             break
-        kind, s_event = pivot_event(code, phase, sigma, params, x, f0, x_new, k7, h, motion, t)
+        kind, s_event = pivot_event(code, phase, sigma, params, x, f0, x_new, k7, h, motion, t, state)
         h_taken = h
         if kind != EVENT_NONE and kind != EVENT_SETTLE and s_event < 1.0:
-            h_taken = refine_event(kind, 0, code, phase, sigma, t, x, f0, h, s_event, motion, params, k, x_new, err)
+            h_taken = refine_event(kind, 0, code, phase, sigma, t, x, f0, h, s_event, motion, params, k, x_new, err,
+                                   state)
         if phase == ROCKING:
             track_peak(x, f0, x_new, k7, h_taken, t, summary, params["overturn"])
         if kind != EVENT_OVERTURN:
@@ -551,6 +567,8 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         t = t + h_taken
         for i in range(4):
             x[i] = x_new[i]
+            f0[i] = k7[i]
+        f0_current = True
         if code != HOUSNER:
             if phase == REST and abs(x[2] - y_static) < SNAP_TO_STATIC_FRACTION * y_static \
                     and abs(x[3]) < SNAP_TO_STATIC_FRACTION * y_static * omega:
@@ -558,6 +576,7 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
                 # the closed-form rest phase takes over (the support force changes by < 1e-4 g)
                 x[2] = y_static
                 x[3] = 0.0
+                f0_current = False
             force = ssi_support(x, params)
             if force < summary["min_support_force"]:
                 summary["min_support_force"] = force
@@ -577,8 +596,10 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
             x[0] = 0.0
             x[1] = 0.0
             sigma = 0.0
+            f0_current = False
         elif kind == EVENT_IMPACT:
             phase, sigma = pivot_impact(code, params, x, sigma, zeno_speed, t, impact_times, summary)
+            f0_current = False
             n_events += 1
         elif kind == EVENT_UPLIFT:
             start_now = True  # uplift located: the top of the loop starts rocking here
@@ -597,7 +618,7 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def bed_event(params, x, f0, x_new, k7, h, motion, t, before, after, min_fraction):
+def bed_event(params, x, f0, x_new, k7, h, motion, t, before, after, min_fraction, state):
     """Earliest contact change or overturning inside the step: (kind, indicator index, fraction s).
 
     before, after: the contact indicators at the step's ends (``winkler.contact_indicators``).
@@ -607,11 +628,11 @@ def bed_event(params, x, f0, x_new, k7, h, motion, t, before, after, min_fractio
     s_event = 2.0
     for i in range(N_CONTACT_INDICATORS):
         if (before[i] > 0.0) != (after[i] > 0.0):
-            s_hit = locate(EVENT_CONTACT, i, WINKLER, 0.0, params, x, f0, x_new, k7, h, motion, t)
+            s_hit = locate(EVENT_CONTACT, i, WINKLER, 0.0, params, x, f0, x_new, k7, h, motion, t, state)
             if s_hit < s_event and s_hit > min_fraction:
                 kind, index, s_event = EVENT_CONTACT, i, s_hit
     if abs(x_new[0]) >= params["overturn"]:
-        s_hit = locate(EVENT_OVERTURN, 0, WINKLER, 0.0, params, x, f0, x_new, k7, h, motion, t)
+        s_hit = locate(EVENT_OVERTURN, 0, WINKLER, 0.0, params, x, f0, x_new, k7, h, motion, t, state)
         if s_hit < s_event:
             kind, index, s_event = EVENT_OVERTURN, 0, s_hit
     return kind, index, s_event
@@ -666,15 +687,12 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     t_final = (ag.size + n_tail - 1) * dt
     omega = params["omega"]
     y_static = params["g"] / (omega * omega)
-    scale = np.empty(4)
+    k, f0, x_new, err, scale = workspace()
     state_scales(code, params, y_static, scale)
-    k = np.empty((6, 4))
-    f0 = np.empty(4)
-    x_new = np.empty(4)
-    err = np.empty(4)
     before = np.empty(N_CONTACT_INDICATORS)
     after = np.empty(N_CONTACT_INDICATORS)
-    k7 = k[5]
+    k7 = k[ROW_F1]
+    state = k[ROW_EVENT]
     force, _ = bed_force(x, params)
     start_summary(summary, x, force)
     contact_indicators(x, params, before)
@@ -686,9 +704,9 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     h = dt * 0.25
     failed = False
     overturned = False
+    rhs(code, ROCKING, 0.0, x, ground(motion, t), params, f0)
     while t < t_final - SEGMENT_END_FRACTION * dt:
         h = min(h, (interval_of(t, dt) + 1) * dt - t)  # steps end on every sample (see pivot_loop)
-        rhs(code, ROCKING, 0.0, x, ground(motion, t), params, f0)
         h, norm = adaptive_step(code, ROCKING, 0.0, t, x, f0, h, motion, params, scale, k, x_new, err, False)
         summary["n_steps"] += 1.0
         if summary["n_steps"] > MAX_STEPS:
@@ -697,12 +715,12 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         contact_indicators(x_new, params, after)
         # an event at the very start of the step is the one just located: ignore it
         kind, index, s_event = bed_event(params, x, f0, x_new, k7, h, motion, t, before, after,
-                                         EVENT_TIME_RESOLUTION / h)
+                                         EVENT_TIME_RESOLUTION / h, state)
         h_taken = h
         event_at_end = False
         if kind != EVENT_NONE and s_event < 1.0:
-            h_taken = refine_event(kind, index, code, ROCKING, 0.0, t, x, f0, h, s_event, motion, params, k,
-                                   x_new, err)
+            h_taken = refine_event(kind, index, code, ROCKING, 0.0, t, x, f0, h, s_event, motion, params, k, x_new,
+                                   err, state)
             far_side = after[index]
             contact_indicators(x_new, params, after)
             if kind == EVENT_CONTACT and ((after[index] > 0.0) != (far_side > 0.0) or after[index] == 0.0):
@@ -714,6 +732,7 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
             next_row = write_rows(history, next_row, dt, t, h_taken, x, f0, x_new, k7)
         for i in range(4):
             x[i] = x_new[i]
+            f0[i] = k7[i]  # first same as last: the bed's force law is continuous, so is f
         t = t + h_taken
         bed_bookkeeping(params, x, h_taken, t, ground(motion, t), k7, before, after, event_at_end, summary,
                         impact_times)
