@@ -121,6 +121,7 @@ class CalibrationResult:
     soil_shear_modulus: float | None
     block_modulus: float
     model: str = "ssi"
+    bed: str | None = None  # winkler's bed type (continuous | two-spring); None for models without a bed
     objective: float = math.nan
     n_simulations: int = 0
     n_windows: int = 0
@@ -605,11 +606,21 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
         k=float(k_fit), xi=float(xi_fit), correlation=score, rms_error=rms,
         peak_error=(peak_model - peak_reference) / peak_reference, peak_reference=peak_reference,
         peak_model=peak_model, area_over_depth=area_over_depth, soil_shear_modulus=soil_shear_modulus,
-        block_modulus=block.E_b, model=model, objective=best_score, n_simulations=search.count,
+        block_modulus=block.E_b, model=model, bed=_bed_of(model, solver_options), objective=best_score,
+        n_simulations=search.count,
         n_windows=n_windows, seconds=clock.perf_counter() - started,
         surface_k=[search.physical((u, 0))[0] for u in u_grid],
         surface_xi=[search.physical((0, v))[1] for v in v_grid],
         surface=surface.reshape(n_k, n_xi).tolist())
+
+
+def _bed_of(model, solver_options):
+    """The bed type a calibration of ``model`` ran with (None when the model has no bed)."""
+    from pipeline.models import SolverOptions, get_model
+
+    if not get_model(model).uses_bed:
+        return None
+    return solver_options.get("bed", SolverOptions.bed)
 
 
 # ----------------------------------------------------------------------------------------- outputs
@@ -637,6 +648,8 @@ def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, blo
         t, th, _, _ = simulate_histories(result.model, ag, dt, [(block, result.k, result.xi)], switch=switch,
                                          t_end=float(ref_time[-1]) + dt, **solver_options)
     label = getattr(get_model(result.model), "label", result.model)
+    if result.bed:
+        label += f" ({result.bed} bed)"
     figure, axis = plt.subplots(figsize=(10, 4.5), constrained_layout=True)
     axis.plot(ref_time, ref_rotation, color="k", lw=1.0, label="reference")
     axis.plot(t, th[0], color="C3", lw=0.9, ls="--",

@@ -276,6 +276,19 @@ def _ground_motion(args, config):
     return record, record.acceleration * args.scale
 
 
+def _calibration_bed(args, config) -> dict:
+    """``{"bed": ...}`` for a model with a bed (``--bed``, else the study's ``[solver] bed``), else ``{}``."""
+    from pipeline.models import BED_TYPES, get_model
+
+    if args.bed is not None and args.bed not in BED_TYPES:
+        raise PipelineError(f"--bed {args.bed!r} unknown; valid: {', '.join(BED_TYPES)}")
+    if not get_model(args.model).uses_bed:
+        if args.bed is not None:
+            raise PipelineError(f"--bed {args.bed}: model {args.model!r} has no bed; --bed applies to winkler")
+        return {}
+    return {"bed": args.bed or config.bed}
+
+
 def command_calibrate(args) -> int:
     from pipeline.calibrate import calibrate, check_reference, load_reference, write_outputs
 
@@ -284,6 +297,7 @@ def command_calibrate(args) -> int:
     if args.block not in blocks:
         raise PipelineError(f"unknown block {args.block!r}; blocks of the study: {', '.join(blocks)}")
     block = blocks[args.block]
+    bed_option = _calibration_bed(args, config)
     reference = load_reference(args.reference, args.time_unit, args.angle_unit)
     print(reference.describe_units())
     record, ag = _ground_motion(args, config)
@@ -301,8 +315,11 @@ def command_calibrate(args) -> int:
     result = calibrate(reference.time, reference.rotation, ag, record.dt, block, model=args.model,
                        k_range=tuple(args.k_range), xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi,
                        soil_shear_modulus=soil_g, switch=config.switch, local=not args.grid_only,
-                       log=lambda line: print(line, file=sys.stderr))
-    files = write_outputs(result, reference.time, reference.rotation, ag, record.dt, block, output, config.switch)
+                       log=lambda line: print(line, file=sys.stderr), **bed_option)
+    files = write_outputs(result, reference.time, reference.rotation, ag, record.dt, block, output, config.switch,
+                          **bed_option)
+    if result.bed:
+        print(f"bed           : {result.bed}")
     print(f"grid optimum  : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation (eq. 17) "
           f"{result.correlation_grid:.4f}")
     if not args.grid_only:
@@ -395,6 +412,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "(default: from its header, else rad)")
     calibrate.add_argument("--model", default="ssi", help="the model to calibrate: any with a foundation, e.g. "
                            "ssi, ssi-paper, winkler (default ssi)")
+    calibrate.add_argument("--bed", default=None, metavar="BED",
+                           help="winkler's bed: continuous or two-spring (default: the study's [solver] bed)")
     calibrate.set_defaults(handler=command_calibrate)
 
     applicability = commands.add_parser(

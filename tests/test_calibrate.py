@@ -4,6 +4,7 @@ its outputs and refuses nonsense with exit code 2."""
 
 from __future__ import annotations
 
+import json
 import math
 import warnings
 
@@ -221,10 +222,30 @@ def test_cli_calibrate_writes_summary_and_figures_and_prints_units(tmp_path, bol
         assert (tmp_path / "out" / name).stat().st_size > 0
 
 
+@pytest.mark.parametrize("bed_arguments, study_bed, bed", [
+    ([], "continuous", "continuous"),                      # the study's [solver] bed
+    ([], "two-spring", "two-spring"),
+    (["--bed", "two-spring"], "continuous", "two-spring"),  # --bed overrides it
+])
+def test_cli_calibrates_winkler_on_the_chosen_bed(tmp_path, bolu_reference_file, capsys, bed_arguments, study_bed,
+                                                  bed):
+    study = tmp_path / "study.toml"
+    study.write_text(f'[solver]\nbed = "{study_bed}"\n')
+    status = main(["calibrate", str(bolu_reference_file), "--record", "DUZCE/BOL090", "--scale", "1.5",
+                   "--model", "winkler", *bed_arguments, "--n-k", "3", "--n-xi", "2", "--grid-only",
+                   "--study", str(study), "--output", str(tmp_path / "out")])
+    assert status == 0
+    assert f"bed           : {bed}" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    assert summary["model"] == "winkler" and summary["bed"] == bed
+
+
 @pytest.mark.parametrize("problem, arguments, message", [  # --n-k 0: the parser's, tests/test_cli_vocabulary.py
     ("zero", [], "constant"),
     ("microseconds", ["--time-unit", "us"], "lasts"),
     ("model", ["--model", "housner"], "no foundation"),
+    ("bed for a model without one", ["--bed", "two-spring"], "model 'ssi' has no bed"),
+    ("unknown bed", ["--model", "winkler", "--bed", "sponge"], "--bed 'sponge' unknown; valid: continuous, two-spring"),
 ])
 def test_cli_calibrate_refuses_nonsense_with_one_line(tmp_path, bolu_reference_file, capsys, problem, arguments,
                                                       message):
