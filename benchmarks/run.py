@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "physics"))
+sys.path.insert(0, str(ROOT))  # this checkout's pipeline and its test suite's scipy references
 warnings.simplefilter("ignore")
 
 import calibration  # noqa: E402  (benchmarks/calibration.py)
-from reference import reference_response  # noqa: E402
+from tests.physics.reference import reference_response  # noqa: E402  (the independent scipy reference)
 
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.config import load_study  # noqa: E402
