@@ -105,6 +105,9 @@ def _output_option():
     parent.add_argument("--output", type=Path, default=None, metavar="DIR",
                         help="output folder (default: the study's study.output, reports/)")
     parent.add_argument("--no-progress", action="store_true", help="hide progress bars")
+    parent.add_argument("--wait", action="store_true",
+                        help="if another rockfrag run is writing to the output folder, wait for it to finish "
+                             "(default: stop with an error)")
     return parent
 
 
@@ -532,7 +535,7 @@ def main(argv=None) -> int:
         if output is None:
             return args.handler(args)
         args.locked_output = output
-        with output_lock(output):
+        with output_lock(output, wait=getattr(args, "wait", False), notify=lambda line: _log(f"rockfrag: {line}")):
             return args.handler(args)
     except PipelineError as error:
         print(f"rockfrag: error: {' '.join(str(error).splitlines())}", file=sys.stderr)

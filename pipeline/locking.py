@@ -3,7 +3,7 @@
 Input : an output folder.
 Output: an advisory lock (``fcntl.flock`` on ``<folder>/.rockfrag.lock``, holding the owner's pid)
         kept while a command writes there. A second run on the same folder stops with one line
-        naming the folder and the owner's pid (or waits, ``wait=True``). The kernel drops the lock
+        naming the folder and the owner's pid (or waits, ``wait=True``, the CLI's ``--wait``). The kernel drops the lock
         when its owner dies, even by ``kill -9``, so a lock is never stale.
 
 Every rockfrag writer in a folder holds its lock, so the temporary ``.*.part`` files found there
@@ -53,12 +53,16 @@ def stale_part_files(folder) -> list[Path]:
             for path in where.glob(".*.part") if path.is_file()]
 
 
+BUSY = (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
+
+
 @contextlib.contextmanager
-def output_lock(folder, wait=False):
+def output_lock(folder, wait=False, notify=None):
     """Hold the advisory lock of ``folder`` (created if needed) for the duration of the block.
 
     Re-entrant within one process. On first acquisition the stale ``.part`` files of dead runs
-    are removed.
+    are removed. A folder held by another run is a one-line ``PipelineError``, or with ``wait`` the
+    call blocks until that run ends, after telling ``notify`` (a callable taking one line) once.
     """
     folder = prepare_output_folder(folder)
     key = folder.resolve()
@@ -75,13 +79,24 @@ def output_lock(folder, wait=False):
     except OSError as error:
         raise PipelineError(f"output folder {folder} is not writable ({error.strerror})") from None
     try:
-        fcntl.flock(descriptor, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as error:
+            if error.errno not in BUSY or not wait:
+                raise
+            if notify is not None:
+                notify(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
+                       "waiting for it to finish (Ctrl-C stops waiting)")
+            fcntl.flock(descriptor, fcntl.LOCK_EX)
     except OSError as error:
         os.close(descriptor)
-        if error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+        if error.errno in BUSY:
             raise PipelineError(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
-                                "wait for it to finish or choose another --output") from None
+                                "wait for it to finish, choose another --output, or pass --wait") from None
         raise PipelineError(f"cannot lock the output folder {folder} ({error.strerror})") from None
+    except BaseException:  # Ctrl-C while waiting
+        os.close(descriptor)
+        raise
     _held[key] = [descriptor, 1]
     try:
         os.ftruncate(descriptor, 0)

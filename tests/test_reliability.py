@@ -12,6 +12,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
@@ -275,6 +276,28 @@ def test_second_run_on_a_locked_folder_stops_with_one_line(tmp_path, capsys):
         assert_one_line_error(captured.err, str(output), "in use by another rockfrag run", "pid 4242")
         assert (output / ".cube.nc.abc.part").exists()  # the other run's temporary file is untouched
     assert not (output / "cube.nc").exists()
+
+
+def test_wait_lets_a_second_run_start_when_the_first_one_ends(tmp_path, capsys):
+    output = tmp_path / "out"
+    output.mkdir()
+    handle = open(output / LOCK_NAME, "w")  # another run holds the folder, and ends 1 s later
+    fcntl.flock(handle, fcntl.LOCK_EX)
+    handle.write("4242\n")
+    handle.flush()
+    released = threading.Timer(1.0, handle.close)
+    released.start()
+    started = time.monotonic()
+    try:
+        status = cli.main(_tiny_run_argv(tmp_path, "--output", str(output), "--wait"))
+    finally:
+        released.join()
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    assert time.monotonic() - started >= 1.0
+    waiting = [line for line in captured.err.splitlines() if "waiting for it to finish" in line]
+    assert len(waiting) == 1 and "pid 4242" in waiting[0] and str(output) in waiting[0]
+    assert (output / "cube.nc").is_file()
 
 
 def test_stale_part_files_are_removed_when_the_folder_is_free(tmp_path, capsys):
