@@ -26,7 +26,7 @@ from tests.physics.reference import reference_response  # noqa: E402  (the indep
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.config import load_study  # noqa: E402
 from pipeline.ida import hunt_and_fill  # noqa: E402
-from pipeline.models import get_model, simulate, simulate_batch  # noqa: E402
+from pipeline.models import Outcome, get_model, simulate, simulate_batch  # noqa: E402
 from pipeline.soils import soil_block_stiffness  # noqa: E402
 from pipeline.processing import process_record  # noqa: E402
 from pipeline.records import load_records  # noqa: E402
@@ -135,7 +135,8 @@ def accuracy_and_chaos(records):
                 nudged = simulate_batch("winkler", record.acceleration, record.dt, scales * (1 + 1e-7), cases,
                                         rtol=1e-10, atol=1e-11, **window)[0]
                 default = simulate_batch("winkler", record.acceleration, record.dt, scales, cases, **window)[0]
-                standing = (truth["status"] != 2) & (nudged["status"] != 2) & (default["status"] != 2)
+                overturned = int(Outcome.OVERTURNED)
+                standing = np.all([run["status"] != overturned for run in (truth, nudged, default)], axis=0)
                 peak = truth["peak_angle"][standing]
                 sensitivity += list(np.abs(nudged["peak_angle"][standing] - peak) / peak)
                 error += list(np.abs(default["peak_angle"][standing] - peak) / peak)

@@ -3,8 +3,8 @@
 Input : an output folder.
 Output: an advisory lock (``fcntl.flock`` on ``<folder>/.rockfrag.lock``, holding the owner's pid)
         kept while a command writes there. A second run on the same folder stops with one line
-        naming the folder and the owner's pid (or waits, ``wait=True``, the CLI's ``--wait``). The kernel drops the lock
-        when its owner dies, even by ``kill -9``, so a lock is never stale.
+        naming the folder and the owner's pid (or waits: ``wait=True``, the CLI's ``--wait``). The
+        kernel drops the lock when its owner dies, even by ``kill -9``, so a lock is never stale.
 
 Every rockfrag writer in a folder holds its lock, so the temporary ``.*.part`` files found there
 by the process that has just taken the lock belong to runs that died: they are removed then, and

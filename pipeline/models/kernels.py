@@ -105,12 +105,6 @@ def ground(motion, t):
 
 
 @njit(cache=True)
-def interval_of(t, dt):
-    """Index of the sample interval that starts at or just before t (t within 1e-9 dt of a sample: that one)."""
-    return int(math.floor(t / dt + 1e-9))
-
-
-@njit(cache=True)
 def rhs(code, phase, sigma, x, accel, params, out):
     """dx/dt for state x = [theta, theta_dot, y, y_dot] given ground acceleration ``accel``."""
     if code == WINKLER:
@@ -288,7 +282,7 @@ def refine_event(kind, index, code, phase, sigma, t, x, f0, h, s_guess, motion, 
     solution (Illinois method on the step length: the cubic interpolant alone is only 4th-order
     accurate, which long steps would feel). On entry x_new, k[5] hold the full step; on return they hold
     the step to the event (on its far side or at it). Returns the step length taken."""
-    f1 = k[5]
+    f1 = k[ROW_F1]
     g_low = event_value(kind, index, code, sigma, params, x, f0, x, f0, h, 0.0, motion, t, state)
     g_high = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h, 1.0, motion, t, state)
     h_low, h_high = 0.0, h
@@ -356,6 +350,12 @@ def state_scales(code, params, y_static, scale):
 
 
 @njit(cache=True)
+def interval_of(t, dt):
+    """Index of the sample interval that starts at or just before t (t within 1e-9 dt of a sample: that one)."""
+    return int(math.floor(t / dt + 1e-9))
+
+
+@njit(cache=True)
 def write_rows(history, next_row, dt, t0, h, x0, f0, x1, f1):
     """History rows at the sample times in (t0, t0 + h], from the step's interpolant; returns the next row."""
     if history.shape[0] == 0:
@@ -390,6 +390,14 @@ def finish(history, next_row, summary, status, t):
                 history[row, i] = np.nan
     summary["status"] = status
     summary["t_end"] = t
+
+
+@njit(cache=True)
+def book_overturn(summary, params, t):
+    """The block reached the overturning angle at time t."""
+    summary["time_of_overturn"] = t
+    summary["peak_angle"] = params["overturn"]
+    summary["time_of_peak"] = t
 
 
 @njit(cache=True)
@@ -587,9 +595,7 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         h = next_step(h, norm)
         if kind == EVENT_OVERTURN:
             status = OVERTURNED
-            summary["time_of_overturn"] = t
-            summary["peak_angle"] = params["overturn"]
-            summary["time_of_peak"] = t
+            book_overturn(summary, params, t)
             break
         if kind == EVENT_SETTLE:
             phase = REST
@@ -744,9 +750,7 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
             break  # the ground is at rest and the block can no longer reach its peak or lift (no history kept)
         if kind == EVENT_OVERTURN:
             overturned = True
-            summary["time_of_overturn"] = t
-            summary["peak_angle"] = params["overturn"]
-            summary["time_of_peak"] = t
+            book_overturn(summary, params, t)
             break
     status = NO_UPLIFT
     if summary["uplifted"] > 0.0:
