@@ -12,18 +12,23 @@ Output: ``reports/applicability.nc`` with, per compared model (``winkler``, the 
 
 from __future__ import annotations
 
+import hashlib
+import json
 import warnings
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from pipeline import __version__
 from pipeline.calibrate import correlation
+from pipeline.executors import shutdown_pool, worker_pool
 from pipeline.models import get_model, simulate_histories
 from pipeline.models.base import Outcome
 from pipeline.outputs import atomic_path
 from pipeline.soils import interface_stiffness
+from pipeline.study import StudyRecords, study_records
 
 DEFAULT_SHEAR_MODULI = np.geomspace(10e6, 100e9, 13)
 DEFAULT_LEVEL_FACTORS = (1.5, 2.5, 4.0)
@@ -94,8 +99,6 @@ def run_applicability(records, blocks, *, shear_moduli=DEFAULT_SHEAR_MODULI, blo
     models = [name for name in models if not get_model(name).is_rigid_base]
     options = dict(options or {})
     from tqdm import tqdm
-
-    from pipeline.study import shutdown_pool, worker_pool
 
     shear_moduli = np.asarray(shear_moduli, float)
     arguments = [(r.acceleration, r.dt, float(np.max(np.abs(r.acceleration))), list(blocks), list(block_moduli),
@@ -213,21 +216,16 @@ def write_applicability(dataset, output) -> list[Path]:
     return [output / "applicability.nc", path]
 
 
-def applicability_stage(config, output, workers=None, progress=True, log=print, loaded=None):
+def applicability_stage(config, output, workers=None, progress=True, log=print,
+                        loaded: StudyRecords | None = None):
     """Run the study's sweep (``config.applicability``), or reuse ``applicability.nc`` when its inputs are unchanged.
 
-    ``loaded`` may pass ``study.study_records(config)`` to avoid reading the records again.
+    ``loaded`` may pass the study's ``StudyRecords`` (``study.study_records(config)``) to avoid reading
+    the records again.
     """
-    import hashlib
-    import json
-
-    from pipeline import __version__
-    from pipeline.study import study_records
-
-    from dataclasses import asdict
-
     output = Path(output)
-    records, _, recipe = loaded or study_records(config, log)
+    loaded = loaded or study_records(config, log)
+    records, recipe = loaded.records, loaded.recipe
     sweep = config.applicability  # the study's [applicability] table: one definition for every caller
     models = [name for name in config.models if not get_model(name).is_rigid_base] or list(DEFAULT_MODELS)
     models.sort(key=lambda name: get_model(name).can_pull)  # the admissible (tensionless) models first

@@ -247,7 +247,7 @@ def command_fragility(args) -> int:
     if "capacity_scale_factor" in cube:  # measure ranking from the adaptive capacities (no solver runs)
         from pipeline.efficiency import efficiency_stage
 
-        efficiency_stage(cube, loaded[0], config, output)
+        efficiency_stage(cube, loaded.records, config, output)
         print(f"wrote {output / 'efficiency.nc'} and {output / 'efficiency.csv'}")
     fragility, risk = fragility_stage(cube, ida, config, output, progress=not args.no_progress)
     for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):

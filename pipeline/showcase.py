@@ -1,7 +1,7 @@
 """pipeline.showcase - study-time data the report draws besides the cube: the record set's measures
 and spectra, and the response histories of one showcase record.
 
-Input : the study configuration and its processed records (``study.study_records``).
+Input : the study configuration and its processed records (``study.StudyRecords``).
 Output: ``reports/showcase.nc`` holding
         * per record (dim ``record``; ``period`` for spectra): PGA [m/s^2], PGV [m/s], Arias
           intensity [m/s], D5-95 [s], Sa(1 s) [m/s^2] and the 5%-damped spectrum of each processed record;
@@ -32,6 +32,7 @@ from pipeline.models import get_model, simulate
 from pipeline.outputs import atomic_path
 from pipeline.processing import integrate, process_record
 from pipeline.soils import soil_block_stiffness
+from pipeline.study import StudyRecords, study_records
 
 PAPER_RECORD = "DUZCE/BOL090"
 SPECTRUM_PERIODS = np.geomspace(0.02, 10.0, 60)
@@ -223,15 +224,15 @@ def input_hash(config, records, recipe) -> str:
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
-def showcase_stage(config, output, loaded=None, log=print) -> xr.Dataset:
+def showcase_stage(config, output, loaded: StudyRecords | None = None, log=print) -> xr.Dataset:
     """Write ``showcase.nc`` (or reuse it when its inputs are unchanged); returns the dataset.
 
-    ``loaded`` may pass ``study.study_records(config)`` to avoid reading the records again.
+    ``loaded`` may pass the study's ``StudyRecords`` (``study.study_records(config)``) to avoid reading
+    the records again.
     """
-    from pipeline.study import study_records
-
     path = Path(output) / FILE_NAME
-    records, _, recipe = loaded or study_records(config, log)
+    loaded = loaded or study_records(config, log)
+    records, recipe = loaded.records, loaded.recipe
     if not records:
         raise PipelineError("no record to describe in showcase.nc")
     key = input_hash(config, records, recipe)

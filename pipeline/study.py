@@ -16,28 +16,25 @@ block, soil, model, solver settings, package version), so an interrupted study r
 stopped and a changed input recomputes only the cells it touches. Housner results do not depend on
 the soil: they are computed once per block and shared by every soil.
 
-Executors: in-process (workers=1), all local cores (default, process pool), or dask.distributed
-(``scheduler`` address of a running cluster, or ``dask_workers`` to start a LocalCluster). Every
-executor runs the same pure task function, so the cube is identical whatever the executor.
+Executors (pipeline.executors): in-process (workers=1), all local cores (default, process pool), or
+dask.distributed (``scheduler`` address of a running cluster, or ``dask_workers`` to start a
+LocalCluster). Every executor runs the same pure task function, so the cube is identical whatever the
+executor.
 
 Reliability: checkpoints verify themselves (pipeline.checkpoints; a damaged one is quarantined and
 recomputed), the output folder is locked for the run (pipeline.locking), pool workers die with the
 study process (parent-death signal), cells of a worker that was killed are retried once in a fresh
-pool and then reported, and a record that cannot be processed or scaled is skipped with its reason.
+pool and then reported (pipeline.executors), and a record that cannot be processed or scaled is
+skipped with its reason. The records are read and processed once per command (``study_records``,
+a ``StudyRecords``) and shared with the showcase, efficiency and applicability stages.
 """
 
 from __future__ import annotations
 
-import ctypes
 import hashlib
 import json
-import os
-import signal
 import sys
-import threading
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from concurrent.futures.process import BrokenProcessPool
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -47,14 +44,15 @@ from pipeline import __version__
 from pipeline.cube import build_cube, write_netcdf
 from pipeline.checkpoints import CheckpointStore
 from pipeline.errors import PipelineError, RecordError
+from pipeline.executors import check_workers, make_executor, pool_executor, run_tasks
 from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
 from pipeline.locking import output_lock
 from pipeline.measures import MEASURES, pga
 from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, simulate_batch
 from pipeline.models.base import Outcome
 from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
-from pipeline.processing import load_recipe, process_records
-from pipeline.records import load_records
+from pipeline.processing import ProcessingRecipe, load_recipe, process_records
+from pipeline.records import Record, load_records
 from pipeline.soils import soil_block_stiffness
 
 
@@ -192,164 +190,49 @@ def _warm_up(models):
         simulate_batch(model, np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
 
 
-PR_SET_PDEATHSIG = 1  # linux/prctl.h
+@dataclass(frozen=True)
+class StudyRecords:
+    """A study's records, read and processed once and handed to every stage that needs them.
 
-
-def _die_with_parent(parent_pid):
-    """Worker initializer: end this worker when the study process dies, even by ``kill -9``.
-
-    Linux delivers SIGKILL on the parent's death (prctl PR_SET_PDEATHSIG); a watchdog thread that
-    polls the parent pid covers other systems and the window before prctl took effect.
+    Attributes
+    ----------
+    records : list of pipeline.records.Record
+        The processed records, in the study's order: acceleration [m/s^2] sampled every ``dt`` [s],
+        with the processing provenance in ``trace.stats.processing``.
+    failures : list of pipeline.errors.RecordError
+        The records that could not be read or processed, each with its one-line reason.
+    recipe : pipeline.processing.ProcessingRecipe
+        The processing recipe applied (part of every cell's checkpoint key and of the outputs' hashes).
     """
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-    except (OSError, AttributeError):  # not Linux: the watchdog alone
-        pass
-    if os.getppid() != parent_pid:
-        os._exit(1)
 
-    def watch():
-        while os.getppid() == parent_pid:
-            time.sleep(1.0)
-        os._exit(1)
-
-    threading.Thread(target=watch, name="rockfrag-parent-watchdog", daemon=True).start()
+    records: list[Record]
+    failures: list[RecordError]
+    recipe: ProcessingRecipe
 
 
-def worker_pool(max_workers) -> ProcessPoolExecutor:
-    """A process pool whose workers die with this process (use it for every local pool)."""
-    return ProcessPoolExecutor(max_workers=max_workers, initializer=_die_with_parent, initargs=(os.getpid(),))
+def study_records(config, log=print) -> StudyRecords:
+    """The study's records, processed with its recipe.
 
-
-POOL_EXIT_SECONDS = 10.0
-"""How long a finished pool's workers may take to exit before they are killed."""
-
-
-def shutdown_pool(pool, wait=True, timeout=POOL_EXIT_SECONDS):
-    """Shut a process pool down; with ``wait``, its workers are gone when this returns.
-
-    ``ProcessPoolExecutor.shutdown(wait=True)`` waits forever if a worker is killed while it holds
-    the task queue's lock (the others then never read their exit sentinel); here stragglers are
-    killed after ``timeout`` seconds instead.
-    """
-    processes = list((getattr(pool, "_processes", None) or {}).values())  # private, only to bound the wait
-    pool.shutdown(wait=False, cancel_futures=True)
-    if not wait:
-        return
-    deadline = time.monotonic() + timeout
-    for process in processes:
-        process.join(max(0.0, deadline - time.monotonic()))
-    for process in processes:
-        if process.is_alive():
-            process.kill()
-            process.join(1.0)
-
-
-def _is_lost_worker(error) -> bool:
-    """A worker process died under the task (OOM killer, kill -9): the task may be retried."""
-    return isinstance(error, BrokenProcessPool) or type(error).__name__ == "KilledWorker"
-
-
-def _executor(workers, scheduler, dask_workers):
-    """(submit, as_completed, shutdown(finished: bool)) for the chosen executor."""
-    if scheduler or dask_workers:
-        from dask.distributed import Client, LocalCluster
-        from dask.distributed import as_completed as dask_completed
-
-        cluster = None
-        if scheduler:
-            try:
-                client = Client(scheduler, timeout="10s")
-            except (OSError, TimeoutError, ValueError) as error:
-                raise PipelineError(f"cannot connect to the dask scheduler at {scheduler!r} ({error}); "
-                                    "expected the address of a running scheduler, e.g. tcp://host:8786") from None
-        else:
-            cluster = LocalCluster(n_workers=dask_workers, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
-            client = Client(cluster)
-            # local dask workers already exit when this process dies (distributed's parent-alive pipe)
-
-        def shutdown(finished):
-            client.close()
-            if cluster is not None:
-                cluster.close()
-
-        return (lambda *a: client.submit(compute_cells, *a, pure=False), dask_completed, shutdown)
-    if workers == 1:
-        class InProcess:  # computed when asked for, so errors surface where pool errors do
-            def __init__(self, arguments):
-                self._arguments = arguments
-
-            def result(self):
-                return compute_cells(*self._arguments)
-
-        return (lambda *a: InProcess(a), lambda futures: list(futures), lambda finished: None)
-    return _pool_executor(workers or os.cpu_count())
-
-
-def _pool_executor(n_workers):
-    pool = worker_pool(n_workers)
-    return (lambda *a: pool.submit(compute_cells, *a), as_completed,
-            lambda finished: shutdown_pool(pool, wait=finished))
-
-
-def run_tasks(tasks, submit_arguments, make_executor, on_result, attempts=2, describe=str, isolate=None):
-    """Run ``tasks`` on executors from ``make_executor()``; returns the tasks lost ``attempts`` times.
-
-    A task whose worker process died (BrokenProcessPool, dask KilledWorker) is run again in a fresh
-    executor; results already received are kept (``on_result(task, result)`` saw them). A broken pool
-    fails every task it still held, so the tasks lost in the last attempt are run once more one by one
-    on ``isolate()`` executors (if given): only a task that kills its own worker is returned. Any other
-    exception propagates, with a note naming the task (``describe(task)``).
-    """
-    pending = list(tasks)
-    for _ in range(attempts):
-        if not pending:
-            break
-        pending = _run_round(pending, submit_arguments, make_executor(), on_result, describe)
-    if pending and isolate is not None and len(pending) > 1:
-        pending = [task for task in pending
-                   for task in _run_round([task], submit_arguments, isolate(), on_result, describe)]
-    return pending
-
-
-def _run_round(pending, submit_arguments, executor, on_result, describe):
-    """Submit ``pending`` to one executor; the tasks lost with a dead worker."""
-    submit, completed, shutdown = executor
-    lost, finished = [], False
-    try:
-        futures = {}
-        for task in pending:
-            try:
-                futures[submit(*submit_arguments(task))] = task
-            except Exception as error:  # the pool broke while tasks were being submitted
-                if not _is_lost_worker(error):
-                    raise
-                lost.append(task)
-        for future in completed(list(futures)):
-            try:
-                result = future.result()
-            except Exception as error:
-                if not _is_lost_worker(error):
-                    error.add_note(describe(futures[future]))
-                    raise
-                lost.append(futures[future])
-                continue
-            on_result(futures[future], result)
-        finished = True
-    finally:
-        # a broken pool is joined before the next one forks, so no thread of it is caught mid-way
-        shutdown(bool(lost) or finished)
-    return lost
-
-
-def study_records(config, log=print):
-    """The study's records, processed with its recipe: (records, failures, recipe).
-
-    Every stage that needs the study's records (study, applicability, report) takes them from here,
-    so ``rockfrag fragility`` reads and processes them once. A record that cannot be read or
+    Every stage that needs the study's records (study, showcase, applicability, efficiency) takes them
+    from here, so ``rockfrag fragility`` reads and processes them once. A record that cannot be read or
     processed is skipped and reported (``log``); the others go on.
+
+    Parameters
+    ----------
+    config : pipeline.config.StudyConfig
+        The study (record sets, record units and dt, processing recipe).
+    log : callable
+        Receives one line per skipped record.
+
+    Returns
+    -------
+    StudyRecords
+        The processed records, the skipped ones with their reasons, and the recipe.
+
+    Raises
+    ------
+    PipelineError
+        When no record could be read and processed.
     """
     recipe = load_recipe(config.processing or None)
     raw_records, failures = load_records(list(config.record_sets), units=config.record_units or None,
@@ -360,13 +243,7 @@ def study_records(config, log=print):
         log(f"rockfrag: skipped {failure}")
     if not processed:
         raise PipelineError("no record could be read; nothing to run")
-    return processed, failures, recipe
-
-
-def _check_workers(workers, dask_workers):
-    for option, value in (("--workers", dask_workers), ("workers", workers)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, int) or value <= 0):
-            raise PipelineError(f"{option} {value!r}: expected a whole number of worker processes >= 1")
+    return StudyRecords(processed, failures, recipe)
 
 
 def _scalable(records, record_im, log):
@@ -392,11 +269,11 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
               progress=True, log=print, loaded=None, wait=False, warn=_to_stderr):
     """Run (or resume) a study and write ``cube.nc``; returns (dataset, statistics dict).
 
-    ``loaded`` may pass the result of ``study_records`` to avoid reading the records again.
+    ``loaded`` may pass the study's ``StudyRecords`` (``study_records``) to avoid reading the records again.
     ``log`` receives progress lines, ``warn`` one line per skipped record or damaged checkpoint.
     The output folder is locked for the run (a second run stops, or waits with ``wait=True``).
     """
-    _check_workers(workers, dask_workers)
+    check_workers(workers, dask_workers)
     output = Path(output or config.output)
     with output_lock(output, wait=wait):
         return _run_locked(config, output, workers, scheduler, dask_workers, progress, log, warn, loaded)
@@ -406,8 +283,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     from tqdm import tqdm
 
     started = time.perf_counter()
-    records, failures, recipe = loaded or study_records(config, warn)
-    failures = list(failures)
+    loaded = loaded or study_records(config, warn)
+    records, failures, recipe = loaded.records, list(loaded.failures), loaded.recipe
     record_im = record_intensities(records, config)
     keep, unscalable = _scalable(records, record_im, warn)
     failures += unscalable
@@ -450,9 +327,9 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                              lambda task: (records[task[0]].acceleration, records[task[0]].dt,
                                            scale_factors[task[0], :, task[1]], task[2], solver_options(config),
                                            config.tail, resolution),
-                             lambda: _executor(workers, scheduler, dask_workers), keep_result,
+                             lambda: make_executor(compute_cells, workers, scheduler, dask_workers), keep_result,
                              describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}",
-                             isolate=None if scheduler or dask_workers else lambda: _pool_executor(1))
+                             isolate=None if scheduler or dask_workers else lambda: pool_executor(compute_cells, 1))
     if lost:
         lost_indices = {index for index, _, _ in lost}
         for index in sorted(lost_indices):

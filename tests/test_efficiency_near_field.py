@@ -28,7 +28,7 @@ def test_near_field_pulse_study_runs_on_a_subset(tmp_path):
     assert np.isfinite(capacity.values).all()
     ratio = capacity / cube.block_uplift_intensity
     assert (ratio > 1.0).all() and (ratio < 40.0).all()
-    efficiency = efficiency_dataset(cube, loaded[0], config)
+    efficiency = efficiency_dataset(cube, loaded.records, config)
     assert np.isfinite(efficiency.record_pulse_period.values).all()
     assert (efficiency.record_pulse_period.values > 0.3).all()  # pulse periods of these records: ~1-5 s
     table = efficiency_table(efficiency)
