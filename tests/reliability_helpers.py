@@ -1,4 +1,5 @@
-"""Shared by the reliability, fuzz and chaos tests: synthetic AT2 records, small studies, one-line checks."""
+"""Shared by the reliability tests (checkpoints, locking, executors, CLI, chaos, issue list) and the fuzz tests:
+synthetic AT2 records, small studies, one-line checks."""
 
 from __future__ import annotations
 
@@ -53,3 +54,42 @@ def assert_one_line_error(stderr: str, *fragments: str) -> str:
     for fragment in fragments:
         assert fragment in lines[0], (fragment, lines[0])
     return lines[0]
+
+
+QUIET = {"progress": False, "log": lambda message: None, "warn": lambda message: None}
+"""run_study keywords for a silent run (no progress bar, no log lines, no warnings)."""
+
+
+def write_tiny_study(folder: Path) -> Path:
+    """One short synthetic record (``folder/records/pulse.AT2``) and its study file ``folder/tiny.toml``:
+    2 levels, 2 soils, the 3 default blocks, Housner and SSI."""
+    folder = Path(folder)
+    write_at2(folder / "records" / "pulse.AT2")
+    study = folder / "tiny.toml"
+    study.write_text(small_study_text(folder / "records"))
+    return study
+
+
+def records_folder(tmp_path: Path, bad=None, good=True, bad_text=None, bad_bytes=None) -> Path:
+    """``tmp_path/records`` with ``good.AT2`` (unless ``good`` is False) and a ``bad.AT2`` written from
+    ``write_at2`` arguments (``bad``), text (``bad_text``) or bytes (``bad_bytes``)."""
+    folder = tmp_path / "records"
+    if good:
+        write_at2(folder / "good.AT2")
+    if bad is not None:
+        write_at2(folder / "bad.AT2", **bad)
+    if bad_text is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "bad.AT2").write_text(bad_text)
+    if bad_bytes is not None:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "bad.AT2").write_bytes(bad_bytes)
+    return folder
+
+
+def tiny_run_argv(tmp_path: Path, *extra: str) -> list[str]:
+    """``rockfrag run`` arguments for a one-record, one-level, one-soil study written in ``tmp_path``."""
+    folder = records_folder(tmp_path)
+    study = tmp_path / "study.toml"
+    study.write_text(small_study_text(folder, levels=[0.5], soils=["rock"]))
+    return ["run", str(study), "--serial", "--no-progress", *extra]

@@ -1,0 +1,74 @@
+"""The output folder is locked for a run (issue 13): a second run stops with one line or waits with
+``--wait``, the other run's temporary files are left alone, stale ``.part`` files of a free folder are
+removed, and the lock is reentrant within one process."""
+
+from __future__ import annotations
+
+import fcntl
+import threading
+import time
+
+import pytest
+
+from pipeline import cli
+from pipeline.locking import LOCK_NAME, output_lock
+from tests.reliability_helpers import assert_one_line_error, tiny_run_argv
+
+
+def test_second_run_on_a_locked_folder_stops_with_one_line(tmp_path, capsys):
+    output = tmp_path / "out"
+    output.mkdir()
+    with open(output / LOCK_NAME, "w") as handle:  # another run holds the folder
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        handle.write("4242\n")
+        handle.flush()
+        (output / ".cube.nc.abc.part").write_text("being written by the other run")
+        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output)))
+        captured = capsys.readouterr()
+        assert status == cli.EXIT_USER_ERROR
+        assert_one_line_error(captured.err, str(output), "in use by another rockfrag run", "pid 4242")
+        assert (output / ".cube.nc.abc.part").exists()  # the other run's temporary file is untouched
+    assert not (output / "cube.nc").exists()
+
+
+def test_wait_lets_a_second_run_start_when_the_first_one_ends(tmp_path, capsys):
+    output = tmp_path / "out"
+    output.mkdir()
+    handle = open(output / LOCK_NAME, "w")  # another run holds the folder, and ends 1 s later
+    fcntl.flock(handle, fcntl.LOCK_EX)
+    handle.write("4242\n")
+    handle.flush()
+    released = threading.Timer(1.0, handle.close)
+    released.start()
+    started = time.monotonic()
+    try:
+        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output), "--wait"))
+    finally:
+        released.join()
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    assert time.monotonic() - started >= 1.0
+    waiting = [line for line in captured.err.splitlines() if "waiting for it to finish" in line]
+    assert len(waiting) == 1 and "pid 4242" in waiting[0] and str(output) in waiting[0]
+    assert (output / "cube.nc").is_file()
+
+
+def test_stale_part_files_are_removed_when_the_folder_is_free(tmp_path, capsys):
+    output = tmp_path / "out"
+    (output / ".checkpoints").mkdir(parents=True)
+    stale = [output / ".cube.nc.x1y2.part", output / ".checkpoints" / ".abc.ckpt.q9.part"]
+    for path in stale:
+        path.write_bytes(b"half-written")
+    assert cli.main(tiny_run_argv(tmp_path, "--output", str(output))) == 0, capsys.readouterr().err
+    assert not any(path.exists() for path in stale) and (output / "cube.nc").is_file()
+
+
+def test_lock_is_reentrant_in_one_process_and_released(tmp_path):
+    with output_lock(tmp_path):
+        with output_lock(tmp_path):
+            pass
+        with open(tmp_path / LOCK_NAME) as handle:
+            with pytest.raises(BlockingIOError):
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    with open(tmp_path / LOCK_NAME) as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)  # free again
