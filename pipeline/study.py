@@ -10,11 +10,12 @@ per (record, level, block).
 Work unit: one record and one block at all its scale factors for all the cells (soil, model) it
 still needs, run by the compiled batch solver. The same task then refines each cell's overturning
 capacity adaptively (pipeline.ida.capacity_from_stripes, to ``capacity_resolution``) and returns it
-as a second checkpoint entry, so capacities come from runs, not from the grid. A cell's result is checkpointed as one small file named by
-a hash of everything it depends on (record checksum, processing recipe, intensity settings, levels,
-block, soil, model, solver settings, package version), so an interrupted study resumes where it
-stopped and a changed input recomputes only the cells it touches. Housner results do not depend on
-the soil: they are computed once per block and shared by every soil.
+as a second checkpoint entry, so capacities come from runs, not from the grid. A cell's result is
+checkpointed as one small file named by a hash of everything it depends on (record checksum,
+processing recipe, intensity settings, levels, block, soil, model, solver settings, package version),
+so an interrupted study resumes where it stopped and a changed input recomputes only the cells it
+touches. Housner results do not depend on the soil: they are computed once per block and shared by
+every soil.
 
 Executors (pipeline.executors): in-process (workers=1), all local cores (default, process pool), or
 dask.distributed (``scheduler`` address of a running cluster, or ``dask_workers`` to start a
@@ -41,8 +42,8 @@ from pathlib import Path
 import numpy as np
 
 from pipeline import __version__
-from pipeline.cube import build_cube, write_netcdf
 from pipeline.checkpoints import CheckpointStore
+from pipeline.cube import build_cube, write_netcdf
 from pipeline.errors import PipelineError, RecordError
 from pipeline.executors import check_workers, make_executor, pool_executor, run_tasks
 from pipeline.ida import capacity_from_stripes, uniform_stripe_runs

@@ -20,8 +20,16 @@ from pipeline import cli
 from pipeline.config import load_study
 from pipeline.records import load_records
 from pipeline.study import run_study
-from tests.reliability_helpers import (QUIET, assert_one_line_error, error_lines, records_folder, small_study_text,
-                                       tiny_run_argv, write_at2, write_tiny_study)
+from tests.reliability_helpers import (
+    QUIET,
+    assert_one_line_error,
+    error_lines,
+    records_folder,
+    small_study_text,
+    tiny_run_argv,
+    write_at2,
+    write_tiny_study,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 

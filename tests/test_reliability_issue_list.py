@@ -13,6 +13,7 @@ from pipeline import cli
 from pipeline.checkpoints import SUFFIX
 from tests.reliability_helpers import error_lines, small_study_text, write_at2
 
+
 def run_cli(argv) -> tuple[int, str, str]:
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
