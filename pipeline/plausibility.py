@@ -298,5 +298,5 @@ def check_study(blocks: Iterable[Block], soils: Iterable[SoilClass], on_implausi
         raise ConfigError(field, f"{message}{more}; {OVERRIDE_HINT}", source)
     prefix = f"{source}: " if source else ""
     for field, message in found:
-        warnings.warn(PlausibilityWarning(f"{prefix}{field}: {message} (run anyway)"), stacklevel=2)
+        warnings.warn(PlausibilityWarning(f"{prefix}{field}: {message} (running anyway, as asked)"), stacklevel=2)
     return [message for _, message in found]
