@@ -216,7 +216,12 @@ def settlement(block: Block, soil: SoilClass, found: Foundation) -> str | None:
 
 @plausibility_check("frequency ratio", "blocks.{block}")
 def frequency_ratio(block: Block, soil: SoilClass, found: Foundation) -> str | None:
-    """omega_v / p below a few: the bed as slow as the rocking, outside a rocking-on-a-bed model."""
+    """omega_v / p below a few: the bed as slow as the rocking, outside a rocking-on-a-bed model.
+
+    (omega_v / p)^2 = 4 R / (3 m g / k): the same fact as the settlement seen from the rocking side. With
+    the limits above a settlement over 10% of min(b, h) <= 0.71 R always comes first (omega_v / p < 3 needs
+    m g / k > 4R/27); this check states the model's range on its own terms, and holds if MAX_SETTLEMENT grows.
+    """
     if found.frequency_ratio >= MIN_FREQUENCY_RATIO:
         return None
     return (f"block {block.name!r} on soil {soil.name!r}: vertical bed frequency omega_v = sqrt(k/m) = "
@@ -294,7 +299,8 @@ def check_study(blocks: Iterable[Block], soils: Iterable[SoilClass], on_implausi
     found = implausibilities(blocks, soils)
     if found and on_implausible == "error":
         field, message = found[0]
-        more = f" (and {len(found) - 1} more implausible value{'s' if len(found) > 2 else ''})" if len(found) > 1 else ""
+        others = len(found) - 1
+        more = f" (and {others} more implausible value{'s' if others > 1 else ''})" if others else ""
         raise ConfigError(field, f"{message}{more}; {OVERRIDE_HINT}", source)
     prefix = f"{source}: " if source else ""
     for field, message in found:
