@@ -20,6 +20,65 @@ def _check(name, value, low, high, unit, low_open=True):
     return Number(low, high, low_open=low_open, unit=unit).check(value, name, None)
 
 
+def geometry_conflict(name: str, b: float | None, h: float | None, R: float | None,
+                      alpha: float | None) -> str | None:
+    """Why a block's geometry is given twice, or None.
+
+    A block is given by its half-width and half-height (``b``, ``h``) or by its semi-diagonal and
+    slenderness (``R``, ``alpha``). A key of the other pair beside a complete one would be silently
+    overwritten, so it is refused, e.g. ``R = 2 m`` with ``b = 0.3 m, h = 1.5 m``. All four keys are
+    accepted only when they agree (``dataclasses.replace`` of a validated block passes all four).
+
+    Parameters
+    ----------
+    name : str
+        The block's name, for the message.
+    b, h : float or None
+        Half-width and half-height [m] as given.
+    R : float or None
+        Semi-diagonal [m] as given.
+    alpha : float or None
+        Slenderness angle [rad] as given.
+
+    Returns
+    -------
+    str or None
+        One line naming the keys given and what to give instead.
+    """
+    given_bh = [f"{key} = {_number(value)} m" for key, value in (("b", b), ("h", h)) if value is not None]
+    given_ra = [f"{key} = {_number(value)} {unit}" for key, value, unit in (("R", R, "m"), ("alpha", alpha, "rad"))
+                if value is not None]
+    if not (given_bh and given_ra):
+        return None
+    if len(given_bh) == 2 and len(given_ra) == 2 and _agree(b, h, R, alpha):
+        return None
+    complete = "b and h" if len(given_bh) == 2 else "R and alpha" if len(given_ra) == 2 else None
+    ignored = ", ".join(given_ra if complete == "b and h" else given_bh)
+    if complete and len(given_bh) + len(given_ra) < 4:
+        why = f"{ignored} would be ignored (the geometry comes from {complete})"
+    elif complete:
+        why = "the two pairs disagree"
+    else:
+        why = "neither pair is complete"
+    return (f"{', '.join(given_bh)} and {', '.join(given_ra)} given: {why}; "
+            "give either b and h, or R and alpha (not both)")
+
+
+def _number(value) -> str:
+    try:
+        return f"{float(value):g}"
+    except (TypeError, ValueError):
+        return repr(value)
+
+
+def _agree(b, h, R, alpha) -> bool:
+    try:
+        return (math.isclose(math.hypot(b, h), R, rel_tol=1e-9)
+                and math.isclose(math.atan2(b, h), alpha, rel_tol=1e-9))
+    except TypeError:
+        return False
+
+
 @dataclass(frozen=True)
 class Block:
     """A rigid rectangular block rocking on its base corners.
@@ -41,12 +100,10 @@ class Block:
     def __post_init__(self):
         geometry_bh = self.b is not None and self.h is not None
         geometry_ra = self.R is not None and self.alpha is not None
-        if geometry_bh and geometry_ra:
-            # both given (e.g. dataclasses.replace of a validated block): accept only if consistent
-            if not (math.isclose(math.hypot(self.b, self.h), self.R, rel_tol=1e-9)
-                    and math.isclose(math.atan2(self.b, self.h), self.alpha, rel_tol=1e-9)):
-                raise ConfigError(f"block {self.name}", "give either b and h, or R and alpha (not both)")
-        elif not (geometry_bh or geometry_ra):
+        conflict = geometry_conflict(self.name, self.b, self.h, self.R, self.alpha)
+        if conflict:
+            raise ConfigError(f"block {self.name}", conflict)
+        if not (geometry_bh or geometry_ra):
             raise ConfigError(f"block {self.name}", "give either b and h, or R and alpha")
         if geometry_bh:
             b = _check(f"block {self.name}.b", self.b, 0, 1e4, "m")

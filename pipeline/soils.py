@@ -3,7 +3,8 @@
 Input : a soil class (shear modulus G_s [Pa], Poisson's ratio, density, damping ratio) and a
         ``Block`` (E_b [Pa], footprint area A [m^2], effective soil depth H [m]).
 Output: the interface stiffness k [N/m] of paper eq. 19, k = (A/H) / (1/G_s + 1/E_b), the vertical
-        circular frequency w = sqrt(k/m) [rad/s] and dashpot c = 2 xi w m [N s/m] (eq. 10).
+        circular frequency w = sqrt(k/m) [rad/s] and dashpot c = 2 xi w m [N s/m] (eq. 10); with
+        ``foundation`` also the static settlement m g / k [m] and w / p, which pipeline.plausibility checks.
 
 The paper's "dynamic elastic modulus" E_d of eq. 7 / Table 1, E_d = 2G(1-nu)/(1-2nu), is the
 constrained (oedometric, P-wave) modulus, not Young's modulus; it is labelled so here.
@@ -15,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 from pipeline.errors import ConfigError
+from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number
 
 
@@ -64,6 +66,51 @@ def interface_stiffness(shear_modulus, block_modulus, footprint_area, soil_depth
 def soil_block_stiffness(soil: SoilClass, block) -> float:
     """Interface stiffness k [N/m] of ``block`` standing on ``soil`` (eq. 19)."""
     return interface_stiffness(soil.shear_modulus, block.E_b, block.footprint_area, block.soil_depth)
+
+
+@dataclass(frozen=True)
+class Foundation:
+    """A block standing on a soil: the interface stiffness and what it implies (SI units).
+
+    Attributes
+    ----------
+    stiffness : float
+        Interface stiffness k of eq. 19 [N/m].
+    settlement : float
+        Static settlement under the block's weight, m g / k [m].
+    vertical_frequency : float
+        Circular frequency of the block bouncing on the bed, omega_v = sqrt(k/m) [rad/s].
+    frequency_ratio : float
+        omega_v / p, the bed's vertical frequency over Housner's frequency parameter [-].
+    """
+
+    stiffness: float
+    settlement: float
+    vertical_frequency: float
+    frequency_ratio: float
+
+
+def foundation(soil: SoilClass, block, g: float = STANDARD_GRAVITY) -> Foundation:
+    """The interface stiffness of ``block`` on ``soil`` and its static settlement and frequencies.
+
+    Parameters
+    ----------
+    soil : SoilClass
+        The foundation material (shear modulus G_s [Pa]).
+    block : pipeline.blocks.Block
+        The block (mass [kg], E_b [Pa], footprint area [m^2], soil depth [m], R [m]).
+    g : float
+        Gravity [m/s^2].
+
+    Returns
+    -------
+    Foundation
+        k [N/m], m g / k [m], omega_v [rad/s] and omega_v / p [-].
+    """
+    stiffness = soil_block_stiffness(soil, block)
+    omega = math.sqrt(stiffness / block.mass)
+    return Foundation(stiffness=stiffness, settlement=block.mass * g / stiffness, vertical_frequency=omega,
+                      frequency_ratio=omega / block.p(g))
 
 
 def _from_constrained(name, constrained_mpa, nu, density, description):

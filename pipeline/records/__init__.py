@@ -16,6 +16,7 @@ K-NET/KiK-net: the header's scale factor in gal; text: a header such as ``acc [g
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
 from dataclasses import dataclass, field
@@ -75,7 +76,8 @@ class Record:
     trace : obspy.Trace
         Ground acceleration [m/s^2]; ``stats.processing`` holds the processing provenance.
     metadata : dict
-        event, year, magnitude, station, component, sets, source, sha256, file.
+        event, year, magnitude, station, component, sets, source, sha256, file (K-NET/KiK-net files:
+        also origin_time).
     """
 
     id: str
@@ -252,7 +254,118 @@ def _load_user_file(path: Path, units, dt=None) -> Record:
                 "component": header.get("component", trace.stats.channel), "sets": "user",
                 "source": str(path), "units": units or header.get("units_in_file", ""),
                 "sha256": sha256_of(path)}
+    if trace.stats.get("knet"):
+        metadata.update(knet_metadata(trace.stats))
     return Record(path.stem, trace, metadata)
+
+
+def knet_metadata(stats) -> dict:
+    """Event, origin time, year, magnitude and station from a K-NET/KiK-net header (obspy's ``stats.knet``).
+
+    Parameters
+    ----------
+    stats : obspy.core.trace.Stats
+        The trace's stats as obspy reads a K-NET/KiK-net ASCII file: ``stats.knet`` holds the origin
+        time ``evot`` (UTC), epicentre ``evla``/``evlo`` [deg], depth ``evdp`` [km] and magnitude ``mag``.
+
+    Returns
+    -------
+    dict
+        ``event`` (origin time, magnitude, epicentre and depth, e.g. ``1996-08-10 18:12:00 UTC M5.9,
+        38.92N 140.63E, 7 km deep``), ``origin_time`` (ISO 8601, UTC), ``year``, ``magnitude``, ``station``
+        and ``units`` (gal, the header's scale factor).
+    """
+    header = stats.knet
+    origin = header.get("evot")
+    magnitude = header.get("mag")
+    parts = [f"{origin.strftime('%Y-%m-%d %H:%M:%S')} UTC" if origin is not None else "K-NET event"]
+    if magnitude is not None:
+        parts[0] += f" M{magnitude:g}"
+    if header.get("evla") is not None and header.get("evlo") is not None:
+        latitude, longitude = float(header["evla"]), float(header["evlo"])
+        parts.append(f"{abs(latitude):.2f}{'N' if latitude >= 0 else 'S'} "
+                     f"{abs(longitude):.2f}{'E' if longitude >= 0 else 'W'}")
+    if header.get("evdp") is not None:
+        parts.append(f"{float(header['evdp']):g} km deep")
+    return {"event": ", ".join(parts), "origin_time": f"{origin.isoformat()}Z" if origin is not None else "",
+            "year": origin.year if origin is not None else None,
+            "magnitude": float(magnitude) if magnitude is not None else None,
+            "station": str(stats.station), "units": "gal"}
+
+
+# ---------------------------------------------------------------- duplicates by content
+
+SAME_SAMPLES = 1e-3
+"""Two records are the same when their time steps agree to 1e-4, they have as many samples, and their
+samples, less their means, agree within this fraction of the peak: e.g. a K-NET file and a CSV export
+of it (the same motion written with four or more significant digits)."""
+
+
+def same_samples(record, other) -> bool:
+    """True if ``record`` and ``other`` hold the same accelerations, whatever their files' formats.
+
+    Parameters
+    ----------
+    record, other : Record
+        Records in m/s^2.
+
+    Returns
+    -------
+    bool
+        Same number of samples, time steps within 1e-4, and demeaned samples within ``SAME_SAMPLES``
+        of the larger peak.
+    """
+    if record.trace.stats.npts != other.trace.stats.npts or not math.isclose(record.dt, other.dt, rel_tol=1e-4):
+        return False
+    first = np.asarray(record.acceleration, dtype=np.float64)
+    second = np.asarray(other.acceleration, dtype=np.float64)
+    first, second = first - first.mean(), second - second.mean()
+    peak = max(float(np.max(np.abs(first))), float(np.max(np.abs(second))))
+    return peak > 0 and float(np.max(np.abs(first - second))) <= SAME_SAMPLES * peak
+
+
+def _duplicate_of(record, kept) -> Record | None:
+    """The kept record holding the same samples as ``record``, when either is the user's own file.
+
+    Catalogue entries are not compared with one another: the catalogue lists genuine PEER originals
+    beside their FEMA P695 exports on purpose (records/MANIFEST.csv notes).
+    """
+    user = record.metadata.get("sets") == "user"
+    for other in kept:
+        if (user or other.metadata.get("sets") == "user") and same_samples(record, other):
+            return other
+    return None
+
+
+# ---------------------------------------------------------------- selections that name nothing
+
+def _did_you_mean(word: str, choices) -> str:
+    """`` (did you mean 'far-field'?)`` for the closest choice, or '' (the study keys' cutoff, 0.75)."""
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.75)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _looks_like_a_path(text: str) -> bool:
+    """A selection written as a file or folder (a separator, a suffix, or ``.``/``~`` first)."""
+    return "/" in text or os.sep in text or bool(Path(text).suffix) or text.startswith((".", "~"))
+
+
+def _unknown_selection(text: str, sets, entries) -> Exception:
+    """The error for a selection that is no set, id, folder or file: "not found" for a path."""
+    names = [*sets, *entries]
+    hint = _did_you_mean(text, names)
+    if not hint and _looks_like_a_path(text):
+        path = Path(text)
+        if path.parent.is_dir():
+            siblings = [p.name for p in path.parent.iterdir()]
+            near = _did_you_mean(path.name, siblings)
+            folder = "the current folder" if str(path.parent) == "." else str(path.parent)
+            where = near or f"; no such file or folder in {folder}"
+        else:
+            where = f"; the folder {path.parent} does not exist either"
+        return RecordError(text, f"not found{where}")
+    return ManifestError(f"unknown record selection {text!r}{hint}: not a record set "
+                         f"({', '.join(sorted(sets))}), a record id, a folder or a file")
 
 
 def load_records(selection, records_dir=None, units: str | None = None, verify_checksums=True,
@@ -273,9 +386,18 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
     Returns
     -------
     records : list of Record
-        The records that were read, in catalogue or file-name order, without duplicates.
+        The records that were read, in catalogue or file-name order, without duplicates: a file named
+        twice is read once, and a file with the same bytes (sha256) or the same samples as a record
+        read before it (``same_samples``: a CSV export of a K-NET file, say) is skipped.
     failures : list of RecordError
-        One per file that could not be read; the other files go on.
+        One per file that could not be read or was skipped as a duplicate; the other files go on.
+
+    Raises
+    ------
+    ManifestError
+        A selection that is no record set or record id (with a did-you-mean).
+    RecordError
+        A selection written as a path that does not exist ("not found"), or a folder without records.
     """
     items = [selection] if isinstance(selection, (str, Path)) else list(selection)
     entries = {entry.id: entry for entry in catalogue(records_dir)}
@@ -296,6 +418,12 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
         if digest and digest in contents:
             failures.append(RecordError(record.metadata.get("file") or record.id,
                                         f"same content as record {contents[digest]}; skipped as a duplicate"))
+            return
+        same = _duplicate_of(record, records)
+        if same is not None:
+            failures.append(RecordError(record.metadata.get("file") or record.id,
+                                        f"same samples as record {same.id} ({same.metadata.get('file') or same.id}, "
+                                        f"within {SAME_SAMPLES:.1%} of the peak); skipped as a duplicate"))
             return
         contents[digest] = record.id
         records.append(record)
@@ -323,8 +451,7 @@ def load_records(selection, records_dir=None, units: str | None = None, verify_c
         elif Path(text).is_file():
             add(lambda p: _load_user_file(p, units, dt), str(Path(text).resolve()), Path(text))
         else:
-            raise ManifestError(f"unknown record selection {text!r}: not a record set "
-                                f"({', '.join(sorted(sets))}), a record id, a folder or a file")
+            raise _unknown_selection(text, sets, entries)
     return unique_ids(records), failures
 
 
