@@ -3,7 +3,7 @@
 Input : a value as the user gave it (TOML or Python), the field's name and the file it came from.
 Output: the value (numbers as float/int), or one ``ConfigError`` naming the file and the field, saying
         what was found (with its TOML type) and what is allowed, e.g. ``soils_custom.loam.shear_modulus:
-        0 out of range; must be a number > 0 and <= 1e+13 [Pa]``.
+        0 out of range; must be a number > 0.0 and <= 1e+13 [Pa]``.
 
 A schema is built from small classes that all have ``check(value, field, source)``: ``Number``,
 ``Text``, ``Flag``, ``Names``, ``Numbers``, ``Interval``, ``Nullable``, ``Table`` (fixed keys),
@@ -37,15 +37,24 @@ class Number:
     unit: str = ""
 
     def describe(self) -> str:
-        """What the value must be, e.g. ``a number > 0 and <= 1 [s]``."""
-        parts = []
-        if self.low is not None:
-            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
-        if self.high is not None:
-            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
+        """What the value must be: ``a number from 0.0 to 0.5``, ``a number > 0.0 and <= 1.0 [s]``,
+        ``a whole number >= 2``."""
         kind = "a whole number" if self.integer else "a number"
         unit = f" [{self.unit}]" if self.unit else ""
+        low, high = (None if bound is None else self._shown(bound) for bound in (self.low, self.high))
+        if low is not None and high is not None and not (self.low_open or self.high_open or self.integer):
+            return f"{kind} from {low} to {high}{unit}"
+        parts = []
+        if low is not None:
+            parts.append(f"{'>' if self.low_open else '>='} {low}")
+        if high is not None:
+            parts.append(f"{'<' if self.high_open else '<='} {high}")
         return f"{kind} {' and '.join(parts)}{unit}" if parts else f"{kind}{unit}"
+
+    def _shown(self, bound: float) -> str:
+        """A bound as a whole number (``integer``) or as a real one (``0.0``, ``1e+13``)."""
+        text = f"{bound:g}"
+        return text if self.integer or any(c in text for c in ".en") else f"{text}.0"
 
     def check(self, value: Any, field: str, source: str | None) -> float | int:
         """The value as float (int with ``integer``), or a ``ConfigError`` naming the allowed range."""

@@ -91,10 +91,10 @@ def test_bad_recipes_name_the_field(data, field):
 
 
 def test_recipe_messages_name_the_allowed_range_and_keys():
-    with pytest.raises(ConfigError, match=r"steps\[0\]\.max_percentage: 0\.9 out of range; must be a number >= 0 "
-                                          r"and <= 0\.5"):
+    with pytest.raises(ConfigError, match=r"steps\[0\]\.max_percentage: 0\.9 out of range; must be a number from "
+                                          r"0\.0 to 0\.5"):
         recipe_from_dict({"steps": [{"name": "taper", "max_percentage": 0.9}]}, source="user.toml")
-    with pytest.raises(ConfigError, match=r"freqmax: missing; must be a number >= 0\.5 and <= 1000 \[Hz\]"):
+    with pytest.raises(ConfigError, match=r"freqmax: missing; must be a number from 0\.5 to 1000\.0 \[Hz\]"):
         recipe_from_dict({"steps": [{"name": "bandpass", "freqmin": 0.1}]}, source="user.toml")
     with pytest.raises(ConfigError, match=r"unknown parameter of step 'taper' \(did you mean 'type'\?\); "
                                           r"allowed: max_percentage, type"):
