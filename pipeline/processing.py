@@ -48,6 +48,7 @@ class ProcessingStep:
     reads: tuple[str, ...] = ()
     """Steps whose parameters this step receives, as keywords named after them."""
     defaults: dict = field(default_factory=dict)
+    """The defaults of the function's signature (parameters without one are required)."""
 
     def arguments(self, params: dict) -> dict:
         """The step's parameters with the defaults of its signature filled in."""
