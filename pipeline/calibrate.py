@@ -51,6 +51,8 @@ from scipy.signal import butter, find_peaks, sosfiltfilt
 from pipeline.errors import ConfigError, PipelineError, RecordError
 from pipeline.models import get_model, simulate_histories
 from pipeline.outputs import atomic_path
+from pipeline.records.text import bracketed_units, read_columns
+from pipeline.validation import Interval, Number, Table
 
 _MICRO = ("us", "\u00b5s", "\u03bcs", "microsecond", "microseconds", "usec")
 TIME_UNITS = {**{name: 1.0 for name in ("s", "sec", "secs", "second", "seconds")},
@@ -146,9 +148,9 @@ class CalibrationResult:
 def _unit_in_header(column, units, path, quantity):
     """(unit, found) from a header such as 'time [ms]', 'theta (deg)', 'rotation_rad', 'time s'."""
     name = str(column).strip()
-    bracketed = re.search(r"[\[({]\s*([^\])}]*?)\s*[\])}]", name)
+    bracketed = bracketed_units(name)
     if bracketed:
-        unit = bracketed.group(1).strip()
+        unit = bracketed[0]
         key = unit if unit in units else unit.lower()
         if key not in units:
             raise ConfigError(f"column {name!r}", f"{quantity} unit {unit!r} unknown; allowed: "
@@ -171,80 +173,37 @@ def _resolve_unit(flag, column, units, default, path, quantity):
     return (unit, "header") if found else (default, "assumed")
 
 
-def _data_lines(path):
-    """1-based line numbers of the lines pandas reads (not blank, not a '#' comment)."""
-    numbers = []
-    with open(path, encoding="utf-8", errors="replace") as handle:
-        for number, line in enumerate(handle, start=1):
-            stripped = line.strip()
-            if stripped and not stripped.startswith("#"):
-                numbers.append(number)
-    return numbers
-
-
-def _numeric_column(table, column, path, lines, header_rows):
-    values = pd.to_numeric(table[column], errors="coerce")
-    bad = np.flatnonzero(values.isna().to_numpy())
-    if bad.size:
-        row = int(bad[0])
-        line = lines[row + header_rows] if row + header_rows < len(lines) else None
-        raise RecordError(path, f"column {str(column)!r}: {str(table[column].iloc[row]).strip()!r} is not a "
-                                "number", line)
-    return values.to_numpy(float)
+REFERENCE_COLUMNS = "two columns (time, rotation)"
+MIN_REFERENCE_ROWS = 10
 
 
 def load_reference(path, time_unit=None, angle_unit=None) -> Reference:
-    """Reference (time [s], rotation [rad]) from a table pandas reads: column 1 time, column 2 rotation.
+    """Reference (time [s], rotation [rad]) from a text table: column 1 time, column 2 rotation.
 
-    Units come from the flags, else from the headers ('time [ms]', 'theta (deg)', 'rotation_rad'; see
-    ``TIME_UNITS``/``ANGLE_UNITS``), else s and rad are assumed (``Reference.describe_units`` says which).
-    A text cell in either column is an error naming its line; an unknown unit is an error naming the
-    column. The result unpacks as ``time, rotation``.
+    The table is read by ``pipeline.records.text.read_columns`` (comma, semicolon, tab or space separated,
+    ``#`` comments, header lines above the numbers; further columns are left out). Units come from the
+    flags, else from the headers ('time [ms]', 'theta (deg)', 'rotation_rad'; see ``TIME_UNITS``/
+    ``ANGLE_UNITS``), else s and rad are assumed (``Reference.describe_units`` says which). A text cell
+    in either column is an error naming its line; an unknown unit is an error naming the column. The
+    result unpacks as ``time, rotation``.
     """
     path = Path(path)
     if not path.is_file():
         raise PipelineError(f"{path}: reference file not found")
-    lines = _data_lines(path)
-    if len(lines) > MAX_REFERENCE_ROWS:
-        raise RecordError(path, f"{len(lines)} rows; at most {MAX_REFERENCE_ROWS} (resample the reference)")
-    try:
-        table = pd.read_csv(path, comment="#", sep=None, engine="python", dtype=str, header=None, na_filter=False,
-                            skipinitialspace=True)
-    except Exception as error:
-        raise RecordError(path, f"cannot read the reference table ({error})") from None
-    header_rows = 0
-    if len(table) and table.shape[1] >= 2 and not all(_is_number(cell) for cell in table.iloc[0, :2]):
-        header_rows = 1  # the first line names the columns
-        table.columns = [str(name).strip() for name in table.iloc[0]]
-        table = table.iloc[1:].reset_index(drop=True)
-    else:
-        table.columns = [f"column {number + 1}" for number in range(table.shape[1])]
-    if table.shape[1] < 2 or len(table) < 10:
-        raise RecordError(path, "expected two columns (time, rotation) and at least 10 rows")
-    time_name, angle_name = table.columns[:2]
+    table = read_columns(path, REFERENCE_COLUMNS, counts=(2,), extra=True, header_lines=1,
+                         max_rows=MAX_REFERENCE_ROWS)
+    if len(table.values) < MIN_REFERENCE_ROWS:
+        raise RecordError(path, f"{len(table.values)} rows; expected {REFERENCE_COLUMNS} and at least "
+                          f"{MIN_REFERENCE_ROWS} rows")
+    time_name, angle_name = table.name(0), table.name(1)
     time_key, time_source = _resolve_unit(time_unit, time_name, TIME_UNITS, DEFAULT_TIME_UNIT, path, "time")
     angle_key, angle_source = _resolve_unit(angle_unit, angle_name, ANGLE_UNITS, DEFAULT_ANGLE_UNIT, path,
                                             "angle")
-    time = _numeric_column(table, time_name, path, lines, header_rows) * TIME_UNITS[time_key]
-    rotation = _numeric_column(table, angle_name, path, lines, header_rows) * ANGLE_UNITS[angle_key]
-    if not (np.all(np.isfinite(time)) and np.all(np.isfinite(rotation))):
-        raise RecordError(path, "the reference contains infinite values")
-    steps = np.diff(time)
-    if np.any(steps <= 0):
-        row = int(np.flatnonzero(steps <= 0)[0]) + 1
-        raise RecordError(path, f"time must increase strictly (column {str(time_name)!r})",
-                          lines[row + header_rows] if row + header_rows < len(lines) else None)
-    return Reference(time=time, rotation=rotation, path=str(path), time_column=str(time_name),
-                     rotation_column=str(angle_name), time_unit=time_key, angle_unit=angle_key,
+    time = table.time(0) * TIME_UNITS[time_key]
+    rotation = table.values[:, 1] * ANGLE_UNITS[angle_key]
+    return Reference(time=time, rotation=rotation, path=str(path), time_column=time_name,
+                     rotation_column=angle_name, time_unit=time_key, angle_unit=angle_key,
                      time_unit_source=time_source, angle_unit_source=angle_source)
-
-
-def _is_number(text):
-    try:
-        float(text)
-    except (TypeError, ValueError):
-        return False
-    return True
 
 
 def check_reference(ref_time, ref_rotation, record_duration, dt, source="reference", time_unit="s"):
@@ -502,19 +461,21 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
     return candidates[0][1], candidates[0][0], number
 
 
+CALIBRATION_OPTIONS = Table({
+    "n_k": Number(2, integer=True),
+    "n_xi": Number(1, integer=True),
+    "k_range": Interval(Number(0.0, low_open=True, unit="N/m"), names=("k_min", "k_max")),
+    "xi_range": Interval(Number(0.0, 1.0, high_open=True), names=("xi_min", "xi_max"), strict=False),
+})
+"""The search settings of ``calibrate`` (pipeline.validation): grid sizes and the search box."""
+
+
 def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi):
     spec = get_model(model)
     if not spec.needs_foundation:
         raise ConfigError("model", f"{model!r} has no foundation parameters to calibrate; choose a model with a "
                           "foundation (e.g. ssi)")
-    if not (isinstance(n_k, (int, np.integer)) and n_k >= 2):
-        raise ConfigError("n_k", f"{n_k}; need an integer >= 2 grid points in k")
-    if not (isinstance(n_xi, (int, np.integer)) and n_xi >= 1):
-        raise ConfigError("n_xi", f"{n_xi}; need an integer >= 1 grid points in xi")
-    if not (0 < k_range[0] < k_range[1] and math.isfinite(k_range[1])):
-        raise ConfigError("k_range", f"{tuple(k_range)}; need 0 < k_min < k_max [N/m]")
-    if not 0 <= xi_range[0] <= xi_range[1] < 1:
-        raise ConfigError("xi_range", f"{tuple(xi_range)}; need 0 <= xi_min <= xi_max < 1")
+    CALIBRATION_OPTIONS.check({"n_k": n_k, "n_xi": n_xi, "k_range": k_range, "xi_range": xi_range}, "", None)
     ref_time = np.asarray(ref_time, float)
     ref_rotation = np.asarray(ref_rotation, float)
     if ref_time.ndim != 1 or ref_time.shape != ref_rotation.shape or ref_time.size < 10:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import difflib
 import hashlib
 import json
 import math
@@ -35,7 +34,8 @@ from pipeline.errors import ConfigError, PipelineError
 from pipeline.measures import MEASURES
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
-from pipeline.validation import Number, shown as _shown
+from pipeline.validation import (Checked, Either, Interval, NamedTables, Names, Number, Numbers, Table, Text,
+                                 shown as _shown)
 
 MEASURE_UNITS = {name: (m.display_unit, m.display_factor) for name, m in MEASURES.items() if m.scalable}
 """Measures a study can scale records to (pipeline.measures registry): name -> (display unit, SI value
@@ -47,128 +47,29 @@ uplift intensity."""
 
 
 # ---------------------------------------------------------------- the schema
+# The schema classes are pipeline.validation's; a study table adds one hint for a top-level key written
+# below a [table] header (TOML puts it into that table).
 
-@dataclass(frozen=True)
-class Text:
-    """A string, optionally one of ``choices``."""
-
-    choices: tuple[str, ...] = ()
-    nonempty: bool = False
-
-    def check(self, value, field, source):
-        allowed = f"; allowed: {', '.join(repr(c) for c in self.choices)}" if self.choices else ""
-        if not isinstance(value, str):
-            raise ConfigError(field, f"{_shown(value)}; must be a string{allowed}", source)
-        if self.choices and value not in self.choices:
-            raise ConfigError(field, f"{value!r} unknown{allowed}", source)
-        if self.nonempty and not value.strip():
-            raise ConfigError(field, "empty; must be a non-empty string", source)
-        return value
+def _misplaced(key: str) -> str:
+    return " (top-level keys such as soils/models must come before the first [table])" if key in SCHEMA.fields else ""
 
 
-@dataclass(frozen=True)
-class Names:
-    """A non-empty list of non-empty strings (names of soils, models, blocks, record sets)."""
-
-    example: str
-
-    def check(self, value, field, source):
-        if not isinstance(value, list):
-            raise ConfigError(field, f"{_shown(value)}; must be a list of names, e.g. {self.example}", source)
-        if not value:
-            raise ConfigError(field, f"empty list; name at least one, e.g. {self.example}", source)
-        for index, item in enumerate(value):
-            if not isinstance(item, str):
-                raise ConfigError(f"{field}[{index}]", f"{_shown(item)}; must be a name (a string)", source)
-            if not item.strip():
-                raise ConfigError(f"{field}[{index}]", "empty name", source)
-        return value
-
-
-@dataclass(frozen=True)
-class Numbers:
-    """A non-empty list of numbers, each checked by ``item``."""
-
-    item: Number
-
-    def check(self, value, field, source):
-        if not isinstance(value, list) or not value:
-            raise ConfigError(field, f"{_shown(value)}; must be a non-empty list of {self.item.describe()}", source)
-        return [self.item.check(v, f"{field}[{i}]", source) for i, v in enumerate(value)]
-
-
-@dataclass(frozen=True)
-class Table:
-    """A TOML table with a fixed set of keys (any other key is an error listing the allowed ones)."""
-
-    fields: dict
-
-    def check(self, value, field, source):
-        if not isinstance(value, dict):
-            raise ConfigError(field or "study", f"{_shown(value)}; must be a table ([{field}] or {{ ... }})",
-                              source)
-        for key, item in value.items():
-            where = f"{field}.{key}" if field else key
-            if key not in self.fields:
-                dotted = (f" (a table name with a dot must be quoted: [{field.rsplit('.', 1)[0]}.\"{field.rsplit('.', 1)[1]}"
-                          f".{key}\"])" if isinstance(item, dict) and field.count(".") == 1 else "")
-                raise ConfigError(where, _unknown_key(key, self.fields, top_level=not field) + dotted, source)
-            self.fields[key].check(item, where, source)
-        return value
-
-
-@dataclass(frozen=True)
-class NamedTables:
-    """``[PREFIX.NAME]`` tables: any name, each a ``Table``."""
-
-    table: Table
-
-    def check(self, value, field, source):
-        if not isinstance(value, dict):
-            raise ConfigError(field, f"{_shown(value)}; must be tables [{field}.NAME]", source)
-        for name, item in value.items():
-            if not isinstance(item, dict):
-                raise ConfigError(f"{field}.{name}", f"{_shown(item)}; must be a table [{field}.{name}] with keys "
-                                  f"{', '.join(sorted(self.table.fields))}", source)
-            self.table.check(item, f"{field}.{name}", source)
-        return value
-
-
-@dataclass(frozen=True)
-class Either:
-    """A list (the first spec) or tables (the second), chosen by the value's TOML type."""
-
-    as_list: Names
-    as_tables: NamedTables
-
-    def check(self, value, field, source):
-        return (self.as_list if isinstance(value, list) else self.as_tables).check(value, field, source)
-
-
-@dataclass(frozen=True)
-class Checked:
-    """A value checked by its own function (``[intensity] levels``: see ``_levels``)."""
-
-    function: object
-
-    def check(self, value, field, source):
-        return self.function(value, field, source)
-
-
-def _unknown_key(key, allowed, top_level=False) -> str:
-    close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.75)
-    hint = f" (did you mean {close[0]!r}?)" if close else ""
-    if not top_level and key in SCHEMA.fields:
-        hint += " (top-level keys such as soils/models must come before the first [table])"
-    return f"unknown key{hint}; allowed: {', '.join(sorted(allowed))}"
+def _table(fields: dict) -> Table:
+    """A table of the study file (see ``_misplaced``)."""
+    return Table(fields, misplaced=_misplaced)
 
 
 TEXT = Text()
-SOIL_TABLE = Table({**SOIL_RANGES, "why": TEXT})
+SOIL_TABLE = _table({**SOIL_RANGES, "why": TEXT})
 # Types only: the ranges of a block are Block's own (pipeline/blocks.py), reported with the user's field.
-BLOCK_TABLE = Table({key: Number() for key in ("b", "h", "R", "alpha", "mass", "E_b", "footprint_area",
+BLOCK_TABLE = _table({key: Number() for key in ("b", "h", "R", "alpha", "mass", "E_b", "footprint_area",
                                                 "soil_depth")} | {"why": TEXT})
-LEVEL_TABLE_KEYS = ("start", "stop", "count", "spacing", "values", "relative_to")
+LEVEL = Number(0, 1e3, low_open=True)
+"""An intensity level (g or m/s), or a multiple of a block's uplift intensity."""
+LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, integer=True),
+                      "spacing": Text(("log", "linear")), "values": Numbers(LEVEL),
+                      "relative_to": Text(LEVEL_REFERENCES)})
+"""``levels = { start, stop, count, spacing }`` or ``{ values, relative_to }``."""
 
 
 def _damage_state_table() -> Table:
@@ -185,25 +86,27 @@ SCHEMA = Table({
     "soils_custom": NamedTables(SOIL_TABLE),
     "blocks_custom": NamedTables(BLOCK_TABLE),
     "damage_states": NamedTables(_damage_state_table()),
-    "study": Table({"name": Text(nonempty=True), "record_sets": Names('["far-field"]'), "processing": TEXT,
-                    "output": Text(nonempty=True),
-                    "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"),
-                    # report metadata, read by pipeline.report
-                    "title": TEXT, "project": TEXT, "author": TEXT}),
-    "intensity": Table({"measure": Text(SCALING_MEASURES), "period": Number(0.01, 20.0, unit="s"),
-                        "damping": Number(0.0, 0.5), "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True)),
-                        "capacity_resolution": Number(0.0, 0.5),
-                        "period_range": Numbers(Number(0.01, 20.0, unit="s"))}),
-    "solver": Table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
-                     "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
-                     "bed": Text(tuple(BED_TYPES))}),
-    "hazard": Table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
-    "fragility": Table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
-                        "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
-    "report": Table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
-                     "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True)}),
-    "applicability": Table({
-        "g_range": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
+    "study": _table({"name": Text(nonempty=True), "record_sets": Names('["far-field"]'), "processing": TEXT,
+                     "output": Text(nonempty=True),
+                     "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"),
+                     # report metadata, read by pipeline.report
+                     "title": TEXT, "project": TEXT, "author": TEXT}),
+    "intensity": _table({"measure": Text(SCALING_MEASURES), "period": Number(0.01, 20.0, unit="s"),
+                         "damping": Number(0.0, 0.5),
+                         "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True),
+                                           "a list of levels or { start, stop, count, spacing }"),
+                         "capacity_resolution": Number(0.0, 0.5),
+                         "period_range": Interval(Number(0.01, 20.0, unit="s"))}),
+    "solver": _table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
+                      "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
+                      "bed": Text(tuple(BED_TYPES))}),
+    "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
+    "fragility": _table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
+                         "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
+    "report": _table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
+                      "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True)}),
+    "applicability": _table({
+        "g_range": Interval(Number(0, 1e13, low_open=True, unit="Pa"), names=("G_min", "G_max")),
         "n_g": Number(2, 200, integer=True),
         "levels": Numbers(Number(0, 100, low_open=True)),
         "block_moduli": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
@@ -223,11 +126,6 @@ def validate(data: dict, source: str) -> None:
             _block(table, name, spec, source)  # Block's own ranges, with the user's field names
     for name, spec in data.get("soils_custom", {}).items():
         _soil(name, spec, source)
-    applicability = data.get("applicability", {})
-    g_range = applicability.get("g_range")
-    if g_range is not None and (len(g_range) != 2 or g_range[1] <= g_range[0]):
-        raise ConfigError("applicability.g_range", f"{g_range}; must be [G_min, G_max] with G_min < G_max [Pa]",
-                          source)
 
 
 # ---------------------------------------------------------------- the study
@@ -345,29 +243,24 @@ def _levels(spec, source, check_only=False):
     Returns (levels, relative_to); with ``check_only`` the spec unchanged.
     """
     where = "intensity.levels"
-    level = Number(0, 1e3, low_open=True)
     relative_to = ""
     if isinstance(spec, list):
         if not spec:
             raise ConfigError(where, "empty list; give at least one level", source)
-        values = [level.check(v, f"{where}[{i}]", source) for i, v in enumerate(spec)]
+        values = [LEVEL.check(v, f"{where}[{i}]", source) for i, v in enumerate(spec)]
     elif isinstance(spec, dict):
-        for key in spec:
-            if key not in LEVEL_TABLE_KEYS:
-                raise ConfigError(f"{where}.{key}", _unknown_key(key, LEVEL_TABLE_KEYS), source)
-        relative_to = Text(LEVEL_REFERENCES).check(spec.get("relative_to", ""), f"{where}.relative_to", source)
+        LEVEL_TABLE.check(spec, where, source)
+        relative_to = spec.get("relative_to", "")
         if "values" in spec:  # { values = [...], relative_to = "uplift" }: listed multiples or levels
-            values = Numbers(level).check(spec["values"], f"{where}.values", source)
+            values = [float(v) for v in spec["values"]]
         else:
             for key in ("start", "stop"):
                 if key not in spec:
-                    raise ConfigError(f"{where}.{key}", f"missing; must be {level.describe()}", source)
-            start = level.check(spec["start"], f"{where}.start", source)
-            stop = level.check(spec["stop"], f"{where}.stop", source)
-            count = Number(1, 1000, integer=True).check(spec.get("count", 40), f"{where}.count", source)
+                    raise ConfigError(f"{where}.{key}", f"missing; must be {LEVEL.describe()}", source)
+            start, stop, count = float(spec["start"]), float(spec["stop"]), int(spec.get("count", 40))
             if stop <= start:
                 raise ConfigError(where, f"stop {stop:g} must exceed start {start:g}", source)
-            spacing = Text(("log", "linear")).check(spec.get("spacing", "log"), f"{where}.spacing", source)
+            spacing = spec.get("spacing", "log")
             values = (np.geomspace if spacing == "log" else np.linspace)(start, stop, count).tolist()
     else:
         raise ConfigError(where, f"{_shown(spec)}; must be a list of levels or "
@@ -441,13 +334,9 @@ def _check_hazard(path, source, measure="pga", period=None):
                           f"({reason})", source) from None
 
 
-def _period_range(value, source) -> tuple[float, float] | None:
-    """``[intensity] period_range`` (AvgSa periods, s): [low, high] with low < high, or None."""
-    if value is None:
-        return None
-    if len(value) != 2 or not value[0] < value[1]:
-        raise ConfigError("intensity.period_range", f"{value!r}; must be [low, high] in s with low < high", source)
-    return float(value[0]), float(value[1])
+def _period_range(value) -> tuple[float, float] | None:
+    """``[intensity] period_range`` (AvgSa periods [s], checked by ``SCHEMA``): (low, high), or None."""
+    return None if value is None else (float(value[0]), float(value[1]))
 
 
 def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
@@ -479,7 +368,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         measure=measure, period=float(intensity.get("period", 1.0)), damping=float(intensity.get("damping", 0.05)),
         levels=levels, levels_relative_to=relative_to,
         capacity_resolution=float(intensity.get("capacity_resolution", 0.02)),
-        period_range=_period_range(intensity.get("period_range"), source),
+        period_range=_period_range(intensity.get("period_range")),
         soils=soils, blocks=blocks, models=models,
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),

@@ -1,87 +1,158 @@
 """pipeline.processing - stage 2: raw acceleration trace -> corrected trace ready for analysis.
 
 Input : a ``Record`` (obspy Trace of acceleration [m/s^2]) and a ``ProcessingRecipe`` (ordered list
-        of named steps with parameters; defaults in ``pipeline/processing.toml``).
+        of named steps with parameters; the shipped one is ``pipeline/processing.toml``).
 Output: a new ``Record`` whose trace is demeaned, detrended, tapered, zero-phase band-passed and
         baseline-corrected, with every step recorded in ``stats.processing`` and QA flags (tail drift
         of velocity/displacement, gmprocess ``check_tail`` style) in ``stats.qa``. Flags never drop
         a record. Inputs are not modified.
 
-A step is one function registered with ``@processing_step``; its keyword parameters (with ranges
-in ``PARAMETER_RANGES``) are what a recipe may set.
+A step is one function registered with ``@processing_step``, which declares the schema of each keyword
+parameter (pipeline.validation): what a recipe may set. A parameter without a default must be set by
+the recipe (the band-pass corners: the recipe file is their one authority). Steps talk through the
+trace: ``pad`` records the samples it added in ``stats.padding`` and ``unpad`` removes them; a step
+that depends on another step's settings names it in ``reads`` and receives that step's parameters
+(``pad`` reads ``bandpass``: its length depends on the filter's corner). The decorator records each
+step in ``stats.processing`` after it succeeds, as obspy's ``_add_processing_info`` does.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import inspect
 import math
 import re
 import tomllib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib.resources import files
+from typing import Any
 
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from pipeline import __version__
 from pipeline.errors import ConfigError, RecordError
-
-PROCESSING_STEPS: dict = {}
-PARAMETER_RANGES: dict[str, tuple[float, float]] = {}
+from pipeline.validation import Checked, Flag, Number, Table, Text, shown
 
 
-def processing_step(**ranges):
-    """Register a step; ``ranges`` gives the allowed (min, max) of numeric parameters."""
+@dataclass(frozen=True)
+class ProcessingStep:
+    """A registered step: the function (wrapped to record provenance) and what a recipe may set."""
+
+    name: str
+    run: Callable[..., Any]
+    parameters: Table
+    """Schema of the parameters a recipe may set; ``required``: those without a default."""
+    reads: tuple[str, ...] = ()
+    """Steps whose parameters this step receives, as keywords named after them."""
+    defaults: dict = field(default_factory=dict)
+    """The defaults of the function's signature (parameters without one are required)."""
+
+    def arguments(self, params: dict) -> dict:
+        """The step's parameters with the defaults of its signature filled in."""
+        return {**self.defaults, **params}
+
+
+PROCESSING_STEPS: dict[str, ProcessingStep] = {}
+"""The registered steps by name (``@processing_step``)."""
+
+
+def processing_step(reads: tuple[str, ...] = (), **parameters):
+    """Register a step ``function(trace, *, parameter=default, ...)`` that works on the trace in place.
+
+    Parameters
+    ----------
+    reads : tuple of str
+        Steps whose parameters (with their defaults) the function receives, one keyword per step.
+    **parameters
+        The schema of each keyword parameter a recipe may set (``Number``, ``Text``, ``Flag`` ...);
+        every keyword parameter of the function but ``reads`` needs one.
+
+    The registered function appends ``"rockfrag VERSION: name(parameter=value, ...)"`` (and
+    ``"; npts N -> M"`` if the step changed the length) to ``trace.stats.processing`` once the step has
+    succeeded.
+    """
 
     def register(function):
-        PROCESSING_STEPS[function.__name__] = function
-        for parameter, bounds in ranges.items():
-            PARAMETER_RANGES[f"{function.__name__}.{parameter}"] = bounds
-        return function
+        signature = inspect.signature(function)
+        settable = [name for name in signature.parameters if name != "trace" and name not in reads]
+        if sorted(settable) != sorted(parameters):
+            raise TypeError(f"step {function.__name__}: declare a schema for each of its parameters "
+                            f"({', '.join(settable) or 'none'}); got {', '.join(parameters) or 'none'}")
+        defaults = {name: signature.parameters[name].default for name in settable
+                    if signature.parameters[name].default is not inspect.Parameter.empty}
+        required = tuple(name for name in settable if name not in defaults)
+
+        @functools.wraps(function)
+        def run(trace, **arguments):
+            npts = trace.stats.npts
+            trace = function(trace, **arguments)
+            given = {**defaults, **arguments}
+            used = ", ".join(f"{name}={given[name]!r}" for name in settable if name in given)
+            resized = f"; npts {npts} -> {trace.stats.npts}" if trace.stats.npts != npts else ""
+            trace.stats.setdefault("processing", []).append(
+                f"rockfrag {__version__}: {function.__name__}({used}){resized}")
+            return trace
+
+        PROCESSING_STEPS[function.__name__] = ProcessingStep(
+            function.__name__, run, Table(parameters, required, what=f"parameter of step {function.__name__!r}"),
+            tuple(reads), defaults)
+        return run
 
     return register
 
 
-def _provenance(trace, text):
-    trace.stats.setdefault("processing", []).append(f"rockfrag {__version__}: {text}")
-
-
 @processing_step()
-def demean(trace, *, context=None):
+def demean(trace):
+    """Remove the mean."""
     trace.detrend("demean")
     return trace
 
 
 @processing_step()
-def detrend(trace, *, context=None):
+def detrend(trace):
+    """Remove a straight line fitted to the whole record."""
     trace.detrend("linear")
     return trace
 
 
-@processing_step(max_percentage=(0.0, 0.5))
-def taper(trace, *, max_percentage=0.05, type="hann", context=None):
+TAPER_TYPES = ("hann", "cosine", "barthann", "bartlett", "blackman", "blackmanharris", "bohman", "boxcar",
+               "flattop", "hamming", "nuttall", "parzen", "triang")
+"""obspy ``Trace.taper`` windows that need no further parameter."""
+
+
+@processing_step(max_percentage=Number(0.0, 0.5), type=Text(TAPER_TYPES))
+def taper(trace, *, max_percentage=0.05, type="hann"):
+    """Taper ``max_percentage`` of the record at each end (obspy ``Trace.taper``)."""
     trace.taper(max_percentage=max_percentage, type=type)
     return trace
 
 
-@processing_step(factor=(0.0, 20.0))
-def pad(trace, *, factor=1.5, context=None):
-    """Zero pads of factor * order / freqmin seconds at both ends (acausal filter transients)."""
-    settings = context["bandpass"]
-    seconds = factor * settings["corners"] / settings["freqmin"]
+@processing_step(reads=("bandpass",), factor=Number(0.0, 20.0))
+def pad(trace, *, factor=1.5, bandpass):
+    """Zero pads of factor * order / freqmin seconds at both ends (acausal filter transients, Boore 2005).
+
+    ``bandpass`` holds the parameters of the recipe's band-pass step for this record; freqmin is the
+    corner that step will use (see ``bandpass_corners``). The samples added at each end go to
+    ``stats.padding``, for ``unpad``.
+    """
+    freqmin = bandpass_corners(trace, bandpass["freqmin"], bandpass["freqmax"], bandpass["nyquist_fraction"],
+                               bandpass["use_header_corners"])[0]
+    seconds = factor * bandpass["corners"] / freqmin
     n_pad = int(math.ceil(seconds / trace.stats.delta))
     trace.data = np.concatenate([np.zeros(n_pad), trace.data, np.zeros(n_pad)])
-    context["n_pad"] = n_pad
-    _provenance(trace, f"pad(samples={n_pad}, seconds={n_pad * trace.stats.delta:.3f})")
+    trace.stats.padding = trace.stats.get("padding", 0) + n_pad
     return trace
 
 
 @processing_step()
-def unpad(trace, *, context=None):
-    n_pad = context.pop("n_pad", 0)
+def unpad(trace):
+    """Remove the zeros ``pad`` added (``stats.padding`` samples at each end)."""
+    n_pad = trace.stats.pop("padding", 0)
     if n_pad:
         trace.data = trace.data[n_pad:-n_pad].copy()
-        _provenance(trace, f"unpad(samples={n_pad})")
     return trace
 
 
@@ -105,8 +176,21 @@ def header_corners(trace):
     return highpass, lowpass
 
 
-def bandpass_corners(trace, freqmin, freqmax, nyquist_fraction=0.8, use_header_corners=True):
-    """Corners [Hz] actually used: header corners where stricter, low-pass below Nyquist."""
+def bandpass_corners(trace, freqmin: float, freqmax: float, nyquist_fraction: float,
+                     use_header_corners: bool) -> tuple[float, float]:
+    """Corners [Hz] actually used: header corners where stricter, low-pass below Nyquist.
+
+    Parameters
+    ----------
+    trace : obspy.Trace
+        The record (its sampling interval and, for NGA-West2 files, its header's filter corners).
+    freqmin, freqmax : float
+        High-pass and low-pass corners the recipe asks for [Hz].
+    nyquist_fraction : float
+        The low-pass is kept at or below this fraction of the Nyquist frequency [-].
+    use_header_corners : bool
+        Raise the high-pass and lower the low-pass to the corners PEER wrote into the header.
+    """
     nyquist = 0.5 / trace.stats.delta
     if use_header_corners:
         header_hp, header_lp = header_corners(trace)
@@ -115,17 +199,20 @@ def bandpass_corners(trace, freqmin, freqmax, nyquist_fraction=0.8, use_header_c
     return freqmin, min(freqmax, nyquist_fraction * nyquist)
 
 
-@processing_step(freqmin=(1e-3, 10.0), freqmax=(0.5, 1000.0), corners=(1, 10),
-                 nyquist_fraction=(0.1, 0.99))
-def bandpass(trace, *, freqmin=0.1, freqmax=25.0, corners=4, nyquist_fraction=0.8,
-             use_header_corners=True, context=None):
+@processing_step(freqmin=Number(1e-3, 10.0, unit="Hz"), freqmax=Number(0.5, 1000.0, unit="Hz"),
+                 corners=Number(1, 10, integer=True), nyquist_fraction=Number(0.1, 0.99), use_header_corners=Flag())
+def bandpass(trace, *, freqmin, freqmax, corners=4, nyquist_fraction=0.8, use_header_corners=True):
+    """Zero-phase Butterworth band-pass of order ``corners`` per pass, at ``bandpass_corners``.
+
+    freqmin and freqmax have no default: the recipe sets them (``pipeline/processing.toml``).
+    """
     low, high = bandpass_corners(trace, freqmin, freqmax, nyquist_fraction, use_header_corners)
     trace.filter("bandpass", freqmin=low, freqmax=high, corners=int(corners), zerophase=True)
     return trace
 
 
-@processing_step(order=(3, 12))
-def baseline(trace, *, order=6, context=None):
+@processing_step(order=Number(3, 12, integer=True))
+def baseline(trace, *, order=6):
     """Remove d''(t) of a polynomial d(t) = sum_{k=2..order} c_k t^k fitted to the displacement.
 
     No constant or linear term, so the correction starts from rest (PEER / Ancheta et al. 2014).
@@ -152,7 +239,6 @@ def baseline(trace, *, order=6, context=None):
     second_derivative = ((powers * (powers - 1)) * coefficients
                          * tau[:, None] ** (powers - 2)).sum(axis=1) / duration**2
     trace.data = trace.data - second_derivative
-    _provenance(trace, f"baseline(order={int(order)}, ends at rest)")
     return trace
 
 
@@ -171,74 +257,81 @@ class ProcessingRecipe:
         return {"steps": [{"name": name, **params} for name, params in self.steps],
                 "qa": dict(self.qa), "overrides": self.overrides}
 
+    def steps_for(self, record_id: str) -> list[tuple[str, dict]]:
+        """The steps as they run on one record: each step's parameters with the record's overrides."""
+        overrides = self.overrides.get(record_id, {})
+        return [(name, {**params, **overrides.get(name, {})}) for name, params in self.steps]
+
 
 QA_DEFAULTS = {"tail_seconds": 5.0, "velocity_ratio": 0.3, "displacement_ratio": 0.6}
-QA_RANGES = {"tail_seconds": (0.1, 100.0), "velocity_ratio": (0.0, 10.0),
-             "displacement_ratio": (0.0, 10.0)}
+QA_TABLE = Table({"tail_seconds": Number(0.1, 100.0, unit="s"), "velocity_ratio": Number(0.0, 10.0),
+                  "displacement_ratio": Number(0.0, 10.0)})
+"""``[qa]``: the arguments of ``tail_checks``."""
 
 
-def _validate_step(name, params, source, where):
+def _step(name, field, source) -> ProcessingStep:
     if name not in PROCESSING_STEPS:
-        raise ConfigError(where, f"unknown step {name!r}; available: {', '.join(PROCESSING_STEPS)}", source)
-    allowed = [p for p in inspect.signature(PROCESSING_STEPS[name]).parameters if p not in ("trace", "context")]
-    for key, value in params.items():
-        if key not in allowed:
-            raise ConfigError(f"{where}.{key}", f"not a parameter of step {name!r}; allowed: "
-                              f"{', '.join(allowed) or 'none'}", source)
-        bounds = PARAMETER_RANGES.get(f"{name}.{key}")
-        if bounds is not None:
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                raise ConfigError(f"{where}.{key}", f"{value!r} is not a number; allowed range "
-                                  f"{bounds[0]} to {bounds[1]}", source)
-            if not bounds[0] <= value <= bounds[1]:
-                raise ConfigError(f"{where}.{key}", f"{value} is out of range; allowed "
-                                  f"{bounds[0]} to {bounds[1]}", source)
+        raise ConfigError(field, f"unknown step {name!r}; available: {', '.join(PROCESSING_STEPS)}", source)
+    return PROCESSING_STEPS[name]
+
+
+def _check_steps(value, field, source) -> list:
+    """``[[steps]]``: a non-empty list of tables, each a step's name and the parameters its schema allows
+    (those without a default required); a step that reads another needs it; pads and unpads pair up."""
+    if not isinstance(value, list) or not value:
+        raise ConfigError(field, f"{shown(value)}; expected a non-empty list of [[steps]] tables", source)
+    names = []
+    for index, raw in enumerate(value):
+        where = f"{field}[{index}]"
+        if not isinstance(raw, dict) or not isinstance(raw.get("name"), str):
+            raise ConfigError(where, "each step needs a name (text)", source)
+        step = _step(raw["name"], where, source)
+        step.parameters.check({k: v for k, v in raw.items() if k != "name"}, where, source)
+        names.append(step.name)
+    for name in dict.fromkeys(names):
+        for other in PROCESSING_STEPS[name].reads:
+            if other not in names:
+                raise ConfigError(field, f"step {name!r} needs a {other!r} step (it reads that step's parameters)",
+                                  source)
+    if names.count("pad") != names.count("unpad"):
+        raise ConfigError(field, "every 'pad' step needs a matching 'unpad' step", source)
+    return value
+
+
+def _check_overrides(value, field, source) -> dict:
+    """``[overrides."RECORD_ID".STEP]``: parameters of one step for one record (none required)."""
+    if not isinstance(value, dict):
+        raise ConfigError(field, f"{shown(value)}; expected tables [overrides.\"RECORD_ID\".STEP]", source)
+    for record_id, by_step in value.items():
+        if not isinstance(by_step, dict):
+            raise ConfigError(f"{field}.{record_id}", "expected a table of steps", source)
+        for name, params in by_step.items():
+            where = f"{field}.{record_id}.{name}"
+            if not isinstance(params, dict):
+                raise ConfigError(where, "expected a table of parameters", source)
+            dataclasses.replace(_step(name, where, source).parameters, required=()).check(params, where, source)
+    return value
+
+
+RECIPE = Table({"steps": Checked(_check_steps, "a non-empty list of [[steps]] tables"), "qa": QA_TABLE,
+                "overrides": Checked(_check_overrides, 'tables [overrides."RECORD_ID".STEP]')},
+               required=("steps",))
+"""The schema of a recipe file (``pipeline/processing.toml``)."""
 
 
 def recipe_from_dict(data: dict, source="<dict>") -> ProcessingRecipe:
     """Validate a recipe given as a dict (the TOML layout) and freeze it."""
-    raw_steps = data.get("steps")
-    if not isinstance(raw_steps, list) or not raw_steps:
-        raise ConfigError("steps", "expected a non-empty list of [[steps]] tables", source)
-    steps = []
-    for index, raw in enumerate(raw_steps):
-        where = f"steps[{index}]"
-        if not isinstance(raw, dict) or not isinstance(raw.get("name"), str):
-            raise ConfigError(where, "each step needs a name (text)", source)
-        params = {k: v for k, v in raw.items() if k != "name"}
-        _validate_step(raw["name"], params, source, where)
-        steps.append((raw["name"], params))
+    RECIPE.check(data, "", source)
+    steps = tuple((raw["name"], {k: v for k, v in raw.items() if k != "name"}) for raw in data["steps"])
     names = [name for name, _ in steps]
-    if "pad" in names and "bandpass" not in names:
-        raise ConfigError("steps", "step 'pad' needs a 'bandpass' step (its length depends on freqmin)", source)
-    if names.count("pad") != names.count("unpad"):
-        raise ConfigError("steps", "every 'pad' step needs a matching 'unpad' step", source)
-    for table in ("qa", "overrides"):
-        if not isinstance(data.get(table, {}), dict):
-            raise ConfigError(table, f"{data[table]!r} is not a table; expected [{table}]", source)
-    unknown = sorted(set(data) - {"steps", "qa", "overrides"})
-    if unknown:
-        raise ConfigError(unknown[0], "unknown key; allowed: steps, qa, overrides", source)
-    qa = dict(QA_DEFAULTS)
-    for key, value in data.get("qa", {}).items():
-        if key not in QA_RANGES:
-            raise ConfigError(f"qa.{key}", f"unknown QA setting; allowed: {', '.join(QA_RANGES)}", source)
-        low, high = QA_RANGES[key]
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not low <= value <= high:
-            raise ConfigError(f"qa.{key}", f"{value!r} out of range; allowed {low} to {high}", source)
-        qa[key] = float(value)
     overrides = data.get("overrides", {})
     for record_id, by_step in overrides.items():
-        if not isinstance(by_step, dict):
-            raise ConfigError(f"overrides.{record_id}", "expected a table of steps", source)
-        for step_name, params in by_step.items():
-            if not isinstance(params, dict):
-                raise ConfigError(f"overrides.{record_id}.{step_name}", "expected a table of parameters", source)
-            if step_name not in names:
-                raise ConfigError(f"overrides.{record_id}.{step_name}", "step not in the recipe; "
-                                  f"steps: {', '.join(names)}", source)
-            _validate_step(step_name, params, source, f"overrides.{record_id}.{step_name}")
-    return ProcessingRecipe(tuple(steps), qa, overrides, source)
+        for name in by_step:
+            if name not in names:
+                raise ConfigError(f"overrides.{record_id}.{name}", f"step not in the recipe; steps: "
+                                  f"{', '.join(names)}", source)
+    qa = {**QA_DEFAULTS, **{key: float(value) for key, value in data.get("qa", {}).items()}}
+    return ProcessingRecipe(steps, qa, overrides, source)
 
 
 def load_recipe(path=None) -> ProcessingRecipe:
@@ -296,18 +389,14 @@ def process_record(record, recipe: ProcessingRecipe | None = None):
     source = record.metadata.get("file") or record.id
     trace = record.trace.copy()
     trace.data = np.asarray(trace.data, dtype=np.float64)
-    overrides = recipe.overrides.get(record.id, {})
-    steps = [(name, {**params, **overrides.get(name, {})}) for name, params in recipe.steps]
-    context = {"bandpass": {"corners": 4, "freqmin": 0.1,
-                            **next((p for n, p in steps if n == "bandpass"), {})}}
-    context["bandpass"]["freqmin"] = bandpass_corners(
-        trace, context["bandpass"]["freqmin"], context["bandpass"].get("freqmax", 25.0),
-        context["bandpass"].get("nyquist_fraction", 0.8),
-        context["bandpass"].get("use_header_corners", True))[0]
+    steps = recipe.steps_for(record.id)
     for name, params in steps:
+        step = PROCESSING_STEPS[name]
+        read = {other: PROCESSING_STEPS[other].arguments(next(p for n, p in steps if n == other))
+                for other in step.reads}
         try:
             with np.errstate(over="raise", invalid="raise", divide="raise"):
-                trace = PROCESSING_STEPS[name](trace, context=context, **params)
+                trace = step.run(trace, **params, **read)
         except PROCESSING_FAILURES as error:
             raise RecordError(source, f"record {record.id} cannot be processed: step {name!r} failed "
                               f"({type(error).__name__}: {str(error)[:200]})") from None

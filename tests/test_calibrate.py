@@ -182,6 +182,13 @@ def test_headerless_table_and_short_or_unordered_tables(tmp_path):
         load_reference(write_table(tmp_path / "order.csv", ["t", "theta"], rows))
 
 
+def test_reference_numbers_are_read_as_written(tmp_path):
+    """Every digit counts (pandas.to_numeric, the reader before, dropped those past the 16th)."""
+    cell = "0.00019800515671750674"
+    path = write_table(tmp_path / "ref.csv", ["time [s]", "theta [rad]"], [(i * 0.01, cell) for i in range(12)])
+    assert load_reference(path).rotation[0] == float(cell)
+
+
 def test_references_that_cannot_belong_to_the_record_are_refused():
     dt, duration = 0.01, 12.0
     seconds = np.arange(0, 12, 0.005)

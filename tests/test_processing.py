@@ -28,9 +28,11 @@ def test_input_is_not_modified_and_provenance_is_kept(bolu_records):
     before = record.acceleration.copy()
     processed = process_record(record)
     np.testing.assert_array_equal(record.acceleration, before)
-    steps = " ".join(processed.trace.stats.processing)
-    for name in ("demean", "linear", "taper", "pad", "bandpass", "unpad", "baseline"):
-        assert name in steps
+    ours = [line.split(": ", 1)[1] for line in processed.trace.stats.processing if line.startswith("rockfrag")]
+    assert [line.split("(")[0] for line in ours] == [name for name, _ in load_recipe().steps]
+    assert "bandpass(freqmin=0.1, freqmax=50.0, corners=4" in " ".join(ours)  # the recipe's, not a default
+    assert ours[3].endswith(f"; npts {record.trace.stats.npts} -> {record.trace.stats.npts + 2 * 6000}")
+    assert "padding" not in processed.trace.stats  # pad tells unpad through the trace; unpad clears it
 
 
 def test_removes_a_known_drift(bolu_records):
@@ -68,7 +70,16 @@ def test_header_filter_corners_are_read(records_dir):
     ({"steps": [{"name": "taper", "width": 0.1}]}, "steps[0].width"),
     ({"steps": [{"name": "bandpass", "corners": "four"}]}, "steps[0].corners"),
     ({"steps": [{"name": "demean"}], "qa": {"tail_seconds": -1}}, "qa.tail_seconds"),
-    ({"steps": [{"name": "bandpass"}, {"name": "pad"}]}, "steps"),
+    ({"steps": [{"name": "bandpass", "freqmin": 0.1, "freqmax": 50.0}, {"name": "pad"}]}, "steps"),
+    ({"steps": [{"name": "pad"}, {"name": "unpad"}]}, "steps"),  # pad reads the band-pass step's corner
+    ({"steps": [{"name": "bandpass", "freqmin": 0.1}]}, "steps[0].freqmax"),  # the recipe sets both corners
+    ({"steps": [{"name": "bandpass", "freqmin": 0.1, "freqmax": 50.0, "use_header_corners": "yes"}]},
+     "steps[0].use_header_corners"),
+    ({"steps": [{"name": "taper", "type": "kaiser"}]}, "steps[0].type"),
+    ({"steps": [{"name": "baseline", "order": 6.5}]}, "steps[0].order"),
+    ({"steps": [{"name": "demean"}], "overrides": {"X": {"bandpass": {"freqmax": -1.0}}}},
+     "overrides.X.bandpass.freqmax"),
+    ({"steps": [{"name": "demean"}], "filters": []}, "filters"),
     ({"steps": [{"name": "demean"}], "overrides": {"X": {"bandpass": {"freqmin": 0.2}}}},
      "overrides.X.bandpass"),
 ])
@@ -79,6 +90,30 @@ def test_bad_recipes_name_the_field(data, field):
     assert "user.toml" in str(caught.value)
 
 
+def test_recipe_messages_name_the_allowed_range_and_keys():
+    with pytest.raises(ConfigError, match=r"steps\[0\]\.max_percentage: 0\.9 out of range; must be a number from "
+                                          r"0\.0 to 0\.5"):
+        recipe_from_dict({"steps": [{"name": "taper", "max_percentage": 0.9}]}, source="user.toml")
+    with pytest.raises(ConfigError, match=r"freqmax: missing; must be a number from 0\.5 to 1000\.0 \[Hz\]"):
+        recipe_from_dict({"steps": [{"name": "bandpass", "freqmin": 0.1}]}, source="user.toml")
+    with pytest.raises(ConfigError, match=r"unknown parameter of step 'taper' \(did you mean 'type'\?\); "
+                                          r"allowed: max_percentage, type"):
+        recipe_from_dict({"steps": [{"name": "taper", "typ": "hann"}]}, source="user.toml")
+
+
+def test_the_shipped_recipe_is_the_authority_for_the_band_pass_corners():
+    import inspect
+
+    from pipeline.processing import PROCESSING_STEPS
+
+    bandpass = dict(load_recipe().steps)["bandpass"]
+    assert (bandpass["freqmin"], bandpass["freqmax"]) == (0.1, 50.0)
+    defaults = PROCESSING_STEPS["bandpass"].defaults
+    assert "freqmin" not in defaults and "freqmax" not in defaults
+    parameters = inspect.signature(PROCESSING_STEPS["bandpass"].run).parameters
+    assert parameters["freqmax"].default is inspect.Parameter.empty
+
+
 def test_per_record_override_changes_only_that_record(bolu_records, tmp_path):
     path = tmp_path / "recipe.toml"
     default = (__import__("pipeline").__path__[0] + "/processing.toml")
@@ -87,7 +122,11 @@ def test_per_record_override_changes_only_that_record(bolu_records, tmp_path):
     record = bolu_records["DUZCE/BOL090"]
     default_result = process_record(record)
     overridden = process_record(record, recipe)
-    assert "'freqmin': 0.5" in " ".join(overridden.trace.stats.processing)
+    assert "bandpass(freqmin=0.5, freqmax=50.0" in " ".join(overridden.trace.stats.processing)
+    assert "'freqmin': 0.5" in " ".join(overridden.trace.stats.processing)  # obspy's own record of the filter
+    # the pad follows the overridden corner: 1.5 * 4 / 0.5 Hz = 12 s of zeros at each end
+    npts = record.trace.stats.npts
+    assert f"pad(factor=1.5); npts {npts} -> {npts + 2 * 1200}" in " ".join(overridden.trace.stats.processing)
     assert not np.allclose(default_result.acceleration, overridden.acceleration)
     other = bolu_records["DUZCE/BOL000"]
     np.testing.assert_array_equal(process_record(other, recipe).acceleration, process_record(other).acceleration)

@@ -129,3 +129,21 @@ def test_one_column_without_dt_is_skipped_with_its_reason(tmp_path, capsys):
     status = main(["records", "--set", str(path), "--units", "g", "--output", str(tmp_path / "out"), "--no-progress"])
     assert status == 2
     assert "--dt" in capsys.readouterr().err
+
+
+def test_one_table_reader_gives_header_names_and_lines(tmp_path):
+    """records/text.read_columns reads text records and calibration references alike."""
+    from pipeline.records.text import read_columns
+
+    text = "# exported by the logger\nsite A, north\ntime [s]; theta [deg]; note\n0;0.1;a\n\n0.01;0.2;b\n"
+    table = read_columns(_write(tmp_path, "table.csv", text), "two columns", counts=(2,), extra=True)
+    assert table.header == ("site A, north", "time [s]; theta [deg]; note")
+    assert table.name(0) == "time [s]" and table.name(1) == "theta [deg]" and table.lines == (4, 6)
+    np.testing.assert_array_equal(table.values, [[0.0, 0.1], [0.01, 0.2]])
+    with pytest.raises(RecordError, match=r"line 3: column 'theta \[deg\]': 'x' is not a number"):
+        read_columns(_write(tmp_path, "bad.csv", "time [s], theta [deg]\n0, 1\n0.01, x\n"), "two columns")
+    with pytest.raises(RecordError, match=r"line 2: column 'time \[s\]': 'x' is not a number"):  # no 2nd header
+        read_columns(_write(tmp_path, "first.csv", "time [s], theta [deg]\nx, 1\n0.01, 2\n"), "two columns",
+                     header_lines=1)
+    with pytest.raises(RecordError, match=r"line 3: time must increase from line to line \(column 't'\)"):
+        read_columns(_write(tmp_path, "back.csv", "t a\n0 1\n0 2\n"), "two columns").time(0)

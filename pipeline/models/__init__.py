@@ -20,11 +20,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from pipeline.blocks import Block
-from pipeline.errors import SolverError
+from pipeline.errors import ConfigError, SolverError
 from pipeline.models import fields, kernels
 from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
 from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
 from pipeline.units import STANDARD_GRAVITY
+from pipeline.validation import Nullable, Number, Table, Text
 
 MODELS: dict[str, RockingModel] = {}
 
@@ -64,18 +65,29 @@ class SolverOptions:
     atol: float = DEFAULT_ATOL
 
     def __post_init__(self):
-        if self.switch not in SWITCH_RULES:
-            raise SolverError(f"switch {self.switch!r} unknown; valid: {', '.join(SWITCH_RULES)}")
-        if self.bed not in BED_TYPES:
-            raise SolverError(f"bed {self.bed!r} unknown; valid: {', '.join(BED_TYPES)}")
-        if not 0 < self.overturn_angle <= math.pi / 2:
-            raise SolverError(f"overturn_angle {self.overturn_angle} [rad] out of range; allowed 0 < angle <= pi/2")
-        if not self.g > 0:
-            raise SolverError(f"g = {self.g} [m/s^2]; must be > 0")
-        if self.restitution is not None and not 0 <= self.restitution <= 1:
-            raise SolverError(f"restitution {self.restitution} out of range; allowed 0 to 1")
-        if not (0 < self.rtol < 1 and 0 < self.atol < 1):
-            raise SolverError(f"rtol {self.rtol}, atol {self.atol}: each must be in (0, 1)")
+        _check(SOLVER_OPTIONS, vars(self))
+
+
+SOLVER_OPTIONS = Table({
+    "switch": Text(tuple(SWITCH_RULES)),
+    "bed": Text(tuple(BED_TYPES)),
+    "restitution": Nullable(Number(0.0, 1.0)),
+    "g": Number(0.0, low_open=True, unit="m/s^2"),
+    "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
+    "rtol": Number(0.0, 1.0, low_open=True, high_open=True),
+    "atol": Number(0.0, 1.0, low_open=True, high_open=True),
+})
+"""The schema of ``SolverOptions`` (pipeline.validation)."""
+FOUNDATION = Table({"k": Number(0.0, low_open=True, unit="N/m"), "xi": Number(0.0, 1.0, high_open=True)})
+"""The schema of a foundation's interface stiffness k and damping ratio xi."""
+
+
+def _check(schema: Table, values: dict) -> None:
+    """Check solver arguments against ``schema``: a value out of range is a ``SolverError`` naming it."""
+    try:
+        schema.check(values, "", None)
+    except ConfigError as error:
+        raise SolverError(str(error)) from None
 
 
 def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options=SolverOptions()):
@@ -87,11 +99,8 @@ def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options
     if model.needs_foundation:
         if k is None:
             raise SolverError(f"model {model.name!r} needs the interface stiffness k [N/m]")
-        if not (k > 0 and math.isfinite(k)):
-            raise SolverError(f"k = {k} [N/m] out of range; allowed finite > 0")
         xi_value = DEFAULT_XI if xi is None else xi
-        if not 0 <= xi_value < 1:
-            raise SolverError(f"xi = {xi_value} out of range; allowed 0 <= xi < 1")
+        _check(FOUNDATION, {"k": k, "xi": xi_value})
         omega = math.sqrt(k / block.mass)
         y0 = options.g / omega**2  # static equilibrium: never drop the block onto an unloaded bed
     restitution = options.restitution
