@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from pipeline.blocks import Block
-from pipeline.config import MEASURE_UNITS
-from pipeline.measures import MEASURES, average_spectral_acceleration, velocity_pulse
+from pipeline.measures import (MEASURES, average_spectral_acceleration, display_units, scaling_measures, short_label,
+                               velocity_pulse)
 from pipeline.units import STANDARD_GRAVITY as G
 
 BLOCK = Block(name="cabinet", b=0.3, h=1.5, mass=2000.0)  # tan(alpha) = 0.2, R = sqrt(0.09 + 2.25)
@@ -79,6 +79,35 @@ def test_every_measure_scales_with_its_exponent(bolu_records, name):
 def test_registry_describes_every_measure_and_feeds_the_config_units():
     for name, measure in MEASURES.items():
         assert measure.name == name and measure.si_unit and measure.display_unit and measure.describe()
-        assert (name in MEASURE_UNITS) == measure.scalable
-    assert MEASURE_UNITS["pga"] == ("g", G) and MEASURE_UNITS["pgv_ratio"] == ("1", 1.0)
+        assert measure.short_label() and (name in scaling_measures()) == measure.scalable
+    assert display_units("pga") == ("g", G) and display_units("pgv_ratio") == ("1", 1.0)
+    assert display_units("pulse_period") == ("", 1.0)  # a record property: no study scales to it
     assert "0.5" in MEASURES["avgsa"].describe(period=2.5, period_range=(0.5, 7.0))
+
+
+@pytest.mark.parametrize("name, options, label", [
+    ("pga", {}, "PGA"), ("pgv", {"period": 2.0}, "PGV"), ("sa", {"period": 0.5, "damping": 0.02}, "Sa(0.5 s)"),
+    ("avgsa", {"period": 1.0}, "AvgSa(0.2-3 s)"), ("avgsa", {"period_range": (0.5, 7.0)}, "AvgSa(0.5-7 s)"),
+])
+def test_the_label_is_read_back_from_the_long_name_the_cube_holds(name, options, label):
+    """The report labels its axes from a result file's ``im_level`` long name: the registry's label with
+    the study's options, whatever text surrounds the long name."""
+    measure = MEASURES[name]
+    assert measure.short_label(**options) == label
+    described = f"intensity level: multiple of the block's uplift intensity ({measure.describe(**options)})"
+    assert short_label(name, described) == label
+    assert short_label("", described) == label  # an old file without ``intensity_measure``: found by its long name
+
+
+def test_a_label_that_needs_options_it_cannot_find_falls_back_on_the_name():
+    assert short_label("sa", "intensity level") == "SA"
+    assert short_label("pga", "") == "PGA"  # nothing to fill in
+    assert short_label("", "") == "intensity" and short_label("unknown") == "UNKNOWN"
+
+
+def test_pelicun_and_openquake_names_are_registered_once():
+    assert MEASURES["pga"].pelicun_demand == ("Peak Ground Acceleration", "g")
+    assert MEASURES["pgv"].pelicun_demand == ("Peak Ground Velocity", "mps")
+    assert MEASURES["sa"].pelicun_demand == ("Spectral Acceleration", "g") and MEASURES["sa"].uses_period
+    assert [m.openquake_imt for m in MEASURES.values() if m.openquake_imt] == ["PGA", "PGV", "SA(T)"]
+    assert not MEASURES["avgsa"].uses_period  # defined over a range, not at one period

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from pipeline.errors import ConfigError
-from pipeline.risk import annual_frequency, hazard_frequency, load_hazard, probability_in_life, study_hazard
+from pipeline.hazard import hazard_frequency, load_hazard, study_hazard
+from pipeline.risk import annual_frequency, probability_in_life
 
 DATA = Path(__file__).parent / "data"
 
