@@ -111,3 +111,31 @@ def test_pelicun_and_openquake_names_are_registered_once():
     assert MEASURES["sa"].pelicun_demand == ("Spectral Acceleration", "g") and MEASURES["sa"].uses_period
     assert [m.openquake_imt for m in MEASURES.values() if m.openquake_imt] == ["PGA", "PGV", "SA(T)"]
     assert not MEASURES["avgsa"].uses_period  # defined over a range, not at one period
+
+
+@pytest.fixture
+def cav_measure():
+    """A measure added as a newcomer would add it: one ``define_measure`` definition (removed afterwards)."""
+    from pipeline.measures import cav, define_measure
+
+    @define_measure("cav_test", si_unit="m/s", long_name="cumulative absolute velocity", label="CAV",
+                    openquake_imt="CAV", openquake_factor=0.01)
+    def _cav(acceleration, dt, block, options):
+        return cav(acceleration, dt)
+
+    yield MEASURES["cav_test"]
+    del MEASURES["cav_test"]
+
+
+def test_one_definition_reaches_every_reader_of_the_registry(cav_measure, tmp_path):
+    from pipeline.efficiency import ranked_measures
+    from pipeline.hazard import _measure_from_imt, load_hazard
+
+    assert cav_measure(np.array([1.0, -1.0, 1.0]), 0.5) == pytest.approx(1.0)
+    assert "cav_test" in scaling_measures() and "cav_test" in ranked_measures()
+    assert display_units("cav_test") == ("m/s", 1.0)
+    assert short_label("cav_test", "intensity level: cumulative absolute velocity") == "CAV"
+    assert _measure_from_imt("CAV", "here") == ("cav_test", None, 0.01)
+    curve = tmp_path / "hazard.csv"
+    curve.write_text("# measure = cav_test\n# units = m/s\nintensity,annual_frequency\n0.1,1e-2\n0.2,2e-3\n")
+    assert load_hazard(curve, "cav_test").label == "CAV"
