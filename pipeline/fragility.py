@@ -44,6 +44,7 @@ from pipeline.lognormal_fit import (CROSSING_TOLERANCE, curves_cross, deviance, 
                                     fit_censored_capacities, fit_independent, fit_shared_beta, goodness_of_fit,
                                     lognormal_cdf, separation)
 from pipeline.measures import MEASURES, display_units
+from pipeline.models import MODELS
 from pipeline.outputs import atomic_path
 from pipeline.risk import risk_dataset
 from pipeline.units import STANDARD_GRAVITY
@@ -104,8 +105,6 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
 
 def uplift_is_rigid_threshold(model_name: str) -> bool:
     """Does the model's uplift happen exactly at g tan(alpha) under PGA scaling? Asks the model."""
-    from pipeline.models import MODELS
-
     model = MODELS.get(model_name)
     if model is None:  # a cube of a model this installation does not know: fall back on its name
         return model_name in RIGID_UPLIFT_MODELS
