@@ -30,17 +30,15 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.blocks import Block
+from pipeline.damage_states import DamageState, damage_states_from_config
 from pipeline.errors import ConfigError, PipelineError
-from pipeline.measures import MEASURES
+from pipeline.hazard import hazard_for
+from pipeline.measures import MEASURES, scaling_measures
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
 from pipeline.validation import (Checked, Either, Interval, NamedTables, Names, Number, Numbers, Table, Text,
                                  shown as _shown)
 
-MEASURE_UNITS = {name: (m.display_unit, m.display_factor) for name, m in MEASURES.items() if m.scalable}
-"""Measures a study can scale records to (pipeline.measures registry): name -> (display unit, SI value
-of one display unit)."""
-SCALING_MEASURES = tuple(MEASURE_UNITS)
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
 uplift intensity."""
@@ -73,8 +71,6 @@ LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, in
 
 
 def _damage_state_table() -> Table:
-    from pipeline.fragility import DamageState
-
     keys = [f.name for f in dataclasses.fields(DamageState) if f.name != "name"]
     return Table({key: Number(0, low_open=True) if key == "threshold" else TEXT for key in keys})
 
@@ -91,7 +87,7 @@ SCHEMA = Table({
                      "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"),
                      # report metadata, read by pipeline.report
                      "title": TEXT, "project": TEXT, "author": TEXT}),
-    "intensity": _table({"measure": Text(SCALING_MEASURES), "period": Number(0.01, 20.0, unit="s"),
+    "intensity": _table({"measure": Text(scaling_measures()), "period": Number(0.01, 20.0, unit="s"),
                          "damping": Number(0.0, 0.5),
                          "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True),
                                            "a list of levels or { start, stop, count, spacing }"),
@@ -178,7 +174,7 @@ class StudyConfig:
 
     @property
     def level_unit(self) -> str:
-        return MEASURE_UNITS[self.measure][0]
+        return MEASURES[self.measure].display_unit
 
     @property
     def relative_levels(self) -> bool:
@@ -195,7 +191,7 @@ class StudyConfig:
         the dimensionless multiples themselves (per-block intensities: pipeline.study.level_intensities)."""
         if self.relative_levels:
             return np.asarray(self.levels, dtype=float)
-        return np.asarray(self.levels) * MEASURE_UNITS[self.measure][1]
+        return np.asarray(self.levels) * MEASURES[self.measure].display_factor
 
     def as_json(self) -> str:
         return json.dumps(self.raw, sort_keys=True, default=str)
@@ -307,8 +303,6 @@ def _select(kind, names, available, source):
 
 def _check_damage_states(data, source):
     """The study's damage states as the fragility stage will read them (its own EDP list)."""
-    from pipeline.fragility import damage_states_from_config
-
     try:
         damage_states_from_config(data)
     except ConfigError as error:
@@ -317,15 +311,12 @@ def _check_damage_states(data, source):
 
 def _check_hazard(path, source, measure="pga", period=None):
     """The hazard curve loads (file exists, numeric, decreasing frequency) and is for the study's
-    intensity measure (and Sa period). No file and a measure other than PGA: no risk, nothing to check."""
-    from pipeline.risk import load_hazard
-
+    intensity measure (and Sa period). No file and a measure other than the shipped example's: no risk,
+    nothing to check (pipeline.hazard.hazard_for)."""
     if path and Path(path).is_dir():
         raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
-    if not path and measure != "pga":
-        return
     try:
-        load_hazard(path or None, measure, period if measure == "sa" else None)
+        hazard_for(path, measure, period)
     except ConfigError as error:
         raise ConfigError(error.field, f"{error.source}: {error.reason}", source) from None
     except (ValueError, UnicodeDecodeError, OSError) as error:

@@ -32,7 +32,7 @@ import xarray as xr
 from scipy import stats
 
 from pipeline.cube import write_netcdf
-from pipeline.measures import MEASURES
+from pipeline.measures import MEASURES, scaling_measures
 from pipeline.outputs import atomic_path
 
 SIGNIFICANCE = 0.05
@@ -46,7 +46,7 @@ COVARIATES = {"magnitude": ("moment magnitude", "1", False),
 
 def ranked_measures() -> list[str]:
     """Measures a capacity can be re-expressed in (scaling exponent 1)."""
-    return [name for name, measure in MEASURES.items() if measure.scalable]
+    return list(scaling_measures())
 
 
 def measure_values(records, blocks, options, names=None) -> xr.DataArray:

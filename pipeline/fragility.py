@@ -1,8 +1,8 @@
 """pipeline.fragility - stage 8: the cube -> lognormal fragility functions per soil and damage state.
 
 Input : the study cube (outcome, peak_angle_ratio over record x im_level x soil x block x model; the
-        intensity of each level per block, see ``intensity_levels``), the damage states (registry below,
-        plus ``[damage_states.NAME]`` tables of the study file).
+        intensity of each level per block, see ``intensity_levels``), the damage states
+        (``pipeline.damage_states``: the registry plus ``[damage_states.NAME]`` tables of the study file).
 Output: ``reports/fragility.nc`` (median, beta, bootstrap bounds, fit method, ``status``, the
         ``extrapolated`` flag, goodness of fit, the non-crossing rule's deviance cost and the studied
         range per soil x block x model x damage state; empirical fractions per level; the three-outcome
@@ -30,17 +30,23 @@ from __future__ import annotations
 import json
 import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
 from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError
+from pipeline.hazard import study_hazard
 from pipeline.lognormal_fit import (CROSSING_TOLERANCE, curves_cross, deviance, fit_binomial,  # noqa: F401
                                     fit_censored_capacities, fit_independent, fit_shared_beta, goodness_of_fit,
                                     lognormal_cdf, separation)
+from pipeline.measures import MEASURES, display_units
+from pipeline.models import MODELS
 from pipeline.outputs import atomic_path
+from pipeline.risk import risk_dataset
 from pipeline.units import STANDARD_GRAVITY
 
 STATUS = {
@@ -59,46 +65,6 @@ SMALL_SAMPLE = 10
 
 RIGID_UPLIFT_MODELS = ("housner", "ssi", "ssi-paper")
 """Fallback when a model object does not say ``uplift_is_rigid_threshold``."""
-
-
-@dataclass(frozen=True)
-class DamageState:
-    """A limit state: ``edp`` >= ``threshold`` (overturning exceeds every rocking threshold)."""
-
-    name: str
-    edp: str  # "uplifted", "overturned", or a cube variable such as "peak_angle_ratio"
-    threshold: float
-    description: str
-
-
-DAMAGE_STATES: dict[str, DamageState] = {}
-
-
-def register_damage_state(state: DamageState) -> None:
-    """Add a damage state; the registry order is the order of increasing severity."""
-    DAMAGE_STATES[state.name] = state
-
-
-register_damage_state(DamageState("uplift", "uplifted", 1.0, "rocking starts (the heel lifts off)"))
-register_damage_state(DamageState("rocking-0.2", "peak_angle_ratio", 0.2, "theta_max/alpha >= 0.2"))
-register_damage_state(DamageState("rocking-0.5", "peak_angle_ratio", 0.5, "theta_max/alpha >= 0.5"))
-register_damage_state(DamageState("overturning", "overturned", 1.0, "the block overturns"))
-
-
-def damage_states_from_config(raw: dict) -> list[DamageState]:
-    """Defaults plus (or replaced by) the study's ``[damage_states.NAME]`` tables."""
-    states = dict(DAMAGE_STATES)
-    for name, spec in raw.get("damage_states", {}).items():
-        edp = spec.get("edp", "peak_angle_ratio")
-        if edp not in ("uplifted", "overturned", "peak_angle_ratio", "peak_angle", "peak_uplift", "n_impacts"):
-            raise ConfigError(f"damage_states.{name}.edp", f"{edp!r}; allowed: uplifted, overturned, "
-                              "peak_angle_ratio, peak_angle, peak_uplift, n_impacts")
-        threshold = spec.get("threshold", 1.0)
-        if not isinstance(threshold, (int, float)) or threshold <= 0:
-            raise ConfigError(f"damage_states.{name}.threshold", f"{threshold!r}; allowed > 0")
-        states[name] = DamageState(name, edp, float(threshold), spec.get("description", ""))
-    order = {"uplifted": 0, "overturned": 2}
-    return sorted(states.values(), key=lambda s: (order.get(s.edp, 1), s.threshold))
 
 
 def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
@@ -123,10 +89,8 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     display unit, e.g. ``intensity`` [g], or in SI, e.g. ``im_level_si`` [m/s^2]; found by its dims and
     units). Returns (n_block, n_level).
     """
-    from pipeline.config import MEASURE_UNITS  # config imports this module (DamageState) at load
-
     n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
-    display, factor = MEASURE_UNITS.get(cube.attrs.get("intensity_measure", "pga"), ("", 1.0))
+    display, factor = display_units(cube.attrs.get("intensity_measure", "pga"))
     per_block = [name for name, coord in cube.coords.items() if set(coord.dims) == {"block", "im_level"}]
     for name in sorted(per_block, key=lambda n: n not in ("intensity", "im_intensity")):
         units = cube[name].attrs.get("units", "")
@@ -141,8 +105,6 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
 
 def uplift_is_rigid_threshold(model_name: str) -> bool:
     """Does the model's uplift happen exactly at g tan(alpha) under PGA scaling? Asks the model."""
-    from pipeline.models import MODELS
-
     model = MODELS.get(model_name)
     if model is None:  # a cube of a model this installation does not know: fall back on its name
         return model_name in RIGID_UPLIFT_MODELS
@@ -493,10 +455,6 @@ def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:
 
 # ---------------------------------------------------------------- pelicun damage-model export
 
-PELICUN_DEMAND = {"pga": ("Peak Ground Acceleration", "g"), "sa": ("Spectral Acceleration", "g"),
-                  "pgv": ("Peak Ground Velocity", "mps")}
-
-
 def pelicun_id(block: str, soil: str, model: str) -> str:
     """A component ID pelicun can parse: it splits IDs on '-', so names keep '_' instead."""
     return ".".join(["ROCK", *(str(part).replace("-", "_").replace(" ", "_") for part in (block, soil, model))])
@@ -509,8 +467,9 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
     record reached leaves its LS empty and marks the component ``Incomplete`` (pelicun then skips it);
     the ``Comment`` column says what each LS is, the studied range and which medians are extrapolated."""
     measure = dataset.attrs.get("intensity_measure", "pga")
-    demand_type, demand_unit = PELICUN_DEMAND.get(measure, ("", ""))
-    if measure == "sa" and period:
+    registered = MEASURES.get(measure)
+    demand_type, demand_unit = (registered and registered.pelicun_demand) or ("", "")
+    if registered is not None and registered.uses_period and period:
         demand_type = f"{demand_type}|{period:g}"
     unit = dataset.attrs.get("intensity_unit", "")
     rows, seen = [], {}
@@ -557,10 +516,6 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=
     The hazard curve is read (and checked against the study's intensity measure) before any fit.
     Fit warnings are printed to ``log`` (stderr by default) and kept in the dataset.
     """
-    from pathlib import Path
-
-    from pipeline.risk import risk_dataset, study_hazard
-
     log = log or (lambda message: print(message, file=sys.stderr))
     progress = sys.stderr.isatty() if progress is None else progress
     output = Path(output)

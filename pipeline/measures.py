@@ -8,8 +8,10 @@ Output: scalar intensity measures in SI units (PGA [m/s^2], PGV [m/s], PGD [m], 
         period and amplitude of the dominant velocity pulse).
 
 ``MEASURES`` registers every measure a study can scale records to or rank (pipeline.efficiency) as
-one ``Measure``: name, function, SI unit, display unit, long name and pelicun demand type. A new
-measure is one ``register_measure(Measure(...))`` call.
+one ``Measure``: name, function, SI and display unit, long name, short label, pelicun demand type and
+OpenQuake IMT. Every stage reads these (the study file's choices and units, the cube's metadata, the
+report's axes, the hazard readers, the pelicun export): a new measure is one ``@define_measure``
+function at the end of this module.
 
 All functions are pure. The oscillator uses the exact solution for ground acceleration that is
 linear between samples (Nigam & Jennings 1969); its recurrence coefficients come from the matrix
@@ -20,9 +22,12 @@ solution written compactly.
 from __future__ import annotations
 
 import math
+import re
+import string
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -30,6 +35,9 @@ from scipy.linalg import expm
 
 from pipeline.processing import integrate
 from pipeline.units import STANDARD_GRAVITY
+
+if TYPE_CHECKING:
+    from pipeline.blocks import Block
 
 DEFAULT_PERIODS = np.round(np.geomspace(0.02, 10.0, 60), 4)
 """Periods of the default response spectrum [s]."""
@@ -60,14 +68,33 @@ def cav(acceleration, dt) -> float:
     return float(np.trapezoid(np.abs(acceleration), dx=dt))
 
 
-def significant_duration(acceleration, dt, start=0.05, end=0.95) -> float:
-    """Time between ``start`` and ``end`` fractions of the Arias intensity (D5-95 by default) [s]."""
+def _husid(acceleration, dt) -> tuple[np.ndarray | None, np.ndarray]:
+    """The normalised Husid curve (cumulative integral of a^2, trapezoidal; None for a record without
+    energy) and the time of each sample [s]."""
     squared = np.asarray(acceleration, dtype=float) ** 2
     husid = np.concatenate([[0.0], np.cumsum(0.5 * (squared[1:] + squared[:-1]) * dt)])
-    if husid[-1] <= 0:
-        return 0.0
-    husid /= husid[-1]
     time = np.arange(husid.size) * dt
+    if husid[-1] <= 0:
+        return None, time
+    return husid / husid[-1], time
+
+
+def significant_window(acceleration, dt, start=0.05, end=0.95) -> tuple[float, float]:
+    """Times [s] at which the Arias intensity reaches ``start`` and ``end`` of its final value (the
+    Husid curve interpolated linearly between samples); the whole record, (0, (n - 1) dt), for a record
+    without energy."""
+    husid, time = _husid(acceleration, dt)
+    if husid is None:
+        return 0.0, float(time[-1])
+    return float(np.interp(start, husid, time)), float(np.interp(end, husid, time))
+
+
+def significant_duration(acceleration, dt, start=0.05, end=0.95) -> float:
+    """Time between ``start`` and ``end`` fractions of the Arias intensity (D5-95 by default) [s]: the
+    length of ``significant_window``, 0 for a record without energy."""
+    husid, time = _husid(acceleration, dt)
+    if husid is None:
+        return 0.0
     return float(np.interp(end, husid, time) - np.interp(start, husid, time))
 
 
@@ -222,31 +249,51 @@ def _zero_crossing(series, i, j, dt) -> float:
 
 # ------------------------------------------------------------------ the measure registry
 
+MeasureFunction = Callable[[np.ndarray, float, "Block | None", dict], float]
+"""``function(acceleration [m/s^2], dt [s], block, options) -> value [si_unit]``."""
+
+
 @dataclass(frozen=True)
 class Measure:
-    """One intensity measure.
+    """One intensity measure: the one place every stage reads it from.
 
     ``function(acceleration [m/s^2], dt [s], block, options) -> value [si_unit]``; ``block`` is a
     ``pipeline.blocks.Block`` for per-block measures (ignored otherwise); ``options`` holds the
     study's ``period`` [s], ``damping`` [-] and ``period_range`` ((low, high) [s] or None).
+    ``long_name`` and ``label`` are templates filled with the options by ``describe`` and
+    ``short_label`` (fields ``period``, ``damping``, ``low``, ``high``): the long name for netCDF
+    metadata, the label for axes, tables and messages ("Sa({period:g} s)").
+    ``display_factor`` is the SI value of one display unit (``STANDARD_GRAVITY`` for g).
+    ``pelicun_demand`` is (pelicun demand type, pelicun unit), None when pelicun has no such demand;
+    ``openquake_imt`` the intensity measure type as OpenQuake and the USGS hazard service write it
+    ("SA(T)" for a period-dependent one), and ``openquake_factor`` the display units per unit of
+    their files (PGV comes in cm/s: 0.01).
     ``scaling_exponent`` n: IM(lambda a) = lambda^n IM(a); a study scales records to measures with
     n = 1 only, and a record's capacity re-expressed in the measure is scale x IM (n = 1).
-    ``display_factor`` is the SI value of one display unit (9.80665 for g).
     """
 
     name: str
-    function: Callable[..., float]
+    function: MeasureFunction
     si_unit: str
     display_unit: str
     display_factor: float
     long_name: str
-    pelicun_demand: tuple[str, str] | None = None  # (pelicun demand type, pelicun unit), None: none
+    label: str
+    pelicun_demand: tuple[str, str] | None = None
+    openquake_imt: str | None = None
+    openquake_factor: float = 1.0
     per_block: bool = False
     scaling_exponent: float = 1.0
 
     @property
     def scalable(self) -> bool:
+        """Can a study scale records to this measure (scaling exponent 1)?"""
         return self.scaling_exponent == 1.0
+
+    @property
+    def uses_period(self) -> bool:
+        """Is the measure defined at the study's one oscillator ``period`` (Sa(T))?"""
+        return "period" in _fields(self.label)
 
     def __call__(self, acceleration, dt, block=None, **options) -> float:
         if self.per_block and block is None:
@@ -255,13 +302,44 @@ class Measure:
 
     def describe(self, **options) -> str:
         """Long name with the study's options filled in."""
-        options = _options(options)
-        low, high = avgsa_range(options)
-        return self.long_name.format(period=options["period"], damping=options["damping"], low=low, high=high)
+        return _fill(self.long_name, options)
+
+    def short_label(self, **options) -> str:
+        """Label with the study's options filled in: "PGA", "Sa(1 s)", "AvgSa(0.2-3 s)"."""
+        return _fill(self.label, options)
+
+    def label_in(self, described: str) -> str | None:
+        """The label with the options read back from ``described``, a text ``describe`` wrote (such as the
+        ``long_name`` of a cube's ``im_level``): "Sa(0.5 s)" from "intensity level: spectral acceleration
+        Sa(0.5 s, 5%)". None when ``described`` does not hold this measure's long name."""
+        pattern, named = "", set()
+        for literal, field, _, _ in string.Formatter().parse(self.long_name):
+            pattern += re.escape(literal)
+            if field is not None:
+                pattern += f"(?P<{field}>[^()]+?)" if field not in named else "[^()]+?"
+                named.add(field)
+        found = re.search(pattern, described)
+        if found is None:
+            return None
+        try:
+            values = {key: float(found.group(key)) for key in _fields(self.label)}
+        except (IndexError, ValueError):
+            return None
+        return self.label.format(**values)
+
+
+def _fields(template: str) -> set[str]:
+    return {field for _, field, _, _ in string.Formatter().parse(template) if field}
 
 
 def _options(options) -> dict:
     return {"period": 1.0, "damping": 0.05, "period_range": None, **options}
+
+
+def _fill(template: str, options) -> str:
+    options = _options(options)
+    low, high = avgsa_range(options)
+    return template.format(period=options["period"], damping=options["damping"], low=low, high=high)
 
 
 def avgsa_range(options) -> tuple[float, float]:
@@ -273,37 +351,123 @@ def avgsa_range(options) -> tuple[float, float]:
 
 
 MEASURES: dict[str, Measure] = {}
-"""Registered measures by name (``register_measure``)."""
+"""Registered measures by name (``register_measure``, ``define_measure``), in registration order."""
 
 
-def register_measure(measure: Measure) -> None:
+def register_measure(measure: Measure) -> Measure:
+    """Add ``measure`` to ``MEASURES`` (replacing one of the same name) and return it."""
     MEASURES[measure.name] = measure
+    return measure
 
 
-def _rocking_pga(a, dt, block, o):
-    return pga(a) / block.uplift_acceleration()
+def define_measure(name: str, *, si_unit: str, long_name: str, label: str, display_unit: str | None = None,
+                   display_factor: float = 1.0, pelicun_demand: tuple[str, str] | None = None,
+                   openquake_imt: str | None = None, openquake_factor: float = 1.0, per_block: bool = False,
+                   scaling_exponent: float = 1.0) -> Callable[[MeasureFunction], MeasureFunction]:
+    """Decorator: register the decorated ``function(acceleration, dt, block, options)`` as measure ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The measure's name in study files (``[intensity] measure``) and result files.
+    si_unit, display_unit : str
+        Unit of the function's value, and of levels and tables (default: the SI unit).
+    display_factor : float
+        SI value of one display unit (``STANDARD_GRAVITY`` for g).
+    long_name, label : str
+        Templates (fields ``period``, ``damping``, ``low``, ``high``) of the netCDF long name and of the
+        short label for axes and messages.
+    pelicun_demand, openquake_imt, openquake_factor, per_block, scaling_exponent
+        See ``Measure``.
+
+    Returns
+    -------
+    callable
+        The decorator; it returns the function unchanged.
+    """
+    def register(function: MeasureFunction) -> MeasureFunction:
+        register_measure(Measure(name, function, si_unit, si_unit if display_unit is None else display_unit,
+                                 display_factor, long_name, label, pelicun_demand, openquake_imt,
+                                 openquake_factor, per_block, scaling_exponent))
+        return function
+
+    return register
 
 
-def _rocking_pgv(a, dt, block, o):
-    return block.p() * pgv(a, dt) / block.uplift_acceleration()
+def scaling_measures() -> tuple[str, ...]:
+    """Names of the registered measures a study can scale records to (scaling exponent 1)."""
+    return tuple(name for name, measure in MEASURES.items() if measure.scalable)
 
 
-register_measure(Measure("pga", lambda a, dt, block, o: pga(a), "m/s^2", "g", STANDARD_GRAVITY,
-                         "peak ground acceleration", ("Peak Ground Acceleration", "g")))
-register_measure(Measure("pgv", lambda a, dt, block, o: pgv(a, dt), "m/s", "m/s", 1.0,
-                         "peak ground velocity", ("Peak Ground Velocity", "mps")))
-register_measure(Measure("sa", lambda a, dt, block, o: spectral_acceleration(a, dt, o["period"], o["damping"]),
-                         "m/s^2", "g", STANDARD_GRAVITY, "spectral acceleration Sa({period:g} s, {damping:.0%})",
-                         ("Spectral Acceleration", "g")))
-register_measure(Measure("avgsa", lambda a, dt, block, o: average_spectral_acceleration(
-    a, dt, *avgsa_range(o), damping=o["damping"]), "m/s^2", "g", STANDARD_GRAVITY,
-    "average spectral acceleration AvgSa({low:g}-{high:g} s, {damping:.0%})"))
-register_measure(Measure("pga_ratio", _rocking_pga, "1", "1", 1.0,
-                         "PGA over the block's uplift acceleration, PGA/(g tan alpha)", per_block=True))
-register_measure(Measure("pgv_ratio", _rocking_pgv, "1", "1", 1.0,
-                         "p PGV/(g tan alpha), p = sqrt(3g/4R) (Makris & Vassiliou)", per_block=True))
-register_measure(Measure("pulse_amplitude", lambda a, dt, block, o: velocity_pulse(a, dt)[2], "m/s^2", "g",
-                         STANDARD_GRAVITY, "acceleration amplitude a_p = 2 pi PGV/Tp of the dominant velocity pulse"))
-register_measure(Measure("pulse_period", lambda a, dt, block, o: velocity_pulse(a, dt)[0], "s", "s", 1.0,
-                         "period Tp of the dominant velocity pulse (a record property: does not scale)",
-                         scaling_exponent=0.0))
+def display_units(name: str) -> tuple[str, float]:
+    """(display unit, SI value of one display unit) of a measure a study can scale to; ("", 1.0) otherwise."""
+    measure = MEASURES.get(name)
+    if measure is None or not measure.scalable:
+        return "", 1.0
+    return measure.display_unit, measure.display_factor
+
+
+def short_label(name: str, described: str = "") -> str:
+    """Short label of measure ``name`` for axes and text ("PGA", "Sa(1 s)"), its options read from
+    ``described`` (see ``Measure.label_in``). For an unknown or empty name: the label of the first
+    registered measure whose long name ``described`` holds; else the upper-case name, or "intensity"."""
+    measure = MEASURES.get(name)
+    for candidate in [measure] if measure is not None else MEASURES.values():
+        label = candidate.label_in(described)
+        if label is not None:
+            return label
+    if measure is not None and not _fields(measure.label):
+        return measure.label
+    return name.upper() or "intensity"
+
+
+@define_measure("pga", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
+                long_name="peak ground acceleration", label="PGA",
+                pelicun_demand=("Peak Ground Acceleration", "g"), openquake_imt="PGA")
+def _pga(acceleration, dt, block, options):
+    return pga(acceleration)
+
+
+@define_measure("pgv", si_unit="m/s", long_name="peak ground velocity", label="PGV",
+                pelicun_demand=("Peak Ground Velocity", "mps"), openquake_imt="PGV", openquake_factor=0.01)
+def _pgv(acceleration, dt, block, options):
+    return pgv(acceleration, dt)
+
+
+@define_measure("sa", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
+                long_name="spectral acceleration Sa({period:g} s, {damping:.0%})", label="Sa({period:g} s)",
+                pelicun_demand=("Spectral Acceleration", "g"), openquake_imt="SA(T)")
+def _sa(acceleration, dt, block, options):
+    return spectral_acceleration(acceleration, dt, options["period"], options["damping"])
+
+
+@define_measure("avgsa", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
+                long_name="average spectral acceleration AvgSa({low:g}-{high:g} s, {damping:.0%})",
+                label="AvgSa({low:g}-{high:g} s)")
+def _avgsa(acceleration, dt, block, options):
+    return average_spectral_acceleration(acceleration, dt, *avgsa_range(options), damping=options["damping"])
+
+
+@define_measure("pga_ratio", si_unit="1", long_name="PGA over the block's uplift acceleration, PGA/(g tan alpha)",
+                label="PGA/(g tan alpha)", per_block=True)
+def _rocking_pga(acceleration, dt, block, options):
+    return pga(acceleration) / block.uplift_acceleration()
+
+
+@define_measure("pgv_ratio", si_unit="1", long_name="p PGV/(g tan alpha), p = sqrt(3g/4R) (Makris & Vassiliou)",
+                label="p PGV/(g tan alpha)", per_block=True)
+def _rocking_pgv(acceleration, dt, block, options):
+    return block.p() * pgv(acceleration, dt) / block.uplift_acceleration()
+
+
+@define_measure("pulse_amplitude", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
+                long_name="acceleration amplitude a_p = 2 pi PGV/Tp of the dominant velocity pulse", label="a_p")
+def _pulse_amplitude(acceleration, dt, block, options):
+    return velocity_pulse(acceleration, dt)[2]
+
+
+@define_measure("pulse_period", si_unit="s",
+                long_name="period Tp of the dominant velocity pulse (a record property: does not scale)",
+                label="Tp", scaling_exponent=0.0)
+def _pulse_period(acceleration, dt, block, options):
+    return velocity_pulse(acceleration, dt)[0]

@@ -27,7 +27,7 @@ import xarray as xr
 
 from pipeline import __version__
 from pipeline.errors import ConfigError, PipelineError
-from pipeline.measures import intensity_measures, response_spectrum
+from pipeline.measures import intensity_measures, response_spectrum, significant_window
 from pipeline.models import get_model, simulate
 from pipeline.outputs import atomic_path
 from pipeline.processing import integrate, process_record
@@ -68,15 +68,6 @@ def showcase_block(config):
             return block
     raise ConfigError("report.showcase_block", f"unknown block {name!r}; blocks of the study: "
                       f"{', '.join(b.name for b in config.blocks)}", config.source)
-
-
-def strong_motion_window(acceleration, dt, start=0.05, end=0.95) -> tuple[float, float]:
-    """Times [s] at which the Arias intensity reaches ``start`` and ``end`` of its final value."""
-    cumulative = np.cumsum(np.asarray(acceleration, dtype=float) ** 2)
-    if cumulative[-1] <= 0:
-        return 0.0, (cumulative.size - 1) * dt
-    fraction = cumulative / cumulative[-1]
-    return float(np.searchsorted(fraction, start) * dt), float(np.searchsorted(fraction, end) * dt)
 
 
 def record_set_variables(records) -> dict:
@@ -181,7 +172,7 @@ def showcase_dataset(config, records, recipe, load=None) -> xr.Dataset:
         ground, ground_time = ground_motion_variables(raw, processed)
         time, theta, settlement, support = simulate_cases(config, block, processed)
         cases = response_cases(config, block)
-        start, end = strong_motion_window(processed.acceleration, processed.dt)
+        start, end = significant_window(processed.acceleration, processed.dt)  # the records table's D5-95
         data_vars.update(ground)
         data_vars.update({
             "theta": (("case", "time"), theta, {"long_name": "rocking angle theta (NaN after overturning)",

@@ -14,9 +14,10 @@ from scipy.special import log_ndtr
 from scipy.stats import norm
 
 from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.fragility import (DAMAGE_STATES, STATUS, curves_cross, damage_states_from_config, fit_binomial,
-                                fit_censored_capacities, fit_independent, fit_shared_beta, fragility_dataset,
-                                fragility_table, intensity_levels, pelicun_id, pelicun_table, separation)
+from pipeline.damage_states import DAMAGE_STATES, damage_states_from_config
+from pipeline.fragility import (STATUS, curves_cross, fit_binomial, fit_censored_capacities, fit_independent,
+                                fit_shared_beta, fragility_dataset, fragility_table, intensity_levels, pelicun_id,
+                                pelicun_table, separation)
 from pipeline.units import STANDARD_GRAVITY
 
 UPLIFT_G = 0.2  # g tan(alpha) of the synthetic block [g]
@@ -306,3 +307,14 @@ def test_pelicun_table_follows_its_conventions(fitted):
     thetas = [row[f"LS{i}-Theta_0"] for i in range(1, 5)]
     assert thetas == sorted(thetas)  # limit states in increasing severity
     assert "studied range 0.05-3 g" in row["Comment"] and "LS1 uplift: deterministic-threshold" in row["Comment"]
+
+
+@pytest.mark.parametrize("measure, period, demand", [
+    ("pga", 1.0, ("Peak Ground Acceleration", "g")), ("pgv", None, ("Peak Ground Velocity", "mps")),
+    ("sa", 0.5, ("Spectral Acceleration|0.5", "g")), ("sa", None, ("Spectral Acceleration", "g")),
+    ("avgsa", 1.0, ("", "")),  # pelicun has no such demand: the columns stay empty
+])
+def test_pelicun_demand_comes_from_the_measure_registry(fitted, measure, period, demand):
+    dataset = fitted.assign_attrs(intensity_measure=measure)
+    row = pelicun_table(dataset, period).iloc[0]
+    assert (row["Demand-Type"], row["Demand-Unit"]) == demand

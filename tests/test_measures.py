@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.measures import (arias_intensity, cav, pga, pgv, response_spectrum,
-                               significant_duration)
+from pipeline.measures import (arias_intensity, cav, pga, pgv, response_spectrum, significant_duration,
+                               significant_window)
 from pipeline.units import STANDARD_GRAVITY
 
 
@@ -62,6 +62,18 @@ def test_arias_cav_duration_of_a_sine():
     assert arias_intensity(a, dt) == pytest.approx(np.pi * amplitude**2 * 10.0 / (4 * STANDARD_GRAVITY), rel=1e-6)
     assert cav(a, dt) == pytest.approx(2 * amplitude * 10.0 / np.pi, rel=1e-6)
     assert significant_duration(a, dt) == pytest.approx(9.0, abs=0.01)
+
+
+def test_the_significant_window_is_the_d5_95_of_the_records_table():
+    """One D5-95: the showcase's strong-motion window (significant_window) spans the records table's
+    duration exactly; a burst of constant |a| from 2 s to 6 s opens at 2.2 s and closes at 5.8 s."""
+    dt = 0.01
+    a = np.where((np.arange(1000) * dt >= 2.0) & (np.arange(1000) * dt < 6.0), 1.5, 0.0)
+    start, end = significant_window(a, dt)
+    assert (start, end) == pytest.approx((2.2, 5.8), abs=dt)
+    assert end - start == significant_duration(a, dt)  # the same numbers, not a second estimate
+    silent = np.zeros(11)  # no energy: the whole record is the window, and the duration is 0
+    assert significant_window(silent, dt) == (0.0, pytest.approx(0.1)) and significant_duration(silent, dt) == 0
 
 
 def test_spectrum_rejects_bad_input():

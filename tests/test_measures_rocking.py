@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from pipeline.blocks import Block
-from pipeline.config import MEASURE_UNITS
-from pipeline.measures import MEASURES, average_spectral_acceleration, velocity_pulse
+from pipeline.measures import (MEASURES, average_spectral_acceleration, display_units, scaling_measures, short_label,
+                               velocity_pulse)
 from pipeline.units import STANDARD_GRAVITY as G
 
 BLOCK = Block(name="cabinet", b=0.3, h=1.5, mass=2000.0)  # tan(alpha) = 0.2, R = sqrt(0.09 + 2.25)
@@ -79,6 +79,63 @@ def test_every_measure_scales_with_its_exponent(bolu_records, name):
 def test_registry_describes_every_measure_and_feeds_the_config_units():
     for name, measure in MEASURES.items():
         assert measure.name == name and measure.si_unit and measure.display_unit and measure.describe()
-        assert (name in MEASURE_UNITS) == measure.scalable
-    assert MEASURE_UNITS["pga"] == ("g", G) and MEASURE_UNITS["pgv_ratio"] == ("1", 1.0)
+        assert measure.short_label() and (name in scaling_measures()) == measure.scalable
+    assert display_units("pga") == ("g", G) and display_units("pgv_ratio") == ("1", 1.0)
+    assert display_units("pulse_period") == ("", 1.0)  # a record property: no study scales to it
     assert "0.5" in MEASURES["avgsa"].describe(period=2.5, period_range=(0.5, 7.0))
+
+
+@pytest.mark.parametrize("name, options, label", [
+    ("pga", {}, "PGA"), ("pgv", {"period": 2.0}, "PGV"), ("sa", {"period": 0.5, "damping": 0.02}, "Sa(0.5 s)"),
+    ("avgsa", {"period": 1.0}, "AvgSa(0.2-3 s)"), ("avgsa", {"period_range": (0.5, 7.0)}, "AvgSa(0.5-7 s)"),
+])
+def test_the_label_is_read_back_from_the_long_name_the_cube_holds(name, options, label):
+    """The report labels its axes from a result file's ``im_level`` long name: the registry's label with
+    the study's options, whatever text surrounds the long name."""
+    measure = MEASURES[name]
+    assert measure.short_label(**options) == label
+    described = f"intensity level: multiple of the block's uplift intensity ({measure.describe(**options)})"
+    assert short_label(name, described) == label
+    assert short_label("", described) == label  # an old file without ``intensity_measure``: found by its long name
+
+
+def test_a_label_that_needs_options_it_cannot_find_falls_back_on_the_name():
+    assert short_label("sa", "intensity level") == "SA"
+    assert short_label("pga", "") == "PGA"  # nothing to fill in
+    assert short_label("", "") == "intensity" and short_label("unknown") == "UNKNOWN"
+
+
+def test_pelicun_and_openquake_names_are_registered_once():
+    assert MEASURES["pga"].pelicun_demand == ("Peak Ground Acceleration", "g")
+    assert MEASURES["pgv"].pelicun_demand == ("Peak Ground Velocity", "mps")
+    assert MEASURES["sa"].pelicun_demand == ("Spectral Acceleration", "g") and MEASURES["sa"].uses_period
+    assert [m.openquake_imt for m in MEASURES.values() if m.openquake_imt] == ["PGA", "PGV", "SA(T)"]
+    assert not MEASURES["avgsa"].uses_period  # defined over a range, not at one period
+
+
+@pytest.fixture
+def cav_measure():
+    """A measure added as a newcomer would add it: one ``define_measure`` definition (removed afterwards)."""
+    from pipeline.measures import cav, define_measure
+
+    @define_measure("cav_test", si_unit="m/s", long_name="cumulative absolute velocity", label="CAV",
+                    openquake_imt="CAV", openquake_factor=0.01)
+    def _cav(acceleration, dt, block, options):
+        return cav(acceleration, dt)
+
+    yield MEASURES["cav_test"]
+    del MEASURES["cav_test"]
+
+
+def test_one_definition_reaches_every_reader_of_the_registry(cav_measure, tmp_path):
+    from pipeline.efficiency import ranked_measures
+    from pipeline.hazard import _measure_from_imt, load_hazard
+
+    assert cav_measure(np.array([1.0, -1.0, 1.0]), 0.5) == pytest.approx(1.0)
+    assert "cav_test" in scaling_measures() and "cav_test" in ranked_measures()
+    assert display_units("cav_test") == ("m/s", 1.0)
+    assert short_label("cav_test", "intensity level: cumulative absolute velocity") == "CAV"
+    assert _measure_from_imt("CAV", "here") == ("cav_test", None, 0.01)
+    curve = tmp_path / "hazard.csv"
+    curve.write_text("# measure = cav_test\n# units = m/s\nintensity,annual_frequency\n0.1,1e-2\n0.2,2e-3\n")
+    assert load_hazard(curve, "cav_test").label == "CAV"

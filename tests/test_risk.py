@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from pipeline.errors import ConfigError
-from pipeline.risk import annual_frequency, hazard_frequency, load_hazard, probability_in_life, study_hazard
+from pipeline.hazard import hazard_frequency, load_hazard, study_hazard
+from pipeline.risk import annual_frequency, probability_in_life
 
 DATA = Path(__file__).parent / "data"
 
@@ -103,3 +104,20 @@ def test_the_study_file_is_refused_before_any_run_when_its_hazard_is_for_another
         load_study(study)
     study.write_text(f'[intensity]\nmeasure = "sa"\nperiod = 1.0\n[hazard]\nfile = "{DATA / "usgs_hazard_SA1P0.json"}"\n')
     assert load_study(study).measure == "sa"
+
+
+@pytest.mark.parametrize("imt, expected", [
+    ("PGA", ("pga", None, 1.0)), ("pgv", ("pgv", None, 0.01)),  # OpenQuake and USGS give PGV in cm/s
+    ("SA(0.2)", ("sa", 0.2, 1.0)), ("SA0P2", ("sa", 0.2, 1.0)), ("SA1P0", ("sa", 1.0, 1.0)),
+])
+def test_openquake_and_usgs_imts_are_read_by_the_measure_registry(imt, expected):
+    from pipeline.hazard import _measure_from_imt
+
+    assert _measure_from_imt(imt, "here") == expected
+
+
+def test_an_imt_no_measure_registers_is_refused_with_the_registered_ones():
+    from pipeline.hazard import _measure_from_imt
+
+    with pytest.raises(ConfigError, match=r"'PGD' not supported; allowed PGA, PGV, SA\(T\)"):
+        _measure_from_imt("PGD", "here")

@@ -201,7 +201,8 @@ def _result(spec, block, dt, summary, history, impacts):
     if spec.can_pull and min_support < 0:
         message += f"; the foundation spring went into tension (min support force {min_support:.3g} N)"
         warnings.warn(f"{spec.name}: foundation spring in tension from t = {float(summary['time_of_tension']):.3f} s "
-                      f"(min support force {min_support:.3g} N = {min_support / (block.mass * 9.80665):.2g} W): "
+                      f"(min support force {min_support:.3g} N = "
+                      f"{min_support / (block.mass * STANDARD_GRAVITY):.2g} W): "
                       "real ground cannot pull; results past that moment are not physical "
                       "(the 'winkler' model has a tensionless bed)", stacklevel=3)
     return RockingResult(

@@ -39,9 +39,10 @@ from pipeline.report.layout import PAGE_SIZE, Page, add_footer  # noqa: E402
 from pipeline.report.sections import (Results, limitations_items, methods_items, summary_items,  # noqa: E402
                                       title_items)
 from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
+from pipeline.units import STANDARD_GRAVITY  # noqa: E402
 
 PNG_DPI = 100
-G = 9.80665
+G = STANDARD_GRAVITY
 
 
 @dataclass

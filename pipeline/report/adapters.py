@@ -9,15 +9,16 @@ Output: small answers the pages draw: model labels and roles (rigid base or on a
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from pipeline.measures import short_label as measure_short_label
 from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
+from pipeline.units import STANDARD_GRAVITY
 
 OUTCOME_ROCKING, OUTCOME_FAILED = int(Outcome.ROCKING), int(Outcome.FAILED)
 
@@ -94,18 +95,12 @@ def measure_label(dataset) -> str:
     unit = source.attrs.get("units", dataset.im_level.attrs.get("units", ""))
     measure = str(dataset.attrs.get("intensity_measure", "")).lower()
     long_name = str(dataset.im_level.attrs.get("long_name", ""))
-    short = {"pga": "PGA", "pgv": "PGV"}.get(measure) or next(
-        (text for phrase, text in (("peak ground acceleration", "PGA"), ("peak ground velocity", "PGV"))
-         if phrase in long_name), None)
-    if short is None:
-        found = re.search(r"Sa\([^)]*\)", long_name)
-        short = found.group(0) if found else (measure.upper() or "intensity")
-    return f"{short} [{unit}]"
+    return f"{measure_short_label(measure, long_name)} [{unit}]"  # the registry's label (pipeline.measures)
 
 
 def state_labels(fragility) -> dict:
     """Human label of each damage state: the registry's description with its symbols."""
-    from pipeline.fragility import DAMAGE_STATES
+    from pipeline.damage_states import DAMAGE_STATES
 
     labels = {}
     descriptions = (fragility["damage_state_description"].values if "damage_state_description" in fragility.coords
@@ -196,4 +191,4 @@ def uplift_intensity(cube, block) -> float:
     """Intensity at which the block starts to rock, in the unit of its levels (g tan(alpha) for PGA)."""
     if "block_uplift_intensity" in cube.variables:
         return float(cube.block_uplift_intensity.sel(block=block))
-    return float(cube.block_uplift_acceleration.sel(block=block)) / 9.80665
+    return float(cube.block_uplift_acceleration.sel(block=block)) / STANDARD_GRAVITY

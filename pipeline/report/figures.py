@@ -14,8 +14,9 @@ import numpy as np
 from pipeline.report.adapters import (OUTCOME_ROCKING, block_levels, cell, measure_label, model_styles, models_of,
                                       panel_label, short_label, state_labels, uplift_intensity)
 from pipeline.report.layout import GRID, FRACTILE_STYLES, log_axis, new_page, outside_legend, panels, soil_colour
+from pipeline.units import STANDARD_GRAVITY
 
-G = 9.80665
+G = STANDARD_GRAVITY
 IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (the flatline)
 WINDOW_BEFORE, WINDOW_AFTER = 3.0, 8.0  # s around the strong-motion window on the time axes
 
