@@ -35,6 +35,7 @@ from pipeline.errors import ConfigError, PipelineError
 from pipeline.hazard import hazard_for
 from pipeline.measures import MEASURES, scaling_measures
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
+from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
 from pipeline.validation import (Checked, Either, Interval, NamedTables, Names, Number, Numbers, Table, Text,
                                  shown as _shown)
@@ -99,6 +100,7 @@ SCHEMA = Table({
     "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
     "fragility": _table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                          "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
+    "checks": _table({"plausibility": Text(ON_IMPLAUSIBLE)}),
     "report": _table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
                       "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True)}),
     "applicability": _table({
@@ -348,6 +350,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     if "blocks" not in data:
         raise ConfigError("blocks", "no block defined; add [blocks.NAME] tables", source)
     blocks = _select("blocks", data["blocks"], library, source)
+    check_study(blocks, soils, data.get("checks", {}).get("plausibility", "error"), source)
     levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
     _check_damage_states(data, source)
     _check_hazard(hazard.get("file", ""), source, measure, float(intensity.get("period", 1.0)))

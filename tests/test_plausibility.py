@@ -169,8 +169,6 @@ def test_checks_are_registered_in_order_with_a_field_each():
     assert all("{block}" in check.field or "{soil}" in check.field for check in CHECKS)
 
 
-@pytest.mark.xfail(strict=True, reason="config.py does not call plausibility.check_study yet (coordinator: add "
-                                       "the call in study_from_dict, then remove this marker)")
 def test_load_study_alone_refuses_a_unit_slip(tmp_path):
     path = _study(tmp_path, {"E_b": 200.0})
     with pytest.raises(ConfigError, match="did you mean 200 GPa"):
