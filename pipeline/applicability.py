@@ -26,7 +26,7 @@ from pipeline.calibrate import correlation
 from pipeline.executors import shutdown_pool, worker_pool
 from pipeline.models import get_model, simulate_histories
 from pipeline.models.base import Outcome
-from pipeline.outputs import atomic_path
+from pipeline.outputs import atomic_path, write_dataset
 from pipeline.soils import interface_stiffness
 from pipeline.study import StudyRecords, study_records
 
@@ -205,9 +205,7 @@ def write_applicability(dataset, output) -> list[Path]:
     import matplotlib.pyplot as plt
 
     output = Path(output)
-    encoding = {n: {"zlib": True} for n, v in dataset.data_vars.items() if v.dtype.kind == "f"}
-    with atomic_path(output / "applicability.nc") as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    write_dataset(dataset, output / "applicability.nc")
     figure = sweep_figure(dataset)
     path = output / "applicability-sweep.png"
     with atomic_path(path) as temporary:

@@ -19,7 +19,6 @@ from pipeline.measures import MEASURES
 from pipeline.models import get_model
 from pipeline.models.base import Outcome
 from pipeline.models.fields import FIELDS_BY_NAME
-from pipeline.outputs import atomic_path
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
 OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = (int(o) for o in Outcome)
@@ -220,11 +219,3 @@ def _level_coordinates(config, measure_name, intensity) -> dict:
                           {"long_name": f"{measure_name} of the level for the block", "units": config.level_unit}),
             "intensity_si": (("block", "im_level"), intensity,
                              {"long_name": f"{measure_name} of the level for the block", "units": measure.si_unit})}
-
-
-def write_netcdf(dataset: xr.Dataset, path) -> None:
-    """Compressed netCDF4, written to a temp file and renamed (never half-written)."""
-    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
-                if var.dtype.kind in "fi"}
-    with atomic_path(path) as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)

@@ -31,9 +31,8 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
-from pipeline.cube import write_netcdf
 from pipeline.measures import MEASURES, scaling_measures
-from pipeline.outputs import atomic_path
+from pipeline.outputs import atomic_path, write_dataset
 
 SIGNIFICANCE = 0.05
 """p-value below which a record property is taken to remain in the residuals (not sufficient)."""
@@ -238,7 +237,7 @@ def write_efficiency(dataset: xr.Dataset, output) -> tuple[Path, Path]:
     """``efficiency.nc`` and ``efficiency.csv`` in ``output``."""
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)
-    write_netcdf(dataset, output / "efficiency.nc")
+    write_dataset(dataset, output / "efficiency.nc")
     with atomic_path(output / "efficiency.csv") as temporary:
         efficiency_table(dataset).to_csv(temporary, index=False, float_format="%.6g")
     return output / "efficiency.nc", output / "efficiency.csv"

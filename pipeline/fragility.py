@@ -40,12 +40,21 @@ from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED,
 from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError
 from pipeline.hazard import study_hazard
-from pipeline.lognormal_fit import (CROSSING_TOLERANCE, curves_cross, deviance, fit_binomial,  # noqa: F401
-                                    fit_censored_capacities, fit_independent, fit_shared_beta, goodness_of_fit,
-                                    lognormal_cdf, separation)
+from pipeline.lognormal_fit import (  # noqa: F401
+    CROSSING_TOLERANCE,
+    curves_cross,
+    deviance,
+    fit_binomial,
+    fit_censored_capacities,
+    fit_independent,
+    fit_shared_beta,
+    goodness_of_fit,
+    lognormal_cdf,
+    separation,
+)
 from pipeline.measures import MEASURES, display_units
 from pipeline.models import MODELS
-from pipeline.outputs import atomic_path
+from pipeline.outputs import atomic_path, write_dataset
 from pipeline.risk import risk_dataset
 from pipeline.units import STANDARD_GRAVITY
 
@@ -428,13 +437,6 @@ def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
     return stacked.transpose("outcome_class", "im_level", "soil", "block", "model")
 
 
-def write_fragility(dataset: xr.Dataset, path) -> None:
-    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
-                if var.dtype.kind == "f"}
-    with atomic_path(path) as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
-
-
 TABLE_COLUMNS = ["median", "beta", "status", "extrapolated", "fit_method", "median_low", "median_high", "beta_low",
                  "beta_high", "gof_p_value", "gof_max_error", "noncrossing_deviance_cost", "capacity_median",
                  "capacity_beta", "fit_warning"]
@@ -529,7 +531,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=
     combined = dataset.merge(risk)
     combined.attrs.update(dataset.attrs)
     combined.attrs.update(risk.attrs)
-    write_fragility(combined, output / "fragility.nc")
+    write_dataset(combined, output / "fragility.nc")
     table = fragility_table(dataset)
     table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])
     write_csv(table, output / "fragility.csv")

@@ -25,7 +25,8 @@ import math
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import OUTCOME_OVERTURNED, write_netcdf
+from pipeline.cube import OUTCOME_OVERTURNED
+from pipeline.outputs import write_dataset
 
 FRACTILES = (0.16, 0.50, 0.84)
 RESPONSE_LEVELS = np.round(np.concatenate([np.linspace(0.05, 1.0, 20), np.linspace(1.5, 5.0, 8)]), 4)
@@ -173,11 +174,6 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
     return dataset
 
 
-def write_ida(dataset: xr.Dataset, path) -> None:
-    """``ida.nc``: the one netCDF writer of the package (pipeline.cube.write_netcdf)."""
-    write_netcdf(dataset, path)
-
-
 def fill(overturns, lower, upper, tolerance=0.02, max_runs=200):
     """Bisect a bracket (``lower`` survives, ``upper`` overturns) until (upper - lower) <= tolerance x upper.
 
@@ -276,5 +272,5 @@ def ida_stage(cube: xr.Dataset, output) -> xr.Dataset:
     from pathlib import Path
 
     dataset = ida_dataset(cube)
-    write_ida(dataset, Path(output) / "ida.nc")
+    write_dataset(dataset, Path(output) / "ida.nc")
     return dataset

@@ -29,7 +29,7 @@ from pipeline import __version__
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.measures import intensity_measures, response_spectrum, significant_window
 from pipeline.models import get_model, simulate
-from pipeline.outputs import atomic_path
+from pipeline.outputs import write_dataset
 from pipeline.processing import integrate, process_record
 from pipeline.soils import soil_block_stiffness
 from pipeline.study import StudyRecords, study_records
@@ -234,9 +234,6 @@ def showcase_stage(config, output, loaded: StudyRecords | None = None, log=print
                 return cached.load()
     dataset = showcase_dataset(config, records, recipe)
     dataset.attrs["input_hash"] = key
-    encoding = {name: {"zlib": True, "complevel": 4} for name, var in dataset.data_vars.items()
-                if var.dtype.kind == "f"}
-    with atomic_path(path) as temporary:
-        dataset.to_netcdf(temporary, engine="netcdf4", encoding=encoding)
+    write_dataset(dataset, path)
     log(f"wrote {path}")
     return dataset

@@ -43,7 +43,7 @@ import numpy as np
 
 from pipeline import __version__
 from pipeline.checkpoints import CheckpointStore
-from pipeline.cube import build_cube, write_netcdf
+from pipeline.cube import build_cube
 from pipeline.errors import PipelineError, RecordError
 from pipeline.executors import check_workers, make_executor, pool_executor, run_tasks
 from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
@@ -52,6 +52,7 @@ from pipeline.measures import MEASURES, pga
 from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, simulate_batch
 from pipeline.models.base import Outcome
 from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
+from pipeline.outputs import write_dataset
 from pipeline.processing import ProcessingRecipe, load_recipe, process_records
 from pipeline.records import Record, load_records
 from pipeline.soils import soil_block_stiffness
@@ -366,7 +367,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                   "processing_steps": {r.id: list(r.trace.stats.get("processing", [])) for r in records}}
     dataset = build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                          intensity=intensity, capacities=capacities, capacity_stats=capacity_stats)
-    write_netcdf(dataset, output / "cube.nc")
+    write_dataset(dataset, output / "cube.nc")
     elapsed = time.perf_counter() - started
     statistics = {"runs_computed": runs_total, "cells_reused": n_cells - n_missing, "cells": n_cells,
                   "seconds": elapsed, "failures": [str(f) for f in failures],

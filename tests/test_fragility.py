@@ -15,9 +15,21 @@ from scipy.stats import norm
 
 from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from pipeline.damage_states import DAMAGE_STATES, damage_states_from_config
-from pipeline.fragility import (STATUS, curves_cross, fit_binomial, fit_censored_capacities, fit_independent,
-                                fit_shared_beta, fragility_dataset, fragility_table, intensity_levels, pelicun_id,
-                                pelicun_table, separation)
+from pipeline.fragility import (
+    STATUS,
+    curves_cross,
+    fit_binomial,
+    fit_censored_capacities,
+    fit_independent,
+    fit_shared_beta,
+    fragility_dataset,
+    fragility_table,
+    intensity_levels,
+    pelicun_id,
+    pelicun_table,
+    separation,
+)
+from pipeline.outputs import write_dataset
 from pipeline.units import STANDARD_GRAVITY
 
 UPLIFT_G = 0.2  # g tan(alpha) of the synthetic block [g]
@@ -227,7 +239,7 @@ def test_extrapolated_and_not_reached_rows_are_flagged_everywhere(tmp_path):
     assert {"status", "extrapolated", "im_lowest", "im_highest", "fit_warning"} <= set(table.columns)
     assert table.im_highest.iloc[0] == pytest.approx(levels[-1])
     path = tmp_path / "f.nc"
-    fragility.to_netcdf(path)
+    write_dataset(fragility, path)
     with xr.open_dataset(path) as back:
         assert back.extrapolated.attrs["units"] == "1" and back.studied_im_max.attrs["units"] == "g"
         assert all("long_name" in back[v].attrs for v in back.data_vars)

@@ -64,6 +64,18 @@ def test_outputs_table_matches_what_fragility_writes(pipeline_output):
 
 
 @pytest.mark.slow
+def test_every_netcdf_file_of_the_run_is_compressed(pipeline_output):
+    output, _, _ = pipeline_output
+    written = sorted(path.name for path in output.glob("*.nc"))
+    assert {"cube.nc", "ida.nc", "fragility.nc", "showcase.nc", "applicability.nc", "efficiency.nc"} <= set(written)
+    for name in written:
+        with xr.open_dataset(output / name) as dataset:
+            plain = [str(key) for key, variable in dataset.data_vars.items()
+                     if variable.ndim and variable.dtype.kind in "biuf" and not variable.encoding.get("zlib")]
+        assert plain == [], f"{name}: numeric variables written without zlib: {plain}"
+
+
+@pytest.mark.slow
 def test_one_numbered_a4_document_with_an_html_twin(pipeline_output):
     output, _, _ = pipeline_output
     pdf = (output / "report.pdf").read_bytes()

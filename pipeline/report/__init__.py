@@ -20,9 +20,8 @@ import base64
 import html
 import io
 import math
-from dataclasses import dataclass
+from dataclasses import replace
 from pathlib import Path
-from typing import Callable
 
 import matplotlib
 
@@ -35,7 +34,7 @@ from pipeline import __version__  # noqa: E402
 from pipeline.outputs import atomic_path  # noqa: E402
 from pipeline.report import figures as pages  # noqa: E402
 from pipeline.report.adapters import models_of, short_label  # noqa: E402
-from pipeline.report.layout import PAGE_SIZE, Page, add_footer  # noqa: E402
+from pipeline.report.layout import PAGE_SIZE, Page, add_footer, new_page  # noqa: E402
 from pipeline.report.sections import (Results, limitations_items, methods_items, summary_items,  # noqa: E402
                                       title_items)
 from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
@@ -45,38 +44,24 @@ PNG_DPI = 100
 G = STANDARD_GRAVITY
 
 
-@dataclass
-class Planned:
-    """A page to draw: its place in the contents and a function that draws its figure."""
-
-    name: str
-    section: str
-    title: str
-    draw: Callable
-    caption: str = ""
-    html: str | None = None
-
-
 def _text_pages(name, section, title, items, caption=""):
     chunks = paginate(items)
     planned = []
     for number, chunk in enumerate(chunks, start=1):
         suffix = f" ({number}/{len(chunks)})" if len(chunks) > 1 else ""
-        planned.append(Planned(f"{name}-{number}" if len(chunks) > 1 else name, section, title + suffix,
-                               lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk, caption),
-                               caption, items_html(chunk)))
+        planned.append(Page(f"{name}-{number}" if len(chunks) > 1 else name, section, title + suffix,
+                            lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk, caption),
+                            caption, items_html(chunk)))
     return planned
 
 
-def title_page(results: Results) -> Planned:
+def title_page(results: Results) -> Page:
     """Page 1: title, project and author large, then the study in a few lines."""
     settings = results.settings
     people = [(str(settings[key]), size) for key, size in (("project", 16), ("author", 12)) if settings.get(key)]
     items = title_items(results)
 
     def draw():
-        from pipeline.report.layout import new_page
-
         figure = new_page("")
         figure.text(0.5, 0.66, results.title, fontsize=24, weight="bold", ha="center", va="bottom", wrap=True)
         y = 0.62
@@ -86,11 +71,11 @@ def title_page(results: Results) -> Planned:
         return draw_text_page("", items, top=y - 0.06, figure=figure)
 
     body = "".join(f"<p><strong>{html.escape(text)}</strong></p>" for text, _ in people)
-    return Planned("title", "Title", results.title, draw, "", body + items_html(items))
+    return Page("title", "Title", results.title, draw, "", body + items_html(items))
 
 
 def _figure(name, section, title, function, *args, caption=""):
-    return Planned(name, section, title, lambda: function(*args, caption), caption)
+    return Page(name, section, title, lambda: function(*args, caption), caption)
 
 
 def records_items(results: Results) -> list[Item]:
@@ -111,7 +96,7 @@ def records_items(results: Results) -> list[Item]:
     return [table(header, rows)]
 
 
-def plan(results: Results) -> list[Planned]:
+def plan(results: Results) -> list[Page]:
     """Every page of the report in order (contents excluded: it is made from this list)."""
     cube, ida, fragility, showcase = results.cube, results.ida, results.fragility, results.showcase
     planned = [title_page(results)]
@@ -179,8 +164,8 @@ def plan(results: Results) -> list[Planned]:
                                        "stiffness E_b/G_s)."))
     efficiency = _efficiency_plotter(results)
     if efficiency is not None:
-        planned.append(Planned("efficiency", "Measure efficiency", "Efficiency of intensity measures", efficiency,
-                               "From efficiency.nc."))
+        planned.append(Page("efficiency", "Measure efficiency", "Efficiency of intensity measures", efficiency,
+                            "From efficiency.nc."))
     return planned
 
 
@@ -203,7 +188,7 @@ def _efficiency_plotter(results):
     return draw
 
 
-def contents_page(planned: list[Planned], title: str) -> Planned:
+def contents_page(planned: list[Page], title: str) -> Page:
     """Page 2: every section and page title with its page number (the contents itself is page 2)."""
     rows, last = [], None
     for number, page in enumerate(planned, start=1):
@@ -214,8 +199,6 @@ def contents_page(planned: list[Planned], title: str) -> Planned:
         rows.append(("page", page.title, shown))
 
     def draw():
-        from pipeline.report.layout import new_page
-
         figure = new_page("Contents")
         per_column = 36
         columns = max(1, math.ceil(len(rows) / per_column))
@@ -241,7 +224,7 @@ def contents_page(planned: list[Planned], title: str) -> Planned:
             items.append(f"<li class='section'>{html.escape(text)}</li>")
         else:
             items.append(f"<li><a href='#page-{number}'>{html.escape(text)}</a> <span>{number}</span></li>")
-    return Planned("contents", "Contents", "Contents", draw, "", "<ul class='contents'>" + "".join(items) + "</ul>")
+    return Page("contents", "Contents", "Contents", draw, "", "<ul class='contents'>" + "".join(items) + "</ul>")
 
 
 def _png(figure) -> bytes:
@@ -304,7 +287,7 @@ def _png_pages(planned, footer, workers):
     return pool, pool.imap(_page_png, tasks)
 
 
-def render(planned: list[Planned], footer: str, output_dir, progress=True, workers=None) -> list[Page]:
+def render(planned: list[Page], footer: str, output_dir, progress=True, workers=None) -> list[Page]:
     """Draw each page, number it, write it to the PDF and its PNG, close it; one figure open at a time."""
     from tqdm import tqdm
 
@@ -332,7 +315,7 @@ def render(planned: list[Planned], footer: str, output_dir, progress=True, worke
                     png = next(pngs)
                     with atomic_path(figure_dir / f"{number:02d}-{page.name}.png") as path:
                         path.write_bytes(png)
-                    rendered.append(Page(page.name, page.section, page.title, None, page.caption, page.html, png))
+                    rendered.append(replace(page, png=png))
     finally:
         if pool is not None:
             pool.terminate()
@@ -341,7 +324,7 @@ def render(planned: list[Planned], footer: str, output_dir, progress=True, worke
     return rendered
 
 
-def write_report(planned: list[Planned], output_dir, title="rockfrag report", footer=None, progress=True,
+def write_report(planned: list[Page], output_dir, title="rockfrag report", footer=None, progress=True,
                  workers=None):
     """Write report.pdf, report.html and figures/*.png; returns (pdf path, png paths).
     ``workers=1`` draws everything in this process (no forked PNG worker)."""
@@ -353,7 +336,7 @@ def write_report(planned: list[Planned], output_dir, title="rockfrag report", fo
     return output_dir / "report.pdf", pngs
 
 
-def build_plan(results: Results) -> list[Planned]:
+def build_plan(results: Results) -> list[Page]:
     """The numbered page list: the contents inserted as page 2."""
     planned = plan(results)
     return [planned[0], contents_page(planned, results.title), *planned[1:]]
@@ -389,4 +372,4 @@ def report_stage(config, cube, ida, fragility, risk, output, runtime_s=float("na
     return write_report(build_plan(results), output, results.title, footer, progress, workers)
 
 
-__all__ = ["Page", "Planned", "Results", "build_plan", "plan", "report_stage", "write_report"]
+__all__ = ["Page", "Results", "build_plan", "plan", "report_stage", "write_report"]

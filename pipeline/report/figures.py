@@ -203,7 +203,9 @@ def _state_axes(figure, fragility, n_rows=1):
     return states, axes
 
 
-def _finish_fragility_axes(axes, fragility, levels):
+def _probability_axes(axes, levels, x_label: str, y_label: str) -> None:
+    """Probability against intensity on every visible panel: log x over the block's levels, y from 0 to 1,
+    a grid; the y label on the first column, the x label on the last row."""
     for axis in axes.flat:
         if not axis.get_visible():
             continue
@@ -212,9 +214,9 @@ def _finish_fragility_axes(axes, fragility, levels):
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
     for axis in axes[:, 0]:
-        axis.set_ylabel("P(damage state | IM) [-]")
+        axis.set_ylabel(y_label)
     for axis in axes[-1]:
-        axis.set_xlabel(measure_label(fragility))
+        axis.set_xlabel(x_label)
 
 
 def fragility_by_soil_page(fragility, block, model, caption):
@@ -234,7 +236,7 @@ def fragility_by_soil_page(fragility, block, model, caption):
             _fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
                               styles[reference.name], short_label(reference))
         axis.set_title(labels[state], fontsize=10)
-    _finish_fragility_axes(axes, fragility, levels)
+    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]")
     outside_legend(figure, list(axes.flat))
     return figure
 
@@ -254,7 +256,7 @@ def fragility_by_model_page(fragility, block, soils, caption):
                 _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                   styles[model.name], short_label(model))
             axis.set_title(f"{labels[state]}\non {soil}", fontsize=9)
-    _finish_fragility_axes(axes, fragility, levels)
+    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]")
     outside_legend(figure, list(axes.flat))
     return figure
 
@@ -281,18 +283,11 @@ def outcomes_page(fragility, block, caption):
             axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
             if soil is None or len(soils) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
-        log_axis(axis)
-        axis.set_xlim(levels[0], levels[-1])
-        axis.set_ylim(-0.02, 1.02)
         axis.set_title(short_label(model), fontsize=10)
-        axis.grid(alpha=0.3, which="both")
+    _probability_axes(axes, levels, measure_label(fragility), "probability [-]")
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
     axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
-    for axis in axes[:, 0]:
-        axis.set_ylabel("probability [-]")
-    for axis in axes[-1]:
-        axis.set_xlabel(measure_label(fragility))
     for axis in axes.flat:
         if axis.get_visible():
             axis.tick_params(labelbottom=True)

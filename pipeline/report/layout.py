@@ -1,7 +1,8 @@
 """pipeline.report.layout - one page size, colours and line styles for every page of the report.
 
-Input : nothing (definitions). Output: ``Page`` (one report page: a matplotlib figure of the page size
-with a title, a caption and an optional HTML body), ``new_page`` and the shared styles.
+Input : nothing (definitions). Output: ``Page`` (one report page: its place in the contents, the function
+that draws its figure of the page size, a caption, an optional HTML body and, once rendered, its PNG),
+``new_page`` and the shared styles.
 
 Every page is A4 landscape (11.69 x 8.27 in). The title sits on top, the caption and the page footer
 (title of the report, page N of M) at the bottom; figures keep their axes clear of both.
@@ -10,12 +11,14 @@ Every page is A4 landscape (11.69 x 8.27 in). The title sits on top, the caption
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 
 PAGE_SIZE = (11.69, 8.27)  # A4 landscape [in]
 GRID = dict(left=0.07, right=0.835, bottom=0.145, top=0.885, wspace=0.2, hspace=0.32)  # axes area
@@ -34,19 +37,32 @@ FRACTILE_STYLES = {0.16: dict(color="#1f77b4", ls="--", lw=1.5), 0.5: dict(color
 OUTCOME_COLOURS = {"no_uplift": "#c7e9c0", "rocking": "#fdae6b", "overturned": "#d7301f"}
 
 
-@dataclass
+@dataclass(frozen=True)
 class Page:
-    """One page of the report.
+    """One page of the report: planned with ``draw``, rendered with its ``png`` filled in.
 
-    name : file-name stem of its PNG; section : heading of the contents; title : page title;
-    figure : the matplotlib figure (page size); caption : one line under the figure;
-    html : the page's body as HTML for text pages (figure pages are embedded as an image).
+    Attributes
+    ----------
+    name : str
+        File-name stem of its PNG.
+    section : str
+        Its heading in the contents.
+    title : str
+        The page title.
+    draw : callable
+        Draws the page: returns a new matplotlib figure of the page size (the caller closes it).
+    caption : str
+        One line under the figure.
+    html : str or None
+        The page's body as HTML for text pages; figure pages are embedded as their PNG.
+    png : bytes
+        The rendered page (empty until ``pipeline.report.render`` has drawn it).
     """
 
     name: str
     section: str
     title: str
-    figure: object
+    draw: Callable[[], Figure] = field(repr=False)
     caption: str = ""
     html: str | None = None
     png: bytes = field(default=b"", repr=False)
