@@ -1,4 +1,4 @@
-"""pipeline.applicability - when is Housner's rigid base good enough? (paper section 2)
+"""pipeline.applicability - when Housner's rigid base is good enough (paper section 2).
 
 Input : blocks, a record set, a few intensity levels (multiples of each block's uplift PGA) and a
         sweep of soil shear modulus G_s (default 10 MPa - 100 GPa) and block modulus E_b.
@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
+from tqdm import tqdm
 
 from pipeline import __version__
 from pipeline.calibrate import correlation
@@ -54,19 +55,19 @@ def _record_task(acceleration, dt, pga, blocks, block_moduli, level_factors, she
                 for shear in shear_moduli:
                     k = interface_stiffness(shear, modulus, block.footprint_area, block.soil_depth)
                     cases.append((stiff_block, k, xi))
-            for l, factor in enumerate(level_factors):
+            for lv, factor in enumerate(level_factors):
                 ag = acceleration * factor * block.uplift_acceleration() / pga
                 _, theta_h, _, summary_h = simulate_histories("housner", ag, dt, [(block, None, None)], t_end=t_end)
-                peak_h[b, l] = summary_h["peak_angle"][0]
-                over_h[b, l] = summary_h["status"][0] == Outcome.OVERTURNED
+                peak_h[b, lv] = summary_h["peak_angle"][0]
+                over_h[b, lv] = summary_h["status"][0] == Outcome.OVERTURNED
                 reference = np.nan_to_num(theta_h[0], nan=np.pi / 2)
                 for m, model in enumerate(models):
                     _, theta_s, _, summary_s = simulate_histories(model, ag, dt, cases, t_end=t_end, **options)
                     for index in range(len(cases)):
                         e, g = divmod(index, n_g)
-                        peak_s[m, b, e, l, g] = summary_s["peak_angle"][index]
-                        over_s[m, b, e, l, g] = summary_s["status"][index] == Outcome.OVERTURNED
-                        corr[m, b, e, l, g] = correlation(reference, np.nan_to_num(theta_s[index], nan=np.pi / 2))
+                        peak_s[m, b, e, lv, g] = summary_s["peak_angle"][index]
+                        over_s[m, b, e, lv, g] = summary_s["status"][index] == Outcome.OVERTURNED
+                        corr[m, b, e, lv, g] = correlation(reference, np.nan_to_num(theta_s[index], nan=np.pi / 2))
     return peak_h, over_h, peak_s, over_s, corr
 
 
@@ -98,8 +99,6 @@ def run_applicability(records, blocks, *, shear_moduli=DEFAULT_SHEAR_MODULI, blo
     """
     models = [name for name in models if not get_model(name).is_rigid_base]
     options = dict(options or {})
-    from tqdm import tqdm
-
     shear_moduli = np.asarray(shear_moduli, float)
     arguments = [(r.acceleration, r.dt, float(np.max(np.abs(r.acceleration))), list(blocks), list(block_moduli),
                   list(level_factors), shear_moduli, xi, tail, list(models), options) for r in records]
@@ -201,8 +200,15 @@ def sweep_figure(dataset):
     return figure
 
 
-def write_applicability(dataset, output) -> list[Path]:
-    import matplotlib.pyplot as plt
+def write_applicability(dataset: xr.Dataset, output: str | Path) -> list[Path]:
+    """Write ``applicability.nc`` (compressed) and ``applicability-sweep.png`` into ``output``.
+
+    Returns
+    -------
+    list of Path
+        The two files written, each replaced atomically.
+    """
+    import matplotlib.pyplot as plt  # lazily, as sweep_figure: importing pyplot costs ~1.7 s
 
     output = Path(output)
     write_dataset(dataset, output / "applicability.nc")

@@ -42,14 +42,17 @@ import time as clock
 import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 from scipy.signal import butter, find_peaks, sosfiltfilt
 
+from pipeline.blocks import Block
 from pipeline.errors import ConfigError, PipelineError, RecordError
-from pipeline.models import get_model, simulate_histories
+from pipeline.models import SolverOptions, get_model, simulate_histories
 from pipeline.outputs import atomic_path
 from pipeline.records.text import bracketed_units, read_columns
 from pipeline.validation import Interval, Number, Table
@@ -98,6 +101,8 @@ class Reference:
         return iter((self.time, self.rotation))
 
     def describe_units(self) -> str:
+        """Where each column's unit came from, e.g. ``time 'time [ms]' in ms (from the header)``."""
+
         def part(column, unit, source):
             origin = {"flag": "from the command line", "header": "from the header",
                       "assumed": "assumed: no unit in the header"}[source]
@@ -109,6 +114,36 @@ class Reference:
 
 @dataclass
 class CalibrationResult:
+    """The outcome of ``calibrate``: the fitted foundation parameters, their quality and the search.
+
+    Attributes
+    ----------
+    k_grid, xi_grid, correlation_grid : float
+        The coarse grid's best interface stiffness [N/m], damping ratio [-] and eq. 17 correlation [-].
+    k, xi, correlation : float
+        The final fit: interface stiffness [N/m], damping ratio [-], eq. 17 correlation [-].
+    rms_error : float
+        RMS difference of the fitted and the reference rotation [rad].
+    peak_error : float
+        (peak_model - peak_reference) / peak_reference [-].
+    peak_reference, peak_model : float
+        Largest |rotation| of the reference and of the fit [rad].
+    area_over_depth : float or None
+        A/H [m] from eq. 19 solved for the fitted k, when the soil shear modulus was given.
+    soil_shear_modulus, block_modulus : float or None, float
+        G_s and E_b [Pa] used for ``area_over_depth``.
+    model, bed : str, str or None
+        The calibrated model, and its bed type (None for models without a bed).
+    objective : float
+        The search objective at the fit (1 - correlation plus the amplitude term).
+    n_simulations, n_windows : int
+        Simulations run and time windows searched.
+    seconds : float
+        Wall time of the search [s].
+    surface_k, surface_xi, surface : list
+        The coarse grid's k [N/m] and xi [-] values and its eq. 17 correlations, (n_k, n_xi).
+    """
+
     k_grid: float
     xi_grid: float
     correlation_grid: float
@@ -133,6 +168,7 @@ class CalibrationResult:
     surface: list = field(repr=False, default_factory=list)
 
     def summary(self) -> dict:
+        """The fields without the surface, plus a ``units`` table (what calibration.json holds)."""
         data = asdict(self)
         for key in ("surface_k", "surface_xi", "surface"):
             data.pop(key)
@@ -276,8 +312,11 @@ class _Objective:
             self.noise_variance = removed * smoothing_hz / (nyquist - smoothing_hz)
 
     def noise_floor(self, n):
-        """Objective expected for the true parameters on the first n samples: 1 - correlation of a signal
-        with itself plus the in-band noise, about half the noise-to-signal variance ratio."""
+        """Objective expected for the true parameters on the first n samples.
+
+        That is 1 - correlation of a signal with itself plus the in-band noise: about half the
+        noise-to-signal variance ratio.
+        """
         signal_variance = float(np.var(self.smoothed_reference[:n]))
         return 0.5 * self.noise_variance / signal_variance if signal_variance > 0 else math.inf
 
@@ -376,8 +415,11 @@ def _local_offsets(values, fixed_xi):
 
 
 def _refine(search, objective, seeds, n, t_end, fixed_xi, evaluations):
-    """Polish seeds (point, local offsets, steps) on the window of n samples: a local batch grid around
-    every seed in one compiled call, then bounded Nelder-Mead from each block's best point."""
+    """Polish seeds (point, local offsets, steps) on the window of n samples.
+
+    A local batch grid around every seed runs in one compiled call, then bounded Nelder-Mead starts
+    from each block's best point.
+    """
     blocks = [np.clip(point + _local_offsets(offsets, fixed_xi) * steps, 0.0, 1.0) for point, offsets, steps in seeds]
     theta = search.histories(np.concatenate(blocks), t_end)
     scores = objective(_interpolate(theta, search.dt, objective.times[:n]), n)
@@ -488,23 +530,37 @@ def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_x
     return ref_time, ref_rotation
 
 
-def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e8, 9e8), xi_range=(0.01, 0.07),
-              n_k=25, n_xi=7, soil_shear_modulus=None, switch="consistent", local=True,
-              smoothing_hz=SMOOTHING_HZ, log=None, **solver_options) -> CalibrationResult:
+def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: float, block: Block, *,
+              model: str = "ssi", k_range: tuple[float, float] = (1e8, 9e8),
+              xi_range: tuple[float, float] = (0.01, 0.07), n_k: int = 25, n_xi: int = 7,
+              soil_shear_modulus: float | None = None, switch: str = "consistent", local: bool = True,
+              smoothing_hz: float | None = SMOOTHING_HZ, log: Callable[[str], object] | None = None,
+              **solver_options: object) -> CalibrationResult:
     """Find (k, xi) maximising eq. 17's correlation between the reference and ``model``'s rotation.
 
     Parameters
     ----------
     ref_time, ref_rotation : array_like
-        Reference time [s] (from the start of ``ag``) and rotation [rad].
-    ag, dt : ndarray [m/s^2], float [s]
-        The ground motion that produced the reference.
+        Reference time [s] (from the start of ``ag``) and rotation [rad], 1-D, equal length >= 10,
+        time strictly increasing.
+    ag : array_like
+        Ground acceleration [m/s^2] that produced the reference.
+    dt : float
+        Time step of ``ag`` [s].
+    block : Block
+        The rocking block (geometry, mass, block modulus ``E_b`` [Pa]).
     model : str
         A registered model with a foundation (``ssi``, ``ssi-paper``, ``winkler``, ...).
-    k_range [N/m], xi_range [-] : (min, max)
-        Search box; k is searched in log space. ``xi_range`` with min == max fixes xi.
+    k_range : (float, float)
+        Search range of the interface stiffness k [N/m] (min, max), searched in log space.
+    xi_range : (float, float)
+        Search range of the damping ratio xi [-] (min, max); min == max fixes xi.
     n_k, n_xi : int
         Coarse grid points (n_k >= 2, n_xi >= 1).
+    soil_shear_modulus : float, optional
+        Soil shear modulus G_s [Pa]; if given, the result also holds A/H [m] from eq. 19.
+    switch : str
+        ssi pivot-switch rule (``consistent`` or ``continuous``).
     local : bool
         False: the coarse grid only (the paper's procedure).
     smoothing_hz : float or None
@@ -513,6 +569,19 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
         Receives one line per search stage.
     **solver_options
         Passed to ``simulate_histories`` (e.g. ``bed=`` for winkler, ``restitution=``).
+
+    Returns
+    -------
+    CalibrationResult
+        The fitted k [N/m] and xi [-], the eq. 17 correlation, errors against the reference and the
+        coarse grid's correlation surface.
+
+    Raises
+    ------
+    ConfigError
+        ``model`` has no foundation, the search settings are out of range, or the reference cannot
+        belong to the record (arrays of different length, not finite, time not increasing, starting
+        outside the record, constant or larger than pi: usually a wrong unit).
     """
     started = clock.perf_counter()
     ref_time, ref_rotation = _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi)
@@ -577,8 +646,6 @@ def calibrate(ref_time, ref_rotation, ag, dt, block, *, model="ssi", k_range=(1e
 
 def _bed_of(model, solver_options):
     """The bed type a calibration of ``model`` ran with (None when the model has no bed)."""
-    from pipeline.models import SolverOptions, get_model
-
     if not get_model(model).uses_bed:
         return None
     return solver_options.get("bed", SolverOptions.bed)
@@ -594,8 +661,6 @@ def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, blo
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from pipeline.models import get_model
 
     output = Path(output)
     output.mkdir(parents=True, exist_ok=True)

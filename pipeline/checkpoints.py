@@ -97,6 +97,7 @@ class CheckpointStore:
         self.quarantined: list[Path] = []
 
     def path(self, key) -> Path:
+        """The checkpoint file of ``key`` (which may not exist yet)."""
         return self.folder / f"{key}{SUFFIX}"
 
     def has(self, key) -> bool:
@@ -104,6 +105,7 @@ class CheckpointStore:
         return self.path(key).is_file()
 
     def save(self, key, array) -> None:
+        """Write ``array`` as the checkpoint of ``key``, with its key, shape, dtype and sha256, atomically."""
         data = encode(key, np.asarray(array))
         with atomic_path(self.path(key)) as temporary:
             with open(temporary, "wb") as handle:

@@ -140,11 +140,62 @@ class ApplicabilitySettings:
 
     @property
     def shear_moduli(self) -> np.ndarray:
+        """The swept soil shear moduli G_s [Pa]: ``n_g`` values log-spaced over ``g_range``."""
         return np.geomspace(self.g_range[0], self.g_range[1], self.n_g)
 
 
 @dataclass(frozen=True)
 class StudyConfig:
+    """A validated study: the defaults merged with the user's file (``load_study``), frozen.
+
+    Attributes
+    ----------
+    name : str
+        The study's name (``[study] name``).
+    record_sets : tuple of str
+        Record sets, record ids, folders or files (``pipeline.records.load_records``).
+    processing : str
+        The processing recipe file; "" for the shipped ``pipeline/processing.toml``.
+    output : Path
+        Folder of the study's outputs.
+    measure, period, damping : str, float, float
+        The intensity measure (``pga``, ``pgv``, ``sa``, ...), the oscillator period [s] and damping
+        ratio [-] of Sa.
+    levels : tuple of float
+        Intensity levels in the measure's display unit (g or m/s), or multiples of each block's uplift
+        intensity when ``levels_relative_to`` is ``"uplift"`` (SI values: ``levels_si``).
+    soils, blocks, models : tuple
+        The ``SoilClass`` and ``Block`` objects and the model names that run.
+    switch, bed : str
+        ssi pivot-switch rule (consistent | continuous) and winkler bed (continuous | two-spring).
+    tail : float
+        Free vibration simulated after the record [s].
+    overturn_angle : float
+        |theta| at which a block has overturned [rad].
+    hazard_file : str
+        Hazard curve CSV (intensity, annual frequency); "" for the shipped example.
+    design_life : float
+        Design life [years] for the probability of each damage state.
+    bootstrap, seed, confidence : int, int, float
+        Bootstrap samples, their generator's seed, and the two-sided confidence level [-] of the bounds.
+    source : str
+        The study file (or ``pipeline/defaults.toml``) that errors name.
+    raw : dict
+        The merged study as a dict (``as_json``, ``config_hash``).
+    levels_relative_to : str
+        "" (absolute levels) or "uplift".
+    capacity_resolution : float
+        Relative bracket of the adaptive overturning capacities [-]; 0 turns them off.
+    period_range : (float, float) or None
+        AvgSa periods [s]; None for 0.2 to 3 times ``period``.
+    record_units : str
+        Acceleration units of the user's record files that do not state them ("" if not given).
+    record_dt : float or None
+        Time step of the user's one-column text records [s]; None: from the files.
+    applicability : ApplicabilitySettings
+        The soil-stiffness sweep (``[applicability]``).
+    """
+
     name: str
     record_sets: tuple[str, ...]
     processing: str
@@ -180,6 +231,7 @@ class StudyConfig:
 
     @property
     def relative_levels(self) -> bool:
+        """True when the levels are multiples of each block's uplift intensity."""
         return self.levels_relative_to == "uplift"
 
     @property
@@ -189,17 +241,22 @@ class StudyConfig:
 
     @property
     def levels_si(self) -> np.ndarray:
-        """Absolute intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV); with relative levels
-        the dimensionless multiples themselves (per-block intensities: pipeline.study.level_intensities)."""
+        """Absolute intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV).
+
+        With relative levels, the dimensionless multiples themselves (per-block intensities:
+        pipeline.study.level_intensities).
+        """
         if self.relative_levels:
             return np.asarray(self.levels, dtype=float)
         return np.asarray(self.levels) * MEASURES[self.measure].display_factor
 
     def as_json(self) -> str:
+        """The merged study dict as canonical JSON (sorted keys)."""
         return json.dumps(self.raw, sort_keys=True, default=str)
 
     @property
     def config_hash(self) -> str:
+        """The first 16 hex digits of the sha256 of ``as_json``."""
         return hashlib.sha256(self.as_json().encode()).hexdigest()[:16]
 
 
@@ -235,8 +292,9 @@ def _user_blocks(default: dict, user: dict) -> dict:
 
 
 def _levels(spec, source, check_only=False):
-    """``[intensity] levels``: a list, or ``{start, stop, count, spacing, relative_to}`` (levels in g or m/s,
-    or multiples of each block's uplift intensity with ``relative_to = "uplift"``).
+    """Check ``[intensity] levels``: a list, or ``{start, stop, count, spacing, relative_to}``.
+
+    Levels are in g or m/s, or multiples of each block's uplift intensity with ``relative_to = "uplift"``.
 
     Returns (levels, relative_to); with ``check_only`` the spec unchanged.
     """
@@ -346,7 +404,8 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
     soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
     models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
-    library = {name: _block("blocks_custom", name, spec, source) for name, spec in data.get("blocks_custom", {}).items()}
+    library = {name: _block("blocks_custom", name, spec, source)
+               for name, spec in data.get("blocks_custom", {}).items()}
     if "blocks" not in data:
         raise ConfigError("blocks", "no block defined; add [blocks.NAME] tables", source)
     blocks = _select("blocks", data["blocks"], library, source)
@@ -401,11 +460,32 @@ def read_study_file(path) -> dict:
         raise ConfigError("study", f"not valid TOML ({error})", str(path)) from None
 
 
-def load_study(path=None, overrides: dict | None = None) -> StudyConfig:
+def load_study(path: str | Path | None = None, overrides: dict | None = None) -> StudyConfig:
     """Defaults merged with a user study file (and a dict of overrides, e.g. from the CLI).
 
     The user file is validated on its own first, so errors name its fields as written; the override
     dict is validated the same way (source "command line").
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        A TOML study file with the layout of ``pipeline/defaults.toml`` (SI units unless a key says
+        otherwise: levels of PGA and Sa in g). None: the shipped default study.
+    overrides : dict, optional
+        Tables and keys replacing those of the file, in the same layout (``{"study": {"output": ...}}``).
+
+    Returns
+    -------
+    StudyConfig
+        The validated, frozen study.
+
+    Raises
+    ------
+    PipelineError
+        The study file does not exist.
+    ConfigError
+        The file cannot be read or is not TOML, or a key is unknown, of the wrong type or out of
+        range; the message names the file and the field as written.
     """
     default = tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text())
     source = "pipeline/defaults.toml"

@@ -213,8 +213,11 @@ def dask_executor(function: Callable[..., Any], scheduler: str | None = None,
 
 def make_executor(function: Callable[..., Any], workers: int | None = None, scheduler: str | None = None,
                   dask_workers: int | None = None) -> Executor:
-    """The executor a stage's options choose: dask if ``scheduler`` or ``dask_workers`` is given, else
-    this process (``workers`` 1) or a local pool of ``workers`` processes (None: one per core)."""
+    """The executor a stage's options choose.
+
+    That is dask if ``scheduler`` or ``dask_workers`` is given, else this process (``workers`` 1) or a
+    local pool of ``workers`` processes (None: one per core).
+    """
     if scheduler or dask_workers:
         return dask_executor(function, scheduler, dask_workers)
     if workers == 1:

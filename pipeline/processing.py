@@ -34,6 +34,7 @@ from scipy.integrate import cumulative_trapezoid
 
 from pipeline import __version__
 from pipeline.errors import ConfigError, RecordError
+from pipeline.records import Record
 from pipeline.validation import Checked, Flag, Number, Table, Text, shown
 
 
@@ -254,6 +255,7 @@ class ProcessingRecipe:
     source: str = "pipeline/processing.toml"
 
     def as_dict(self) -> dict:
+        """The recipe as plain data (``steps``, ``qa``, ``overrides``): JSON for provenance and cache keys."""
         return {"steps": [{"name": name, **params} for name, params in self.steps],
                 "qa": dict(self.qa), "overrides": self.overrides}
 
@@ -276,8 +278,11 @@ def _step(name, field, source) -> ProcessingStep:
 
 
 def _check_steps(value, field, source) -> list:
-    """``[[steps]]``: a non-empty list of tables, each a step's name and the parameters its schema allows
-    (those without a default required); a step that reads another needs it; pads and unpads pair up."""
+    """Check ``[[steps]]``: a non-empty list of tables, each a step's name and its schema's parameters.
+
+    Parameters without a default are required; a step that reads another needs it; pads and unpads
+    pair up.
+    """
     if not isinstance(value, list) or not value:
         raise ConfigError(field, f"{shown(value)}; expected a non-empty list of [[steps]] tables", source)
     names = []
@@ -379,11 +384,29 @@ def tail_checks(acceleration, dt, tail_seconds=5.0, velocity_ratio=0.3, displace
     return flags
 
 
-def process_record(record, recipe: ProcessingRecipe | None = None):
+def process_record(record: Record, recipe: ProcessingRecipe | None = None) -> Record:
     """Apply the recipe to a copy of the record; return the new, corrected ``Record``.
 
-    Raises ``RecordError`` (naming the record's file and the step) when the record cannot be
-    processed: a numerical failure of a step, or a result that is not finite or is all zero.
+    Parameters
+    ----------
+    record : Record
+        A record as read (``pipeline.records``): ground acceleration [m/s^2] in ``record.trace``.
+        It is not modified.
+    recipe : ProcessingRecipe, optional
+        The steps to run (``load_recipe``); the shipped ``pipeline/processing.toml`` if omitted. The
+        record's entry in ``recipe.overrides`` changes its steps' parameters.
+
+    Returns
+    -------
+    Record
+        A new record with the same id and metadata whose trace holds the corrected acceleration
+        [m/s^2], one ``stats.processing`` line per step and the tail-drift flags in ``stats.qa``.
+
+    Raises
+    ------
+    RecordError
+        Naming the record's file and the step, when the record cannot be processed: a numerical
+        failure of a step, or a result that is not finite or is all zero.
     """
     recipe = recipe or load_recipe()
     source = record.metadata.get("file") or record.id

@@ -19,7 +19,6 @@ from pipeline.errors import ConfigError
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number
 
-
 SOIL_RANGES = {
     "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),
     "poisson_ratio": Number(0, 0.5, high_open=True),

@@ -40,8 +40,10 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from pipeline import __version__
+from pipeline.blocks import Block
 from pipeline.checkpoints import CheckpointStore
 from pipeline.cube import build_cube
 from pipeline.errors import PipelineError, RecordError
@@ -74,8 +76,10 @@ def record_intensity(acceleration, dt, config, block=None) -> float:
 
 
 def record_intensities(records, config) -> np.ndarray:
-    """The study's measure of every record for every block, (n_record, n_block) [SI]; one value per
-    record repeated over the blocks unless the measure is defined per block."""
+    """The study's measure of every record for every block, (n_record, n_block) [SI].
+
+    One value per record, repeated over the blocks, unless the measure is defined per block.
+    """
     measure = MEASURES[config.measure]
     values = np.empty((len(records), len(config.blocks)))
     for r, record in enumerate(records):
@@ -132,8 +136,11 @@ def _hash(payload) -> str:
 
 
 def cells_for_record(record, config, recipe, block_scales=None) -> list[Cell]:
-    """The cells of one record with their checkpoint keys (``block_scales``: the record's scale
-    factors per block, (n_level, n_block), part of each cell's key)."""
+    """The cells of one record with their checkpoint keys.
+
+    ``block_scales`` holds the record's scale factors per block, (n_level, n_block), part of each
+    cell's key.
+    """
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
@@ -185,8 +192,6 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
 
 def _warm_up(models):
     """Compile (or load from the on-disk cache) the kernels once before starting workers."""
-    from pipeline.blocks import Block
-
     block = Block(name="warm-up", R=1.0, alpha=0.2, mass=1.0)
     for model in models:
         simulate_batch(model, np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
@@ -249,8 +254,10 @@ def study_records(config, log=print) -> StudyRecords:
 
 
 def _scalable(records, record_im, log):
-    """Split records into those whose intensity (per block) is positive and finite, and RecordErrors
-    for the rest (record_im: (n_record, n_block) [SI])."""
+    """Split records into those whose intensity (per block) is positive and finite, and the rest.
+
+    ``record_im`` is (n_record, n_block) [SI]; the rest come back as ``RecordError``.
+    """
     keep, failures = [], []
     for index, (record, im) in enumerate(zip(records, np.atleast_2d(record_im.T).T)):
         if np.all(np.isfinite(im)) and np.all(im > 0):
@@ -282,8 +289,6 @@ def run_study(config, *, output=None, workers=None, scheduler=None, dask_workers
 
 
 def _run_locked(config, output, workers, scheduler, dask_workers, progress, log, warn, loaded):
-    from tqdm import tqdm
-
     started = time.perf_counter()
     loaded = loaded or study_records(config, warn)
     records, failures, recipe = loaded.records, list(loaded.failures), loaded.recipe
@@ -376,9 +381,11 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
 
 def block_tasks(all_cells, available, config, stiffness, resolution) -> list:
-    """(record index, block index, jobs) for every record and block with cells still to run (not in
-    ``available``, the verified checkpoints); a job is (key, model, block, k, xi). Grouped by block
-    because scale factors are per block."""
+    """(record index, block index, jobs) for every record and block with cells still to run.
+
+    Cells still to run are those not in ``available``, the verified checkpoints; a job is
+    (key, model, block, k, xi). Grouped by block because scale factors are per block.
+    """
     tasks = []
     for index, cells in enumerate(all_cells):
         by_block = {}
@@ -396,9 +403,12 @@ def block_tasks(all_cells, available, config, stiffness, resolution) -> list:
 
 
 def gather_capacities(all_cells, available, config, intensity, resolution):
-    """Adaptive capacities as scale factors (4, record, soil, block, model): capacity, lower, upper,
-    extra runs; and the run accounting against uniform stripes of the same resolution (a dict,
-    empty when capacities are off)."""
+    """Adaptive capacities as scale factors, and the run accounting.
+
+    The capacities are (4, record, soil, block, model): capacity, lower, upper, extra runs. The
+    accounting compares with uniform stripes of the same resolution (a dict, empty when capacities
+    are off).
+    """
     shape = (4, len(all_cells), len(config.soils), len(config.blocks), len(config.models))
     capacities = np.full(shape, np.nan)
     if resolution <= 0:

@@ -37,8 +37,10 @@ class Number:
     unit: str = ""
 
     def describe(self) -> str:
-        """What the value must be: ``a number from 0.0 to 0.5``, ``a number > 0.0 and <= 1.0 [s]``,
-        ``a whole number >= 2``."""
+        """What the value must be.
+
+        For example ``a number from 0.0 to 0.5``, ``a number > 0.0 and <= 1.0 [s]``, ``a whole number >= 2``.
+        """
         kind = "a whole number" if self.integer else "a number"
         unit = f" [{self.unit}]" if self.unit else ""
         low, high = (None if bound is None else self._shown(bound) for bound in (self.low, self.high))
@@ -149,8 +151,10 @@ class Numbers:
 
 @dataclass(frozen=True)
 class Interval:
-    """``[low, high]`` (a list or tuple of two numbers, each checked by ``item``) with low < high
-    (low <= high unless ``strict``); ``names`` are what the message calls the two ends."""
+    """``[low, high]``: a list or tuple of two numbers, each checked by ``item``, with low < high.
+
+    low <= high is allowed unless ``strict``; ``names`` are what the message calls the two ends.
+    """
 
     item: Number
     names: tuple[str, str] = ("low", "high")

@@ -12,8 +12,16 @@ import pytest
 from pipeline.blocks import Block
 from pipeline.config import load_study
 from pipeline.errors import ConfigError
-from pipeline.plausibility import (CHECKS, MIN_FREQUENCY_RATIO, OVERRIDE_HINT, PlausibilityWarning, check_study,
-                                   frequency_ratio, implausibilities, settlement)
+from pipeline.plausibility import (
+    CHECKS,
+    MIN_FREQUENCY_RATIO,
+    OVERRIDE_HINT,
+    PlausibilityWarning,
+    check_study,
+    frequency_ratio,
+    implausibilities,
+    settlement,
+)
 from pipeline.soils import SOILS, Foundation, SoilClass, foundation
 from pipeline.units import STANDARD_GRAVITY
 

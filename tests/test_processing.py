@@ -2,12 +2,22 @@
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 import pytest
 
 from pipeline.errors import ConfigError
-from pipeline.processing import (header_corners, integrate, load_recipe, process_record,
-                                 recipe_from_dict)
+from pipeline.processing import (
+    PROCESSING_STEPS,
+    header_corners,
+    integrate,
+    load_recipe,
+    process_record,
+    recipe_from_dict,
+    tail_checks,
+)
+from pipeline.records import read_record
 
 
 def test_every_real_record_ends_at_rest(all_records):
@@ -46,8 +56,6 @@ def test_removes_a_known_drift(bolu_records):
 
 
 def test_qa_flags_a_record_that_drifts_but_keeps_it(bolu_records):
-    from pipeline.processing import tail_checks
-
     record = bolu_records["DUZCE/BOL000"]
     drifting = record.acceleration.copy()
     drifting[-500:] += 0.5  # a step near the end: velocity grows in the tail
@@ -57,8 +65,6 @@ def test_qa_flags_a_record_that_drifts_but_keeps_it(bolu_records):
 
 
 def test_header_filter_corners_are_read(records_dir):
-    from pipeline.records import read_record
-
     trace = read_record(records_dir / "peer_original/NHERI-SimCenter__EE-UQ/RSN1084_NORTHR_SCS052.AT2")
     assert header_corners(trace) == (0.2, 40.0)
 
@@ -102,10 +108,6 @@ def test_recipe_messages_name_the_allowed_range_and_keys():
 
 
 def test_the_shipped_recipe_is_the_authority_for_the_band_pass_corners():
-    import inspect
-
-    from pipeline.processing import PROCESSING_STEPS
-
     bandpass = dict(load_recipe().steps)["bandpass"]
     assert (bandpass["freqmin"], bandpass["freqmax"]) == (0.1, 50.0)
     defaults = PROCESSING_STEPS["bandpass"].defaults

@@ -12,6 +12,7 @@ import pytest
 from pipeline.cli import main
 from pipeline.errors import RecordError
 from pipeline.records import detect_format, load_records, read_record
+from pipeline.records.text import read_columns
 from pipeline.units import STANDARD_GRAVITY
 
 KNET_FILE = Path(obspy.__file__).parent / "io" / "nied" / "tests" / "data" / "test.knet"
@@ -133,8 +134,6 @@ def test_one_column_without_dt_is_skipped_with_its_reason(tmp_path, capsys):
 
 def test_one_table_reader_gives_header_names_and_lines(tmp_path):
     """records/text.read_columns reads text records and calibration references alike."""
-    from pipeline.records.text import read_columns
-
     text = "# exported by the logger\nsite A, north\ntime [s]; theta [deg]; note\n0;0.1;a\n\n0.01;0.2;b\n"
     table = read_columns(_write(tmp_path, "table.csv", text), "two columns", counts=(2,), extra=True)
     assert table.header == ("site A, north", "time [s]; theta [deg]; note")

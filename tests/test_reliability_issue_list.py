@@ -81,21 +81,24 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
     ("empty checkpoint", corrupt_checkpoint, 0, ["damaged", "quarantine"], ()),
     # 2. mistakes that silently changed results (time [min]/[us] and theta [degrees] units: the
     #    calibration helper's tests check the converted values)
-    ("typo under soils_custom", lambda p: ["run", replaced(p, 'soils = ["rock"]', 'soils = ["wet"]',
-                                                           "[soils_custom.wet]\nshear_modulus = 5e7\ndamping_raito = 0.2\n"),
-                                           "--output", p / "o", *RUN], 2, ["damping_raito"], ()),
-    ("typo under damage_states", lambda p: ["run", study_with(p, '[damage_states.x]\nedp = "overturned"\nthreshhold = 1\n'),
-                                            "--output", p / "o", *RUN], 2, ["threshhold"], ()),
-    ("calibrate text cell in theta", lambda p: ["calibrate", _write(p / "t.csv", "time [s],theta [rad],other\n" + "".join(
-        f"{0.01 * i},{'x' if i == 5 else 1e-4 * i},{i}\n" for i in range(30))), "--record", p / "records" / "good.AT2",
+    ("typo under soils_custom", lambda p: ["run", replaced(
+        p, 'soils = ["rock"]', 'soils = ["wet"]', "[soils_custom.wet]\nshear_modulus = 5e7\ndamping_raito = 0.2\n"),
+        "--output", p / "o", *RUN], 2, ["damping_raito"], ()),
+    ("typo under damage_states", lambda p: [
+        "run", study_with(p, '[damage_states.x]\nedp = "overturned"\nthreshhold = 1\n'),
+        "--output", p / "o", *RUN], 2, ["threshhold"], ()),
+    ("calibrate text cell in theta", lambda p: [
+        "calibrate", _write(p / "t.csv", "time [s],theta [rad],other\n" + "".join(
+            f"{0.01 * i},{'x' if i == 5 else 1e-4 * i},{i}\n" for i in range(30))),
+        "--record", p / "records" / "good.AT2",
         "--output", p / "o", "--grid-only", "--n-k", "2", "--n-xi", "2"], 2, ["theta"], ()),
     # 3. tracebacks with rc 1
     ("output is a file", lambda p: _write(p / "f", "x") and ["records", "--set", p / "records", "--output", p / "f"],
      2, ["is a file"], ()),
     ("output below a file", lambda p: _write(p / "f", "x") and
      ["run", p / "study.toml", "--output", p / "f" / "o", *RUN], 2, ["output folder"], ()),
-    ("1-sample record", lambda p: ["records", "--set", bad_record(p, values=[0.1]), "--output", p / "o", "--no-progress"], 1,
-     ["bad.AT2", "only 1 samples"], ()),
+    ("1-sample record", lambda p: ["records", "--set", bad_record(p, values=[0.1]), "--output", p / "o",
+                                   "--no-progress"], 1, ["bad.AT2", "only 1 samples"], ()),
     ("2-sample record", lambda p: ["run", study_with(p, ""), "--output", p / "o", *RUN]
      if bad_record(p, values=[0.1, 0.2]) else None, 1, ["bad.AT2", "only 2 samples"], ()),
     ("DT 5 s", lambda p: ["run", p / "study.toml", "--output", p / "o", *RUN] if bad_record(p, dt=5.0) else None,
@@ -131,12 +134,12 @@ PROBES = [  # (id, argv builder, exit status, words in the one line, marks)
     ("--workers -1", lambda p: ["run", p / "study.toml", "--output", p / "o", "--workers", "-1", "--no-progress"], 2,
      ["--workers", "-1"], ()),
     # 7. inconsistent or unchecked records and values
-    ("all-zero record in records", lambda p: ["records", "--set", bad_record(p, amplitude_g=0.0), "--output", p / "o", "--no-progress"],
-     1, ["bad.AT2", "zero"], ()),
+    ("all-zero record in records", lambda p: ["records", "--set", bad_record(p, amplitude_g=0.0), "--output", p / "o",
+                                              "--no-progress"], 1, ["bad.AT2", "zero"], ()),
     ("all-zero record in run", lambda p: ["run", p / "study.toml", "--output", p / "o", *RUN]
      if bad_record(p, amplitude_g=0.0) else None, 1, ["bad.AT2", "zero"], ()),
-    ("1e305 g record", lambda p: ["records", "--set", bad_record(p, amplitude_g=1e305), "--output", p / "o", "--no-progress"], 1,
-     ["bad.AT2", "implausible"], ()),
+    ("1e305 g record", lambda p: ["records", "--set", bad_record(p, amplitude_g=1e305), "--output", p / "o",
+                                  "--no-progress"], 1, ["bad.AT2", "implausible"], ()),
     ("empty AT2", lambda p: _write(p / "records" / "bad.AT2", "") and
      ["records", "--set", p / "records", "--output", p / "o", "--no-progress"], 1, ["bad.AT2", "empty"], ()),
     ("binary AT2", lambda p: _write_bytes(p / "records" / "bad.AT2", b"\x00\x01\x02" * 50) and

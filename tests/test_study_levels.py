@@ -9,6 +9,8 @@ from pipeline.config import load_study
 from pipeline.cube import OUTCOME_NO_UPLIFT
 from pipeline.errors import ConfigError
 from pipeline.models import simulate
+from pipeline.processing import process_record
+from pipeline.records import load_records
 from pipeline.study import run_study, uplift_intensity
 from pipeline.units import STANDARD_GRAVITY as G
 
@@ -60,9 +62,6 @@ def test_every_block_stays_put_below_uplift_and_rocks_above(relative_cube):
 
 def test_adaptive_capacities_bracket_overturning_by_direct_runs(relative_cube):
     config, cube, stats = relative_cube
-    from pipeline.processing import process_record
-    from pipeline.records import load_records
-
     loaded, _ = load_records(["DUZCE/BOL090"])
     record = process_record(loaded[0])
     block = next(b for b in config.blocks if b.name == "slender-cabinet")

@@ -21,9 +21,10 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, NamedTuple
+from typing import Callable, Iterable, NamedTuple
 
 import numpy as np
+import obspy
 
 from pipeline.errors import ManifestError, RecordError
 from pipeline.records import peer_at2
@@ -40,6 +41,8 @@ is one or two numeric columns); other formats: name the files."""
 
 
 class RecordFormat(NamedTuple):
+    """A registered record format: its detector and its reader."""
+
     is_format: Callable  # (path) -> bool, never raises
     read_format: Callable  # (path, units=None, dt=None) -> obspy.Stream with acceleration in m/s^2
 
@@ -81,7 +84,7 @@ class Record:
     """
 
     id: str
-    trace: object
+    trace: obspy.Trace
     metadata: dict = field(default_factory=dict)
 
     @property
@@ -99,11 +102,13 @@ class Record:
         """Record length [s]."""
         return self.dt * (self.trace.stats.npts - 1)
 
-    def with_trace(self, trace) -> "Record":
+    def with_trace(self, trace: obspy.Trace) -> Record:
+        """A copy of this record (same id, a copy of the metadata) holding ``trace``."""
         return Record(self.id, trace, dict(self.metadata))
 
 
-def read_record(path, format: str | None = None, units: str | None = None, dt: float | None = None):
+def read_record(path: str | Path, format: str | None = None, units: str | None = None,
+                dt: float | None = None) -> obspy.Trace:
     """Read one acceleration record into an ``obspy.Trace`` in m/s^2.
 
     Parameters
@@ -118,6 +123,11 @@ def read_record(path, format: str | None = None, units: str | None = None, dt: f
         for PEER AT2 (g) and K-NET/KiK-net (the header's scale factor in gal), whose headers state them.
     dt : float, optional
         Time step [s] of one-column text records (files with a time column or a header state theirs).
+
+    Returns
+    -------
+    obspy.Trace
+        Ground acceleration [m/s^2] (``stats.units``), with the format's header in ``stats``.
 
     Raises
     ------
@@ -137,8 +147,6 @@ def read_record(path, format: str | None = None, units: str | None = None, dt: f
 
 
 def _read_with_obspy(path, format, units):
-    import obspy
-
     try:
         stream = obspy.read(str(path), format=format)
     except Exception as error:  # obspy raises TypeError/ValueError/... for unknown content
@@ -210,8 +218,11 @@ def check_record(record) -> None:
 
 
 def unique_ids(records) -> list:
-    """The records with unique ids: a user file whose name clashes with another record's id gets
-    its path's last folders in its id (``site-a/X``, ``site-b/X``); catalogue ids never change."""
+    """The records with unique ids.
+
+    A user file whose name clashes with another record's id gets its path's last folders in its id
+    (``site-a/X``, ``site-b/X``); catalogue ids never change.
+    """
     ids = [r.id for r in records]
     movable = [r.metadata.get("sets") == "user" and bool(r.metadata.get("file")) for r in records]
     for depth in range(2, 64):
@@ -368,16 +379,20 @@ def _unknown_selection(text: str, sets, entries) -> Exception:
                          f"({', '.join(sorted(sets))}), a record id, a folder or a file")
 
 
-def load_records(selection, records_dir=None, units: str | None = None, verify_checksums=True,
-                 dt: float | None = None):
+def load_records(selection: str | Path | Iterable[str | Path], records_dir: str | Path | None = None,
+                 units: str | None = None, verify_checksums: bool = True,
+                 dt: float | None = None) -> tuple[list[Record], list[RecordError]]:
     """Load a record set by name, a folder of files, or a list of these.
 
     Parameters
     ----------
     selection : str, Path or list
         Set names (``record_sets()``), record ids, folders or files.
+    records_dir : str or Path, optional
+        Folder of the catalogue (``MANIFEST.csv`` and its files); ``RECORDS_DIR`` if omitted.
     units : str, optional
-        Acceleration units for user files in formats that do not state them.
+        Acceleration units for user files in formats that do not state them (``g``, ``m/s^2``,
+        ``cm/s^2``, ``gal``).
     dt : float, optional
         Time step [s] of the user's one-column text records.
     verify_checksums : bool

@@ -18,6 +18,8 @@ import os
 import re
 
 import numpy as np
+from obspy import Stream, Trace
+from obspy.core.util import AttribDict
 
 from pipeline.errors import RecordError
 from pipeline.units import acceleration_factor
@@ -269,9 +271,6 @@ def read_peer_at2(filename, headonly: bool = False, **kwargs):
 
     This is the ``readFormat`` hook obspy calls for format ``PEER_AT2``.
     """
-    from obspy import Stream, Trace
-    from obspy.core.util import AttribDict
-
     data, dt, header = parse_peer_at2(filename, headonly=headonly)
     trace = Trace(data=data)
     trace.stats.delta = dt

@@ -1,5 +1,7 @@
-"""pipeline.records.text - plain text / CSV acceleration records, the most common exchange format, and the
-one reader of numeric text tables with units in the header (also used for calibration references).
+"""pipeline.records.text - plain text / CSV acceleration records, and the one reader of numeric text tables.
+
+Text is the most common exchange format; tables with units in the header are read here also for
+calibration references.
 
 Input : a text file with one column (acceleration; the time step from ``dt``) or two columns (time [s],
         acceleration), separated by commas, semicolons, tabs or spaces. Header lines before the numbers
@@ -19,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from obspy import Stream, Trace
 
 from pipeline.errors import RecordError
 from pipeline.units import acceleration_factor
@@ -90,8 +93,10 @@ class ColumnTable:
 
 
 def _column_names(header: list[str], count: int) -> tuple[str, ...]:
-    """The cells of the last header line (split at commas, semicolons or tabs, else at spaces) if it
-    names at least ``count`` columns, else ()."""
+    """The cells of the last header line if it names at least ``count`` columns, else ().
+
+    The line is split at commas, semicolons or tabs, else at spaces.
+    """
     last = header[-1] if header else ""
     cells = _HEADER_SEPARATOR.split(last) if _HEADER_SEPARATOR.search(last) else last.split()
     return tuple(cell.strip() for cell in cells) if len(cells) >= count else ()
@@ -240,8 +245,6 @@ def parse_text_record(path, units: str | None = None, dt: float | None = None):
 
 def read_text_record(filename, units: str | None = None, dt: float | None = None, **kwargs):
     """An ``obspy.Stream`` with one acceleration trace [m/s^2] from a text record."""
-    from obspy import Stream, Trace
-
     acceleration, step, details = parse_text_record(filename, units=units, dt=dt)
     trace = Trace(data=acceleration)
     trace.stats.delta = step
