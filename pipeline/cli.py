@@ -223,7 +223,8 @@ def command_run(args) -> int:
 
 
 def command_fragility(args) -> int:
-    """The whole pipeline: study cube, IDA, fragility and risk, applicability, report."""
+    """The whole pipeline: study cube, IDA, fragility and risk, applicability (``run_applicability``), report,
+    and the answer table (``pipeline.answer``; not with ``--quiet``)."""
     import time
 
     import xarray as xr
@@ -419,8 +420,8 @@ def build_parser() -> argparse.ArgumentParser:
                               help="run a study into the cube (cube.nc)")
     run.set_defaults(handler=command_run)
     fragility = commands.add_parser("fragility", parents=[study, record_set, reading, output, dask],
-                                    help="run the whole pipeline: cube, IDA, fragility, applicability (--applicability), "
-                                         "report; ends with the answer table")
+                                    help="run the whole pipeline: cube, IDA, fragility, applicability (see "
+                                         "--applicability), report; ends with the answer table")
     fragility.add_argument("--applicability", action=argparse.BooleanOptionalAction, default=None,
                            help="run (or not) the soil-stiffness sweep of `rockfrag applicability` (minutes); "
                                 "default: the study's [applicability] run, else only for the default study "
