@@ -223,8 +223,11 @@ def command_run(args) -> int:
 
 
 def command_fragility(args) -> int:
-    """The whole pipeline: study cube, IDA, fragility and risk, applicability, report."""
+    """The whole pipeline: study cube, IDA, fragility and risk, applicability (``run_applicability``), report,
+    and the answer table (``pipeline.answer``; not with ``--quiet``)."""
     import time
+
+    import xarray as xr
 
     from pipeline.fragility import fragility_stage
     from pipeline.ida import ida_stage
@@ -252,18 +255,52 @@ def command_fragility(args) -> int:
     fragility, risk = fragility_stage(cube, ida, config, output, progress=not args.no_progress)
     for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
         print(f"wrote {output / name}")
-    applicability = None
-    if not args.skip_applicability:
+    if run_applicability(args, config):
         from pipeline.applicability import applicability_stage
 
         applicability = applicability_stage(config, output, workers=args.workers, progress=not args.no_progress,
                                             loaded=loaded)
+    else:  # not None: the report would read an applicability.nc an earlier run left in the folder
+        applicability = xr.Dataset()
+        _log("rockfrag: applicability sweep not run (a study file's default); --applicability or the study's "
+             "[applicability] run = true runs it")
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, time.perf_counter() - started,
                              applicability, progress=not args.no_progress)
     print(f"wrote {pdf} ({len(pngs)} numbered pages), {output / 'report.html'} and {len(pngs)} page images "
           f"in {output / 'figures'}/")
     print(f"done in {time.perf_counter() - started:.0f} s")
+    if not args.quiet:
+        from pipeline.answer import answer_table
+
+        print()
+        print(answer_table(fragility, outputs=(pdf, output / "fragility.csv", output / "fragility.nc")))
     return EXIT_PARTIAL if stats["failures"] else 0
+
+
+def run_applicability(args, config) -> bool:
+    """Whether ``rockfrag fragility`` runs the applicability sweep.
+
+    ``--applicability``/``--no-applicability`` decide if given; else the study's ``[applicability] run``;
+    else the sweep runs for the default study only (no study file), not for a user's study.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed ``fragility`` command line (``applicability``: True, False or None; ``study``).
+    config : pipeline.config.StudyConfig
+        The loaded study.
+
+    Returns
+    -------
+    bool
+        True to run the sweep.
+    """
+    if args.applicability is not None:
+        return bool(args.applicability)
+    run = config.raw.get("applicability", {}).get("run")
+    if run is not None:
+        return bool(run)
+    return args.study is None
 
 
 def _ground_motion(args, config):
@@ -383,9 +420,16 @@ def build_parser() -> argparse.ArgumentParser:
                               help="run a study into the cube (cube.nc)")
     run.set_defaults(handler=command_run)
     fragility = commands.add_parser("fragility", parents=[study, record_set, reading, output, dask],
-                                    help="run the whole pipeline: cube, IDA, fragility, applicability, report")
-    fragility.add_argument("--skip-applicability", action="store_true",
-                           help="skip the soil-stiffness sweep of `rockfrag applicability` (saves minutes)")
+                                    help="run the whole pipeline: cube, IDA, fragility, applicability (see "
+                                         "--applicability), report; ends with the answer table")
+    fragility.add_argument("--applicability", action=argparse.BooleanOptionalAction, default=None,
+                           help="run (or not) the soil-stiffness sweep of `rockfrag applicability` (minutes); "
+                                "default: the study's [applicability] run, else only for the default study "
+                                "(no study file)")
+    fragility.add_argument("--skip-applicability", dest="applicability", action="store_false", default=None,
+                           help=argparse.SUPPRESS)  # the old spelling of --no-applicability
+    fragility.add_argument("--quiet", action="store_true",
+                           help="do not print the answer table (overturning median and bounds per block and soil)")
     fragility.set_defaults(handler=command_fragility)
 
     calibrate = commands.add_parser("calibrate", parents=[_study_option(positional=False), reading, output],

@@ -76,6 +76,13 @@ def _damage_state_table() -> Table:
     return Table({key: Number(0, low_open=True) if key == "threshold" else TEXT for key in keys})
 
 
+def _flag(value, field, source):
+    """A TOML boolean (``true``/``false``), else a ``ConfigError``."""
+    if not isinstance(value, bool):
+        raise ConfigError(field, f"{_shown(value)}; must be true or false", source)
+    return value
+
+
 SCHEMA = Table({
     "soils": Names('["sand", "rock"]'),
     "models": Names('["housner", "ssi"]'),
@@ -109,6 +116,7 @@ SCHEMA = Table({
         "levels": Numbers(Number(0, 100, low_open=True)),
         "block_moduli": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
         "tolerance": Number(0, 10, low_open=True),
+        "run": Checked(_flag),  # read by pipeline.cli (rockfrag fragility); absent: only the default study
     }),
 })
 """Every key a study file may hold, with its type and range."""

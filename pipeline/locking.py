@@ -9,6 +9,11 @@ Output: an advisory lock (``fcntl.flock`` on ``<folder>/.rockfrag.lock``, holdin
 Every rockfrag writer in a folder holds its lock, so the temporary ``.*.part`` files found there
 by the process that has just taken the lock belong to runs that died: they are removed then, and
 never while another run holds the folder.
+
+A command that fails (any exception out of the locked block) leaves the folder as it found it: the
+lock file goes if this run created it, and so does the folder (and any parent it created) if
+nothing else is left in it. A run that waited on a lock file removed this way takes the lock again
+on the file now at its path, so two runs never hold the same folder.
 """
 
 from __future__ import annotations
@@ -24,6 +29,16 @@ from pipeline.errors import PipelineError
 LOCK_NAME = ".rockfrag.lock"
 
 _held: dict[Path, list] = {}  # resolved folder -> [file descriptor, depth]; re-entrant per process
+
+
+def missing_folders(folder) -> list[Path]:
+    """``folder`` and those of its parents that do not exist yet, deepest first (what a mkdir creates)."""
+    missing = []
+    folder = Path(folder)
+    while not folder.exists() and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
 
 
 def prepare_output_folder(folder) -> Path:
@@ -56,6 +71,66 @@ def stale_part_files(folder) -> list[Path]:
 BUSY = (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
 
 
+def _same_file(descriptor: int, path: Path) -> bool:
+    """Whether ``path`` still names the open file ``descriptor`` (a failed run may have removed it)."""
+    try:
+        named = os.stat(path)
+    except FileNotFoundError:
+        return False
+    held = os.fstat(descriptor)
+    return (named.st_dev, named.st_ino) == (held.st_dev, held.st_ino)
+
+
+def _acquire(folder: Path, wait: bool, notify) -> tuple[int, bool]:
+    """An exclusive flock on ``folder``'s lock file: (descriptor, whether this call created the file)."""
+    lock_path = folder / LOCK_NAME
+    told = False
+    while True:
+        prepare_output_folder(folder)  # again after a failed run removed the folder it had created
+        created = not lock_path.exists()
+        try:
+            descriptor = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        except FileNotFoundError:
+            continue  # the folder went between the two calls
+        except OSError as error:
+            raise PipelineError(f"output folder {folder} is not writable ({error.strerror})") from None
+        try:
+            try:
+                fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as error:
+                if error.errno not in BUSY or not wait:
+                    raise
+                if notify is not None and not told:
+                    notify(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
+                           "waiting for it to finish (Ctrl-C stops waiting)")
+                    told = True
+                fcntl.flock(descriptor, fcntl.LOCK_EX)
+        except OSError as error:
+            os.close(descriptor)
+            if error.errno in BUSY:
+                raise PipelineError(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
+                                    "wait for it to finish, choose another --output, or pass --wait") from None
+            raise PipelineError(f"cannot lock the output folder {folder} ({error.strerror})") from None
+        except BaseException:  # Ctrl-C while waiting
+            os.close(descriptor)
+            raise
+        if _same_file(descriptor, lock_path):
+            return descriptor, created
+        os.close(descriptor)  # the run we waited for failed and removed this lock file: lock the new one
+
+
+def _leave_as_found(lock_path: Path, created_lock: bool, created_folders: list[Path]) -> None:
+    """After a failure: remove the lock file this run created, then the folders it created if empty."""
+    if created_lock:
+        with contextlib.suppress(OSError):
+            lock_path.unlink()
+    for folder in created_folders:  # deepest first; rmdir refuses a folder that holds anything
+        try:
+            folder.rmdir()
+        except OSError:
+            break
+
+
 @contextlib.contextmanager
 def output_lock(folder, wait=False, notify=None):
     """Hold the advisory lock of ``folder`` (created if needed) for the duration of the block.
@@ -63,7 +138,11 @@ def output_lock(folder, wait=False, notify=None):
     Re-entrant within one process. On first acquisition the stale ``.part`` files of dead runs
     are removed. A folder held by another run is a one-line ``PipelineError``, or with ``wait`` the
     call blocks until that run ends, after telling ``notify`` (a callable taking one line) once.
+    If the block raises, the lock file and the folders this call created go again when nothing
+    else was written to them (see the module docstring).
     """
+    folder = Path(folder)
+    created_folders = missing_folders(folder) if not folder.is_dir() else []
     folder = prepare_output_folder(folder)
     key = folder.resolve()
     if key in _held:
@@ -73,37 +152,22 @@ def output_lock(folder, wait=False, notify=None):
         finally:
             _held[key][1] -= 1
         return
-    lock_path = folder / LOCK_NAME
     try:
-        descriptor = os.open(lock_path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
-    except OSError as error:
-        raise PipelineError(f"output folder {folder} is not writable ({error.strerror})") from None
-    try:
-        try:
-            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as error:
-            if error.errno not in BUSY or not wait:
-                raise
-            if notify is not None:
-                notify(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
-                       "waiting for it to finish (Ctrl-C stops waiting)")
-            fcntl.flock(descriptor, fcntl.LOCK_EX)
-    except OSError as error:
-        os.close(descriptor)
-        if error.errno in BUSY:
-            raise PipelineError(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
-                                "wait for it to finish, choose another --output, or pass --wait") from None
-        raise PipelineError(f"cannot lock the output folder {folder} ({error.strerror})") from None
-    except BaseException:  # Ctrl-C while waiting
-        os.close(descriptor)
+        descriptor, created_lock = _acquire(folder, wait, notify)
+    except BaseException:
+        _leave_as_found(folder / LOCK_NAME, False, created_folders)
         raise
     _held[key] = [descriptor, 1]
+    failed = True
     try:
         os.ftruncate(descriptor, 0)
         os.pwrite(descriptor, f"{os.getpid()}\n".encode(), 0)
         for stale in stale_part_files(folder):
             stale.unlink(missing_ok=True)
         yield folder
+        failed = False
     finally:
         del _held[key]
+        if failed:  # still holding the lock, so no other run can be using the file or the folder
+            _leave_as_found(folder / LOCK_NAME, created_lock, created_folders)
         os.close(descriptor)

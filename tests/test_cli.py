@@ -64,3 +64,80 @@ def test_unreachable_scheduler_is_one_line(tmp_path):
                              "--scheduler", "tcp://127.0.0.1:9", "--no-progress"], capture_output=True, text=True)
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "cannot connect to the dask scheduler" in result.stderr
+
+
+# ---------------------------------------------------------------- a failed command leaves no trace (issue 21)
+
+def test_a_failed_command_leaves_no_empty_folder_or_lock_behind(tmp_path, capsys):
+    output = tmp_path / "new" / "reports"  # neither folder exists yet
+    status = main(["calibrate", str(tmp_path / "missing.csv"), "--record", "DUZCE/BOL090", "--output", str(output)])
+    assert status == 2 and "missing.csv: reference file not found" in capsys.readouterr().err
+    assert not (tmp_path / "new").exists()
+
+
+def test_a_failed_command_leaves_an_existing_folder_as_it_found_it(tmp_path, capsys):
+    from pipeline.locking import LOCK_NAME
+
+    empty, used = tmp_path / "empty", tmp_path / "used"
+    empty.mkdir()
+    used.mkdir()
+    (used / LOCK_NAME).write_text("1\n")  # left by an earlier, successful run
+    (used / "cube.nc").write_bytes(b"earlier results")
+    for folder in (empty, used):
+        assert main(["calibrate", str(tmp_path / "missing.csv"), "--record", "DUZCE/BOL090",
+                     "--output", str(folder)]) == 2
+    assert empty.is_dir() and not list(empty.iterdir())
+    assert sorted(p.name for p in used.iterdir()) == sorted([LOCK_NAME, "cube.nc"])
+    capsys.readouterr()
+
+
+def test_output_lock_cleans_up_only_after_a_failure(tmp_path):
+    import pytest
+
+    from pipeline.locking import LOCK_NAME, output_lock
+
+    with pytest.raises(RuntimeError):
+        with output_lock(tmp_path / "a" / "b"):
+            raise RuntimeError("the command failed")
+    assert not (tmp_path / "a").exists()
+    with pytest.raises(RuntimeError):
+        with output_lock(tmp_path / "kept"):
+            (tmp_path / "kept" / "partial.csv").write_text("written before the failure")
+            raise RuntimeError("the command failed")
+    assert sorted(p.name for p in (tmp_path / "kept").iterdir()) == ["partial.csv"]
+    with output_lock(tmp_path / "done"):
+        pass
+    assert (tmp_path / "done" / LOCK_NAME).is_file()  # a successful run keeps its lock file, as before
+
+
+def test_a_run_waiting_on_a_failed_run_locks_the_new_lock_file(tmp_path):
+    """The waiting run must not hold a lock on the file the failed run removed (two runs in one folder)."""
+    import fcntl
+    import textwrap
+    import time
+
+    import pytest
+
+    from pipeline.locking import LOCK_NAME, output_lock
+
+    output = tmp_path / "out"
+    script = textwrap.dedent(f"""
+        import time
+        from pipeline.locking import output_lock
+        try:
+            with output_lock({str(output)!r}):
+                print("locked", flush=True)
+                time.sleep(1.5)
+                raise RuntimeError("failed")
+        except RuntimeError:
+            pass
+    """)
+    failing = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert failing.stdout.readline().strip() == "locked"
+    started = time.monotonic()
+    with output_lock(output, wait=True):
+        assert time.monotonic() - started > 0.5  # it waited for the failing run
+        with open(output / LOCK_NAME) as other:  # the file at the path is the one held
+            with pytest.raises(BlockingIOError):
+                fcntl.flock(other, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    failing.wait(timeout=30)
