@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.risk import EXAMPLE_HAZARD
+from pipeline.hazard import EXAMPLE_HAZARD
 from pipeline.units import STANDARD_GRAVITY
 
 ANSWER_MODELS = ("winkler", "ssi", "ssi-paper", "housner")

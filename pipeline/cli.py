@@ -17,6 +17,7 @@ import sys
 import tempfile
 import time
 import traceback
+import warnings
 from pathlib import Path
 
 from pipeline import __version__
@@ -105,6 +106,8 @@ def _output_option():
     parent.add_argument("--output", type=Path, default=None, metavar="DIR",
                         help="output folder (default: the study's study.output, reports/)")
     parent.add_argument("--no-progress", action="store_true", help="hide progress bars")
+    parent.add_argument("--force", action="store_true",
+                        help="run a study whose blocks or soils look physically implausible (one warning each)")
     parent.add_argument("--wait", action="store_true",
                         help="if another rockfrag run is writing to the output folder, wait for it to finish "
                              "(default: stop with an error)")
@@ -143,6 +146,8 @@ def _study_config(args, applicability=None):
         if value is not None:
             study[key] = str(value) if isinstance(value, Path) else value
     overrides = {"study": study} if study else {}
+    if getattr(args, "force", False):
+        overrides["checks"] = {"plausibility": "warn"}
     if applicability:
         overrides["applicability"] = applicability
     config = load_study(args.study, overrides or None)
@@ -569,7 +574,14 @@ def _parse_arguments(parser, argv):
         raise SystemExit(EXIT_USER_ERROR) from None
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Print a warning as one ``rockfrag: warning:`` line (no source location: users read it, not developers)."""
+    print(f"rockfrag: warning: {' '.join(str(message).splitlines())}", file=sys.stderr)
+
+
 def main(argv=None) -> int:
+    """Run the ``rockfrag`` command line; returns the exit code (see ``EXIT_CODES``)."""
+    warnings.showwarning = _one_line_warning
     parser = build_parser()
     parser.epilog = EXIT_CODES
     parser.formatter_class = argparse.RawDescriptionHelpFormatter

@@ -37,7 +37,7 @@ from pipeline.measures import MEASURES, scaling_measures
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
-from pipeline.validation import (Checked, Either, Interval, NamedTables, Names, Number, Numbers, Table, Text,
+from pipeline.validation import (Checked, Either, Flag, Interval, NamedTables, Names, Number, Numbers, Table, Text,
                                  shown as _shown)
 
 LEVEL_REFERENCES = ("", "uplift")
@@ -76,13 +76,6 @@ def _damage_state_table() -> Table:
     return Table({key: Number(0, low_open=True) if key == "threshold" else TEXT for key in keys})
 
 
-def _flag(value, field, source):
-    """A TOML boolean (``true``/``false``), else a ``ConfigError``."""
-    if not isinstance(value, bool):
-        raise ConfigError(field, f"{_shown(value)}; must be true or false", source)
-    return value
-
-
 SCHEMA = Table({
     "soils": Names('["sand", "rock"]'),
     "models": Names('["housner", "ssi"]'),
@@ -116,7 +109,7 @@ SCHEMA = Table({
         "levels": Numbers(Number(0, 100, low_open=True)),
         "block_moduli": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
         "tolerance": Number(0, 10, low_open=True),
-        "run": Checked(_flag),  # read by pipeline.cli (rockfrag fragility); absent: only the default study
+        "run": Flag(),  # read by pipeline.cli (rockfrag fragility); absent: only the default study
     }),
 })
 """Every key a study file may hold, with its type and range."""

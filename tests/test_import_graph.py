@@ -35,8 +35,8 @@ LAYERS: list[tuple[str, ...]] = [
     ("pipeline.study", "pipeline.fragility", "pipeline.efficiency"),
     # 8 stages built on the sweep
     ("pipeline.showcase", "pipeline.applicability"),
-    # 9 the report
-    ("pipeline.report", "pipeline.report.*"),
+    # 9 what the reader gets: the report and the terminal's answer table
+    ("pipeline.report", "pipeline.report.*", "pipeline.answer"),
     # 10 the command
     ("pipeline.cli", "pipeline.__main__"),
 ]
