@@ -23,13 +23,14 @@ from pipeline.blocks import Block
 from pipeline.errors import SolverError
 from pipeline.models import fields, kernels
 from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
+from pipeline.models.contact import BED_LAWS
 from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
 from pipeline.units import STANDARD_GRAVITY
 
 MODELS: dict[str, RockingModel] = {}
 
 SWITCH_RULES = {"consistent": fields.SWITCH_CONSISTENT, "continuous": fields.SWITCH_CONTINUOUS}
-BED_TYPES = {"continuous": fields.BED_CONTINUOUS, "two-spring": fields.BED_TWO_SPRING}
+BED_TYPES = BED_LAWS  # the winkler bed's contact laws, registered in pipeline.models.contact
 
 DEFAULT_RTOL = 1e-6  # relative error per step; peak angles agree with scipy at 1e-10 to ~1e-6
 DEFAULT_ATOL = 1e-7  # absolute error per step, as a fraction of alpha, alpha*p, y_static, y_static*omega
