@@ -1,8 +1,8 @@
 """pipeline.models.bed_continuous - the continuous Kelvin-Voigt bed, a contact law of ``winkler``.
 
 Input : the state x = [theta, theta_dot, y, y_dot] and a parameter record (b, omega = sqrt(K/m), xi).
-Output: the hooks of a bed contact law (pipeline.models.contact): ``force``, ``indicator``,
-        ``indicators``, ``rocking_stiffness`` and ``full_contact_energy``; all per unit mass.
+Output: the hooks of a bed contact law (pipeline.models.contact): ``NAME``, ``force``,
+        ``indicator``, ``indicators`` and ``full_contact``; all per unit mass.
 
 The bed's stiffness K and dashpot C = 2 xi sqrt(K m) are spread uniformly over the footprint width 2b.
 A base point s in [-b, b] is in the ground by delta(s) = y + s sin(theta) and carries the pressure
@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 
 from pipeline.models.jit import njit
+
+NAME = "continuous"  # selects this law: simulate(..., bed="continuous"), [solver] bed
 
 
 @njit(cache=True)
@@ -85,16 +87,11 @@ def indicators(x, params, out):
 
 
 @njit(cache=True)
-def rocking_stiffness(params):
-    """Small-tilt rocking stiffness of the bed about the base centre per unit mass, K b^2 / 3m [m^2/s^2]."""
-    stiffness = params["omega"] * params["omega"]  # K/m
-    return stiffness * params["b"] * params["b"] * (1.0 / 3.0)
-
-
-@njit(cache=True)
-def full_contact_energy(x, params, sin_t):
-    """Elastic energy of the bed per unit mass [m^2/s^2] while the whole base is in the ground:
+def full_contact(x, params, sin_t):
+    """The bed while the whole base is in the ground, per unit mass: (small-tilt rocking stiffness about
+    the base centre K b^2 / 3m [m^2/s^2], elastic energy [m^2/s^2]); the energy is
     int_{-b}^{b} 1/2 (K/2b) (y + s sin)^2 ds / m = K/2m (y^2 + b^2 sin^2 / 3)."""
-    stiffness = params["omega"] * params["omega"]
+    stiffness = params["omega"] * params["omega"]  # K/m
     b = params["b"]
-    return 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t / 3.0)
+    return (stiffness * b * b * (1.0 / 3.0),
+            0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t / 3.0))

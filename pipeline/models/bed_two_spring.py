@@ -1,8 +1,8 @@
 """pipeline.models.bed_two_spring - two Kelvin-Voigt corner springs, a contact law of ``winkler``.
 
 Input : the state x = [theta, theta_dot, y, y_dot] and a parameter record (b, omega = sqrt(K/m), xi).
-Output: the hooks of a bed contact law (pipeline.models.contact): ``force``, ``indicator``,
-        ``indicators``, ``rocking_stiffness`` and ``full_contact_energy``; all per unit mass.
+Output: the hooks of a bed contact law (pipeline.models.contact): ``NAME``, ``force``,
+        ``indicator``, ``indicators`` and ``full_contact``; all per unit mass.
 
 The classic model of Psycharis & Jennings (1983) and Chopra & Yim (1985): K/2 and C/2 at each corner
 s = -b, +b, each pushing with max(0, (K/2) delta + (C/2) delta') while its corner is in the ground
@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from pipeline.models.bed_continuous import indicator, indicators  # noqa: F401  (the same Kelvin-Voigt corners)
 from pipeline.models.jit import njit
+
+NAME = "two-spring"  # selects this law: simulate(..., bed="two-spring"), [solver] bed
 
 
 @njit(cache=True)
@@ -40,16 +42,10 @@ def force(x, params, sin_t, cos_t):
 
 
 @njit(cache=True)
-def rocking_stiffness(params):
-    """Small-tilt rocking stiffness of the bed about the base centre per unit mass, K b^2 / m [m^2/s^2]."""
-    stiffness = params["omega"] * params["omega"]  # K/m
-    return stiffness * params["b"] * params["b"]
-
-
-@njit(cache=True)
-def full_contact_energy(x, params, sin_t):
-    """Elastic energy of the two springs per unit mass [m^2/s^2] while both corners are in the ground:
+def full_contact(x, params, sin_t):
+    """The springs while both corners are in the ground, per unit mass: (small-tilt rocking stiffness
+    about the base centre K b^2 / m [m^2/s^2], elastic energy [m^2/s^2]); the energy is
     K/4m ((y - b sin)^2 + (y + b sin)^2) = K/2m (y^2 + b^2 sin^2)."""
-    stiffness = params["omega"] * params["omega"]
+    stiffness = params["omega"] * params["omega"]  # K/m
     b = params["b"]
-    return 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t)
+    return stiffness * b * b, 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t)

@@ -2,28 +2,29 @@
 
 Input : a law's option name (``SolverOptions.bed``) on the Python side; in the kernels, the law code
         in the parameter record (``params["bed"]``) and the state x = [theta, theta_dot, y, y_dot].
-Output: ``BED_LAWS`` (option name -> law code) and the compiled dispatchers the bed model and its time
-        loop call (``bed_force_at``, ``contact_indicator``, ``contact_indicators``,
-        ``bed_rocking_stiffness``, ``bed_full_contact_energy``).
+Output: ``LAWS`` (law code -> module), ``BED_LAWS`` (option name -> law code) and the compiled
+        dispatchers that the bed model and its time loop call: ``bed_force_at``, ``contact_indicator``,
+        ``contact_indicators`` and ``bed_full_contact``.
 
-A contact law says how the ground pushes on the base of the block. Each law is one module with the
-same five compiled hooks (all per unit mass; bed_continuous.py is the worked example):
+A contact law says how the ground pushes on the base of the block. Each law is one module with its
+option name ``NAME`` and the same four compiled hooks (all per unit mass; bed_continuous.py is the
+worked example):
 
     force(x, params, sin_t, cos_t) -> (F, M)   vertical force [m/s^2], its moment about the base centre
                                                 [m^2/s^2]; the hot call (every right-hand side)
     indicator(index, x, params) -> value       contact indicator ``index``: its sign changes where the
                                                 contact changes (located as an event)
     indicators(x, params, out)                  all N_CONTACT_INDICATORS at once (at every step's end)
-    rocking_stiffness(params) -> K_r / m        small-tilt rocking stiffness about the base centre
-    full_contact_energy(x, params, sin_t)       elastic energy while the whole base is in the ground
+    full_contact(x, params, sin_t)              (K_r/m, V/m): small-tilt rocking stiffness about the
+        -> (stiffness, energy)                  base centre and elastic energy, whole base in the ground
 
 Indicators 0 and 1 are the penetrations of the -b and +b corners [m] (the time loop reads them for
 uplift, impacts and flights); 2 and 3 are the law's own, e.g. where a corner's force switches on or off.
 
-Registering a law is one import, one line in ``BED_LAWS`` and one branch in each dispatcher below, all
-in this file; tests/physics/test_contact_registry.py checks that every registered law reaches its own
-hooks through every dispatcher. numba cannot cache a kernel that receives functions as arguments, so
-the dispatch is an if/elif on the integer law code, written out here once.
+Registering a law is one import, one code, one entry in ``LAWS`` and one branch in each dispatcher
+below, all in this file; tests/physics/test_contact_registry.py checks that every registered law
+reaches its own hooks through every dispatcher. numba cannot cache a kernel that receives functions
+as arguments, so the dispatch is an if/elif on the integer law code, written out here once.
 """
 
 from __future__ import annotations
@@ -34,11 +35,12 @@ from pipeline.models.jit import njit
 # contact indicators every law reports (see the module docstring)
 N_CONTACT_INDICATORS = 4
 
-# ---- the registration: law codes and their option names -------------------------------------
-CONTINUOUS = 0  # bed_continuous.py: Kelvin-Voigt bed spread over the footprint width
-TWO_SPRING = 1  # bed_two_spring.py: Kelvin-Voigt springs at the two corners
+# ---- the registration: one code per law, and its module (which names it and holds its hooks) ----
+CONTINUOUS = 0  # Kelvin-Voigt bed spread over the footprint width
+TWO_SPRING = 1  # Kelvin-Voigt springs at the two corners
 
-BED_LAWS = {"continuous": CONTINUOUS, "two-spring": TWO_SPRING}
+LAWS = {CONTINUOUS: bed_continuous, TWO_SPRING: bed_two_spring}
+BED_LAWS = {law.NAME: code for code, law in LAWS.items()}  # option name (SolverOptions.bed) -> law code
 
 UNREGISTERED = "bed contact law code not registered in pipeline.models.contact"
 
@@ -80,22 +82,11 @@ def contact_indicators(x, params, out):
 
 
 @njit(cache=True)
-def bed_rocking_stiffness(params):
-    """The law's ``rocking_stiffness``: K_r / m [m^2/s^2] about the base centre, for small tilts."""
+def bed_full_contact(x, params, sin_t):
+    """The law's ``full_contact``: (rocking stiffness K_r/m, elastic energy V/m) [m^2/s^2], whole base down."""
     law = params["bed"]
     if law == CONTINUOUS:
-        return bed_continuous.rocking_stiffness(params)
+        return bed_continuous.full_contact(x, params, sin_t)
     if law == TWO_SPRING:
-        return bed_two_spring.rocking_stiffness(params)
-    raise ValueError(UNREGISTERED)
-
-
-@njit(cache=True)
-def bed_full_contact_energy(x, params, sin_t):
-    """The law's ``full_contact_energy``: elastic energy per unit mass [m^2/s^2], whole base in the ground."""
-    law = params["bed"]
-    if law == CONTINUOUS:
-        return bed_continuous.full_contact_energy(x, params, sin_t)
-    if law == TWO_SPRING:
-        return bed_two_spring.full_contact_energy(x, params, sin_t)
+        return bed_two_spring.full_contact(x, params, sin_t)
     raise ValueError(UNREGISTERED)

@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 
 from pipeline.models.base import RockingModel
-from pipeline.models.contact import bed_force_at, bed_full_contact_energy, bed_rocking_stiffness
+from pipeline.models.contact import bed_force_at, bed_full_contact
 from pipeline.models.fields import WINKLER
 from pipeline.models.jit import njit
 
@@ -99,15 +99,15 @@ def settled_beyond_reach(x, params, peak_angle):
     g = params["g"]
     omega = params["omega"]
     stiffness = omega * omega  # K/m
-    tilt_stiffness = bed_rocking_stiffness(params) - g * h
+    sin_t = math.sin(x[0])
+    rocking_stiffness, bed = bed_full_contact(x, params, sin_t)  # the caller checks: the whole base is down
+    tilt_stiffness = rocking_stiffness - g * h
     if tilt_stiffness <= 0.0:
         return False  # the bed cannot even hold the block upright elastically
     y_static = g / stiffness
-    sin_t = math.sin(x[0])
     cos_t = math.cos(x[0])
     j = (b * b + 4.0 * h * h) / 3.0
     kinetic = 0.5 * ((h * cos_t * x[1]) ** 2 + (x[3] + h * sin_t * x[1]) ** 2 + (j - h * h) * x[1] * x[1])
-    bed = bed_full_contact_energy(x, params, sin_t)  # the caller checks that the whole base is in the ground
     excess = kinetic + g * (h * cos_t - x[2]) + bed - (g * (h - y_static) + 0.5 * stiffness * y_static * y_static)
     lift_angle = y_static / b  # a corner lifts at about this tilt (settled base)
     reach = 0.25 * 0.5 * tilt_stiffness * min(peak_angle, lift_angle) ** 2
