@@ -118,11 +118,11 @@ def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options
 
 
 def parameter_table(model: RockingModel, cases, options: SolverOptions):
-    """Parameter records (n_case,) and initial states (n_case, 4) for (block, k, xi) cases."""
+    """Parameter records (n_case,) and initial states (n_case, STATE_SIZE) for (block, k, xi) cases."""
     if len(cases) == 0:
         raise SolverError("no (block, k, xi) case given")
     table = fields.new_params(len(cases))
-    states = np.empty((len(cases), 4))
+    states = np.empty((len(cases), fields.STATE_SIZE))
     for row, (block, k, xi) in enumerate(cases):
         table[row], states[row] = parameter_record(model, block, k, xi, options)
     return table, states
@@ -178,7 +178,7 @@ def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0
     table, states = parameter_table(spec, [(block, k, xi)], settings)
     state = states[0]
     state[0], state[1] = float(theta0), float(thetadot0)
-    history = np.empty((ag.size + n_tail, 4))
+    history = np.empty((ag.size + n_tail, fields.STATE_SIZE))
     impacts = np.empty(IMPACT_CAPACITY)
     summaries = new_summaries(1)
     kernels.single_kernel(spec.kernel_code, ag, float(dt), n_tail, table, state, history, impacts, summaries)
@@ -251,7 +251,7 @@ def simulate_histories(model, ag, dt, cases, *, t_end=None, **options):
     spec = get_model(model)
     ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
     table, states = parameter_table(spec, cases, SolverOptions(**options))
-    histories = np.empty((len(table), ag.size + n_tail, 4))
+    histories = np.empty((len(table), ag.size + n_tail, fields.STATE_SIZE))
     summaries = new_summaries(len(table))
     kernels.history_batch_kernel(spec.kernel_code, ag, float(dt), n_tail, table, states, histories, summaries)
     return np.arange(ag.size + n_tail) * dt, histories[:, :, 0], histories[:, :, 2], summaries
