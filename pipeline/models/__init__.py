@@ -23,6 +23,7 @@ from pipeline.blocks import Block
 from pipeline.errors import ConfigError, SolverError
 from pipeline.models import fields, kernels
 from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
+from pipeline.models.contact import BED_LAWS
 from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Nullable, Number, Table, Text
@@ -30,7 +31,7 @@ from pipeline.validation import Nullable, Number, Table, Text
 MODELS: dict[str, RockingModel] = {}
 
 SWITCH_RULES = {"consistent": fields.SWITCH_CONSISTENT, "continuous": fields.SWITCH_CONTINUOUS}
-BED_TYPES = {"continuous": fields.BED_CONTINUOUS, "two-spring": fields.BED_TWO_SPRING}
+BED_TYPES = BED_LAWS  # the winkler bed's contact laws, registered in pipeline.models.contact
 
 DEFAULT_RTOL = 1e-6  # relative error per step; peak angles agree with scipy at 1e-10 to ~1e-6
 DEFAULT_ATOL = 1e-7  # absolute error per step, as a fraction of alpha, alpha*p, y_static, y_static*omega
@@ -126,11 +127,11 @@ def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options
 
 
 def parameter_table(model: RockingModel, cases, options: SolverOptions):
-    """Parameter records (n_case,) and initial states (n_case, 4) for (block, k, xi) cases."""
+    """Parameter records (n_case,) and initial states (n_case, STATE_SIZE) for (block, k, xi) cases."""
     if len(cases) == 0:
         raise SolverError("no (block, k, xi) case given")
     table = fields.new_params(len(cases))
-    states = np.empty((len(cases), 4))
+    states = np.empty((len(cases), fields.STATE_SIZE))
     for row, (block, k, xi) in enumerate(cases):
         table[row], states[row] = parameter_record(model, block, k, xi, options)
     return table, states
@@ -186,7 +187,7 @@ def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0
     table, states = parameter_table(spec, [(block, k, xi)], settings)
     state = states[0]
     state[0], state[1] = float(theta0), float(thetadot0)
-    history = np.empty((ag.size + n_tail, 4))
+    history = np.empty((ag.size + n_tail, fields.STATE_SIZE))
     impacts = np.empty(IMPACT_CAPACITY)
     summaries = new_summaries(1)
     kernels.single_kernel(spec.kernel_code, ag, float(dt), n_tail, table, state, history, impacts, summaries)
@@ -260,7 +261,7 @@ def simulate_histories(model, ag, dt, cases, *, t_end=None, **options):
     spec = get_model(model)
     ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
     table, states = parameter_table(spec, cases, SolverOptions(**options))
-    histories = np.empty((len(table), ag.size + n_tail, 4))
+    histories = np.empty((len(table), ag.size + n_tail, fields.STATE_SIZE))
     summaries = new_summaries(len(table))
     kernels.history_batch_kernel(spec.kernel_code, ag, float(dt), n_tail, table, states, histories, summaries)
     return np.arange(ag.size + n_tail) * dt, histories[:, :, 0], histories[:, :, 2], summaries

@@ -9,10 +9,12 @@ The contract for a model (as scipy's ``integrate/_ivp/base.py`` states its own),
 
 1. The module defines its physics as small compiled functions of plain arrays and a
    ``fields.PARAMS_DTYPE`` record, and names its kernel code (``fields.HOUSNER``, ``SSI``,
-   ``WINKLER``); ``kernels.rhs`` dispatches on that code (a new kernel code is one branch there).
+   ``WINKLER``); the kernels dispatch on that code, each model by name, never by exclusion
+   (``kernels.rhs``, ``support``, ``static_settlement``, ...: a new kernel code is one branch in each).
 2. Pivot models (``kernel_code`` HOUSNER or SSI) rest until the uplift condition, rock on one corner
    and switch pivot at theta = 0 through an impact rule; bed models (WINKLER) have no rest phase and
-   no impact rule: their contact law does everything.
+   no impact rule: their contact law does everything. A new contact law of the bed is one module and
+   one registration in ``pipeline.models.contact``, not a new model.
 3. ``needs_foundation``: the model needs the interface stiffness k [N/m] and damping ratio xi [-];
    ``is_rigid_base``: its result does not depend on the soil (computed once per block).
 4. ``uses_restitution``, ``uses_switch``, ``uses_bed``: which solver options apply; a caller asks

@@ -1,8 +1,9 @@
 """pipeline.models.fields - the named fields that cross the compiled-kernel boundary.
 
 Input : nothing (definitions). Output: ``PARAMS_DTYPE`` (what a kernel is told about one case),
-``SUMMARY_FIELDS``/``SUMMARY_DTYPE`` (what it reports about one run), the model codes and the
-event kinds. Both records are NumPy structured dtypes: numba reads and writes their fields by name
+``SUMMARY_FIELDS``/``SUMMARY_DTYPE`` (what it reports about one run), the layout of the state, the
+model codes and the event kinds. (The codes of the bed contact laws are registered with the laws, in
+pipeline.models.contact.) Both records are NumPy structured dtypes: numba reads and writes their fields by name
 (``params["alpha"]``, ``summary["peak_angle"]``), so no slot index leaks out of the kernels, and the
 cube's variables are generated from ``SUMMARY_FIELDS`` (pipeline.cube).
 """
@@ -13,18 +14,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# Kernel codes: which right-hand side and which time loop a model uses (pipeline.models.kernels).
+# The state every kernel integrates: x = [theta, theta_dot, y, y_dot] (rotation [rad] and its rate
+# [rad/s], settlement of the pivot or base centre [m, positive down] and its rate [m/s]). A model
+# with more degrees of freedom (a sliding base, say) widens it here.
+STATE_SIZE = 4
+
+# Kernel codes: which right-hand side and which time loop a model uses (pipeline.models.kernels
+# dispatches on them; a model states its code in its ``RockingModel``).
 HOUSNER = 0   # rigid base, pivot rocking with a restitution rule
 SSI = 1       # one vertical spring-dashpot under the active pivot (the paper's model)
-WINKLER = 2   # tensionless viscoelastic Winkler bed (continuous or two springs)
+WINKLER = 2   # tensionless bed of vertical contact (pipeline.models.contact: the bed's contact law)
 
 # Pivot-switch rules of the SSI model at theta = 0.
 SWITCH_CONSISTENT = 0
 SWITCH_CONTINUOUS = 1
-
-# Bed types of the Winkler model.
-BED_CONTINUOUS = 0
-BED_TWO_SPRING = 1
 
 # Event kinds located inside a step.
 EVENT_NONE = -1
@@ -45,7 +48,7 @@ PARAMS_DTYPE = np.dtype([
     ("xi", "f8"),           # damping ratio of the vertical foundation mode [-]
     ("restitution", "f8"),  # factor on theta' at each impact (pivot models)
     ("switch", "f8"),       # SWITCH_* (SSI)
-    ("bed", "f8"),          # BED_* (winkler)
+    ("bed", "f8"),          # code of the bed's contact law (winkler; pipeline.models.contact.BED_LAWS)
     ("overturn", "f8"),     # |theta| of overturning [rad]
     ("rtol", "f8"),         # relative error per step [-]
     ("atol", "f8"),         # absolute error per step as a fraction of each state's scale [-]

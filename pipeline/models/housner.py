@@ -1,7 +1,7 @@
 """pipeline.models.housner - Housner's rigid-base rocking block (paper eqs. 1-6).
 
 Input : block (R, alpha), ground acceleration. Output: registered model ``housner`` and its
-compiled right-hand side ``housner_rhs``.
+compiled physics: ``housner_rhs`` (rocking), ``housner_rest_rhs`` and ``housner_support``.
 
 theta'' = -p^2 [sin(sigma alpha - theta) + (ag/g) cos(sigma alpha - theta)], p^2 = 3g/(4R), sigma
 the active pivot. At rest until |ag| > g tan(alpha); at each impact (theta = 0) theta' <- r theta'
@@ -23,6 +23,19 @@ def housner_rhs(sigma, x, accel, params, out):
     out[1] = -params["kappa"] * (params["g"] * math.sin(angle) + accel * math.cos(angle)) / params["R"]
     out[2] = 0.0
     out[3] = 0.0
+
+
+@njit(cache=True)
+def housner_rest_rhs(out):
+    """dx/dt at rest on a rigid base: nothing moves."""
+    for i in range(out.size):
+        out[i] = 0.0
+
+
+@njit(cache=True)
+def housner_support(params):
+    """Vertical force of the rigid base on the block per unit mass [m/s^2]: g, whatever the state."""
+    return params["g"]
 
 
 MODEL = RockingModel(

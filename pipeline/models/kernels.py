@@ -11,32 +11,44 @@ between samples), so every step sees a smooth right-hand side. Events (impact, u
 changes, overturning) are located on a cubic Hermite interpolant and the step is redone exactly to
 the event time, after which integration restarts cleanly.
 
+Four small records travel between the functions, as scipy's rk.py passes one state and its
+``DenseOutput`` carries one step:
+- ``GroundMotion`` (samples, dt): the input; ``ground`` is the one place it is read.
+- ``System`` (model code, phase, active pivot, parameters, ground motion): the right-hand side
+  f(t, x), evaluated by ``derivatives``.
+- ``Step`` (t, h, x0, f0, x1, f1): one step and its dense output, read by event location, peak
+  tracking and the history rows.
+- ``Workspace``: the work arrays of one response (Runge-Kutta stages, error, scales), allocated once.
+
 Two time loops:
 - ``pivot_loop`` (housner, ssi, ssi-paper): the block rests until the uplift condition, rocks on one
   corner, and at theta = 0 an impact rule switches the pivot.
 - ``bed_loop`` (winkler): no rest phase and no impact rule; the block tilts on its bed from the first
-  sample and the bed's contact law (pipeline.models.winkler) decides everything.
+  sample and the bed's contact law (registered in pipeline.models.contact) decides everything.
 
-The physics of each model sits in its own module (housner.py, ssi.py, winkler.py) as small compiled
-functions; ``rhs`` dispatches on the kernel code. Set PIPELINE_NO_NUMBA=1 to run as plain Python.
+The physics of each model sits in its own module (housner.py, ssi.py, winkler.py and the bed laws) as
+small compiled functions. What differs between models is dispatched on the model's kernel code
+(``rhs``, ``support``, ``static_settlement``, ``vertical_at_rest``, ``pivot_impact``); what differs
+between beds, on the law code (pipeline.models.contact). Set PIPELINE_NO_NUMBA=1 to run as plain Python.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from pipeline.models.base import Outcome
+from pipeline.models.contact import N_CONTACT_INDICATORS, contact_indicator, contact_indicators
 from pipeline.models.fields import (EVENT_CONTACT, EVENT_IMPACT, EVENT_NONE, EVENT_OVERTURN, EVENT_SETTLE,
-                                    EVENT_UPLIFT, HOUSNER, SWITCH_CONSISTENT, WINKLER)
-from pipeline.models.housner import housner_rhs
+                                    EVENT_UPLIFT, HOUSNER, SSI, STATE_SIZE, SWITCH_CONSISTENT, WINKLER)
+from pipeline.models.housner import housner_rest_rhs, housner_rhs, housner_support
 from pipeline.models.jit import njit
 from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
-from pipeline.models.winkler import (N_CONTACT_INDICATORS, bed_force, contact_indicator, contact_indicators,
-                                     friction_demand, settled_beyond_reach, winkler_rhs)
+from pipeline.models.winkler import bed_force, friction_demand, settled_beyond_reach, winkler_rhs
 
-# phases of the pivot loop
+# phases of the pivot loop (bed models are always ROCKING)
 REST = 0
 ROCKING = 1
 
@@ -63,12 +75,12 @@ ZENO_STEP_SHRINK = 0.25         # a whole excursion inside one step: retry with 
 MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
+UNKNOWN_CODE = "model kernel code not handled by pipeline.models.kernels"
 
-# rows of the work array (``workspace``): the Dormand-Prince stages k2..k7 (row 5 is f(t + h, x_new),
-# which the dense output and the next step reuse), then the interpolated state of the event functions
-ROW_F1 = 5
-ROW_EVENT = 6
-WORK_ROWS = 7
+# The Dormand-Prince stages k2..k7 are the rows of ``Workspace.stages``; the last one is f(t + h, x_new),
+# which the dense output and the next step reuse (first same as last).
+N_STAGES = 6
+END_STAGE = 5
 
 # Dormand-Prince 5(4) tableau
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
@@ -83,82 +95,150 @@ E1, E3, E4, E5, E6, E7 = (71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253
 
 
 # ---------------------------------------------------------------------------------------------
-# right-hand side and the Dormand-Prince step
+# the records that travel between the functions
+# ---------------------------------------------------------------------------------------------
+
+class GroundMotion(NamedTuple):
+    """The ground's acceleration: linear between samples, zero after the last one (the free tail).
+
+    A vertical component (ag_vertical, same sampling) is one more field here, read by ``ground``
+    beside the horizontal one and handed to the right-hand sides by ``derivatives``.
+    """
+
+    horizontal: np.ndarray  # (n,) [m/s^2] at t = i dt
+    dt: float               # sampling step [s]
+
+
+class System(NamedTuple):
+    """The right-hand side f(t, x) being integrated (scipy's ``fun``), with what it depends on."""
+
+    code: int               # the model's kernel code (fields.HOUSNER, SSI, WINKLER)
+    phase: int              # REST or ROCKING (bed models: always ROCKING)
+    sigma: float            # active pivot, +1 or -1 while rocking; 0 at rest and for bed models
+    params: np.void         # the case's ``fields.PARAMS_DTYPE`` record
+    motion: GroundMotion
+
+
+class Step(NamedTuple):
+    """One step from (t, x0, f0) to (t + h, x1, f1), f = dx/dt, and its cubic Hermite dense output."""
+
+    t: float                # start [s]
+    h: float                # length [s]
+    x0: np.ndarray          # (STATE_SIZE,) state at t
+    f0: np.ndarray          # (STATE_SIZE,) its derivative
+    x1: np.ndarray          # (STATE_SIZE,) state at t + h
+    f1: np.ndarray          # (STATE_SIZE,) its derivative
+
+
+class Workspace(NamedTuple):
+    """The work arrays of one response; the loops never allocate after ``workspace()``."""
+
+    stages: np.ndarray        # (N_STAGES, STATE_SIZE) Dormand-Prince stages k2..k7; k7 = f(t + h, x_new)
+    f0: np.ndarray            # (STATE_SIZE,) f(t, x) at the start of the step
+    x_new: np.ndarray         # (STATE_SIZE,) state at the end of the step
+    error: np.ndarray         # (STATE_SIZE,) local error estimate of the step
+    scale: np.ndarray         # (STATE_SIZE,) absolute-error scale of each state component
+    interpolated: np.ndarray  # (STATE_SIZE,) interpolated state of the event functions
+
+
+@njit(cache=True)
+def workspace():
+    """The work arrays of one response."""
+    return Workspace(np.empty((N_STAGES, STATE_SIZE)), np.empty(STATE_SIZE), np.empty(STATE_SIZE),
+                     np.empty(STATE_SIZE), np.empty(STATE_SIZE), np.empty(STATE_SIZE))
+
+
+# ---------------------------------------------------------------------------------------------
+# ground motion, right-hand side and the Dormand-Prince step
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def sample(ag, index):
+def sample(samples, index):
     """Ground acceleration sample [m/s^2]; zero after the record (the tail of free vibration)."""
-    return ag[index] if index < ag.size else 0.0
+    return samples[index] if index < samples.size else 0.0
 
 
 @njit(cache=True)
 def ground(motion, t):
-    """Ground acceleration [m/s^2] at time t: linear between the samples of motion = (ag, dt)."""
-    ag, dt = motion
-    u = t / dt
-    index = int(math.floor(u))
+    """Horizontal ground acceleration [m/s^2] at time t [s] (linear between samples)."""
+    samples = motion.horizontal
+    position = t / motion.dt  # in samples
+    index = int(math.floor(position))
     if index < 0:
-        return ag[0]
-    a0 = sample(ag, index)
-    return a0 + (sample(ag, index + 1) - a0) * (u - index)
+        return samples[0]
+    a0 = sample(samples, index)
+    return a0 + (sample(samples, index + 1) - a0) * (position - index)
 
 
 @njit(cache=True)
 def rhs(code, phase, sigma, x, accel, params, out):
-    """dx/dt for state x = [theta, theta_dot, y, y_dot] given ground acceleration ``accel``."""
-    if code == WINKLER:
-        winkler_rhs(x, accel, params, out)
-    elif phase == REST:
-        if code == HOUSNER:
-            for i in range(4):
-                out[i] = 0.0
+    """dx/dt into out for state x = [theta, theta_dot, y, y_dot] and ground acceleration ``accel``
+    [m/s^2], by the model's kernel code (and, for the pivot models, the phase and active pivot sigma)."""
+    if code == HOUSNER:
+        if phase == REST:
+            housner_rest_rhs(out)
         else:
+            housner_rhs(sigma, x, accel, params, out)
+    elif code == SSI:
+        if phase == REST:
             ssi_rest_rhs(x, params, out)
-    elif code == HOUSNER:
-        housner_rhs(sigma, x, accel, params, out)
+        else:
+            ssi_rhs(sigma, x, accel, params, out)
+    elif code == WINKLER:
+        winkler_rhs(x, accel, params, out)
     else:
-        ssi_rhs(sigma, x, accel, params, out)
+        raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
-def dopri_step(code, phase, sigma, t, x, f0, h, motion, params, k, x_new, err):
-    """One Dormand-Prince step from (t, x), f0 = f(t, x); fills x_new, k[5] = f(t+h, x_new), err.
+def derivatives(system, t, x, out):
+    """f(t, x) of ``system`` into out: the one place where the ground motion enters the right-hand side."""
+    rhs(system.code, system.phase, system.sigma, x, ground(system.motion, t), system.params, out)
 
-    k : (WORK_ROWS, 4) work array: the stages k2..k7 in rows 0-5.
+
+@njit(cache=True)
+def dopri_step(system, t, x, h, work):
+    """One Dormand-Prince step of length h from (t, x), with ``work.f0`` = f(t, x): fills ``work.x_new``,
+    ``work.error`` and the stages, whose last row is f(t + h, x_new).
+
+    k2..k7 are the stages in the notation of Hairer, Norsett & Wanner (table 5.2).
     """
-    k2, k3, k4, k5, k6, k7 = k[0], k[1], k[2], k[3], k[4], k[5]
-    tmp = err  # err is written last: use it as the stage buffer meanwhile
-    for i in range(4):
-        tmp[i] = x[i] + h * A21 * f0[i]
-    rhs(code, phase, sigma, tmp, ground(motion, t + C2 * h), params, k2)
-    for i in range(4):
-        tmp[i] = x[i] + h * (A31 * f0[i] + A32 * k2[i])
-    rhs(code, phase, sigma, tmp, ground(motion, t + C3 * h), params, k3)
-    for i in range(4):
-        tmp[i] = x[i] + h * (A41 * f0[i] + A42 * k2[i] + A43 * k3[i])
-    rhs(code, phase, sigma, tmp, ground(motion, t + C4 * h), params, k4)
-    for i in range(4):
-        tmp[i] = x[i] + h * (A51 * f0[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-    rhs(code, phase, sigma, tmp, ground(motion, t + C5 * h), params, k5)
-    for i in range(4):
-        tmp[i] = x[i] + h * (A61 * f0[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-    rhs(code, phase, sigma, tmp, ground(motion, t + h), params, k6)
-    for i in range(4):
+    f0 = work.f0
+    x_new = work.x_new
+    k2, k3, k4, k5, k6, k7 = (work.stages[0], work.stages[1], work.stages[2], work.stages[3], work.stages[4],
+                              work.stages[5])
+    stage_state = work.error  # the error is written last: the stage states use its array meanwhile
+    for i in range(STATE_SIZE):
+        stage_state[i] = x[i] + h * A21 * f0[i]
+    derivatives(system, t + C2 * h, stage_state, k2)
+    for i in range(STATE_SIZE):
+        stage_state[i] = x[i] + h * (A31 * f0[i] + A32 * k2[i])
+    derivatives(system, t + C3 * h, stage_state, k3)
+    for i in range(STATE_SIZE):
+        stage_state[i] = x[i] + h * (A41 * f0[i] + A42 * k2[i] + A43 * k3[i])
+    derivatives(system, t + C4 * h, stage_state, k4)
+    for i in range(STATE_SIZE):
+        stage_state[i] = x[i] + h * (A51 * f0[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+    derivatives(system, t + C5 * h, stage_state, k5)
+    for i in range(STATE_SIZE):
+        stage_state[i] = x[i] + h * (A61 * f0[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+    derivatives(system, t + h, stage_state, k6)
+    for i in range(STATE_SIZE):
         x_new[i] = x[i] + h * (B1 * f0[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i] + B6 * k6[i])
-    rhs(code, phase, sigma, x_new, ground(motion, t + h), params, k7)
-    for i in range(4):
-        err[i] = h * (E1 * f0[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+    derivatives(system, t + h, x_new, k7)
+    error = work.error
+    for i in range(STATE_SIZE):
+        error[i] = h * (E1 * f0[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
 
 
 @njit(cache=True)
-def error_norm(x, x_new, err, scale, rtol, atol):
+def error_norm(x, x_new, error, scale, rtol, atol):
     """RMS of the local error over the mixed absolute/relative tolerance (accept when <= 1)."""
     total = 0.0
-    for i in range(4):
+    for i in range(STATE_SIZE):
         tolerance = atol * scale[i] + rtol * max(abs(x[i]), abs(x_new[i]))
-        total += (err[i] / tolerance) ** 2
-    return math.sqrt(total / 4.0)
+        total += (error[i] / tolerance) ** 2
+    return math.sqrt(total / STATE_SIZE)
 
 
 @njit(cache=True)
@@ -170,20 +250,20 @@ def next_step(h, norm):
 
 
 @njit(cache=True)
-def adaptive_step(code, phase, sigma, t, x, f0, h, motion, params, scale, k, x_new, err, zeno_guard):
-    """Take one accepted step of at most h; returns (h_taken, error norm).
+def adaptive_step(system, t, x, h, work, zeno_guard):
+    """Take one accepted step of at most h from (t, x) into ``work``; returns (h_taken, error norm).
 
     zeno_guard: the step starts at an impact (theta = 0, moving off): a step that would contain a
     whole excursion is shortened so that the next impact is seen (Zeno cascades are followed).
     """
-    rtol = params["rtol"]
-    atol = params["atol"]
+    rtol = system.params["rtol"]
+    atol = system.params["atol"]
     while True:
-        dopri_step(code, phase, sigma, t, x, f0, h, motion, params, k, x_new, err)
-        norm = error_norm(x, x_new, err, scale, rtol, atol)
+        dopri_step(system, t, x, h, work)
+        norm = error_norm(x, work.x_new, work.error, work.scale, rtol, atol)
         if h < MIN_STEP:
             return h, norm
-        if norm <= 1.0 and zeno_guard and sigma * x_new[0] <= 0.0:
+        if norm <= 1.0 and zeno_guard and system.sigma * work.x_new[0] <= 0.0:
             h = h * ZENO_STEP_SHRINK
             continue
         if norm <= 1.0:
@@ -191,68 +271,69 @@ def adaptive_step(code, phase, sigma, t, x, f0, h, motion, params, scale, k, x_n
         h = h * max(MIN_FACTOR, SAFETY * norm ** ERROR_EXPONENT)
 
 
-@njit(cache=True)
-def workspace():
-    """Work arrays of one response: (k, f0, x_new, err, scale); the loops never allocate after this."""
-    return np.empty((WORK_ROWS, 4)), np.empty(4), np.empty(4), np.empty(4), np.empty(4)
-
-
 # ---------------------------------------------------------------------------------------------
 # dense output and event location
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def hermite(x0, f0, x1, f1, h, s, i):
-    """Cubic Hermite interpolant of component i at fraction s of a step of length h."""
+def hermite(step, s, i):
+    """Cubic Hermite interpolant of state component i at fraction s in [0, 1] of ``step``."""
     h00 = 2 * s**3 - 3 * s**2 + 1
     h10 = s**3 - 2 * s**2 + s
     h01 = -2 * s**3 + 3 * s**2
     h11 = s**3 - s**2
-    return h00 * x0[i] + h10 * h * f0[i] + h01 * x1[i] + h11 * h * f1[i]
+    h = step.h
+    return h00 * step.x0[i] + h10 * h * step.f0[i] + h01 * step.x1[i] + h11 * h * step.f1[i]
 
 
 @njit(cache=True)
-def hermite_derivative(x0, f0, x1, f1, h, s, i):
+def hermite_derivative(step, s, i):
+    """Time derivative of ``hermite`` at fraction s."""
+    h = step.h
     d00 = (6 * s**2 - 6 * s) / h
     d10 = 3 * s**2 - 4 * s + 1
     d01 = (-6 * s**2 + 6 * s) / h
     d11 = 3 * s**2 - 2 * s
-    return d00 * x0[i] + d10 * f0[i] + d01 * x1[i] + d11 * f1[i]
+    return d00 * step.x0[i] + d10 * step.f0[i] + d01 * step.x1[i] + d11 * step.f1[i]
 
 
 @njit(cache=True)
 def support(code, params, x):
-    """Vertical support force per unit mass [m/s^2] of the pivot models (g for a rigid base)."""
+    """Vertical support force per unit mass [m/s^2] of a pivot model at state x, by its kernel code."""
     if code == HOUSNER:
-        return params["g"]
-    return ssi_support(x, params)
+        return housner_support(params)
+    if code == SSI:
+        return ssi_support(x, params)
+    raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
-def event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s, motion, t0, state):
-    """The event function of ``kind`` on the step's interpolant at fraction s (sign change = event).
+def event_value(kind, index, system, step, s, interpolated):
+    """The event function of ``kind`` (and contact indicator ``index``) on the step's interpolant at
+    fraction s; a sign change is the event.
 
-    state : (4,) scratch array (the interpolated state; passed in so the hot event loops never allocate).
+    interpolated : (STATE_SIZE,) scratch for the interpolated state (the event loops never allocate).
     """
+    params = system.params
     if kind == EVENT_IMPACT:
-        return sigma * hermite(x0, f0, x1, f1, h, s, 0)
+        return system.sigma * hermite(step, s, 0)
     if kind == EVENT_OVERTURN:
-        return abs(hermite(x0, f0, x1, f1, h, s, 0)) - params["overturn"]
-    for i in range(4):
-        state[i] = hermite(x0, f0, x1, f1, h, s, i)
+        return abs(hermite(step, s, 0)) - params["overturn"]
+    for i in range(STATE_SIZE):
+        interpolated[i] = hermite(step, s, i)
     if kind == EVENT_CONTACT:
-        return contact_indicator(index, state, params)
+        return contact_indicator(index, interpolated, params)
     # uplift of a pivot model: |ag| - tan(alpha) * support force per mass
-    accel = ground(motion, t0 + s * h)
-    return abs(accel) - math.tan(params["alpha"]) * support(code, params, state)
+    accel = ground(system.motion, step.t + s * step.h)
+    return abs(accel) - math.tan(params["alpha"]) * support(system.code, params, interpolated)
 
 
 @njit(cache=True)
-def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0, state):
+def locate(kind, index, system, step, interpolated):
     """Fraction s in (0, 1] of the step where the event function changes sign (Illinois method)."""
     s_low, s_high = 0.0, 1.0
-    v_low = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_low, motion, t0, state)
-    v_high = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_high, motion, t0, state)
+    v_low = event_value(kind, index, system, step, s_low, interpolated)
+    v_high = event_value(kind, index, system, step, s_high, interpolated)
     side = 0
     for _ in range(100):
         if v_high == v_low:
@@ -260,7 +341,7 @@ def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0, stat
         s_mid = (s_low * v_high - s_high * v_low) / (v_high - v_low)
         if not (s_low < s_mid < s_high):
             s_mid = 0.5 * (s_low + s_high)
-        v_mid = event_value(kind, index, code, sigma, params, x0, f0, x1, f1, h, s_mid, motion, t0, state)
+        v_mid = event_value(kind, index, system, step, s_mid, interpolated)
         if (v_mid > 0) == (v_high > 0):
             s_high, v_high = s_mid, v_mid
             if side == 1:
@@ -271,82 +352,103 @@ def locate(kind, index, code, sigma, params, x0, f0, x1, f1, h, motion, t0, stat
             if side == -1:
                 v_high *= 0.5
             side = -1
-        if (s_high - s_low) * h < EVENT_TIME_RESOLUTION:
+        if (s_high - s_low) * step.h < EVENT_TIME_RESOLUTION:
             break
     return s_high
 
 
 @njit(cache=True)
-def refine_event(kind, index, code, phase, sigma, t, x, f0, h, s_guess, motion, params, k, x_new, err, state):
+def refine_event(kind, index, system, step, s_guess, work):
     """Take the step to the event found on the interpolant, then sharpen the event time on the real
     solution (Illinois method on the step length: the cubic interpolant alone is only 4th-order
-    accurate, which long steps would feel). On entry x_new, k[5] hold the full step; on return they hold
-    the step to the event (on its far side or at it). Returns the step length taken."""
-    f1 = k[ROW_F1]
-    g_low = event_value(kind, index, code, sigma, params, x, f0, x, f0, h, 0.0, motion, t, state)
-    g_high = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h, 1.0, motion, t, state)
+    accurate, which long steps would feel).
+
+    On entry ``step`` is the full step, whose x1, f1 are ``work.x_new`` and the last stage; on return
+    these hold the step to the event (on its far side or at it). Returns that step's length.
+    """
+    t, x, f0, h = step.t, step.x0, step.f0, step.h
+    interpolated = work.interpolated
+    v_low = event_value(kind, index, system, Step(t, h, x, f0, x, f0), 0.0, interpolated)
+    v_high = event_value(kind, index, system, step, 1.0, interpolated)
     h_low, h_high = 0.0, h
-    tolerance = EVENT_VALUE_FRACTION * max(abs(g_low), abs(g_high))
+    tolerance = EVENT_VALUE_FRACTION * max(abs(v_low), abs(v_high))
     h_event = s_guess * h
     side = 0
     for _ in range(EVENT_REFINEMENTS):
-        dopri_step(code, phase, sigma, t, x, f0, h_event, motion, params, k, x_new, err)
-        g_event = event_value(kind, index, code, sigma, params, x, f0, x_new, f1, h_event, 1.0, motion, t, state)
-        if (g_event > 0.0) == (g_high > 0.0):
-            h_high, g_high = h_event, g_event
+        dopri_step(system, t, x, h_event, work)
+        v_event = event_value(kind, index, system, Step(t, h_event, x, f0, step.x1, step.f1), 1.0, interpolated)
+        if (v_event > 0.0) == (v_high > 0.0):
+            h_high, v_high = h_event, v_event
             if side == 1:
-                g_low *= 0.5
+                v_low *= 0.5
             side = 1
-            if abs(g_event) <= tolerance or h_high - h_low < EVENT_TIME_RESOLUTION:
+            if abs(v_event) <= tolerance or h_high - h_low < EVENT_TIME_RESOLUTION:
                 return h_event
         else:
-            h_low, g_low = h_event, g_event
+            h_low, v_low = h_event, v_event
             if side == -1:
-                g_high *= 0.5
+                v_high *= 0.5
             side = -1
             if h_high - h_low < EVENT_TIME_RESOLUTION:
                 break
-        if g_high == g_low:
+        if v_high == v_low:
             break
-        h_event = (h_low * g_high - h_high * g_low) / (g_high - g_low)
+        h_event = (h_low * v_high - h_high * v_low) / (v_high - v_low)
         if not (h_low < h_event < h_high):
             h_event = 0.5 * (h_low + h_high)
     # end on the far side of the event
-    dopri_step(code, phase, sigma, t, x, f0, h_high, motion, params, k, x_new, err)
+    dopri_step(system, t, x, h_high, work)
     return h_high
 
 
 @njit(cache=True)
-def track_peak(x0, f0, x1, f1, h, t, summary, overturn):
+def track_peak(step, summary, overturn):
     """Update the peak |theta| with the extremum inside the step (theta' changes sign) and its end."""
-    if x0[1] * f1[0] < 0.0 or x0[1] * x1[1] < 0.0:
+    x0, x1 = step.x0, step.x1
+    if x0[1] * step.f1[0] < 0.0 or x0[1] * x1[1] < 0.0:
         s_low, s_high = 0.0, 1.0
-        d_low = hermite_derivative(x0, f0, x1, f1, h, s_low, 0)
+        rate_low = hermite_derivative(step, s_low, 0)
         for _ in range(60):
             s_mid = 0.5 * (s_low + s_high)
-            d_mid = hermite_derivative(x0, f0, x1, f1, h, s_mid, 0)
-            if (d_mid > 0) == (d_low > 0):
-                s_low, d_low = s_mid, d_mid
+            rate_mid = hermite_derivative(step, s_mid, 0)
+            if (rate_mid > 0) == (rate_low > 0):
+                s_low, rate_low = s_mid, rate_mid
             else:
                 s_high = s_mid
-        theta_mid = abs(hermite(x0, f0, x1, f1, h, 0.5 * (s_low + s_high), 0))
+        theta_mid = abs(hermite(step, 0.5 * (s_low + s_high), 0))
         if theta_mid > summary["peak_angle"] and theta_mid <= overturn:
             summary["peak_angle"] = theta_mid
-            summary["time_of_peak"] = t + 0.5 * (s_low + s_high) * h
+            summary["time_of_peak"] = step.t + 0.5 * (s_low + s_high) * step.h
     if abs(x1[0]) > summary["peak_angle"]:
         summary["peak_angle"] = min(abs(x1[0]), overturn)
-        summary["time_of_peak"] = t + h
+        summary["time_of_peak"] = step.t + step.h
+
+
+# ---------------------------------------------------------------------------------------------
+# shared bookkeeping
+# ---------------------------------------------------------------------------------------------
+
+@njit(cache=True)
+def static_settlement(code, params):
+    """Settlement of the foundation under the block's weight [m], by the model's kernel code."""
+    if code == HOUSNER:
+        return 0.0  # rigid base
+    if code == SSI or code == WINKLER:
+        omega = params["omega"]
+        return params["g"] / (omega * omega)
+    raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
-def state_scales(code, params, y_static, scale):
-    """Absolute-error scales of [theta, theta_dot, y, y_dot]: alpha, alpha p, static settlement, ..."""
-    p2 = params["kappa"] * params["g"] / params["R"]  # p^2 of the model's own pivot equation
+def state_scales(params, y_static, scale):
+    """Absolute-error scales of [theta, theta_dot, y, y_dot] into scale: alpha, alpha p, the static
+    settlement and its rate (floored for a rigid base). Returns p^2 of the model's own pivot equation."""
+    p_squared = params["kappa"] * params["g"] / params["R"]
     scale[0] = params["alpha"]
-    scale[1] = params["alpha"] * math.sqrt(p2)
+    scale[1] = params["alpha"] * math.sqrt(p_squared)
     scale[2] = max(y_static, STATE_SCALE_FLOOR)
     scale[3] = max(y_static * params["omega"], STATE_SCALE_FLOOR)
-    return p2
+    return p_squared
 
 
 @njit(cache=True)
@@ -356,15 +458,16 @@ def interval_of(t, dt):
 
 
 @njit(cache=True)
-def write_rows(history, next_row, dt, t0, h, x0, f0, x1, f1):
-    """History rows at the sample times in (t0, t0 + h], from the step's interpolant; returns the next row."""
+def write_rows(history, next_row, dt, step):
+    """History rows at the sample times in (t, t + h] of ``step``, from its interpolant; returns the next row."""
     if history.shape[0] == 0:
         return next_row
+    t0, h = step.t, step.h
     t1 = t0 + h
     while next_row < history.shape[0] and next_row * dt <= t1 + SEGMENT_END_FRACTION * dt:
         s = min(max((next_row * dt - t0) / h, 0.0), 1.0) if h > 0.0 else 1.0
-        for i in range(4):
-            history[next_row, i] = hermite(x0, f0, x1, f1, h, s, i)
+        for i in range(STATE_SIZE):
+            history[next_row, i] = hermite(step, s, i)
         next_row += 1
     return next_row
 
@@ -375,7 +478,7 @@ def hold_rows(history, next_row, dt, t1, x):
     if history.shape[0] == 0:
         return next_row
     while next_row < history.shape[0] and next_row * dt <= t1 + SEGMENT_END_FRACTION * dt:
-        for i in range(4):
+        for i in range(STATE_SIZE):
             history[next_row, i] = x[i]
         next_row += 1
     return next_row
@@ -386,7 +489,7 @@ def finish(history, next_row, summary, status, t):
     """Blank the history after overturning or failure and write the outcome."""
     if history.shape[0] > 0 and (status == OVERTURNED or status == FAILED):
         for row in range(next_row, history.shape[0]):
-            for i in range(4):
+            for i in range(STATE_SIZE):
                 history[row, i] = np.nan
     summary["status"] = status
     summary["t_end"] = t
@@ -401,7 +504,17 @@ def book_overturn(summary, params, t):
 
 
 @njit(cache=True)
+def book_impact(summary, impact_times, t):
+    """Count an impact at time t and keep its time while there is room."""
+    summary["n_impacts"] += 1.0
+    count = int(summary["n_impacts"])
+    if count <= impact_times.size:
+        impact_times[count - 1] = t
+
+
+@njit(cache=True)
 def start_summary(summary, x, min_support):
+    """Initial values of every summary field for a run starting at state x."""
     summary["peak_angle"] = abs(x[0])
     summary["time_of_peak"] = 0.0
     summary["n_impacts"] = 0.0
@@ -423,63 +536,99 @@ def start_summary(summary, x, min_support):
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def rest_until_uplift(motion, t, t_seg_end, threshold):
+def rest_until_uplift(motion, t, t_sample_end, threshold):
     """Closed-form rest phase inside one sample interval: the state is constant; find where |ag| first
-    beats the threshold. Returns (t_new, start_now); t_new = t_seg_end when it is not reached."""
-    ag, dt = motion
-    a_end = ground(motion, t_seg_end)
+    beats the threshold. Returns (t_new, start_now); t_new = t_sample_end when it is not reached."""
+    samples, dt = motion.horizontal, motion.dt
+    a_end = ground(motion, t_sample_end)
     if abs(a_end) <= threshold:
-        return t_seg_end, False
+        return t_sample_end, False
     index = interval_of(t, dt)
-    a_start = sample(ag, index)
-    slope = (sample(ag, index + 1) - a_start) / dt
+    a_start = sample(samples, index)
+    slope = (sample(samples, index + 1) - a_start) / dt
     target = threshold if a_end > 0 else -threshold
-    t_cross = t_seg_end
+    t_cross = t_sample_end
     if slope != 0.0:
         t_cross = index * dt + (target - a_start) / slope
-    return min(max(t_cross, t), t_seg_end), True
+    return min(max(t_cross, t), t_sample_end), True
 
 
 @njit(cache=True)
-def pivot_event(code, phase, sigma, params, x, f0, x_new, k7, h, motion, t, state):
+def vertical_at_rest(code, x, y_static, scale):
+    """True when a pivot model at rest has no vertical vibration left, so that its rest phase is the
+    closed form (``rest_until_uplift``): always on a rigid base; for ssi below AT_REST_FRACTION."""
+    if code == HOUSNER:
+        return True
+    if code == SSI:
+        return (abs(x[2] - y_static) <= AT_REST_FRACTION * scale[2] + 1e-15
+                and abs(x[3]) <= AT_REST_FRACTION * scale[3])
+    raise ValueError(UNKNOWN_CODE)
+
+
+@njit(cache=True)
+def pivot_event(system, step, interpolated):
     """The earliest event inside an accepted step of a pivot model: (kind, fraction s)."""
+    params = system.params
+    sigma = system.sigma
+    x, x_new = step.x0, step.x1
     kind = EVENT_NONE
     s_event = 2.0
-    if phase == ROCKING:
+    if system.phase == ROCKING:
         if sigma * x[0] > 0.0 and sigma * x_new[0] <= 0.0:
             kind = EVENT_IMPACT
-            s_event = locate(EVENT_IMPACT, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t, state)
+            s_event = locate(EVENT_IMPACT, 0, system, step, interpolated)
         if abs(x_new[0]) >= params["overturn"]:
-            s_hit = locate(EVENT_OVERTURN, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t, state)
+            s_hit = locate(EVENT_OVERTURN, 0, system, step, interpolated)
             if s_hit < s_event:
                 kind, s_event = EVENT_OVERTURN, s_hit
         if kind == EVENT_NONE and sigma * x[0] == 0.0 and sigma * x_new[0] < 0.0:
             kind, s_event = EVENT_SETTLE, 1.0
     else:
-        v_start = event_value(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, 0.0, motion, t, state)
-        v_end = event_value(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, 1.0, motion, t, state)
+        v_start = event_value(EVENT_UPLIFT, 0, system, step, 0.0, interpolated)
+        v_end = event_value(EVENT_UPLIFT, 0, system, step, 1.0, interpolated)
         if v_start <= 0.0 and v_end > 0.0:
             kind = EVENT_UPLIFT
-            s_event = locate(EVENT_UPLIFT, 0, code, sigma, params, x, f0, x_new, k7, h, motion, t, state)
+            s_event = locate(EVENT_UPLIFT, 0, system, step, interpolated)
     return kind, s_event
 
 
 @njit(cache=True)
-def pivot_impact(code, params, x, sigma, zeno_speed, t, impact_times, summary):
-    """Impact at theta = 0: restitution, pivot switch; returns (phase, sigma) after it."""
-    summary["n_impacts"] += 1.0
-    n = int(summary["n_impacts"])
-    if n <= impact_times.size:
-        impact_times[n - 1] = t
+def pivot_impact(system, x, zeno_speed, t, impact_times, summary):
+    """Impact at theta = 0: restitution and pivot switch by the model's rule; returns (phase, sigma) after
+    it (rocking on the other pivot, or at rest when the next excursion would be below the Zeno angle)."""
+    params = system.params
+    book_impact(summary, impact_times, t)
     x[0] = 0.0
-    if code != HOUSNER and params["switch"] == SWITCH_CONSISTENT:
+    if system.code == SSI and params["switch"] == SWITCH_CONSISTENT:
         ssi_pivot_switch(x, params)
     x[1] = x[1] * params["restitution"]
     if abs(x[1]) < zeno_speed:
-        # the next excursion would be below the Zeno angle: the block comes to rest
         x[1] = 0.0
         return REST, 0.0
-    return ROCKING, -sigma
+    return ROCKING, -system.sigma
+
+
+@njit(cache=True)
+def ssi_bookkeeping(system, x, y_static, t, summary):
+    """After a step of the ssi model: book the support force, tension and settlement; at rest, snap a
+    died-out vertical vibration to the static equilibrium. Returns True when it snapped (f(t, x) changed)."""
+    params = system.params
+    snapped = False
+    if system.phase == REST and abs(x[2] - y_static) < SNAP_TO_STATIC_FRACTION * y_static \
+            and abs(x[3]) < SNAP_TO_STATIC_FRACTION * y_static * params["omega"]:
+        # the free vertical vibration has died out: snap to the static equilibrium so that
+        # the closed-form rest phase takes over (the support force changes by < 1e-4 g)
+        x[2] = y_static
+        x[3] = 0.0
+        snapped = True
+    force = ssi_support(x, params)
+    if force < summary["min_support_force"]:
+        summary["min_support_force"] = force
+    if force < 0.0 and math.isnan(summary["time_of_tension"]):
+        summary["time_of_tension"] = t
+    if x[2] > summary["peak_settlement"]:
+        summary["peak_settlement"] = x[2]
+    return snapped
 
 
 @njit(cache=True)
@@ -489,24 +638,23 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     At rest the state is constant (closed form) or only the SSI vertical vibration moves; steps never
     cross a sample of the ground motion.
     """
-    motion = (ag, dt)
+    motion = GroundMotion(ag, dt)
     t_final = (ag.size + n_tail - 1) * dt
     alpha = params["alpha"]
     tan_alpha = math.tan(alpha)
-    omega = params["omega"]
-    y_static = params["g"] / (omega * omega) if code != HOUSNER else 0.0
-    k, f0, x_new, err, scale = workspace()
-    p2 = state_scales(code, params, y_static, scale)
-    zeno_speed = math.sqrt(2.0 * p2 * math.sin(alpha) * params["zeno"])
-    k7 = k[ROW_F1]
-    state = k[ROW_EVENT]
-    f0_current = False  # f0 = f(t, x) is known (first same as last: k7 of the step just taken)
+    y_static = static_settlement(code, params)
+    work = workspace()
+    p_squared = state_scales(params, y_static, work.scale)
+    zeno_speed = math.sqrt(2.0 * p_squared * math.sin(alpha) * params["zeno"])
+    f0, x_new, f1 = work.f0, work.x_new, work.stages[END_STAGE]
+    f0_current = False  # f0 = f(t, x) is known (first same as last: f1 of the step just taken)
 
     phase = REST
     sigma = 0.0
     if x[0] != 0.0 or x[1] != 0.0:
         phase = ROCKING
         sigma = 1.0 if (x[0] > 0.0 or (x[0] == 0.0 and x[1] > 0.0)) else -1.0
+    system = System(code, phase, sigma, params, motion)
     status = NO_UPLIFT if phase == REST else ROCKING_OUTCOME
     start_summary(summary, x, support(code, params, x))
     if phase == ROCKING:
@@ -523,14 +671,13 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     while t < t_final - SEGMENT_END_FRACTION * dt:
         # Steps end on every sample: a kink of the piecewise-linear ground motion inside a step fools the
         # embedded error estimate (measured: 5% peak-angle errors on real records when steps spanned samples).
-        t_seg_end = (interval_of(t, dt) + 1) * dt
-        if phase == REST:
+        t_sample_end = (interval_of(t, dt) + 1) * dt
+        if system.phase == REST:
             accel = ground(motion, t)
             if start_now or abs(accel) > tan_alpha * support(code, params, x):
                 # start rocking towards the side the inertia force pushes
                 start_now = False
-                phase = ROCKING
-                sigma = -1.0 if accel > 0 else 1.0
+                system = System(code, ROCKING, -1.0 if accel > 0 else 1.0, params, motion)
                 x[0] = 0.0
                 x[1] = 0.0
                 f0_current = False
@@ -544,67 +691,51 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
                     failed = True
                     break
                 continue
-            at_rest = code == HOUSNER or (abs(x[2] - y_static) <= AT_REST_FRACTION * scale[2] + 1e-15
-                                          and abs(x[3]) <= AT_REST_FRACTION * scale[3])
-            if at_rest:
-                t, start_now = rest_until_uplift(motion, t, t_seg_end, tan_alpha * support(code, params, x))
-                if t >= t_seg_end - SEGMENT_END_FRACTION * dt:
-                    t = t_seg_end  # (a crossing at the very end starts at the next interval's top)
+            if vertical_at_rest(code, x, y_static, work.scale):
+                t, start_now = rest_until_uplift(motion, t, t_sample_end, tan_alpha * support(code, params, x))
+                if t >= t_sample_end - SEGMENT_END_FRACTION * dt:
+                    t = t_sample_end  # (a crossing at the very end starts at the next interval's top)
                     start_now = False
                 next_row = hold_rows(history, next_row, dt, t, x)
                 f0_current = False
                 continue
-        h = min(h, t_seg_end - t)
+        h = min(h, t_sample_end - t)
         if not f0_current:
-            rhs(code, phase, sigma, x, ground(motion, t), params, f0)
-        zeno_guard = phase == ROCKING and x[0] == 0.0 and sigma * x[1] > 0.0
-        h, norm = adaptive_step(code, phase, sigma, t, x, f0, h, motion, params, scale, k, x_new, err, zeno_guard)
+            derivatives(system, t, x, f0)
+        zeno_guard = system.phase == ROCKING and x[0] == 0.0 and system.sigma * x[1] > 0.0
+        h, norm = adaptive_step(system, t, x, h, work, zeno_guard)
         summary["n_steps"] += 1.0
         if summary["n_steps"] > MAX_STEPS:
             failed = True
             break
-        kind, s_event = pivot_event(code, phase, sigma, params, x, f0, x_new, k7, h, motion, t, state)
-        h_taken = h
+        step = Step(t, h, x, f0, x_new, f1)
+        kind, s_event = pivot_event(system, step, work.interpolated)
         if kind != EVENT_NONE and kind != EVENT_SETTLE and s_event < 1.0:
-            h_taken = refine_event(kind, 0, code, phase, sigma, t, x, f0, h, s_event, motion, params, k, x_new, err,
-                                   state)
-        if phase == ROCKING:
-            track_peak(x, f0, x_new, k7, h_taken, t, summary, params["overturn"])
+            step = Step(t, refine_event(kind, 0, system, step, s_event, work), x, f0, x_new, f1)
+        if system.phase == ROCKING:
+            track_peak(step, summary, params["overturn"])
         if kind != EVENT_OVERTURN:
-            next_row = write_rows(history, next_row, dt, t, h_taken, x, f0, x_new, k7)
-        t = t + h_taken
-        for i in range(4):
+            next_row = write_rows(history, next_row, dt, step)
+        t = t + step.h
+        for i in range(STATE_SIZE):
             x[i] = x_new[i]
-            f0[i] = k7[i]
+            f0[i] = f1[i]
         f0_current = True
-        if code != HOUSNER:
-            if phase == REST and abs(x[2] - y_static) < SNAP_TO_STATIC_FRACTION * y_static \
-                    and abs(x[3]) < SNAP_TO_STATIC_FRACTION * y_static * omega:
-                # the free vertical vibration has died out: snap to the static equilibrium so that
-                # the closed-form rest phase takes over (the support force changes by < 1e-4 g)
-                x[2] = y_static
-                x[3] = 0.0
-                f0_current = False
-            force = ssi_support(x, params)
-            if force < summary["min_support_force"]:
-                summary["min_support_force"] = force
-            if force < 0.0 and math.isnan(summary["time_of_tension"]):
-                summary["time_of_tension"] = t
-            if x[2] > summary["peak_settlement"]:
-                summary["peak_settlement"] = x[2]
+        if code == SSI and ssi_bookkeeping(system, x, y_static, t, summary):
+            f0_current = False
         h = next_step(h, norm)
         if kind == EVENT_OVERTURN:
             status = OVERTURNED
             book_overturn(summary, params, t)
             break
         if kind == EVENT_SETTLE:
-            phase = REST
+            system = System(code, REST, 0.0, params, motion)
             x[0] = 0.0
             x[1] = 0.0
-            sigma = 0.0
             f0_current = False
         elif kind == EVENT_IMPACT:
-            phase, sigma = pivot_impact(code, params, x, sigma, zeno_speed, t, impact_times, summary)
+            phase, sigma = pivot_impact(system, x, zeno_speed, t, impact_times, summary)
+            system = System(code, phase, sigma, params, motion)
             f0_current = False
             n_events += 1
         elif kind == EVENT_UPLIFT:
@@ -620,37 +751,42 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
 
 
 # ---------------------------------------------------------------------------------------------
-# bed models: winkler
+# bed models: winkler (the bed's contact law: pipeline.models.contact)
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def bed_event(params, x, f0, x_new, k7, h, motion, t, before, after, min_fraction, state):
+def bed_event(system, step, before, after, min_fraction, interpolated):
     """Earliest contact change or overturning inside the step: (kind, indicator index, fraction s).
 
-    before, after: the contact indicators at the step's ends (``winkler.contact_indicators``).
+    before, after: the contact indicators at the step's ends (``contact.contact_indicators``); an event
+    at a fraction below min_fraction is the one just located and is ignored.
     """
     kind = EVENT_NONE
     index = 0
     s_event = 2.0
     for i in range(N_CONTACT_INDICATORS):
         if (before[i] > 0.0) != (after[i] > 0.0):
-            s_hit = locate(EVENT_CONTACT, i, WINKLER, 0.0, params, x, f0, x_new, k7, h, motion, t, state)
+            s_hit = locate(EVENT_CONTACT, i, system, step, interpolated)
             if s_hit < s_event and s_hit > min_fraction:
                 kind, index, s_event = EVENT_CONTACT, i, s_hit
-    if abs(x_new[0]) >= params["overturn"]:
-        s_hit = locate(EVENT_OVERTURN, 0, WINKLER, 0.0, params, x, f0, x_new, k7, h, motion, t, state)
+    if abs(step.x1[0]) >= system.params["overturn"]:
+        s_hit = locate(EVENT_OVERTURN, 0, system, step, interpolated)
         if s_hit < s_event:
             kind, index, s_event = EVENT_OVERTURN, 0, s_hit
     return kind, index, s_event
 
 
 @njit(cache=True)
-def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, event_at_end, summary, impact_times):
-    """Uplift, flights, touch-downs, corner uplift, support and friction demand after a step.
+def bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_times):
+    """Uplift, flights, touch-downs, corner uplift, support and friction demand after ``step``.
 
     before, after: contact indicators at the step's ends; indicators 0, 1 are the corners' penetrations;
     event_at_end: the step ends on a located contact change (a take-off or landing exactly there).
     """
+    params = system.params
+    x1 = step.x1
+    h = step.h
+    t_end = step.t + step.h
     lift_minus = -after[0]
     lift_plus = -after[1]
     if summary["uplifted"] == 0.0 and (lift_minus > 0.0 or lift_plus > 0.0):
@@ -661,10 +797,7 @@ def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, event_at_end
         summary["peak_corner_uplift"] = highest
     # a corner coming back into the ground is an impact
     if (before[0] < 0.0 and after[0] >= 0.0) or (before[1] < 0.0 and after[1] >= 0.0):
-        summary["n_impacts"] += 1.0
-        n = int(summary["n_impacts"])
-        if n <= impact_times.size:
-            impact_times[n - 1] = t_end
+        book_impact(summary, impact_times, t_end)
     flying_before = before[0] < 0.0 and before[1] < 0.0
     flying = after[0] < 0.0 and after[1] < 0.0
     if flying and not flying_before:
@@ -681,7 +814,7 @@ def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, event_at_end
     if x1[2] > summary["peak_settlement"]:
         summary["peak_settlement"] = x1[2]
     if force >= FRICTION_MIN_SUPPORT * params["g"]:
-        demand = friction_demand(x1, f1, accel, force, params)
+        demand = friction_demand(x1, step.f1, ground(system.motion, t_end), force, params)
         if demand > summary["peak_friction_demand"]:
             summary["peak_friction_demand"] = demand
 
@@ -689,16 +822,14 @@ def bed_bookkeeping(params, x1, h, t_end, accel, f1, before, after, event_at_end
 @njit(cache=True)
 def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     """Integrate one response of a bed model from state x; no rest phase, no impact rule."""
-    motion = (ag, dt)
+    motion = GroundMotion(ag, dt)
+    system = System(code, ROCKING, 0.0, params, motion)
     t_final = (ag.size + n_tail - 1) * dt
-    omega = params["omega"]
-    y_static = params["g"] / (omega * omega)
-    k, f0, x_new, err, scale = workspace()
-    state_scales(code, params, y_static, scale)
+    work = workspace()
+    state_scales(params, static_settlement(code, params), work.scale)
+    f0, x_new, f1 = work.f0, work.x_new, work.stages[END_STAGE]
     before = np.empty(N_CONTACT_INDICATORS)
     after = np.empty(N_CONTACT_INDICATORS)
-    k7 = k[ROW_F1]
-    state = k[ROW_EVENT]
     force, _ = bed_force(x, params)
     start_summary(summary, x, force)
     contact_indicators(x, params, before)
@@ -710,38 +841,35 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     h = dt * 0.25
     failed = False
     overturned = False
-    rhs(code, ROCKING, 0.0, x, ground(motion, t), params, f0)
+    derivatives(system, t, x, f0)
     while t < t_final - SEGMENT_END_FRACTION * dt:
         h = min(h, (interval_of(t, dt) + 1) * dt - t)  # steps end on every sample (see pivot_loop)
-        h, norm = adaptive_step(code, ROCKING, 0.0, t, x, f0, h, motion, params, scale, k, x_new, err, False)
+        h, norm = adaptive_step(system, t, x, h, work, False)
         summary["n_steps"] += 1.0
         if summary["n_steps"] > MAX_STEPS:
             failed = True
             break
         contact_indicators(x_new, params, after)
+        step = Step(t, h, x, f0, x_new, f1)
         # an event at the very start of the step is the one just located: ignore it
-        kind, index, s_event = bed_event(params, x, f0, x_new, k7, h, motion, t, before, after,
-                                         EVENT_TIME_RESOLUTION / h, state)
-        h_taken = h
+        kind, index, s_event = bed_event(system, step, before, after, EVENT_TIME_RESOLUTION / h, work.interpolated)
         event_at_end = False
         if kind != EVENT_NONE and s_event < 1.0:
-            h_taken = refine_event(kind, index, code, ROCKING, 0.0, t, x, f0, h, s_event, motion, params, k, x_new,
-                                   err, state)
+            step = Step(t, refine_event(kind, index, system, step, s_event, work), x, f0, x_new, f1)
             far_side = after[index]
             contact_indicators(x_new, params, after)
             if kind == EVENT_CONTACT and ((after[index] > 0.0) != (far_side > 0.0) or after[index] == 0.0):
                 # the step ends exactly on the contact change: book it as crossed
                 after[index] = math.copysign(TINY_INDICATOR, far_side)
             event_at_end = kind == EVENT_CONTACT
-        track_peak(x, f0, x_new, k7, h_taken, t, summary, params["overturn"])
+        track_peak(step, summary, params["overturn"])
         if kind != EVENT_OVERTURN:
-            next_row = write_rows(history, next_row, dt, t, h_taken, x, f0, x_new, k7)
-        for i in range(4):
+            next_row = write_rows(history, next_row, dt, step)
+        for i in range(STATE_SIZE):
             x[i] = x_new[i]
-            f0[i] = k7[i]  # first same as last: the bed's force law is continuous, so is f
-        t = t + h_taken
-        bed_bookkeeping(params, x, h_taken, t, ground(motion, t), k7, before, after, event_at_end, summary,
-                        impact_times)
+            f0[i] = f1[i]  # first same as last: the bed's force law is continuous, so is f
+        t = t + step.h
+        bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_times)
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
@@ -773,13 +901,15 @@ def simulate_kernel(code, ag, dt, n_tail, params, x0, history, impact_times, sum
     code : int
         Kernel code (fields.HOUSNER, SSI or WINKLER).
     ag : ndarray (n,)
-        Ground acceleration [m/s^2] at t = k dt.
+        Ground acceleration [m/s^2] at t = i dt.
+    dt : float
+        Sampling step of ag [s].
     n_tail : int
         Samples of free vibration after the record (zero ground acceleration).
     params : PARAMS_DTYPE record
-    x0 : ndarray (4,)
+    x0 : ndarray (STATE_SIZE,)
         Initial [theta, theta_dot, y, y_dot]; overwritten with the final state.
-    history : ndarray (n + n_tail, 4) or (0, 4)
+    history : ndarray (n + n_tail, STATE_SIZE) or (0, STATE_SIZE)
         Filled with the state at the sample times (NaN after overturning).
     impact_times : ndarray (capacity,)
         Filled with the first ``capacity`` impact times [s].
@@ -787,8 +917,10 @@ def simulate_kernel(code, ag, dt, n_tail, params, x0, history, impact_times, sum
     """
     if code == WINKLER:
         bed_loop(code, ag, dt, n_tail, params, x0, history, impact_times, summary)
-    else:
+    elif code == HOUSNER or code == SSI:
         pivot_loop(code, ag, dt, n_tail, params, x0, history, impact_times, summary)
+    else:
+        raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
@@ -801,28 +933,28 @@ def single_kernel(code, ag, dt, n_tail, params_table, x0, history, impact_times,
 def batch_kernel(code, ag, dt, n_tail, scales, params_table, initial_states, summaries):
     """One record at each factor in ``scales`` for each parameter row (no histories).
 
-    scales (n_scale,); params_table (n_case,) records; initial_states (n_case, 4);
+    scales (n_scale,); params_table (n_case,) records; initial_states (n_case, STATE_SIZE);
     summaries (n_case, n_scale) records, filled.
     """
-    empty = np.empty((0, 4))
+    empty = np.empty((0, STATE_SIZE))
     impacts = np.empty(0)
     scaled = np.empty(ag.size)
-    x = np.empty(4)
+    x = np.empty(STATE_SIZE)
     for j in range(scales.size):
         for i in range(ag.size):
             scaled[i] = ag[i] * scales[j]
         for row in range(params_table.shape[0]):
-            for i in range(4):
+            for i in range(STATE_SIZE):
                 x[i] = initial_states[row, i]
             simulate_kernel(code, scaled, dt, n_tail, params_table[row], x, empty, impacts, summaries[row, j])
 
 
 @njit(cache=True)
 def history_batch_kernel(code, ag, dt, n_tail, params_table, initial_states, histories, summaries):
-    """One ground motion for each parameter row, keeping the histories (n_case, n + n_tail, 4)."""
+    """One ground motion for each parameter row, keeping the histories (n_case, n + n_tail, STATE_SIZE)."""
     impacts = np.empty(0)
-    x = np.empty(4)
+    x = np.empty(STATE_SIZE)
     for row in range(params_table.shape[0]):
-        for i in range(4):
+        for i in range(STATE_SIZE):
             x[i] = initial_states[row, i]
         simulate_kernel(code, ag, dt, n_tail, params_table[row], x, histories[row], impacts, summaries[row])

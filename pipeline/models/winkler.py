@@ -2,10 +2,11 @@
 
 Input : block (b, h, m), the bed's total vertical stiffness K [N/m] (eq. 19, as for ``ssi``), its
         damping ratio xi [-] relative to the vertical mode (total dashpot C = 2 xi sqrt(K m)) and the
-        bed type: ``continuous`` (K spread uniformly over the footprint width 2b) or ``two-spring``
-        (K/2 and C/2 at each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model).
+        bed's contact law, a registered law of pipeline.models.contact: ``continuous`` (K spread
+        uniformly over the footprint width 2b, bed_continuous.py) or ``two-spring`` (K/2 and C/2 at
+        each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model, bed_two_spring.py).
 Output: registered model ``winkler`` and its compiled physics: ``bed_force``, ``accelerations``,
-        ``winkler_rhs``, ``contact_indicator``, ``corner_height``, ``friction_demand``.
+        ``winkler_rhs``, ``settled_beyond_reach``, ``friction_demand``.
 
 Why: the paper's model puts one linear spring-dashpot under the active pivot, and that spring pulls
 the block down whenever it rebounds, which real ground cannot do. Here every point of the base
@@ -38,23 +39,9 @@ from __future__ import annotations
 import math
 
 from pipeline.models.base import RockingModel
-from pipeline.models.fields import BED_TWO_SPRING, WINKLER
+from pipeline.models.contact import bed_force_at, bed_full_contact
+from pipeline.models.fields import WINKLER
 from pipeline.models.jit import njit
-
-# contact indicators located as events: penetration and contact force at each corner
-N_CONTACT_INDICATORS = 4
-
-
-@njit(cache=True)
-def _clip(low, high, c0, c1):
-    """Restrict [low, high] to where c0 + c1 s > 0."""
-    if c1 > 0.0:
-        low = max(low, -c0 / c1)
-    elif c1 < 0.0:
-        high = min(high, -c0 / c1)
-    elif c0 <= 0.0:
-        high = low
-    return low, high
 
 
 @njit(cache=True)
@@ -62,42 +49,9 @@ def bed_force(x, params):
     """Vertical force F and its moment M about the base centre, both per unit mass, for state x.
 
     F [m/s^2] pushes the block up; M [m^2/s^2] is int q(s) s ds (positive when the +b side carries more).
+    The bed's contact law (``params["bed"]``, pipeline.models.contact) gives them.
     """
     return bed_force_at(x, params, math.sin(x[0]), math.cos(x[0]))
-
-
-@njit(cache=True)
-def bed_force_at(x, params, sin_t, cos_t):
-    """``bed_force`` with sin(theta) and cos(theta) already known."""
-    b = params["b"]
-    omega = params["omega"]
-    stiffness = omega * omega           # K/m
-    damping = 2.0 * params["xi"] * omega  # C/m
-    if params["bed"] == BED_TWO_SPRING:
-        force = 0.0
-        moment = 0.0
-        for side in (-1.0, 1.0):
-            s = side * b
-            delta = x[2] + s * sin_t
-            if delta > 0.0:
-                f = 0.5 * (stiffness * delta + damping * (x[3] + s * cos_t * x[1]))
-                if f > 0.0:
-                    force += f
-                    moment += s * f
-        return force, moment
-    # continuous bed: q(s) = p0 + p1 s on the interval where both delta(s) > 0 and q(s) > 0
-    k_l = stiffness / (2.0 * b)
-    c_l = damping / (2.0 * b)
-    p0 = k_l * x[2] + c_l * x[3]
-    p1 = k_l * sin_t + c_l * cos_t * x[1]
-    low, high = _clip(-b, b, x[2], sin_t)
-    low, high = _clip(low, high, p0, p1)
-    if high <= low:
-        return 0.0, 0.0
-    d1 = high - low
-    d2 = (high * high - low * low) / 2.0
-    d3 = (high * high * high - low * low * low) / 3.0
-    return max(p0 * d1 + p1 * d2, 0.0), p0 * d2 + p1 * d3
 
 
 @njit(cache=True)
@@ -134,22 +88,6 @@ def winkler_rhs(x, accel, params, out):
 
 
 @njit(cache=True)
-def contact_indicator(index, x, params):
-    """Event functions whose sign changes are contact changes.
-
-    0, 1: penetration of the -b and +b corner [m]; 2, 3: the bed's pressure law k delta + c delta'
-    at the -b and +b corner (per unit stiffness, [m]), where the contact force switches on or off.
-    """
-    side = -1.0 if index % 2 == 0 else 1.0
-    s = side * params["b"]
-    delta = x[2] + s * math.sin(x[0])
-    if index < 2:
-        return delta
-    omega = params["omega"]
-    return delta + 2.0 * params["xi"] / omega * (x[3] + s * math.cos(x[0]) * x[1])
-
-
-@njit(cache=True)
 def settled_beyond_reach(x, params, peak_angle):
     """True when, with the ground at rest and the base in full contact, the block can no longer reach its
     recorded peak angle nor lift a corner: its energy above the settled state is below a quarter of the
@@ -161,44 +99,19 @@ def settled_beyond_reach(x, params, peak_angle):
     g = params["g"]
     omega = params["omega"]
     stiffness = omega * omega  # K/m
-    tilt_stiffness = stiffness * b * b * (1.0 if params["bed"] == BED_TWO_SPRING else 1.0 / 3.0) - g * h
+    sin_t = math.sin(x[0])
+    rocking_stiffness, bed = bed_full_contact(x, params, sin_t)  # the caller checks: the whole base is down
+    tilt_stiffness = rocking_stiffness - g * h
     if tilt_stiffness <= 0.0:
         return False  # the bed cannot even hold the block upright elastically
     y_static = g / stiffness
-    sin_t = math.sin(x[0])
     cos_t = math.cos(x[0])
     j = (b * b + 4.0 * h * h) / 3.0
     kinetic = 0.5 * ((h * cos_t * x[1]) ** 2 + (x[3] + h * sin_t * x[1]) ** 2 + (j - h * h) * x[1] * x[1])
-    # bed energy in full contact (the caller checks it): two springs K/2, or
-    # int_{-b}^{b} 1/2 (K/2b) (y + s sin)^2 ds = K/2 (y^2 + b^2 sin^2 / 3) for the continuous bed
-    if params["bed"] == BED_TWO_SPRING:
-        bed = 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t)
-    else:
-        bed = 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t / 3.0)
     excess = kinetic + g * (h * cos_t - x[2]) + bed - (g * (h - y_static) + 0.5 * stiffness * y_static * y_static)
     lift_angle = y_static / b  # a corner lifts at about this tilt (settled base)
     reach = 0.25 * 0.5 * tilt_stiffness * min(peak_angle, lift_angle) ** 2
     return excess < reach
-
-
-@njit(cache=True)
-def contact_indicators(x, params, out):
-    """All four ``contact_indicator`` values at once (one sin and cos)."""
-    b = params["b"]
-    sin_t = math.sin(x[0])
-    rate = 2.0 * params["xi"] / params["omega"] * b * math.cos(x[0]) * x[1]
-    base_rate = 2.0 * params["xi"] / params["omega"] * x[3]
-    out[0] = x[2] - b * sin_t
-    out[1] = x[2] + b * sin_t
-    out[2] = out[0] + base_rate - rate
-    out[3] = out[1] + base_rate + rate
-
-
-@njit(cache=True)
-def corner_height(index, x, params):
-    """Height of corner 0 (-b) or 1 (+b) above the ground surface [m] (negative: in the ground)."""
-    s = -params["b"] if index == 0 else params["b"]
-    return -(x[2] + s * math.sin(x[0]))
 
 
 @njit(cache=True)
