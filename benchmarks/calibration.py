@@ -47,7 +47,8 @@ def reference_case():
 
 def run(print=print):
     print(f"Calibration: {RECORD}, first {DURATION:.0f} s at {PGA_OVER_UPLIFT:g}x the uplift PGA, paper block, "
-          f"reference by the SSI model at k = {K_TRUE:.3g} N/m, xi = {XI_TRUE} with {NOISE:.0%} noise; default grid 25 x 7")
+          f"reference by the SSI model at k = {K_TRUE:.3g} N/m, xi = {XI_TRUE} with {NOISE:.0%} noise; "
+          "default grid 25 x 7")
     ag, dt, ref_time, ref_rotation = reference_case()
     simulate("ssi", ag[:100], dt, PAPER_BLOCK, k=K_TRUE, xi=XI_TRUE)  # compiled-kernel cache warm
     start, cpu_start = time.perf_counter(), time.process_time()

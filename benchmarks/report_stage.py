@@ -1,8 +1,8 @@
 """Time the report stage alone on the result files of a finished study (not part of the tests).
 
-Usage: ``python benchmarks/report_stage.py OUTPUT_DIR [STUDY.toml [WORKERS]]`` (WORKERS 1: no PNG worker) - reads cube.nc, ida.nc,
-fragility.nc (and showcase.nc, applicability.nc) from OUTPUT_DIR, rewrites report.pdf, report.html and
-figures/, and prints the wall time and the number of pages.
+Usage: ``python benchmarks/report_stage.py OUTPUT_DIR [STUDY.toml [WORKERS]]`` (WORKERS 1: no PNG worker) -
+reads cube.nc, ida.nc, fragility.nc (and showcase.nc, applicability.nc) from OUTPUT_DIR, rewrites report.pdf,
+report.html and figures/, and prints the wall time and the number of pages.
 """
 
 from __future__ import annotations

@@ -21,15 +21,18 @@ sys.path.insert(0, str(ROOT))  # this checkout's pipeline and its test suite's s
 warnings.simplefilter("ignore")
 
 import calibration  # noqa: E402  (benchmarks/calibration.py)
-from tests.physics.reference import reference_response  # noqa: E402  (the independent scipy reference)
+import fragility as fragility_benchmark  # noqa: E402  (benchmarks/fragility.py)
+from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/opensees_winkler.py)
 
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.config import load_study  # noqa: E402
 from pipeline.ida import hunt_and_fill  # noqa: E402
 from pipeline.models import Outcome, get_model, simulate, simulate_batch  # noqa: E402
-from pipeline.soils import soil_block_stiffness  # noqa: E402
 from pipeline.processing import process_record  # noqa: E402
 from pipeline.records import load_records  # noqa: E402
+from pipeline.soils import soil_block_stiffness  # noqa: E402
+from pipeline.units import STANDARD_GRAVITY  # noqa: E402
+from tests.physics.reference import reference_response  # noqa: E402  (the independent scipy reference)
 
 BLOCK = Block(name="bench", R=2.0, alpha=0.25, mass=5000.0)
 SCALES_OF_THRESHOLD = np.array([0.8, 1.2, 1.6, 2.0, 3.0])  # PGA / (g tan alpha)
@@ -42,7 +45,8 @@ def far_field():
 
 def solver_throughput(records):
     print("1. Solvers, one core: compiled kernel vs scipy solve_ivp reference (DOP853, rtol 1e-10)")
-    motions = [(r.acceleration, r.dt, SCALES_OF_THRESHOLD * BLOCK.uplift_acceleration() / np.max(np.abs(r.acceleration)))
+    motions = [(r.acceleration, r.dt,
+                SCALES_OF_THRESHOLD * BLOCK.uplift_acceleration() / np.max(np.abs(r.acceleration)))
                for r in records]
     simulate_batch("housner", motions[0][0], motions[0][1], [1.0], [(BLOCK, None, None)])  # compile / load cache
     simulate_batch("ssi", motions[0][0], motions[0][1], [1.0], [(BLOCK, 1e7, 0.05)])
@@ -98,7 +102,6 @@ def per_run_cost(records):
                     runs += out.size
                     steps += out["n_steps"].sum()
                 elapsed = time.perf_counter() - start
-                omega_over_p = np.sqrt(k / block.mass) / block.p()
                 cells.append(f"{elapsed / runs * 1e3:6.2f} ms {steps / runs / 1e3:5.1f}k")
                 if get_model(model).is_rigid_base:
                     cells[-1] += " (all soils)"
@@ -145,7 +148,8 @@ def accuracy_and_chaos(records):
         regular_error = error[~chaotic] if np.any(~chaotic) else np.array([np.nan])
         chaotic_error = error[chaotic] if np.any(chaotic) else np.array([np.nan])
         print(f"   {soil.name:8} {error.size:5d} {chaotic.mean():8.0%} | {'':21}{np.median(regular_error):8.1e} "
-              f"{regular_error.max():8.1e} | {'':14}{np.median(chaotic_error):8.1e} {np.quantile(chaotic_error, 0.9):8.1e}")
+              f"{regular_error.max():8.1e} | {'':14}{np.median(chaotic_error):8.1e} "
+              f"{np.quantile(chaotic_error, 0.9):8.1e}")
     print("   (overturned runs are left out; in a chaotic run no tolerance gives a reproducible peak angle, only the")
     print("    distribution over records is meaningful)")
 
@@ -190,7 +194,7 @@ def hunt_and_fill_savings(records):
         pga = np.max(np.abs(record.acceleration))
 
         def overturns(im_g):
-            return simulate("housner", record.acceleration * im_g * 9.80665 / pga, record.dt, block).overturned
+            return simulate("housner", record.acceleration * im_g * STANDARD_GRAVITY / pga, record.dt, block).overturned
 
         capacity, lower, upper, runs = hunt_and_fill(overturns, start=0.1, step=0.1, tolerance=0.02)
         total_adaptive += runs
@@ -206,14 +210,8 @@ if __name__ == "__main__":
     accuracy_and_chaos(records)
     study_timing()
     hunt_and_fill_savings(records)
-
-    from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/ is on sys.path)
-
     winkler_against_opensees()
     print("\n5. ", end="")
     calibration.run()
-
-    import fragility as fragility_benchmark  # benchmarks/fragility.py (this folder is on sys.path)
-
     print("\n6. ", end="")
     fragility_benchmark.run(print=print)

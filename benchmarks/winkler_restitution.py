@@ -24,9 +24,9 @@ sys.path.insert(0, str(ROOT))
 
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.models import simulate  # noqa: E402
+from pipeline.units import STANDARD_GRAVITY as G  # noqa: E402
 from tests.physics.winkler_reference import effective_restitution, rocking_peaks  # noqa: E402
 
-G = 9.80665
 ALPHAS = (0.1, 0.15, 0.25, 0.4)
 XIS = (0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7, 0.9)
 STIFFNESS_RATIOS = (300, 1000)  # omega_v / p

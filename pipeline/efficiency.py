@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import csv
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -33,6 +34,10 @@ from scipy import stats
 
 from pipeline.measures import MEASURES, scaling_measures
 from pipeline.outputs import atomic_path, write_dataset
+from pipeline.records import RECORDS_DIR
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 SIGNIFICANCE = 0.05
 """p-value below which a record property is taken to remain in the residuals (not sufficient)."""
@@ -66,8 +71,6 @@ def measure_values(records, blocks, options, names=None) -> xr.DataArray:
 
 def site_table(records_dir=None) -> pd.DataFrame:
     """Rupture distance [km] (and the P695 set) by record id from records/P695-SITES.csv."""
-    from pipeline.records import RECORDS_DIR
-
     path = Path(records_dir or RECORDS_DIR) / "P695-SITES.csv"
     if not path.is_file():
         return pd.DataFrame(columns=["distance_rupture_km"]).rename_axis("id")
@@ -89,8 +92,10 @@ def record_covariates(records, sites=None) -> dict[str, np.ndarray]:
 
 
 def sufficiency_p_value(log_capacity, covariate, use_log) -> float:
-    """p-value of the slope of ln-capacity residuals regressed on one record property (NaN if
-    fewer than 3 records have both, or the property does not vary)."""
+    """p-value of the slope of ln-capacity residuals regressed on one record property.
+
+    NaN if fewer than 3 records have both, or if the property does not vary.
+    """
     x = np.log(covariate) if use_log else np.asarray(covariate, float)
     keep = np.isfinite(log_capacity) & np.isfinite(x)
     if keep.sum() < 3 or np.ptp(x[keep]) == 0:
@@ -100,8 +105,11 @@ def sufficiency_p_value(log_capacity, covariate, use_log) -> float:
 
 
 def rank_ascending(values) -> np.ndarray:
-    """1 for the smallest value along the last axis, 2 for the next, ...; equal values (to 1e-9,
-    e.g. PGA and PGA/(g tan alpha) within one block) share the lower rank; NaN stays NaN."""
+    """1 for the smallest value along the last axis, 2 for the next, ...
+
+    Equal values (to 1e-9, e.g. PGA and PGA/(g tan alpha) within one block) share the lower rank;
+    NaN stays NaN.
+    """
     values = np.asarray(values, float)
     filled = np.where(np.isnan(values), np.inf, values)
     smaller = filled[..., None, :] < filled[..., :, None] * (1.0 - 1e-9)
@@ -194,10 +202,14 @@ def efficiency_table(dataset: xr.Dataset) -> pd.DataFrame:
     return table.sort_values(["soil", "block", "model", "efficiency_rank"]).reset_index(drop=True)
 
 
-def plot_efficiency(dataset: xr.Dataset, figsize=(8.27, 11.69)):
-    """One page: dispersion of each measure per block (bars, median over soils and models, whiskers
-    their range), sufficiency p-values against magnitude and distance, and the pooled dispersion."""
-    from matplotlib.figure import Figure  # not pyplot: the caller owns the figure, no global state
+def plot_efficiency(dataset: xr.Dataset, figsize: tuple[float, float] = (8.27, 11.69)) -> Figure:
+    """One page (``figsize`` in inches, A4 portrait by default) of the measure ranking.
+
+    The dispersion of each measure per block (bars, median over soils and models, whiskers their
+    range), the sufficiency p-values against magnitude and distance, and the pooled dispersion.
+    """
+    # lazy: the efficiency stage runs without matplotlib; not pyplot: the caller owns the figure, no global state
+    from matplotlib.figure import Figure
 
     measures = list(dataset.measure.values)
     blocks = list(dataset.block.values)

@@ -18,12 +18,15 @@ below the first point with the slope of its first.
 from __future__ import annotations
 
 import json
+import os
 import re
 from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pipeline.errors import ConfigError
 from pipeline.measures import MEASURES, display_units, scaling_measures
@@ -54,8 +57,10 @@ class HazardCurve:
 
 
 def measure_label(measure: str, period: float | None = None) -> str:
-    """The registry's short label of ``measure`` at ``period`` [s] ("PGA", "Sa(1 s)"); the upper-case
-    name for an unknown measure, or one defined at a period that is not given."""
+    """The registry's short label of ``measure`` at ``period`` [s] ("PGA", "Sa(1 s)").
+
+    The upper-case name for an unknown measure, or for one defined at a period that is not given.
+    """
     known = MEASURES.get(measure)
     if known is None or (known.uses_period and not period):
         return str(measure).upper()
@@ -67,8 +72,11 @@ def _fail(message, source):
 
 
 def _measure_from_imt(imt: str, source: str) -> tuple[str, float | None, float]:
-    """(measure, period, factor to our unit) from an OpenQuake IMT ('PGA', 'SA(1.0)', 'PGV') or a USGS
-    IMT id ('PGA', 'SA1P0', 'SA0P2', 'PGV'), by the registry's ``openquake_imt`` ('SA(T)' for Sa)."""
+    """(measure, period [s], factor to our unit) of an OpenQuake or USGS intensity measure type.
+
+    OpenQuake writes 'PGA', 'SA(1.0)', 'PGV', USGS 'PGA', 'SA1P0', 'SA0P2', 'PGV'; both are matched
+    against the registry's ``openquake_imt`` ('SA(T)' for Sa).
+    """
     text = imt.strip().upper()
     match = re.fullmatch(r"([A-Z]+)\(([0-9.]+)\)", text) or re.fullmatch(r"([A-Z]+?)([0-9]+)P([0-9]+)", text)
     period = None
@@ -112,8 +120,10 @@ def _read_rockfrag_csv(text: str, source: str):
 
 
 def _read_openquake_csv(text: str, source: str):
-    """OpenQuake hazard_curve-*.csv: '#...investigation_time=T, imt='PGA'' line, then lon,lat,depth,poe-...;
-    lambda = -ln(1 - poe) / T (Poisson)."""
+    """Read an OpenQuake hazard_curve-*.csv: lambda = -ln(1 - poe) / T (Poisson).
+
+    The file holds a '#...investigation_time=T, imt='PGA'' line, then lon,lat,depth,poe-<level>,...
+    """
     lines = [line for line in text.splitlines() if line.strip()]
     first = lines[0]
     time_match = re.search(r"investigation_time\s*=\s*([0-9.eE+-]+)", first)
@@ -140,8 +150,11 @@ def _read_openquake_csv(text: str, source: str):
 
 
 def _read_usgs_json(text: str, source: str):
-    """USGS NSHMP hazard web service: response[i].metadata.{imt, xvalues}, response[i].data[j].{component,
-    yvalues}; the 'Total' component, one IMT (the file must hold exactly one)."""
+    """Read a USGS NSHMP hazard web-service response: the 'Total' component of its one IMT.
+
+    The JSON holds response[i].metadata.{imt, xvalues} and response[i].data[j].{component, yvalues};
+    the file must hold exactly one IMT.
+    """
     try:
         document = json.loads(text)
     except json.JSONDecodeError as error:
@@ -175,11 +188,31 @@ def _read_any(text: str, source: str):
     return _read_rockfrag_csv(text, source)
 
 
-def load_hazard(path=None, measure="pga", period=None) -> HazardCurve:
+def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
+                period: float | None = None) -> HazardCurve:
     """Read and check a hazard curve against the study's intensity ``measure`` (and Sa ``period`` [s]).
 
-    ``path`` empty or None reads the shipped example (PGA only). Raises ConfigError naming the file
-    when the file is missing or malformed, or states another measure or period than the study's.
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        A rockfrag CSV, an OpenQuake hazard-curve CSV or a USGS hazard JSON (module docstring); empty
+        or None reads the shipped example (PGA only).
+    measure : str, optional
+        The study's intensity measure, a name of the registry (``pipeline.measures.MEASURES``).
+    period : float, optional
+        The study's Sa period [s]; checked only for a measure defined at a period.
+
+    Returns
+    -------
+    HazardCurve
+        Intensities in the measure's display unit (g for PGA and Sa, m/s for PGV), increasing, and
+        their annual frequencies of exceedance [1/yr], decreasing.
+
+    Raises
+    ------
+    ConfigError
+        Field ``hazard.file``: the file is missing or malformed, has fewer than two points, is not
+        monotone, or states another measure or period than the study's.
     """
     if path is None or str(path) == "":
         source_file = files("pipeline").joinpath(EXAMPLE_HAZARD)
@@ -208,23 +241,58 @@ def load_hazard(path=None, measure="pga", period=None) -> HazardCurve:
     return HazardCurve(intensity, frequency, file_measure, file_period, source, notes)
 
 
-def hazard_for(path, measure: str, period: float | None = None) -> HazardCurve | None:
-    """The hazard curve of a study of ``measure`` (at ``period`` [s] for Sa): ``path`` checked against
-    the measure; without a path the shipped example for a study of its measure, else None (no risk)."""
+def hazard_for(path: str | os.PathLike | None, measure: str, period: float | None = None) -> HazardCurve | None:
+    """The hazard curve of a study of ``measure`` (at ``period`` [s] for Sa), or None (no risk).
+
+    ``path`` is read and checked against the measure (``load_hazard``); without a path, the shipped
+    example for a study of its measure, else None.
+    """
     if not path and measure != EXAMPLE_MEASURE:
         return None
     uses_period = measure in MEASURES and MEASURES[measure].uses_period
     return load_hazard(path or None, measure, period if uses_period else None)
 
 
-def study_hazard(config) -> HazardCurve | None:
-    """The study's hazard curve: its ``hazard.file`` checked against its measure; without a file the
-    shipped example for a PGA study, and None (no risk computed) for another measure."""
+class HazardSettings(Protocol):
+    """What ``study_hazard`` reads of a study; ``pipeline.config.StudyConfig`` has it."""
+
+    @property
+    def hazard_file(self) -> str:
+        """The hazard curve file ("" for none)."""
+
+    @property
+    def measure(self) -> str:
+        """The study's intensity measure (a name of ``pipeline.measures.MEASURES``)."""
+
+    @property
+    def period(self) -> float:
+        """The Sa period [s] (unused for measures not defined at a period)."""
+
+
+def study_hazard(config: HazardSettings) -> HazardCurve | None:
+    """The study's hazard curve: its ``hazard.file`` checked against its measure.
+
+    Parameters
+    ----------
+    config : HazardSettings
+        The study (``pipeline.config.StudyConfig``): ``hazard_file``, ``measure`` and ``period`` [s].
+
+    Returns
+    -------
+    HazardCurve or None
+        The curve (``load_hazard``); without a file, the shipped example for a PGA study and None
+        (no risk computed) for another measure.
+
+    Raises
+    ------
+    ConfigError
+        The file is missing or malformed, or is for another measure or period (``load_hazard``).
+    """
     return hazard_for(config.hazard_file, config.measure, config.period)
 
 
-def hazard_frequency(hazard: HazardCurve, intensity):
-    """lambda(im) [1/yr], log-log interpolation, power-law extrapolation at both ends."""
+def hazard_frequency(hazard: HazardCurve, intensity: ArrayLike) -> np.ndarray | float:
+    """lambda(im) [1/yr] at ``intensity`` [the curve's unit]: log-log interpolation, power laws beyond both ends."""
     x = np.log(hazard.intensity)
     y = np.log(hazard.annual_frequency)
     log_im = np.log(np.asarray(intensity, float))

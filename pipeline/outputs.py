@@ -104,6 +104,12 @@ def write_dataset(dataset: xr.Dataset, path: str | os.PathLike, *, compress: boo
     -------
     pathlib.Path
         ``path``.
+
+    Raises
+    ------
+    Exception
+        Whatever xarray or netCDF4 raise while writing; the temporary file is deleted and ``path`` is
+        left as it was.
     """
     merged = netcdf_encoding(dataset, compress, complevel)
     for name, extra in (encoding or {}).items():

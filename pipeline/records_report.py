@@ -8,10 +8,12 @@ Output: a pandas table of catalogue metadata and intensity measures of the proce
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from tqdm import tqdm
 
 from pipeline.errors import RecordError
 from pipeline.measures import intensity_measures, response_spectrum
@@ -40,7 +42,8 @@ def measures_row(raw, processed) -> dict:
     return row
 
 
-def write_table(rows, path) -> pd.DataFrame:
+def write_table(rows: list[dict], path: str | os.PathLike) -> pd.DataFrame:
+    """Write the rows of ``measures_row`` as ``path`` (CSV, 6 significant digits); returns the table."""
     table = pd.DataFrame(rows)
     with atomic_path(path) as temporary:
         table.to_csv(temporary, index=False, float_format="%.6g")
@@ -49,7 +52,7 @@ def write_table(rows, path) -> pd.DataFrame:
 
 def plot_record(raw, processed, path):
     """PNG of raw vs processed acceleration, velocity, displacement and the 5% spectrum."""
-    import matplotlib
+    import matplotlib  # lazy: the records stage runs without matplotlib unless it plots
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -89,8 +92,6 @@ def records_stage(records, recipe, output_dir, plot=False, progress=True, failur
     A record that cannot be processed is left out; its ``RecordError`` is appended to ``failures``
     (raised if ``failures`` is None).
     """
-    from tqdm import tqdm
-
     output_dir = Path(output_dir)
     rows, pngs = [], []
     for raw in tqdm(records, desc="records", unit="rec", disable=not progress):

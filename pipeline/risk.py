@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike
 from scipy.special import ndtr
 
 from pipeline.hazard import HazardCurve, hazard_frequency
-from pipeline.hazard import load_hazard, study_hazard  # noqa: F401 (re-exported: cli.py imports them from here)
+from pipeline.hazard import study_hazard as study_hazard  # re-exported: cli.py imports it from here
 
 
-def annual_frequency(median, beta, hazard: HazardCurve, points=4000) -> float:
+def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, points: int = 4000) -> float:
     """Mean annual frequency of reaching a damage state with a lognormal fragility [1/yr].
 
     beta = 0 is a step at the median: lambda_DS = lambda(median).
@@ -37,14 +38,31 @@ def annual_frequency(median, beta, hazard: HazardCurve, points=4000) -> float:
     return float(np.sum(middle * (frequency[:-1] - frequency[1:])) + probability[-1] * frequency[-1])
 
 
-def probability_in_life(frequency, years):
-    """Poisson probability of at least one occurrence in ``years``."""
+def probability_in_life(frequency: ArrayLike, years: float) -> np.ndarray:
+    """Poisson probability [-] of at least one occurrence in ``years`` at ``frequency`` [1/yr]."""
     return 1.0 - np.exp(-np.asarray(frequency) * years)
 
 
-def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life=50.0) -> xr.Dataset:
-    """lambda_DS and P(DS in design_life) for every soil x block x model x damage state (NaN without a
-    hazard curve for the study's measure)."""
+def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life: float = 50.0) -> xr.Dataset:
+    """lambda_DS and P(DS in design_life) for every soil x block x model x damage state.
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        The fitted fragility (``pipeline.fragility``): ``median`` [the measure's display unit, as the
+        hazard curve] and ``beta`` [-] over (soil, block, model, damage_state); beta = 0 is a step.
+    hazard : HazardCurve or None
+        The site's hazard curve for the study's measure (``study_hazard``); None: no risk computed,
+        every value NaN.
+    design_life : float, optional
+        Years of the probability in life (default 50).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``annual_frequency`` [1/yr] and ``probability_in_life`` [-] on the dimensions of ``median``,
+        with the attributes ``hazard_source``, ``design_life_years`` and ``hazard_measure``.
+    """
     medians = fragility["median"].values
     betas = fragility["beta"].values
     rate = np.vectorize(lambda m, b: annual_frequency(m, b, hazard), otypes=[float])(medians, betas) \

@@ -1,5 +1,4 @@
-"""pipeline.showcase - study-time data the report draws besides the cube: the record set's measures
-and spectra, and the response histories of one showcase record.
+"""pipeline.showcase - study-time data for the report: record-set measures and spectra, showcase histories.
 
 Input : the study configuration and its processed records (``study.StudyRecords``).
 Output: ``reports/showcase.nc`` holding
@@ -31,6 +30,7 @@ from pipeline.measures import intensity_measures, response_spectrum, significant
 from pipeline.models import get_model, simulate
 from pipeline.outputs import write_dataset
 from pipeline.processing import integrate, process_record
+from pipeline.records import load_records
 from pipeline.soils import soil_block_stiffness
 from pipeline.study import StudyRecords, study_records
 
@@ -159,8 +159,6 @@ def showcase_dataset(config, records, recipe, load=None) -> xr.Dataset:
              "source": f"rockfrag {__version__}", "config_hash": config.config_hash, "showcase_record": ""}
     record_id = showcase_record_id(config, ids)
     if record_id is not None:
-        from pipeline.records import load_records
-
         raw_records, failures = (load or load_records)(record_id)
         if failures or len(raw_records) != 1:
             raise ConfigError("report.showcase_record", f"{record_id!r} must name exactly one readable record "

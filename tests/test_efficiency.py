@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import xarray as xr
-import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
-from pipeline.efficiency import (capacities_in_measures, efficiency_from_capacities, efficiency_table,
-                                 plot_efficiency, rank_ascending, write_efficiency)
+from pipeline.efficiency import (
+    capacities_in_measures,
+    efficiency_from_capacities,
+    efficiency_table,
+    plot_efficiency,
+    rank_ascending,
+    write_efficiency,
+)
 
 N = 40
 rng = np.random.default_rng(7)

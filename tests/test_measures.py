@@ -5,8 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.measures import (arias_intensity, cav, pga, pgv, response_spectrum, significant_duration,
-                               significant_window)
+from pipeline.measures import (
+    arias_intensity,
+    cav,
+    pga,
+    pgv,
+    response_spectrum,
+    significant_duration,
+    significant_window,
+)
 from pipeline.units import STANDARD_GRAVITY
 
 

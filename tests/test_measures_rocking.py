@@ -8,8 +8,18 @@ import numpy as np
 import pytest
 
 from pipeline.blocks import Block
-from pipeline.measures import (MEASURES, average_spectral_acceleration, display_units, scaling_measures, short_label,
-                               velocity_pulse)
+from pipeline.efficiency import ranked_measures
+from pipeline.hazard import _measure_from_imt, load_hazard
+from pipeline.measures import (
+    MEASURES,
+    average_spectral_acceleration,
+    cav,
+    define_measure,
+    display_units,
+    scaling_measures,
+    short_label,
+    velocity_pulse,
+)
 from pipeline.units import STANDARD_GRAVITY as G
 
 BLOCK = Block(name="cabinet", b=0.3, h=1.5, mass=2000.0)  # tan(alpha) = 0.2, R = sqrt(0.09 + 2.25)
@@ -116,8 +126,6 @@ def test_pelicun_and_openquake_names_are_registered_once():
 @pytest.fixture
 def cav_measure():
     """A measure added as a newcomer would add it: one ``define_measure`` definition (removed afterwards)."""
-    from pipeline.measures import cav, define_measure
-
     @define_measure("cav_test", si_unit="m/s", long_name="cumulative absolute velocity", label="CAV",
                     openquake_imt="CAV", openquake_factor=0.01)
     def _cav(acceleration, dt, block, options):
@@ -128,9 +136,6 @@ def cav_measure():
 
 
 def test_one_definition_reaches_every_reader_of_the_registry(cav_measure, tmp_path):
-    from pipeline.efficiency import ranked_measures
-    from pipeline.hazard import _measure_from_imt, load_hazard
-
     assert cav_measure(np.array([1.0, -1.0, 1.0]), 0.5) == pytest.approx(1.0)
     assert "cav_test" in scaling_measures() and "cav_test" in ranked_measures()
     assert display_units("cav_test") == ("m/s", 1.0)

@@ -19,7 +19,8 @@ from pipeline.units import STANDARD_GRAVITY
 VARIANT_FILES = {
     "nga-west2": "peer_original/NHERI-SimCenter__EE-UQ/RSN125_FRIULI.A_A-TMZ000.AT2",
     "nga-west2 with filter text": "peer_original/NHERI-SimCenter__EE-UQ/RSN1084_NORTHR_SCS052.AT2",
-    "nga-west2 CRLF": "peer_original/GeorgePapazafeiropoulos__PEER-Ground-Motion-Data-Base-Reader/RSN1633_MANJIL_ABBAR--L.AT2",
+    "nga-west2 CRLF":
+        "peer_original/GeorgePapazafeiropoulos__PEER-Ground-Motion-Data-Base-Reader/RSN1633_MANJIL_ABBAR--L.AT2",
     "nga-west1 'NPTS, DT'": "peer_original/arkottke__pystrata/NIS090.AT2",
     "old PEER Pacific Engineering": "peer_original/adzetto__DASK_26/BOL090.AT2",
     "old PEER CDMG": "peer_original/OpenSees__OpenSees/RIO270.AT2",

@@ -9,8 +9,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from pipeline.config import load_study
 from pipeline.errors import ConfigError
-from pipeline.hazard import hazard_frequency, load_hazard, study_hazard
+from pipeline.hazard import _measure_from_imt, hazard_frequency, load_hazard, study_hazard
 from pipeline.risk import annual_frequency, probability_in_life
 
 DATA = Path(__file__).parent / "data"
@@ -96,13 +97,12 @@ def test_bad_hazard_file_is_named(tmp_path):
 
 
 def test_the_study_file_is_refused_before_any_run_when_its_hazard_is_for_another_measure(tmp_path):
-    from pipeline.config import load_study
-
     study = tmp_path / "study.toml"
     study.write_text(f'[hazard]\nfile = "{DATA / "usgs_hazard_SA1P0.json"}"\n')
     with pytest.raises(ConfigError, match="hazard.file.*Sa\\(1 s\\).*PGA"):
         load_study(study)
-    study.write_text(f'[intensity]\nmeasure = "sa"\nperiod = 1.0\n[hazard]\nfile = "{DATA / "usgs_hazard_SA1P0.json"}"\n')
+    study.write_text(f'[intensity]\nmeasure = "sa"\nperiod = 1.0\n'
+                     f'[hazard]\nfile = "{DATA / "usgs_hazard_SA1P0.json"}"\n')
     assert load_study(study).measure == "sa"
 
 
@@ -111,13 +111,9 @@ def test_the_study_file_is_refused_before_any_run_when_its_hazard_is_for_another
     ("SA(0.2)", ("sa", 0.2, 1.0)), ("SA0P2", ("sa", 0.2, 1.0)), ("SA1P0", ("sa", 1.0, 1.0)),
 ])
 def test_openquake_and_usgs_imts_are_read_by_the_measure_registry(imt, expected):
-    from pipeline.hazard import _measure_from_imt
-
     assert _measure_from_imt(imt, "here") == expected
 
 
 def test_an_imt_no_measure_registers_is_refused_with_the_registered_ones():
-    from pipeline.hazard import _measure_from_imt
-
     with pytest.raises(ConfigError, match=r"'PGD' not supported; allowed PGA, PGV, SA\(T\)"):
         _measure_from_imt("PGD", "here")

@@ -20,6 +20,8 @@ import base64
 import html
 import io
 import math
+import multiprocessing
+import os
 from dataclasses import replace
 from pathlib import Path
 
@@ -29,14 +31,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import xarray as xr  # noqa: E402
 from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
+from tqdm import tqdm  # noqa: E402
 
 from pipeline import __version__  # noqa: E402
+from pipeline.config import StudyConfig  # noqa: E402
 from pipeline.outputs import atomic_path  # noqa: E402
 from pipeline.report import figures as pages  # noqa: E402
 from pipeline.report.adapters import models_of, short_label  # noqa: E402
 from pipeline.report.layout import PAGE_SIZE, Page, add_footer, new_page  # noqa: E402
-from pipeline.report.sections import (Results, limitations_items, methods_items, summary_items,  # noqa: E402
-                                      title_items)
+from pipeline.report.sections import Results, limitations_items, methods_items, summary_items, title_items  # noqa: E402
 from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
 from pipeline.units import STANDARD_GRAVITY  # noqa: E402
 
@@ -172,10 +175,7 @@ def plan(results: Results) -> list[Page]:
 def _efficiency_plotter(results):
     if results.efficiency is None:
         return None
-    try:
-        from pipeline.efficiency import plot_efficiency
-    except ImportError:
-        return None
+    from pipeline.efficiency import plot_efficiency  # lazy: tests/test_report.py swaps the module in sys.modules
 
     def draw():
         figure = plot_efficiency(results.efficiency)
@@ -275,11 +275,12 @@ def _page_png(task) -> bytes:
 
 
 def _png_pages(planned, footer, workers):
-    """PNG bytes of every page, in order: drawn in one forked worker process while this process writes
-    the PDF (both cores busy; about 40% less wall time), or here, page by page, when ``workers`` is 1
-    or the platform cannot fork."""
-    import multiprocessing
+    """PNG bytes of every page, in order, and the pool drawing them (None: drawn here).
 
+    The pages are drawn in one forked worker process while this process writes the PDF (both cores
+    busy; about 40% less wall time), or here, page by page, when ``workers`` is 1 or the platform
+    cannot fork.
+    """
     tasks = [(index, footer, len(planned)) for index in range(len(planned))]
     if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
         return None, (_page_png(task) for task in tasks)
@@ -289,8 +290,6 @@ def _png_pages(planned, footer, workers):
 
 def render(planned: list[Page], footer: str, output_dir, progress=True, workers=None) -> list[Page]:
     """Draw each page, number it, write it to the PDF and its PNG, close it; one figure open at a time."""
-    from tqdm import tqdm
-
     global _PLANNED
     output_dir = Path(output_dir)
     figure_dir = output_dir / "figures"
@@ -327,7 +326,9 @@ def render(planned: list[Page], footer: str, output_dir, progress=True, workers=
 def write_report(planned: list[Page], output_dir, title="rockfrag report", footer=None, progress=True,
                  workers=None):
     """Write report.pdf, report.html and figures/*.png; returns (pdf path, png paths).
-    ``workers=1`` draws everything in this process (no forked PNG worker)."""
+
+    ``workers=1`` draws everything in this process (no forked PNG worker).
+    """
     output_dir = Path(output_dir)
     rendered = render(planned, footer or title, output_dir, progress, workers)
     with atomic_path(output_dir / "report.html") as temporary:
@@ -350,12 +351,41 @@ def _open_optional(path):
         return dataset.load()
 
 
-def report_stage(config, cube, ida, fragility, risk, output, runtime_s=float("nan"), applicability=None,
-                 loaded=None, progress=True, workers=None):
+def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragility: xr.Dataset,
+                 risk: xr.Dataset | None, output: str | os.PathLike, runtime_s: float = float("nan"),
+                 applicability: xr.Dataset | None = None, progress: bool = True,
+                 workers: int | None = None) -> tuple[Path, list[Path]]:
     """Read what the report needs beyond the given datasets from ``output`` and write the report.
 
-    ``risk`` is merged into ``fragility`` when it is a separate dataset; ``loaded`` is accepted for
-    compatibility and not used (the report reads showcase.nc instead of the records).
+    The report reads ``showcase.nc`` for the records, never the records themselves, and runs no solver.
+
+    Parameters
+    ----------
+    config : StudyConfig
+        The study (its ``[report]`` table gives the title, project and author).
+    cube, ida, fragility : xarray.Dataset
+        The opened ``cube.nc``, ``ida.nc`` and ``fragility.nc`` of the study.
+    risk : xarray.Dataset or None
+        The risk variables (``pipeline.risk.risk_dataset``), merged into ``fragility`` when they are a
+        separate dataset; None when ``fragility`` holds them or there is no risk.
+    output : str or os.PathLike
+        The study's output folder: ``showcase.nc``, ``efficiency.nc`` and ``applicability.nc`` are read
+        from it when present, and the report is written to it.
+    runtime_s : float, optional
+        Wall time of the pipeline run [s], stated on the title page; NaN leaves it out.
+    applicability : xarray.Dataset, optional
+        The applicability sweep; None reads ``applicability.nc`` if there is one.
+    progress : bool, optional
+        Show a progress bar over the pages.
+    workers : int, optional
+        1 draws every page in this process; otherwise the PNGs are drawn in one forked worker.
+
+    Returns
+    -------
+    pdf : pathlib.Path
+        ``output/report.pdf`` (``report.html`` beside it).
+    pngs : list of pathlib.Path
+        ``output/figures/NN-name.png``, one per page in page order.
     """
     output = Path(output)
     if risk is not None and risk is not fragility and "probability_in_life" not in fragility:

@@ -15,7 +15,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.damage_states import DAMAGE_STATES
 from pipeline.measures import short_label as measure_short_label
+from pipeline.models import MODELS
 from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
 from pipeline.units import STANDARD_GRAVITY
@@ -25,6 +27,24 @@ OUTCOME_ROCKING, OUTCOME_FAILED = int(Outcome.ROCKING), int(Outcome.FAILED)
 
 @dataclass(frozen=True)
 class ModelInfo:
+    """What the report shows of a model: its registry name, label and role.
+
+    Attributes
+    ----------
+    name : str
+        The registry name (``housner``, ``ssi``, ...).
+    label : str
+        The registry label, or "name: description" when the model has none.
+    rigid_base : bool
+        The result does not depend on the soil (computed once per block).
+    description : str
+        The registry description ("" for a model no longer registered).
+    can_pull : bool
+        The foundation can pull on the block (tension).
+    uses_bed : bool
+        The model rests on a bed of springs (``solver.bed``), not on the pivot-switch rule.
+    """
+
     name: str
     label: str
     rigid_base: bool
@@ -35,8 +55,6 @@ class ModelInfo:
 
 def model_info(name: str) -> ModelInfo:
     """Label and role of a model from the registry (a model no longer registered keeps its name)."""
-    from pipeline.models import MODELS
-
     model = MODELS.get(name)
     if model is None:
         return ModelInfo(name, name, False, "")
@@ -100,8 +118,6 @@ def measure_label(dataset) -> str:
 
 def state_labels(fragility) -> dict:
     """Human label of each damage state: the registry's description with its symbols."""
-    from pipeline.damage_states import DAMAGE_STATES
-
     labels = {}
     descriptions = (fragility["damage_state_description"].values if "damage_state_description" in fragility.coords
                     else [""] * fragility.sizes["damage_state"])
@@ -113,9 +129,12 @@ def state_labels(fragility) -> dict:
 
 
 def extrapolation(fragility, output=None) -> pd.DataFrame:
-    """One row per fitted median: soil, block, model, damage_state, median, status
-    (``within``, ``above-range``, ``below-range``). ``fragility.csv``'s ``status`` or ``extrapolated``
-    column is used when present; otherwise the median is compared with the block's studied levels."""
+    """One row per fitted median: soil, block, model, damage_state, median, status.
+
+    The status is ``within``, ``above-range``, ``below-range``, ``extrapolated`` or ``no fit``.
+    ``fragility.csv``'s ``status`` or ``extrapolated`` column is used when present; otherwise the median
+    is compared with the block's studied levels.
+    """
     table = fragility["median"].to_dataframe().reset_index()[["soil", "block", "model", "damage_state", "median"]]
     csv = Path(output) / "fragility.csv" if output is not None else None
     if csv is not None and csv.is_file():
@@ -156,8 +175,10 @@ def _status_word(status: str, median: float) -> str:
 
 
 def run_fraction(cube, flag, model: ModelInfo):
-    """Fraction of a model's valid runs where ``flag`` (a boolean DataArray over the cube) holds,
-    per soil and block (soil collapsed for rigid-base models); None when the flag is all NaN."""
+    """Fraction of a model's valid runs where ``flag`` (a boolean DataArray over the cube) holds.
+
+    Per soil and block (soil collapsed for rigid-base models); None when the flag is all NaN.
+    """
     valid = cube.outcome.sel(model=model.name) != OUTCOME_FAILED
     values = flag.sel(model=model.name)
     known = values.notnull() & valid

@@ -10,10 +10,22 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import xarray as xr
 
-from pipeline.report.adapters import (OUTCOME_ROCKING, block_levels, cell, measure_label, model_styles, models_of,
-                                      panel_label, short_label, state_labels, uplift_intensity)
-from pipeline.report.layout import GRID, FRACTILE_STYLES, log_axis, new_page, outside_legend, panels, soil_colour
+from pipeline.fragility import lognormal_cdf
+from pipeline.report.adapters import (
+    OUTCOME_ROCKING,
+    block_levels,
+    cell,
+    measure_label,
+    model_styles,
+    models_of,
+    panel_label,
+    short_label,
+    state_labels,
+    uplift_intensity,
+)
+from pipeline.report.layout import FRACTILE_STYLES, GRID, log_axis, new_page, outside_legend, panels, soil_colour
 from pipeline.units import STANDARD_GRAVITY
 
 G = STANDARD_GRAVITY
@@ -28,6 +40,11 @@ def _grid(n):
 
 
 def spectra_page(showcase, caption):
+    """A page figure of the record set's 5%-damped spectra and their fractiles.
+
+    ``showcase`` is the opened ``showcase.nc`` (``record_spectrum`` [m/s^2] over ``period`` [s]); drawn
+    log-log in g, under the page title and ``caption``.
+    """
     figure = new_page("Response spectra of the record set", caption)
     axis = panels(figure)[0, 0]
     periods = showcase.period.values
@@ -45,6 +62,11 @@ def spectra_page(showcase, caption):
 
 
 def showcase_ground_page(showcase, caption):
+    """A page figure of the showcase record, raw and processed, over its whole length.
+
+    ``showcase`` is the opened ``showcase.nc``: acceleration (drawn in g), velocity [m/s] and
+    displacement [m] against time [s], under the page title and ``caption``.
+    """
     title = (f"{showcase.attrs.get('showcase_event', '')}, {showcase.attrs.get('showcase_station', '')} "
              f"{showcase.attrs.get('showcase_component', '')} ({showcase.attrs['showcase_record']}): raw and processed")
     figure = new_page(title, caption)
@@ -71,10 +93,10 @@ def _time_window(showcase):
 
 
 def showcase_response_page(showcase, caption):
-    """Ground motion on top, then per soil theta(t) (left) and the foundation's settlement (right);
-    one y-scale per column, time cropped to the strong motion."""
-    import xarray as xr
+    """Ground motion on top, then per soil theta(t) (left) and the foundation's settlement (right).
 
+    One y-scale per column, time cropped to the strong motion.
+    """
     block = showcase.attrs["showcase_block"]
     figure = new_page(f"{showcase.attrs['showcase_record']}, block '{block}' (R = "
                       f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
@@ -172,8 +194,6 @@ def ida_page(ida, block, caption):
 
 
 def _fragility_series(axis, fragility, levels, picked, state, style, label):
-    from pipeline.fragility import lognormal_cdf
-
     values = picked.sel(damage_state=state)
     grid = np.geomspace(levels[0], levels[-1], 200)
     median, beta = float(values["median"]), float(values["beta"])
@@ -204,8 +224,11 @@ def _state_axes(figure, fragility, n_rows=1):
 
 
 def _probability_axes(axes, levels, x_label: str, y_label: str) -> None:
-    """Probability against intensity on every visible panel: log x over the block's levels, y from 0 to 1,
-    a grid; the y label on the first column, the x label on the last row."""
+    """Probability against intensity on every visible panel.
+
+    Log x over the block's levels, y from 0 to 1, a grid; the y label on the first column, the x label
+    on the last row.
+    """
     for axis in axes.flat:
         if not axis.get_visible():
             continue
@@ -296,8 +319,10 @@ def outcomes_page(fragility, block, caption):
 
 
 def applicability_page(cube, caption, limit=0.10):
-    """Median peak angle of each foundation model over the rigid-base reference against G_s, per block;
-    soils named on the top axis."""
+    """Median peak angle of each foundation model over the rigid-base reference against G_s, per block.
+
+    The soils are named on the top axis.
+    """
     models = models_of(cube)
     reference = next(m for m in models if m.rigid_base)
     founded = [m for m in models if not m.rigid_base]

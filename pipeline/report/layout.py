@@ -19,6 +19,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 PAGE_SIZE = (11.69, 8.27)  # A4 landscape [in]
 GRID = dict(left=0.07, right=0.835, bottom=0.145, top=0.885, wspace=0.2, hspace=0.32)  # axes area
@@ -68,9 +69,12 @@ class Page:
     png: bytes = field(default=b"", repr=False)
 
 
-def new_page(title: str, caption: str = ""):
-    """A figure of the page size with its title and caption (no layout engine: every page has the
-    same fixed margins, which is faster than constrained layout and keeps pages alike)."""
+def new_page(title: str, caption: str = "") -> Figure:
+    """A figure of the page size with its title and caption.
+
+    No layout engine: every page has the same fixed margins, which is faster than constrained layout
+    and keeps pages alike.
+    """
     figure = plt.figure(figsize=PAGE_SIZE)
     figure.text(0.015, 0.975, title, fontsize=TITLE_SIZE, weight="bold", va="top", ha="left")
     if caption:
@@ -96,8 +100,6 @@ def add_footer(figure, left: str, number: int, total: int) -> None:
 
 def log_axis(axis) -> None:
     """Log x axis with plain-number tick labels at 1, 2, 5 x 10^n (no overlapping minor labels)."""
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
-
     axis.set_xscale("log")
     axis.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
     axis.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
@@ -105,6 +107,7 @@ def log_axis(axis) -> None:
 
 
 def soil_colour(soil: str, index: int) -> str:
+    """The colour of a soil: its own for the shipped soils, else the ``index``-th of matplotlib's cycle."""
     return SOIL_COLOURS.get(soil, f"C{index % 10}")
 
 

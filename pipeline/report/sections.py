@@ -10,14 +10,28 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
 from pipeline import __version__
-from pipeline.report.adapters import (OUTCOME_FAILED, block_levels, cell, extrapolation, friction_flag,
-                                      measure_label, models_of, run_fraction, state_labels, tension_flag)
+from pipeline.config import StudyConfig
+from pipeline.fragility import STATUS
+from pipeline.report.adapters import (
+    OUTCOME_FAILED,
+    block_levels,
+    cell,
+    extrapolation,
+    friction_flag,
+    measure_label,
+    models_of,
+    run_fraction,
+    state_labels,
+    tension_flag,
+)
 from pipeline.report.layout import pretty
-from pipeline.report.text import bullet, heading, note, paragraph, table
+from pipeline.report.text import Item, bullet, heading, note, paragraph, table
 from pipeline.units import STANDARD_GRAVITY
 
 DEFAULT_FRICTION_COEFFICIENT = 0.5
@@ -28,15 +42,15 @@ EXTRAPOLATION_ROWS = 30
 class Results:
     """Everything the report reads (datasets already opened)."""
 
-    config: object
-    cube: object
-    ida: object
-    fragility: object  # fitted curves merged with the risk variables
-    output: object
-    showcase: object = None
-    applicability: object = None
-    efficiency: object = None
-    runtime_s: float = float("nan")
+    config: StudyConfig
+    cube: xr.Dataset
+    ida: xr.Dataset
+    fragility: xr.Dataset  # fitted curves merged with the risk variables
+    output: Path  # the study's output folder (fragility.csv is read from it)
+    showcase: xr.Dataset | None = None
+    applicability: xr.Dataset | None = None
+    efficiency: xr.Dataset | None = None
+    runtime_s: float = float("nan")  # wall time of the pipeline run [s]; NaN: not stated
 
     @property
     def settings(self) -> dict:
@@ -50,10 +64,12 @@ class Results:
 
     @property
     def title(self) -> str:
+        """The report's title: ``[report] title`` or ``[study] title``, else a generic one."""
         return str(self.settings.get("title") or "Seismic fragility of unanchored rocking blocks")
 
     @property
     def friction_coefficient(self) -> float:
+        """The friction coefficient [-] the sliding check compares with (``[report] friction_coefficient``)."""
         return float(self.settings.get("friction_coefficient", DEFAULT_FRICTION_COEFFICIENT))
 
 
@@ -72,7 +88,7 @@ def n_runs(cube) -> int:
     return int(sum(per_soil * (1 if m.rigid_base else cube.sizes["soil"]) for m in models_of(cube)))
 
 
-def title_items(results: Results):
+def title_items(results: Results) -> list[Item]:
     """The title page below the title: study, size of the run, what the report holds."""
     config, cube = results.config, results.cube
     items = [
@@ -92,7 +108,7 @@ def title_items(results: Results):
     return items
 
 
-def summary_items(results: Results):
+def summary_items(results: Results) -> list[Item]:
     """Per block, model and soil: median/beta of the two most severe states, P(most severe in life)."""
     fragility = results.fragility
     labels = state_labels(fragility)
@@ -142,7 +158,8 @@ def _processing_text(cube):
     return "; ".join(steps) or "not recorded in the cube"
 
 
-def methods_items(results: Results):
+def methods_items(results: Results) -> list[Item]:
+    """The methods pages: models, soils and blocks, records and processing, scaling, fits, hazard and risk."""
     config, cube, fragility = results.config, results.cube, results.fragility
     items = [heading("Models and their assumptions")]
     bed = (config.raw.get("solver", {}) or {}).get("bed", "continuous")
@@ -177,7 +194,8 @@ def methods_items(results: Results):
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
     items += [heading("Record set and processing"),
               paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
-                        f"from {events} earthquake{'s' if events != 1 else ''}; PGA of the processed records {pga.min():.3g} to {pga.max():.3g} g. "
+                        f"from {events} earthquake{'s' if events != 1 else ''}; PGA of the processed records "
+                        f"{pga.min():.3g} to {pga.max():.3g} g. "
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
                         "files and each record's processing steps are stored in cube.nc.")]
 
@@ -203,14 +221,16 @@ def methods_items(results: Results):
               paragraph(f"Damage states: {'; '.join(f'{n}: {t}' for n, t in labels.items())}. Each soil × block × "
                         "model × state is fitted by maximum likelihood on the binomial counts per level (Baker 2015); "
                         "overturning also from the per-record IDA capacities, right-censored at the highest level. "
-                        f"Confidence bounds ({config.confidence:.0%}) from {fragility.attrs.get('bootstrap_samples', '?')} "
+                        f"Confidence bounds ({config.confidence:.0%}) from "
+                        f"{fragility.attrs.get('bootstrap_samples', '?')} "
                         f"bootstrap samples of the records (seed {fragility.attrs.get('bootstrap_seed', '?')}). States "
                         "that would cross inside the studied range are refitted with one shared β; a state reached at "
                         "one intensity by every record is a deterministic threshold. Fit methods used: "
                         f"{', '.join(methods)}.")]
     if "annual_frequency" in fragility:
         items += [heading("Hazard and risk"),
-                  paragraph(f"Hazard curve: {fragility.attrs.get('hazard_source', config.hazard_file or 'shipped example')}. "
+                  paragraph("Hazard curve: "
+                            f"{fragility.attrs.get('hazard_source', config.hazard_file or 'shipped example')}. "
                             "Mean annual frequency of each damage state λ = ∫ P(DS | im) |dλ(im)|, the hazard "
                             "interpolated log-log; probability in the design life "
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
@@ -224,7 +244,8 @@ def _fraction_table(fraction, soils, blocks):
     return table(header, rows)
 
 
-def limitations_items(results: Results):
+def limitations_items(results: Results) -> list[Item]:
+    """The limitations pages: foundation tension, sliding, extrapolated medians, solver failures (from the results)."""
     cube, fragility = results.cube, results.fragility
     models = models_of(cube)
     items = [heading("Foundation tension")]
@@ -302,10 +323,6 @@ def limitations_items(results: Results):
                             "studied range", "status"], rows))
         if len(outside) > EXTRAPOLATION_ROWS:
             items.append(note(f"... and {len(outside) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
-        try:
-            from pipeline.fragility import STATUS
-        except ImportError:
-            STATUS = {}
         for word in dict.fromkeys(outside.status):
             if word in STATUS:
                 items.append(note(f"{word}: {STATUS[word]}."))

@@ -11,6 +11,8 @@ import html
 import textwrap
 from dataclasses import dataclass, field
 
+import matplotlib.lines
+
 from pipeline.report.layout import new_page
 
 TOP, BOTTOM = 0.925, 0.085  # figure fractions available to text
@@ -30,23 +32,28 @@ class Item:
     rows: list = field(default_factory=list)
 
 
-def heading(text):
+def heading(text: str) -> Item:
+    """A section heading (two lines of the page)."""
     return Item("heading", text)
 
 
-def paragraph(text):
+def paragraph(text: str) -> Item:
+    """A paragraph, wrapped to the page width and followed by a blank line."""
     return Item("paragraph", text)
 
 
-def bullet(text):
+def bullet(text: str) -> Item:
+    """One item of a bullet list."""
     return Item("bullet", text)
 
 
-def note(text):
+def note(text: str) -> Item:
+    """A note in smaller italic type."""
     return Item("note", text)
 
 
-def table(header, rows):
+def table(header, rows) -> Item:
+    """A table: ``header`` a list of column titles, ``rows`` lists of cells (each cell shown as ``str``)."""
     return Item("table", header=[str(h) for h in header], rows=[[str(c) for c in row] for row in rows])
 
 
@@ -60,8 +67,10 @@ def _lines(item) -> int:
 
 
 def paginate(items, capacity=None) -> list[list[Item]]:
-    """Split items into pages; a table longer than a page is split with its header repeated;
-    a heading never ends a page."""
+    """Split items into pages of ``capacity`` lines (default: a full page).
+
+    A table longer than a page is split with its header repeated; a heading never ends a page.
+    """
     capacity = capacity or int((TOP - BOTTOM) / LINE)
     pages, current, used = [], [], 0
     queue = list(items)
@@ -144,8 +153,6 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
 
 
 def _rule(y, right):
-    import matplotlib.lines
-
     return matplotlib.lines.Line2D([LEFT, min(right, 0.985)], [y, y], color="0.5", lw=0.6)
 
 
