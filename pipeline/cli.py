@@ -176,6 +176,7 @@ def _log(message):
 # ---------------------------------------------------------------- commands
 
 def command_records(args) -> int:
+    """``rockfrag records``: the records table (records.csv) and, with ``--plot``, a figure per record."""
     import pandas as pd
 
     from pipeline.processing import load_recipe
@@ -212,6 +213,7 @@ def command_records(args) -> int:
 
 
 def command_run(args) -> int:
+    """``rockfrag run``: the study cube (cube.nc) and the showcase (showcase.nc); resumes from checkpoints."""
     from pipeline.showcase import showcase_stage
     from pipeline.study import run_study, study_records
 
@@ -228,8 +230,11 @@ def command_run(args) -> int:
 
 
 def command_fragility(args) -> int:
-    """The whole pipeline: study cube, IDA, fragility and risk, applicability (``run_applicability``), report,
-    and the answer table (``pipeline.answer``; not with ``--quiet``)."""
+    """``rockfrag fragility``: the whole pipeline.
+
+    Study cube, IDA, fragility and risk, applicability (``run_applicability``), report, and the answer table
+    (``pipeline.answer``; not with ``--quiet``).
+    """
     import time
 
     import xarray as xr
@@ -335,6 +340,7 @@ def _calibration_bed(args, config) -> dict:
 
 
 def command_calibrate(args) -> int:
+    """``rockfrag calibrate``: k and xi of the SSI model fitted to a reference history (eq. 17)."""
     from pipeline.calibrate import calibrate, check_reference, load_reference, write_outputs
 
     config, output = _study_config(args)
@@ -385,6 +391,7 @@ APPLICABILITY_OPTIONS = ("g_range", "n_g", "levels", "block_moduli", "tolerance"
 
 
 def command_applicability(args) -> int:
+    """``rockfrag applicability``: the rigid-base applicability sweep (applicability.nc and its figure)."""
     from pipeline.applicability import applicability_stage
     from pipeline.study import study_records
 
@@ -403,6 +410,7 @@ def command_applicability(args) -> int:
 # ---------------------------------------------------------------- the parser
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``rockfrag`` argument parser with one subcommand per stage."""
     parser = argparse.ArgumentParser(
         prog="rockfrag",
         description="Seismic fragility of unanchored rocking structures (Housner and SSI-rocking "
@@ -559,7 +567,7 @@ def _output_folder(args) -> Path | None:
 
 
 def _parse_arguments(parser, argv):
-    """argparse's namespace; a usage error is one line (argparse's own, without the usage block)."""
+    """The parsed namespace; a usage error is one line (argparse's own, without the usage block)."""
     captured = io.StringIO()
     try:
         with contextlib.redirect_stderr(captured):

@@ -37,8 +37,8 @@ from pipeline.measures import MEASURES, scaling_measures
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
-from pipeline.validation import (Checked, Either, Flag, Interval, NamedTables, Names, Number, Numbers, Table, Text,
-                                 shown as _shown)
+from pipeline.validation import Checked, Either, Flag, Interval, NamedTables, Names, Number, Numbers, Table, Text
+from pipeline.validation import shown as _shown
 
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
@@ -228,6 +228,7 @@ class StudyConfig:
 
     @property
     def level_unit(self) -> str:
+        """The display unit of the levels (g for accelerations, m/s for PGV)."""
         return MEASURES[self.measure].display_unit
 
     @property
@@ -371,9 +372,11 @@ def _check_damage_states(data, source):
 
 
 def _check_hazard(path, source, measure="pga", period=None):
-    """The hazard curve loads (file exists, numeric, decreasing frequency) and is for the study's
-    intensity measure (and Sa period). No file and a measure other than the shipped example's: no risk,
-    nothing to check (pipeline.hazard.hazard_for)."""
+    """Check that the hazard curve loads and is for the study's intensity measure (and Sa period).
+
+    Loads means: the file exists, is numeric, and its frequencies decrease. No file and a measure other than
+    the shipped example's: no risk, nothing to check (pipeline.hazard.hazard_for).
+    """
     if path and Path(path).is_dir():
         raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
     try:
