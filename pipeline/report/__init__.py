@@ -158,7 +158,7 @@ def plan(results: Results) -> list[Page]:
                                caption="Medians over records and levels from 1.2 to 3 times each block's uplift "
                                        "threshold where both models rocked without overturning; top axis: the "
                                        "study's soils."))
-    if results.applicability is not None and "peak_angle_ratio_ssi_housner" in results.applicability:
+    if results.applicability is not None and "peak_angle_ratio_to_housner" in results.applicability:
         planned.append(_figure("applicability-sweep", "Applicability", "Rigid-base error against soil stiffness",
                                pages.sweep_page, results.applicability,
                                caption=f"`rockfrag applicability`: median over "

@@ -274,7 +274,8 @@ def fragility_by_model_page(fragility, block, soils, caption):
     levels = block_levels(fragility, block)
     for row, soil in enumerate(soils):
         for column, state in enumerate(states):
-            axis = axes[row, column]
+            # one soil: _state_axes lays the states out on a grid, not in one row
+            axis = axes[row, column] if len(soils) > 1 else axes.flat[column]
             for model in models:
                 _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                   styles[model.name], short_label(model))
@@ -361,31 +362,30 @@ def applicability_page(cube, caption, limit=0.10):
 
 
 def sweep_page(dataset, caption):
-    """The fine G_s sweep of `rockfrag applicability`, one panel per block."""
+    """The fine G_s sweep of `rockfrag applicability`: rows are the compliant models, columns the blocks."""
     tolerance = float(dataset.attrs.get("tolerance", 0.1))
     blocks = list(dataset.block.values)
-    rows, columns = _grid(len(blocks))
+    models = list(dataset.model.values)
     figure = new_page(f"Rigid-base error against soil stiffness (grey: ±{tolerance:.0%}; green: paper's "
                       "300-1000 MPa)", caption)
-    axes = panels(figure, rows, columns, sharey=True, gridspec_kw=dict(hspace=0.4))
-    for axis in axes.flat[len(blocks):]:
-        axis.set_visible(False)
+    axes = panels(figure, len(models), len(blocks), sharey=True, gridspec_kw=dict(hspace=0.5))
     shear = dataset.shear_modulus.values / 1e6
     dash = ["-", "--", ":", "-."]
-    for axis, block in zip(axes.flat, blocks):
-        for e_index, modulus in enumerate(dataset.block_modulus.values):
-            for l_index, level in enumerate(dataset.level.values):
-                ratio = dataset.peak_angle_ratio_ssi_housner.sel(block=block).values[e_index, l_index]
-                axis.plot(shear, ratio, color=f"C{l_index}", ls=dash[e_index % 4], marker=".",
-                              label=f"E_b = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
-        axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
-        axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
-        axis.axhline(1.0, color="k", lw=0.7)
-        axis.set_title(str(block), fontsize=10)
-        log_axis(axis)
-        axis.set_xlabel("soil shear modulus G_s [MPa]")
-        axis.grid(alpha=0.3, which="both")
-    for axis in axes[:, 0]:
-        axis.set_ylabel("median θmax SSI / Housner [-]")
+    for row, model in enumerate(models):
+        label = str(dataset.model_label.values[row]) if "model_label" in dataset.coords else str(model)
+        for axis, block in zip(axes[row], blocks):
+            ratios = dataset.peak_angle_ratio_to_housner.sel(model=model, block=block).values
+            for e_index, modulus in enumerate(dataset.block_modulus.values):
+                for l_index, level in enumerate(dataset.level.values):
+                    axis.plot(shear, ratios[e_index, l_index], color=f"C{l_index}", ls=dash[e_index % 4],
+                              marker=".", label=f"E_b = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
+            axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
+            axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
+            axis.axhline(1.0, color="k", lw=0.7)
+            axis.set_title(f"{block}: {label}", fontsize=9)
+            log_axis(axis)
+            axis.set_xlabel("soil shear modulus G_s [MPa]")
+            axis.grid(alpha=0.3, which="both")
+        axes[row, 0].set_ylabel("median θmax model / Housner [-]")
     outside_legend(figure, [axes.flat[0]])
     return figure

@@ -88,6 +88,14 @@ def n_runs(cube) -> int:
     return int(sum(per_soil * (1 if m.rigid_base else cube.sizes["soil"]) for m in models_of(cube)))
 
 
+
+def _result_files(results: Results) -> list[str]:
+    """The result files this report read: the optional ones only when the run wrote them."""
+    optional = {"showcase.nc": results.showcase, "applicability.nc": results.applicability,
+                "efficiency.nc": results.efficiency}
+    return ["cube.nc", "ida.nc", "fragility.nc"] + [name for name, dataset in optional.items()
+                                                    if dataset is not None and len(dataset.data_vars)]
+
 def title_items(results: Results) -> list[Item]:
     """The title page below the title: study, size of the run, what the report holds."""
     config, cube = results.config, results.cube
@@ -100,8 +108,8 @@ def title_items(results: Results) -> list[Item]:
                   f"{n_runs(cube)} solver runs."),
         paragraph("This report states the fragility of each block on each soil for each model, the methods and "
                   "assumptions behind the numbers, and where the models are outside their validity (page "
-                  "'Limitations'). Every number is read from the result files in the same folder (cube.nc, "
-                  "ida.nc, fragility.nc, showcase.nc, applicability.nc)."),
+                  "'Limitations'). Every number is read from the result files in the same folder "
+                  f"({', '.join(_result_files(results))})."),
     ]
     if np.isfinite(results.runtime_s):
         items.append(note(f"Run time of the pipeline run that wrote this report: {results.runtime_s:.0f} s."))
