@@ -15,10 +15,10 @@ import numpy as np
 
 from pipeline import __version__
 from pipeline.report.adapters import (OUTCOME_FAILED, block_levels, cell, extrapolation, friction_flag,
-                                      measure_label, models_of, run_fraction, state_labels, tension_flag)
+                                      measure_label, models_of, record_pga_g, run_fraction, state_labels,
+                                      tension_flag)
 from pipeline.report.layout import pretty
 from pipeline.report.text import bullet, heading, note, paragraph, table
-from pipeline.units import STANDARD_GRAVITY
 
 DEFAULT_FRICTION_COEFFICIENT = 0.5
 EXTRAPOLATION_ROWS = 30
@@ -173,7 +173,7 @@ def methods_items(results: Results):
             for b in cube.block.values]
     items.append(table(header, rows))
 
-    pga = cube.record_pga.values / STANDARD_GRAVITY
+    pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
     items += [heading("Record set and processing"),
               paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
