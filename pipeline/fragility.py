@@ -362,7 +362,7 @@ def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n
                        capacities: list | None, top: float) -> None:
     """The overturning row of one cell: the capacity fit of its refined capacities into ``out`` (see
     ``CAPACITY_FIT``), and warnings on ``row`` for resurrection and for a capacity median outside the stripe
-    fit's bootstrap bounds.
+    fit's bootstrap bounds (when the stripe fit has a spread: beta > 0 and distinct bounds).
 
     capacities : [capacity, censor point] per record [unit] or None; top : the cell's highest level, where
     a record that never overturned is censored when its own survival is unknown.
@@ -376,7 +376,7 @@ def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n
     median, beta = fit_censored_capacities(capacity, np.where(np.isfinite(censor), censor, top))
     out["capacity_median"][key], out["capacity_beta"][key] = median, beta
     low, high = out["median_low"][key], out["median_high"][key]
-    if np.isfinite(median) and np.isfinite(low) and not low <= median <= high:
+    if row.beta > 0 and np.isfinite(median) and low < high and not low <= median <= high:
         row.warn(f"the refined capacities' median {median:.3g} {unit} lies outside the bounds "
                  f"{low:.3g}-{high:.3g} {unit} of the stripe fit")
 

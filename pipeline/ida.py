@@ -38,6 +38,7 @@ from pipeline.measures import convert_units, parse_units, udunits
 from pipeline.outputs import write_dataset
 
 FRACTILES = (0.16, 0.50, 0.84)
+FRACTILE_ATTRS = {"long_name": "fractile (non-exceedance probability) over the records", "units": "1"}
 RESPONSE_LEVELS = np.round(np.concatenate([np.linspace(0.05, 1.0, 20), np.linspace(1.5, 5.0, 8)]), 4)
 """Response levels theta_max/alpha at which the intensity-given-response fractiles are computed."""
 
@@ -149,7 +150,8 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
     intensities, unit = block_intensities(cube)
     edp_fractile = xr.DataArray(
         np.quantile(edp.values, FRACTILES, axis=0, method="inverted_cdf"),
-        dims=("fractile", *edp.dims[1:]), coords={"fractile": list(FRACTILES), **{d: cube[d] for d in edp.dims[1:]}},
+        dims=("fractile", *edp.dims[1:]),
+        coords={"fractile": ("fractile", list(FRACTILES), FRACTILE_ATTRS), **{d: cube[d] for d in edp.dims[1:]}},
         attrs={"long_name": "fractile of theta_max/alpha given intensity (inf = overturned)", "units": "1"})
     stack_dims = ("soil", "block", "model")
     block_axis = stack_dims.index("block")
@@ -203,7 +205,7 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
                                   ("capacity_runs_saved_fraction", "runs_saved_fraction")):
             if cube_key in cube.attrs:
                 attrs[ida_key] = cube.attrs[cube_key]
-    dataset = xr.Dataset(data_vars, coords={**coords, "fractile": list(FRACTILES),
+    dataset = xr.Dataset(data_vars, coords={**coords, "fractile": ("fractile", list(FRACTILES), FRACTILE_ATTRS),
                          "response_level": ("response_level", RESPONSE_LEVELS,
                                             {"long_name": "theta_max/alpha", "units": "1"})})
     dataset.attrs = attrs
