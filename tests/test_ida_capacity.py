@@ -82,6 +82,7 @@ def test_adaptive_capacity_matches_a_brute_force_fine_grid(bolu_records, record_
     fine_overturned = status(fine)
     transitions = fine[1:][fine_overturned[1:] & ~fine_overturned[:-1]]  # first overturning after a survival
     assert np.any((transitions > lower) & (transitions <= upper))
+    assert stripes[j - 1] <= lower < found < upper <= stripes[j]  # inside the FIRST overturning stripe gap
     assert runs < fine.size / 20
     first = fine[int(np.flatnonzero(fine_overturned)[0])]
     if record_id == "DUZCE/BOL090":
