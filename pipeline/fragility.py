@@ -42,7 +42,12 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from pipeline.cube import (
+    OUTCOME_FAILED,
+    OUTCOME_NO_UPLIFT,
+    OUTCOME_OVERTURNED,
+    OUTCOME_ROCKING,
+)
 from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError
 from pipeline.hazard import study_hazard
@@ -83,9 +88,9 @@ RIGID_UPLIFT_MODELS = ("housner", "ssi", "ssi-paper")
 """Fallback when a model object does not say ``uplift_is_rigid_threshold``."""
 
 OVERTURNING_CONVENTION = (
-    "first overturning (Vamvatsikos & Cornell 2002): a record counts as overturned, and as beyond every "
-    "damage state, at every level from its first overturning level on; a record that survives a higher "
-    "level (resurrection) is counted in n_resurrected, not fitted")
+    "first-overturn convention (Vamvatsikos & Cornell 2002): a record counts as overturned, and as beyond "
+    "every damage state, at every level from its first overturning level on; records that survive a higher "
+    "level (resurrection) are counted in n_resurrected, not fitted")
 """How the fits count overturning (a global attribute of fragility.nc; the report quotes it)."""
 
 CAPACITY_FIT = (

@@ -12,6 +12,8 @@ one ``Measure``: name, function, SI and display unit, long name, short label, pe
 OpenQuake IMT. Every stage reads these (the study file's choices and units, the cube's metadata, the
 report's axes, the hazard readers, the pelicun export): a new measure is one ``@define_measure``
 function at the end of this module.
+``Measure.cf_units``, ``file_units``, ``parse_units`` and ``convert_units`` are the one place for the
+``units`` strings of result files (as UDUNITS parses them: g is "9.80665 m s-2") and for reading them back.
 
 All functions are pure. The oscillator uses the exact solution for ground acceleration that is
 linear between samples (Nigam & Jennings 1969); its recurrence coefficients come from the matrix

@@ -12,7 +12,14 @@ import xarray as xr
 
 from pipeline.cli import main
 from pipeline.config import load_study
-from pipeline.measures import MEASURES, convert_units, file_units, parse_units, udunits, unit_label
+from pipeline.measures import (
+    MEASURES,
+    convert_units,
+    file_units,
+    parse_units,
+    udunits,
+    unit_label,
+)
 from pipeline.study import run_study
 
 from .test_study import SMALL
@@ -84,7 +91,7 @@ def test_the_measure_registry_derives_every_units_string():
     assert udunits("m/s^2", 9.80665) == "9.80665 m s-2"
     for measure in MEASURES.values():
         for display in (True, False):
-            quantity, value = parse(measure.cf_units(display))
+            _, value = parse(measure.cf_units(display))
             assert value == pytest.approx(measure.display_factor if display else 1.0)
             assert parse_units(measure.cf_units(display))[0] == pytest.approx(value)
     assert parse_units("g") == (9.80665, "m s-2")  # files written before: read back correctly

@@ -15,7 +15,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
+from pipeline.measures import (
+    MEASURES,
+    convert_units,
+    file_units,
+    parse_units,
+    unit_label,
+)
 from pipeline.measures import short_label as measure_short_label
 from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty

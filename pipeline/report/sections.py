@@ -202,7 +202,9 @@ def methods_items(results: Results):
     items += [heading("Fragility fits"),
               paragraph(f"Damage states: {'; '.join(f'{n}: {t}' for n, t in labels.items())}. Each soil × block × "
                         "model × state is fitted by maximum likelihood on the binomial counts per level (Baker 2015); "
-                        "overturning also from the per-record IDA capacities, right-censored at the highest level. "
+                        f"overturning by the {fragility.attrs.get('overturning_convention', 'outcomes as run')} "
+                        f"({int(fragility.n_resurrected.sum()) if 'n_resurrected' in fragility else 0} here); the refined "
+                        "IDA capacities are also fitted, as a check (capacity_median in fragility.csv). "
                         f"Confidence bounds ({config.confidence:.0%}) from {fragility.attrs.get('bootstrap_samples', '?')} "
                         f"bootstrap samples of the records (seed {fragility.attrs.get('bootstrap_seed', '?')}). States "
                         "that would cross inside the studied range are refitted with one shared β; a state reached at "
