@@ -5,6 +5,11 @@ Input : per-run summary vectors from the solvers, arranged (record, im_level, so
 Output: an ``xarray.Dataset`` following CF-1.12 (every variable with ``units`` and ``long_name``,
         ``outcome`` with ``flag_values``/``flag_meanings``), written atomically as compressed netCDF4
         (``reports/cube.nc``) that plain ``xarray.open_dataset`` reads.
+
+Units: one per quantity in the file, as UDUNITS parses it (``pipeline.measures.file_units``). Every
+acceleration (levels, ``intensity``, ``record_pga``, ``block_uplift_acceleration``, ``record_im`` of an
+acceleration measure) is in multiples of g, written "9.80665 m s-2" (UDUNITS reads "g" as grams);
+velocities in "m s-1"; the rest SI.
 """
 
 from __future__ import annotations
@@ -15,7 +20,7 @@ import numpy as np
 import xarray as xr
 
 from pipeline import __version__
-from pipeline.measures import MEASURES
+from pipeline.measures import MEASURES, file_units, parse_units
 from pipeline.models import get_model
 from pipeline.models.base import Outcome
 from pipeline.models.fields import FIELDS_BY_NAME
@@ -103,16 +108,17 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     (pipeline.study.gather_capacities) or None; capacity_stats : its run accounting.
 
     Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
-    with ``levels.relative_to = "uplift"``, else the levels in the measure's unit. The physical
-    intensity is always the (block, im_level) coordinate ``intensity`` [display unit] with
-    ``intensity_si``; read those, not ``im_level``, for intensities.
+    with ``levels.relative_to = "uplift"``, else the levels in the measure's display unit. The physical
+    intensity is always the (block, im_level) coordinate ``intensity`` [display unit]; read it, not
+    ``im_level``, for intensities. Intensities, ``record_im`` and every acceleration are stored in the
+    measure's display unit (g for accelerations), with ``units`` as UDUNITS parses them (see module docstring).
     """
     model_names = list(config.models)
     n_block = len(config.blocks)
     values = summaries_to_variables(summaries, config.blocks, model_names)
     measure = MEASURES[config.measure]
-    unit = config.level_unit
-    im_si_unit = measure.si_unit
+    acceleration_units = file_units("m/s^2")
+    g_factor = parse_units(acceleration_units)[0]  # SI value of one unit of acceleration_units
     measure_name = measure.describe(**config.measure_options)
     record_im = np.asarray(record_im, float)
     if record_im.ndim == 1:
@@ -154,10 +160,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "record_station": ("record", [str(r.metadata.get("station", "")) for r in records], {"long_name": "station"}),
         "record_component": ("record", [str(r.metadata.get("component", "")) for r in records],
                              {"long_name": "component"}),
-        "record_pga": ("record", [float(np.max(np.abs(r.acceleration))) for r in records],
-                       {"long_name": "PGA of the processed record", "units": "m/s^2"}),
-        "record_im": (("record", "block"), record_im, {"long_name": f"{measure_name} of the processed record",
-                                                       "units": im_si_unit}),
+        "record_pga": ("record", [float(np.max(np.abs(r.acceleration))) / g_factor for r in records],
+                       {"long_name": "PGA of the processed record", "units": acceleration_units}),
+        "record_im": (("record", "block"), record_im / measure.display_factor,
+                      {"long_name": f"{measure_name} of the processed record", "units": measure.cf_units()}),
         "soil_shear_modulus": ("soil", [s.shear_modulus for s in config.soils],
                                {"long_name": "soil shear modulus G_s", "units": "Pa"}),
         "soil_constrained_modulus": ("soil", [s.constrained_modulus for s in config.soils],
@@ -171,8 +177,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "block_b": ("block", [b.b for b in config.blocks], {"long_name": "half-width b", "units": "m"}),
         "block_h": ("block", [b.h for b in config.blocks], {"long_name": "half-height h", "units": "m"}),
         "block_mass": ("block", [b.mass for b in config.blocks], {"long_name": "mass", "units": "kg"}),
-        "block_uplift_acceleration": ("block", [b.uplift_acceleration() for b in config.blocks],
-                                      {"long_name": "Housner uplift threshold g tan(alpha)", "units": "m/s^2"}),
+        "block_uplift_acceleration": ("block", [b.uplift_acceleration() / g_factor for b in config.blocks],
+                                      {"long_name": "Housner uplift threshold g tan(alpha)",
+                                       "units": acceleration_units}),
     }
     dataset = xr.Dataset(data_vars, coords=coords)
     dataset.attrs = {
@@ -199,8 +206,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
 
 
 def _level_coordinates(config, measure_name, intensity) -> dict:
-    """``im_level`` (index: multiples of uplift or absolute levels) and the per-block intensities."""
+    """``im_level`` (index: multiples of uplift or absolute levels) and the per-block intensities, in the
+    measure's display unit (``Measure.cf_units``)."""
     measure = MEASURES[config.measure]
+    units = measure.cf_units()
     if config.relative_levels:
         level = ("im_level", np.asarray(config.levels, float),
                  {"long_name": f"intensity level: multiple of the block's uplift intensity ({measure_name})",
@@ -208,14 +217,11 @@ def _level_coordinates(config, measure_name, intensity) -> dict:
         uplift = intensity[:, 0] / float(config.levels[0])
         extra = {"block_uplift_intensity": ("block", uplift / measure.display_factor, {
             "long_name": f"{measure_name} at which the block starts to rock (pipeline.study.uplift_intensity)",
-            "units": config.level_unit})}
+            "units": units})}
     else:
         level = ("im_level", np.asarray(config.levels, float),
-                 {"long_name": f"intensity level: {measure_name}", "units": config.level_unit})
-        extra = {"im_level_si": ("im_level", config.levels_si, {"long_name": f"intensity level: {measure_name}",
-                                                                 "units": measure.si_unit})}
+                 {"long_name": f"intensity level: {measure_name}", "units": units})
+        extra = {}
     return {"im_level": level, **extra,
             "intensity": (("block", "im_level"), intensity / measure.display_factor,
-                          {"long_name": f"{measure_name} of the level for the block", "units": config.level_unit}),
-            "intensity_si": (("block", "im_level"), intensity,
-                             {"long_name": f"{measure_name} of the level for the block", "units": measure.si_unit})}
+                          {"long_name": f"{measure_name} of the level for the block", "units": units})}

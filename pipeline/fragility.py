@@ -10,8 +10,14 @@ Output: ``reports/fragility.nc`` (median, beta, bootstrap bounds, fit method, ``
 
 Fits (Baker 2015, Earthquake Spectra 31(1); the numerics on arrays are in ``pipeline.lognormal_fit``):
 binomial maximum likelihood on the counts per level, a probit regression solved by vectorised Fisher
-scoring; for overturning also from the IDA
-capacities, right-censored at the highest level. Every row says what it is (``STATUS``):
+scoring. Overturning follows the IDA capacity convention of Vamvatsikos & Cornell (2002): a record
+counts as overturned at every level from its first overturning level on (``OVERTURNING_CONVENTION``);
+a record that survives a higher level (resurrection) is counted per cell (``n_resurrected``) and
+named in a warning, not fitted. These stripe fits (``median``, ``beta``) are the answer: the CSV, the
+pelicun file, the risk and the report carry them. For overturning the refined capacities of
+``ida.nc`` (the first overturning transition bisected to ``capacity_resolution``) are also fitted, a
+censored lognormal MLE (``capacity_median``, ``capacity_beta``; ``CAPACITY_FIT``) that checks the
+stripe fit. Every row says what it is (``STATUS``):
 - uplift under PGA scaling of a model whose uplift is the rigid-body threshold is the exact step
   g tan(alpha) (``deterministic-threshold``, beta = 0), not a fit;
 - perfectly separated counts have no lognormal MLE: a step between the two bracketing levels,
@@ -36,10 +42,16 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pipeline.cube import OUTCOME_FAILED, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from pipeline.cube import (
+    OUTCOME_FAILED,
+    OUTCOME_NO_UPLIFT,
+    OUTCOME_OVERTURNED,
+    OUTCOME_ROCKING,
+)
 from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError
 from pipeline.hazard import study_hazard
+from pipeline.ida import resurrected
 from pipeline.lognormal_fit import (  # noqa: F401
     CROSSING_TOLERANCE,
     curves_cross,
@@ -52,7 +64,7 @@ from pipeline.lognormal_fit import (  # noqa: F401
     lognormal_cdf,
     separation,
 )
-from pipeline.measures import MEASURES, display_units
+from pipeline.measures import MEASURES, convert_units, parse_units, udunits, unit_label
 from pipeline.models import MODELS
 from pipeline.outputs import atomic_path, write_dataset
 from pipeline.risk import risk_dataset
@@ -75,10 +87,31 @@ SMALL_SAMPLE = 10
 RIGID_UPLIFT_MODELS = ("housner", "ssi", "ssi-paper")
 """Fallback when a model object does not say ``uplift_is_rigid_threshold``."""
 
+OVERTURNING_CONVENTION = (
+    "first-overturn convention (Vamvatsikos & Cornell 2002): a record counts as overturned, and as beyond "
+    "every damage state, at every level from its first overturning level on; records that survive a higher "
+    "level (resurrection) are counted in n_resurrected, not fitted")
+"""How the fits count overturning (a global attribute of fragility.nc; the report quotes it)."""
+
+CAPACITY_FIT = (
+    "capacity_median/capacity_beta: lognormal MLE of the refined overturning capacities of ida.nc (the first "
+    "overturning transition bisected to capacity_resolution), right-censored at the highest intensity a "
+    "record was seen to survive where it never overturned; a check of the stripe fit. median/beta, the "
+    "answer carried by fragility.csv, the pelicun file, the risk and the report: binomial MLE on the stripes")
+"""Which fit is which (a global attribute of fragility.nc)."""
+
+
+def first_overturn_outcomes(cube: xr.Dataset) -> xr.DataArray:
+    """The cube's ``outcome`` with every level from a record's first overturning level on set to overturned
+    (``OVERTURNING_CONVENTION``); levels increase along ``im_level``."""
+    since = (cube.outcome == OUTCOME_OVERTURNED).cumsum("im_level") > 0
+    return cube.outcome.where(~since, OUTCOME_OVERTURNED)
+
 
 def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
-    """1.0 where a run reached the damage state, 0.0 where not, NaN where the solver failed."""
-    outcome = cube.outcome
+    """1.0 where a run reached the damage state, 0.0 where not, NaN where the solver failed; a record is
+    beyond every state from its first overturning level on (``first_overturn_outcomes``)."""
+    outcome = first_overturn_outcomes(cube)
     if state.edp == "uplifted":
         reached = outcome >= OUTCOME_ROCKING
     elif state.edp == "overturned":
@@ -91,25 +124,32 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
 # ---------------------------------------------------------------- intensity levels of a cube
 
 def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
-    """The physical intensity of every (block, im_level) in the study's display unit, and the unit.
+    """The physical intensity of every (block, im_level) in the study's display unit, and its ``units``
+    as UDUNITS parses them ("9.80665 m s-2" for g; ``pipeline.measures.Measure.cf_units``).
 
     Works for both cube layouts: one physical ``im_level`` coordinate shared by all blocks, or a
-    dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate (in the
-    display unit, e.g. ``intensity`` [g], or in SI, e.g. ``im_level_si`` [m/s^2]; found by its dims and
-    units). Returns (n_block, n_level).
+    dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate (``intensity``,
+    or any other found by its dims and units, in any unit ``pipeline.measures.parse_units`` reads: g
+    multiples, SI, or an older file's "g"). Returns (n_block, n_level).
     """
     n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
-    display, factor = display_units(cube.attrs.get("intensity_measure", "pga"))
+    measure = MEASURES.get(cube.attrs.get("intensity_measure", "pga"))
+    target = measure.cf_units() if measure is not None else ""
+
+    def in_display(values, units):
+        parsed, wanted = parse_units(units), parse_units(target)
+        if parsed is not None and wanted is not None and parsed[1] == wanted[1]:
+            return np.asarray(convert_units(values, units, target), float), target
+        return values, units if parsed is None else udunits(parsed[1], parsed[0])
+
     per_block = [name for name, coord in cube.coords.items() if set(coord.dims) == {"block", "im_level"}]
     for name in sorted(per_block, key=lambda n: n not in ("intensity", "im_intensity")):
         units = cube[name].attrs.get("units", "")
-        values = cube[name].transpose("block", "im_level").values.astype(float)
-        if units == display:
-            return values, units
-        if (units in ("m/s^2", "m s-2", "m/s", "m s-1") or name == "im_level_si") and display:
-            return values / factor, display
+        if parse_units(units) is not None:
+            return in_display(cube[name].transpose("block", "im_level").values.astype(float), units)
     levels = cube.im_level.values.astype(float)
-    return np.broadcast_to(levels, (n_block, n_level)).copy(), cube.im_level.attrs.get("units", "")
+    values, units = in_display(levels, cube.im_level.attrs.get("units", ""))
+    return np.broadcast_to(values, (n_block, n_level)).copy(), units
 
 
 def uplift_is_rigid_threshold(model_name: str) -> bool:
@@ -121,14 +161,16 @@ def uplift_is_rigid_threshold(model_name: str) -> bool:
 
 
 def uplift_threshold(cube: xr.Dataset, unit: str) -> np.ndarray | None:
-    """g tan(alpha) per block in the study's intensity unit, or None when the cube cannot tell."""
-    factor = {"g": STANDARD_GRAVITY, "m/s^2": 1.0, "m s-2": 1.0}.get(unit)
-    if factor is None:
+    """g tan(alpha) per block in the study's intensity ``unit`` (an acceleration unit ``parse_units``
+    reads), or None when the cube cannot tell or ``unit`` is no acceleration."""
+    parsed = parse_units(unit)
+    if parsed is None or parsed[1] != udunits("m/s^2"):
         return None
     if "block_uplift_acceleration" in cube.coords:
-        return cube.block_uplift_acceleration.values / factor
+        values = cube.block_uplift_acceleration
+        return np.asarray(convert_units(values.values, values.attrs.get("units", "m s-2"), unit), float)
     if "block_alpha" in cube.coords:
-        return STANDARD_GRAVITY * np.tan(cube.block_alpha.values) / factor
+        return np.asarray(convert_units(STANDARD_GRAVITY * np.tan(cube.block_alpha.values), "m s-2", unit), float)
     return None
 
 
@@ -289,8 +331,9 @@ ROW_VARIABLES = {
     "gof_p_value": ("goodness of fit: deviance chi-square p-value of the binomial fit", "1"),
     "gof_max_error": ("goodness of fit: max |fitted - empirical| exceedance fraction", "1"),
     "noncrossing_deviance_cost": ("binomial deviance added by the shared-beta (non-crossing) refit", "1"),
-    "capacity_median": ("median of the IDA overturning capacities (censored lognormal MLE)", None),
-    "capacity_beta": ("dispersion of the IDA overturning capacities (censored lognormal MLE)", "1"),
+    "capacity_median": ("median of the refined IDA overturning capacities (censored lognormal MLE; see the "
+                        "capacity_fit attribute)", None),
+    "capacity_beta": ("dispersion of the refined IDA overturning capacities (censored lognormal MLE)", "1"),
 }
 
 
@@ -301,6 +344,46 @@ def record_resamples(n_records, n_bootstrap, seed):
     weights = np.zeros((n_bootstrap, n_records))
     np.add.at(weights, (np.repeat(np.arange(n_bootstrap), n_records), picks.ravel()), 1.0)
     return weights
+
+
+def refined_capacities(ida: xr.Dataset | None, unit: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """The refined overturning capacities of ``ida.nc`` in ``unit``, (record, soil, block, model), and where
+    each record that never overturned is censored: the highest intensity it was seen to survive
+    (``capacity_lower``; NaN where unknown). None without refined capacities."""
+    if ida is None or "capacity" not in ida:
+        return None
+    out = []
+    for name in ("capacity", "capacity_lower"):
+        if name not in ida:
+            out.append(np.full(out[0].shape, np.nan))
+            continue
+        values = ida[name].transpose("record", "soil", "block", "model")
+        out.append(np.asarray(convert_units(values.values, values.attrs.get("units", unit), unit), float))
+    capacity, lower = out
+    return capacity, np.where(np.isfinite(capacity), np.nan, lower)
+
+
+def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n_records: int, unit: str,
+                       capacities: list | None, top: float) -> None:
+    """The overturning row of one cell: the capacity fit of its refined capacities into ``out`` (see
+    ``CAPACITY_FIT``), and warnings on ``row`` for resurrection and for a capacity median outside the stripe
+    fit's bootstrap bounds (when the stripe fit has a spread: beta > 0 and distinct bounds).
+
+    capacities : [capacity, censor point] per record [unit] or None; top : the cell's highest level, where
+    a record that never overturned is censored when its own survival is unknown.
+    """
+    if n_resurrected:
+        row.warn(f"{n_resurrected} of {n_records} records survived a level above their first overturning level "
+                 "(resurrection): counted as overturned from their first overturning level on")
+    if capacities is None:
+        return
+    capacity, censor = capacities
+    median, beta = fit_censored_capacities(capacity, np.where(np.isfinite(censor), censor, top))
+    out["capacity_median"][key], out["capacity_beta"][key] = median, beta
+    low, high = out["median_low"][key], out["median_high"][key]
+    if row.beta > 0 and np.isfinite(median) and low < high and not low <= median <= high:
+        row.warn(f"the refined capacities' median {median:.3g} {unit} lies outside the bounds "
+                 f"{low:.3g}-{high:.3g} {unit} of the stripe fit")
 
 
 def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, seed=0,
@@ -327,9 +410,9 @@ def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, 
         fraction = reached.sum(0) / valid.sum(0)
     n_records = cube.sizes["record"]
     weights = record_resamples(n_records, n_bootstrap, seed)
-    first_overturn = None
-    if ida is not None:
-        first_overturn = ida.first_overturn_im.transpose("record", *group_dims).values
+    n_resurrected = resurrected(cube.outcome.transpose("record", *group_dims, "im_level").values).sum(0)
+    capacities = refined_capacities(ida, unit)
+    label = unit_label(unit)
     tail = (1 - confidence) / 2
     cells = list(np.ndindex(*shape[:-1]))
     for index in tqdm(cells, desc="fragility fits + bootstrap", unit="cell", disable=not progress):
@@ -339,7 +422,7 @@ def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, 
         exceed = reached[data].sum(0).T  # (state, level)
         total = valid[data].sum(0).T.astype(float)
         threshold = thresholds[block] if thresholds is not None and rigid[models[model]] else None
-        rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, unit)
+        rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, label)
         if n_bootstrap:
             boot_exceed = np.einsum("br,rls->bsl", weights, reached[data])
             boot_total = np.einsum("br,rls->bsl", weights, valid[data].astype(float))
@@ -349,16 +432,17 @@ def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, 
             out["median"][key], out["beta"][key] = row.median, row.beta
             out["noncrossing_deviance_cost"][key] = row.deviance_cost if np.isfinite(row.median) else np.nan
             text["fit_method"][key], text["status"][key] = row.method, row.status
-            text["fit_warning"][key] = "; ".join(row.warnings)
             extrapolated[key] = row.status == "extrapolated"
             if n_bootstrap and np.isfinite(row.median) and np.isfinite(boot_median[:, s]).any():
                 out["median_low"][key], out["median_high"][key] = np.nanquantile(boot_median[:, s], [tail, 1 - tail])
                 out["beta_low"][key], out["beta_high"][key] = np.nanquantile(boot_beta[:, s], [tail, 1 - tail])
             out["gof_p_value"][key], out["gof_max_error"][key] = goodness_of_fit(
                 levels, exceed[s], total[s], row.median, row.beta)
-            if state.edp == "overturned" and first_overturn is not None:
-                out["capacity_median"][key], out["capacity_beta"][key] = fit_censored_capacities(
-                    first_overturn[(slice(None), *index)], levels[-1])
+            if state.edp == "overturned":
+                overturning_checks(row, out, key, n_resurrected[index], n_records, label,
+                                   None if capacities is None else [c[(slice(None), *index)] for c in capacities],
+                                   levels[-1])
+            text["fit_warning"][key] = "; ".join(row.warnings)
 
     dims = (*group_dims, "damage_state")
     data_vars = {}
@@ -381,12 +465,20 @@ def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, 
     data_vars["studied_im_max"] = (("block",), intensity[:, -1], {
         "long_name": "highest intensity level studied for the block", "units": unit})
     data_vars["n_records"] = ((), n_records, {"long_name": "number of records", "units": "1"})
+    data_vars["n_resurrected"] = (group_dims, n_resurrected.astype(np.int32), {
+        "long_name": "records that survived a level above their first overturning level (resurrection; counted "
+                     "as overturned from their first overturning level on)", "units": "1"})
     data_vars["empirical_fraction"] = (("im_level", *dims), fraction, {
-        "long_name": "fraction of records reaching the damage state", "units": "1"})
+        "long_name": "fraction of records reaching the damage state (first-overturn convention)", "units": "1"})
     data_vars["outcome_probability"] = (("outcome_class", "im_level", *group_dims), three_outcomes(cube).values,
-                                        {"long_name": "fraction of records in each outcome", "units": "1"})
+                                        {"long_name": "fraction of records in each outcome (a record is "
+                                                      "overturned from its first overturning level on)",
+                                         "units": "1"})
+    im_level = cube.im_level
+    if parse_units(im_level.attrs.get("units", "")) == parse_units(unit):
+        im_level = im_level.assign_attrs(units=unit)  # an older file's "g": the same unit, spelled as UDUNITS reads
     coords = {d: cube[d] for d in group_dims}
-    coords.update({"im_level": cube.im_level, "damage_state": [s.name for s in states],
+    coords.update({"im_level": im_level, "damage_state": [s.name for s in states],
                    "damage_state_description": ("damage_state", [s.description for s in states]),
                    "outcome_class": ["no_uplift", "rocking", "overturned"],
                    "intensity": (("block", "im_level"), intensity, {
@@ -395,7 +487,11 @@ def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, 
     warnings = warning_summary(dataset)
     dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag lognormal fragility functions",
                      "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", ""),
-                     "intensity_measure": measure, "intensity_unit": unit,
+                     "intensity_measure": measure, "intensity_unit": unit, "intensity_unit_label": label,
+                     "overturning_convention": OVERTURNING_CONVENTION,
+                     "capacity_fit": CAPACITY_FIT if capacities is not None else
+                     "capacity_median/capacity_beta: none (no refined capacities: capacity_resolution = 0 or no "
+                     "ida.nc)",
                      "bootstrap_samples": n_bootstrap, "bootstrap_seed": seed,
                      "fit_warnings": json.dumps(warnings),
                      "references": "Baker (2015) Efficient analytical fragility function fitting using "
@@ -424,13 +520,25 @@ def warning_summary(dataset: xr.Dataset) -> list[str]:
     disagree = int(np.sum(["disagree" in w for w in warnings]))
     if disagree:
         lines.append(f"{disagree} uplift rows: runs disagree with the exact g tan(alpha) step (see fit_warning)")
+    if "n_resurrected" in dataset:
+        cells = int(np.sum(dataset.n_resurrected.values > 0))
+        if cells:
+            lines.append(f"{cells} of {dataset.n_resurrected.size} cells: {int(dataset.n_resurrected.sum())} records "
+                         "survived a level above their first overturning (resurrection), counted as overturned from "
+                         "their first overturning level on (n_resurrected)")
+    outside = int(np.sum(["refined capacities' median" in w for w in warnings]))
+    if outside:
+        lines.append(f"{outside} overturning rows: the refined capacities' median lies outside the stripe fit's "
+                     "bounds (see fit_warning)")
     return lines
 
 
 def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
-    """P(no uplift), P(rocking without overturning), P(overturning) per level, from the cube."""
-    valid = cube.outcome != OUTCOME_FAILED
-    counts = [((cube.outcome == code) & valid).sum("record") for code in
+    """P(no uplift), P(rocking without overturning), P(overturning) per level, from the cube; a record is
+    overturned from its first overturning level on (``first_overturn_outcomes``)."""
+    outcome = first_overturn_outcomes(cube)
+    valid = outcome != OUTCOME_FAILED
+    counts = [((outcome == code) & valid).sum("record") for code in
               (OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED)]
     total = valid.sum("record")
     stacked = xr.concat([c / total for c in counts], dim="outcome_class")
@@ -448,11 +556,19 @@ def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:
     studied = dataset[["studied_im_min", "studied_im_max"]].to_dataframe().reset_index()
     table = table.merge(studied.rename(columns={"studied_im_min": "im_lowest", "studied_im_max": "im_highest"}),
                         on="block")
-    table["im_units"] = dataset.attrs.get("intensity_unit", "")
+    table["im_units"] = _unit_label(dataset)
     table["n_records"] = int(dataset.n_records)
-    keep = ["soil", "block", "model", "damage_state", *TABLE_COLUMNS[:-1], "im_lowest", "im_highest", "im_units",
-            "n_records", "fit_warning"]
+    resurrections = ["n_resurrected"] if "n_resurrected" in dataset else []
+    if resurrections:
+        table = table.merge(dataset["n_resurrected"].to_dataframe().reset_index(), on=["soil", "block", "model"])
+    keep = ["soil", "block", "model", "damage_state", *TABLE_COLUMNS[:-1], *resurrections, "im_lowest", "im_highest",
+            "im_units", "n_records", "fit_warning"]
     return table[keep]
+
+
+def _unit_label(dataset: xr.Dataset) -> str:
+    """The intensity unit as tables show it ("g"), from a fragility dataset's attributes."""
+    return dataset.attrs.get("intensity_unit_label") or unit_label(dataset.attrs.get("intensity_unit", ""))
 
 
 # ---------------------------------------------------------------- pelicun damage-model export
@@ -473,7 +589,7 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
     demand_type, demand_unit = (registered and registered.pelicun_demand) or ("", "")
     if registered is not None and registered.uses_period and period:
         demand_type = f"{demand_type}|{period:g}"
-    unit = dataset.attrs.get("intensity_unit", "")
+    unit = _unit_label(dataset)
     rows, seen = [], {}
     for soil in dataset.soil.values:
         for block in dataset.block.values:

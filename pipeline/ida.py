@@ -12,9 +12,17 @@ Output: ``reports/ida.nc`` with, per soil, block and model:
         - ``first_overturn_im`` and ``last_resurrection_free_im``: per-record overturning capacity, as
           the first overturning level and the level above which every level overturns;
         - ``capacity``: per-record overturning capacity from the study's adaptive runs (the stripes
-          refined by bisection to the study's ``capacity_resolution``), with the runs it took and,
-          as attributes, the runs saved against uniform stripes of the same resolution.
-Intensities are per block: the cube's (block, im_level) coordinate ``intensity``.
+          refined by bisection to the study's ``capacity_resolution``), its bracket
+          ``capacity_lower``/``capacity_upper`` (the highest intensity seen to survive below it, the
+          lowest seen to overturn), the runs it took and, as attributes, the runs saved against
+          uniform stripes of the same resolution.
+Intensities are per block: the cube's (block, im_level) coordinate ``intensity``, in the measure's display
+unit, written as UDUNITS parses it ("9.80665 m s-2" for g; ``pipeline.measures.parse_units``).
+
+Capacity convention (Vamvatsikos & Cornell 2002): a record's overturning capacity is its FIRST
+overturning intensity; a record that survives a higher level (resurrection) is still taken to have
+overturned there. The refinement bisects the gap between the first overturning stripe and the stripe
+below it, so a refined capacity never exceeds ``first_overturn_im``.
 ``hunt_and_fill`` traces one record's overturning capacity adaptively (Vamvatsikos & Cornell 2004).
 """
 
@@ -25,10 +33,12 @@ import math
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import OUTCOME_OVERTURNED
+from pipeline.cube import OUTCOME_FAILED, OUTCOME_OVERTURNED
+from pipeline.measures import convert_units, parse_units, udunits
 from pipeline.outputs import write_dataset
 
 FRACTILES = (0.16, 0.50, 0.84)
+FRACTILE_ATTRS = {"long_name": "fractile (non-exceedance probability) over the records", "units": "1"}
 RESPONSE_LEVELS = np.round(np.concatenate([np.linspace(0.05, 1.0, 20), np.linspace(1.5, 5.0, 8)]), 4)
 """Response levels theta_max/alpha at which the intensity-given-response fractiles are computed."""
 
@@ -80,32 +90,58 @@ def overturning_capacities(outcome, levels):
     return first, stable
 
 
+def resurrected(outcome) -> np.ndarray:
+    """1 where a record survived a level above its first overturning level (resurrection), else 0.
+
+    outcome : (..., n_level) integer outcome codes over increasing levels; a failed run is no survival.
+    Returns an int8 array of shape (...,).
+    """
+    overturned = np.asarray(outcome) == OUTCOME_OVERTURNED
+    after_first = np.cumsum(overturned, axis=-1) > 0
+    survived = ~overturned & (np.asarray(outcome) != OUTCOME_FAILED)
+    return np.any(after_first & survived, axis=-1).astype(np.int8)
+
+
 def block_intensities(cube: xr.Dataset) -> tuple[np.ndarray, str]:
-    """(n_block, n_level) intensity of every level for every block [display unit], and the unit.
+    """(n_block, n_level) intensity of every level for every block [display unit], and its ``units``.
 
     Reads the (block, im_level) coordinate ``intensity`` (pipeline.cube); a cube without it (absolute
-    levels from an older layout) has the same levels ``im_level`` for every block.
+    levels from an older layout) has the same levels ``im_level`` for every block. The units come back as
+    UDUNITS parses them (an older file's "g" becomes "9.80665 m s-2").
     """
     if "intensity" in cube.coords or "intensity" in cube:
         values = cube["intensity"].transpose("block", "im_level").values
-        return values, cube["intensity"].attrs.get("units", "")
+        return values, _canonical(cube["intensity"].attrs.get("units", ""))
     levels = cube.im_level.values
-    return np.broadcast_to(levels, (cube.sizes["block"], levels.size)), cube.im_level.attrs.get("units", "")
+    return np.broadcast_to(levels, (cube.sizes["block"], levels.size)), _canonical(cube.im_level.attrs.get("units", ""))
 
 
-def adaptive_capacities(cube: xr.Dataset) -> xr.DataArray | None:
-    """Overturning capacity of every (record, soil, block, model) from the adaptive runs, in the
-    study's measure [display unit]: capacity scale factor x the record's measure. None without them."""
+def _canonical(units: str) -> str:
+    """``units`` as UDUNITS writes it (``pipeline.measures.udunits``), unchanged when not an intensity unit."""
+    parsed = parse_units(units)
+    return units if parsed is None else udunits(parsed[1], parsed[0])
+
+
+def adaptive_capacities(cube: xr.Dataset) -> xr.Dataset | None:
+    """Overturning capacity of every (record, soil, block, model) from the adaptive runs, with its bracket,
+    in the study's measure [the unit of the cube's ``intensity``]: scale factor x the record's measure.
+    None without them. Variables ``capacity``, ``capacity_lower`` and ``capacity_upper``."""
     if "capacity_scale_factor" not in cube:
         return None
-    factor = cube["intensity_si"].isel(im_level=0) / cube["intensity"].isel(im_level=0)
-    capacity = cube["capacity_scale_factor"] * cube["record_im"] / factor
-    unit = cube["intensity"].attrs.get("units", "")
-    capacity = capacity.transpose("record", "soil", "block", "model")
-    capacity.attrs = {"long_name": f"overturning capacity from adaptive runs, bracketed to "
-                                   f"{cube.attrs.get('capacity_resolution', float('nan')):.0%} "
-                                   "(NaN: no overturning found)", "units": unit}
-    return capacity
+    _, units = block_intensities(cube)
+    record_im = cube["record_im"]
+    record_im = record_im.copy(data=convert_units(record_im.values, record_im.attrs.get("units", ""), units))
+    resolution = cube.attrs.get("capacity_resolution", float("nan"))
+    out = {}
+    for name, source, long_name in (
+            ("capacity", "capacity_scale_factor",
+             f"overturning capacity from adaptive runs, bracketed to {resolution:.0%} (NaN: no overturning found)"),
+            ("capacity_lower", "capacity_scale_lower", "highest intensity seen to survive below the capacity"),
+            ("capacity_upper", "capacity_scale_upper", "lowest intensity seen to overturn (the capacity bracket)")):
+        capacity = (cube[source] * record_im).transpose("record", "soil", "block", "model")
+        capacity.attrs = {"long_name": long_name, "units": units}
+        out[name] = capacity
+    return xr.Dataset(out)
 
 
 def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
@@ -114,7 +150,8 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
     intensities, unit = block_intensities(cube)
     edp_fractile = xr.DataArray(
         np.quantile(edp.values, FRACTILES, axis=0, method="inverted_cdf"),
-        dims=("fractile", *edp.dims[1:]), coords={"fractile": list(FRACTILES), **{d: cube[d] for d in edp.dims[1:]}},
+        dims=("fractile", *edp.dims[1:]),
+        coords={"fractile": ("fractile", list(FRACTILES), FRACTILE_ATTRS), **{d: cube[d] for d in edp.dims[1:]}},
         attrs={"long_name": "fractile of theta_max/alpha given intensity (inf = overturned)", "units": "1"})
     stack_dims = ("soil", "block", "model")
     block_axis = stack_dims.index("block")
@@ -136,9 +173,10 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
             im_given_edp[(slice(None), j, *index)] = np.quantile(capacity, FRACTILES, method="inverted_cdf")
     im_given_edp[~np.isfinite(im_given_edp)] = np.nan
     coords = {d: cube[d] for d in ("record", "im_level", *stack_dims)}
-    for name in ("intensity", "intensity_si"):
-        if name in cube.coords:
-            coords[name] = cube[name]
+    if parse_units(cube.im_level.attrs.get("units", "")) == parse_units(unit):
+        coords["im_level"] = cube.im_level.assign_attrs(units=unit)  # an older file's "g", spelled as UDUNITS reads
+    if "intensity" in cube.coords:
+        coords["intensity"] = cube["intensity"].assign_attrs(units=unit)
     data_vars = {
         "edp": edp,
         "edp_fractile": edp_fractile,
@@ -150,15 +188,15 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
         "last_resurrection_free_im": (("record", *stack_dims), stable,
                                       {"long_name": "intensity above which every level overturns "
                                                     "(no resurrection)", "units": unit}),
-        "resurrected": (("record", *stack_dims), (stable > first).astype(np.int8),
+        "resurrected": (("record", *stack_dims), resurrected(np.moveaxis(outcome_t, 1, -1)),
                         {"long_name": "1 if the block survived a level above its first overturning level",
                          "units": "1"}),
     }
-    capacity = adaptive_capacities(cube)
+    capacities = adaptive_capacities(cube)
     attrs = {"Conventions": "CF-1.12", "title": "rockfrag IDA curves",
              "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", "")}
-    if capacity is not None:
-        data_vars["capacity"] = capacity
+    if capacities is not None:
+        data_vars.update(capacities.data_vars)
         data_vars["capacity_runs"] = cube["capacity_runs"]
         for ida_key, cube_key in (("capacity_resolution", "capacity_resolution"),
                                   ("capacity_refining_runs", "capacity_runs"),
@@ -167,7 +205,7 @@ def ida_dataset(cube: xr.Dataset) -> xr.Dataset:
                                   ("capacity_runs_saved_fraction", "runs_saved_fraction")):
             if cube_key in cube.attrs:
                 attrs[ida_key] = cube.attrs[cube_key]
-    dataset = xr.Dataset(data_vars, coords={**coords, "fractile": list(FRACTILES),
+    dataset = xr.Dataset(data_vars, coords={**coords, "fractile": ("fractile", list(FRACTILES), FRACTILE_ATTRS),
                          "response_level": ("response_level", RESPONSE_LEVELS,
                                             {"long_name": "theta_max/alpha", "units": "1"})})
     dataset.attrs = attrs

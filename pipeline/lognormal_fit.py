@@ -219,26 +219,57 @@ def lognormal_cdf(im, median, beta):
 
 
 def fit_censored_capacities(capacities, censor_at):
-    """Lognormal fit of per-record capacities, right-censored at ``censor_at`` where NaN."""
+    """Lognormal fit (median, beta) of per-record capacities by maximum likelihood, right-censored where NaN.
+
+    Parameters
+    ----------
+    capacities : array_like, shape (n,)
+        Capacity of each record [IM units], > 0; NaN where the record was not seen to fail.
+    censor_at : float or array_like, shape (n,)
+        Where a NaN capacity is censored [IM units]: the capacity lies above it (e.g. the highest
+        intensity the record was seen to survive). Ignored for finite capacities.
+
+    Returns
+    -------
+    (median, beta) : float
+        Without censoring the closed form: median = exp(mean ln c), beta = the standard deviation of ln c
+        with divisor n (the MLE). With censoring the maximum of the Tobit likelihood on ln c, which is
+        concave in (mu/beta, 1/beta) (Olsen 1978): a quasi-Newton solve with the exact gradient to a
+        relative parameter change of about 1e-10. (NaN, NaN) with fewer than two finite capacities or
+        when every finite one is equal.
+    """
     capacities = np.asarray(capacities, float)
-    observed = capacities[np.isfinite(capacities)]
-    n_censored = np.sum(~np.isfinite(capacities))
-    if observed.size < 2:
+    censor_at = np.broadcast_to(np.asarray(censor_at, float), capacities.shape)
+    finite = np.isfinite(capacities)
+    log_observed = np.log(capacities[finite])
+    log_censored = np.log(censor_at[~finite])
+    if log_observed.size < 2 or np.ptp(log_observed) == 0 or not np.all(np.isfinite(log_censored)):
         return np.nan, np.nan
-    log_observed = np.log(observed)
+    mean, std = log_observed.mean(), log_observed.std()
+    if log_censored.size == 0:
+        return float(np.exp(mean)), float(std)
 
     def negative(params):
-        log_median, log_beta = params
-        beta = np.exp(log_beta)
-        z = (log_observed - log_median) / beta
-        z_censor = (np.log(censor_at) - log_median) / beta
-        return -(np.sum(-0.5 * z**2 - np.log(beta)) + n_censored * log_ndtr(-z_censor))
+        theta, h = params  # mu / beta and 1 / beta
+        if h <= 0:
+            return np.inf, np.zeros(2)
+        residual = h * log_observed - theta  # (ln c - mu) / beta
+        z = theta - h * log_censored  # P(capacity > c) = Phi((mu - ln c) / beta)
+        log_tail = log_ndtr(z)
+        ratio = np.exp(-0.5 * z**2 - 0.5 * np.log(2 * np.pi) - log_tail)  # phi(z) / Phi(z)
+        value = np.sum(np.log(h) - 0.5 * residual**2) + np.sum(log_tail)
+        d_theta = np.sum(residual) + np.sum(ratio)
+        d_h = np.sum(1.0 / h - residual * log_observed) - np.sum(ratio * log_censored)
+        return -value, -np.array([d_theta, d_h])
 
-    start = [log_observed.mean(), np.log(max(log_observed.std(), 0.05))]
-    # two parameters and a smooth likelihood: Nelder-Mead is fast here (L-BFGS-B spent ~0.3 s per cell)
-    result = minimize(negative, x0=start, method="Nelder-Mead",
-                      options={"xatol": 1e-9, "fatol": 1e-12, "maxiter": 4000})
-    return float(np.exp(result.x[0])), float(np.exp(result.x[1]))
+    start = np.array([mean / max(std, 0.05), 1.0 / max(std, 0.05)])
+    result = minimize(negative, start, jac=True, method="BFGS", options={"gtol": 1e-10, "maxiter": 500})
+    theta, h = result.x
+    if not (result.success or np.linalg.norm(result.jac) < 1e-7) or h <= 0:
+        result = minimize(lambda x: negative(x)[0], result.x, method="Nelder-Mead",
+                          options={"xatol": 1e-12, "fatol": 1e-14, "maxiter": 20000})
+        theta, h = result.x
+    return float(np.exp(theta / h)), float(1.0 / h)
 
 
 def goodness_of_fit(im, exceed, total, median, beta):

@@ -12,6 +12,8 @@ one ``Measure``: name, function, SI and display unit, long name, short label, pe
 OpenQuake IMT. Every stage reads these (the study file's choices and units, the cube's metadata, the
 report's axes, the hazard readers, the pelicun export): a new measure is one ``@define_measure``
 function at the end of this module.
+``Measure.cf_units``, ``file_units``, ``parse_units`` and ``convert_units`` are the one place for the
+``units`` strings of result files (as UDUNITS parses them: g is "9.80665 m s-2") and for reading them back.
 
 All functions are pure. The oscillator uses the exact solution for ground acceleration that is
 linear between samples (Nigam & Jennings 1969); its recurrence coefficients come from the matrix
@@ -300,6 +302,11 @@ class Measure:
             raise ValueError(f"measure {self.name!r} is defined per block; pass the block")
         return float(self.function(acceleration, dt, block, _options(options)))
 
+    def cf_units(self, display: bool = True) -> str:
+        """The measure's ``units`` attribute in result files, as UDUNITS parses it: the display unit
+        ("9.80665 m s-2" for g, "m s-1" for m/s; see ``udunits``) or, with ``display=False``, the SI unit."""
+        return udunits(self.si_unit, self.display_factor if display else 1.0)
+
     def describe(self, **options) -> str:
         """Long name with the study's options filled in."""
         return _fill(self.long_name, options)
@@ -419,6 +426,90 @@ def short_label(name: str, described: str = "") -> str:
     if measure is not None and not _fields(measure.label):
         return measure.label
     return name.upper() or "intensity"
+
+
+# ------------------------------------------------------------------ units in result files
+#
+# Result files store every quantity of an intensity measure's SI unit in the display unit of the
+# registered measures of that unit (accelerations in multiples of g, velocities in m/s), the same in
+# every variable of a file, and write it as UDUNITS parses it: UDUNITS (netCDF, CF, cf-units, xarray's
+# unit-aware tools) reads "g" as grams, so g is "9.80665 m s-2".
+
+_UDUNITS_SPELLING = {"m/s^2": "m s-2", "m/s**2": "m s-2", "m/s2": "m s-2", "m/s": "m s-1", "N/m": "N m-1",
+                     "1/yr": "yr-1"}
+"""Our SI spellings (the registry's ``si_unit``) that UDUNITS writes differently."""
+
+
+def udunits(unit: str, factor: float = 1.0) -> str:
+    """``unit`` (an SI unit as the registry spells it: "m/s^2", "m/s", "1", "s", ...) scaled by ``factor``, as a
+    UDUNITS ``units`` string: ``udunits("m/s^2") == "m s-2"``, ``udunits("m/s^2", STANDARD_GRAVITY) ==
+    "9.80665 m s-2"`` (g), ``udunits("1", 2.0) == "2"``."""
+    base = _UDUNITS_SPELLING.get(unit, unit)
+    if factor == 1.0:
+        return base
+    return f"{factor:.10g}" if base == "1" else f"{factor:.10g} {base}"
+
+
+def file_units(si_unit: str) -> str:
+    """The ``units`` of a quantity of SI unit ``si_unit`` in result files: the display unit of the first
+    registered measure of that SI unit ("9.80665 m s-2" for any acceleration: record PGAs, levels, uplift
+    thresholds), else the SI unit (``udunits``)."""
+    for measure in MEASURES.values():
+        if measure.si_unit == si_unit:
+            return measure.cf_units(display=True)
+    return udunits(si_unit)
+
+
+def parse_units(units: str) -> tuple[float, str] | None:
+    """(SI value of one unit, SI unit in UDUNITS spelling) of a ``units`` attribute of an intensity-like
+    quantity: "9.80665 m s-2" -> (9.80665, "m s-2"), "m/s^2" -> (1.0, "m s-2"), "m s-1" -> (1.0, "m s-1"),
+    "1" -> (1.0, "1"); "g" (files written before the UDUNITS spellings, where it meant standard gravity)
+    -> (9.80665, "m s-2"). None for anything else (an empty string included)."""
+    text = str(units).strip()
+    if not text:
+        return None
+    if text == "g":
+        return STANDARD_GRAVITY, "m s-2"
+    number, _, rest = text.partition(" ")
+    try:
+        factor = float(number)
+    except ValueError:
+        factor, rest = 1.0, text
+    rest = rest.strip() or "1"
+    base = _UDUNITS_SPELLING.get(rest, rest)
+    if base not in {udunits(measure.si_unit) for measure in MEASURES.values()}:
+        return None
+    return factor, base
+
+
+def convert_units(values, units: str, to: str):
+    """``values`` given in ``units`` expressed in ``to`` (both forms ``parse_units`` reads).
+
+    Raises
+    ------
+    ValueError
+        When either is not such a unit or they measure different quantities.
+    """
+    source, target = parse_units(units), parse_units(to)
+    if source is None or target is None or source[1] != target[1]:
+        raise ValueError(f"cannot convert intensity values from units {units!r} to {to!r}")
+    if source[0] == target[0]:
+        return values
+    return np.asarray(values, float) * (source[0] / target[0])
+
+
+def unit_label(units: str) -> str:
+    """The unit as tables and axes show it: the registered display or SI unit whose ``units`` string this
+    is ("9.80665 m s-2" -> "g", "m s-1" -> "m/s", "m s-2" -> "m/s^2"); else ``units`` unchanged."""
+    parsed = parse_units(units)
+    if parsed is None:
+        return str(units)
+    for measure in MEASURES.values():
+        if parse_units(measure.cf_units(display=True)) == parsed:
+            return measure.display_unit
+        if parse_units(measure.cf_units(display=False)) == parsed:
+            return measure.si_unit
+    return str(units)
 
 
 @define_measure("pga", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,

@@ -29,6 +29,7 @@ from pipeline.fragility import (
     pelicun_table,
     separation,
 )
+from pipeline.ida import ida_dataset
 from pipeline.outputs import write_dataset
 from pipeline.units import STANDARD_GRAVITY
 
@@ -241,7 +242,7 @@ def test_extrapolated_and_not_reached_rows_are_flagged_everywhere(tmp_path):
     path = tmp_path / "f.nc"
     write_dataset(fragility, path)
     with xr.open_dataset(path) as back:
-        assert back.extrapolated.attrs["units"] == "1" and back.studied_im_max.attrs["units"] == "g"
+        assert back.extrapolated.attrs["units"] == "1" and back.studied_im_max.attrs["units"] == "9.80665 m s-2"
         assert all("long_name" in back[v].attrs for v in back.data_vars)
 
 
@@ -268,7 +269,7 @@ def test_per_block_intensity_layout_gives_the_same_fits():
     per_block = per_block.assign_coords(intensity=(("block", "im_level"), levels[None, :], {"units": "g"}))
     intensity, unit = intensity_levels(per_block)
     np.testing.assert_allclose(intensity[0], levels)
-    assert unit == "g"
+    assert unit == "9.80665 m s-2"  # an older file's "g" comes back as UDUNITS reads it
     a = fragility_dataset(single, n_bootstrap=10, seed=3)
     b = fragility_dataset(per_block, n_bootstrap=10, seed=3)
     np.testing.assert_allclose(a["median"].values, b["median"].values)
@@ -282,7 +283,7 @@ def test_si_intensity_coordinate_is_read_in_display_units():
                               im_level=("im_level", np.arange(25.0), {"units": "1"}))
     intensity, unit = intensity_levels(cube)
     np.testing.assert_allclose(intensity[0], np.geomspace(0.05, 3.0, 25))
-    assert unit == "g"
+    assert unit == "9.80665 m s-2"
 
 
 def test_bootstrap_is_seeded():
@@ -330,3 +331,105 @@ def test_pelicun_demand_comes_from_the_measure_registry(fitted, measure, period,
     dataset = fitted.assign_attrs(intensity_measure=measure)
     row = pelicun_table(dataset, period).iloc[0]
     assert (row["Demand-Type"], row["Demand-Unit"]) == demand
+
+
+# ---------------------------------------------------------------- overturning: first-overturn convention
+
+def capacity_cube(outcomes, capacities, levels, lower=None, record_im=0.5):
+    """One soil, block and model: outcomes (record, level) over the block's ``levels`` [g] and the refined
+    capacities [g] (NaN: never overturned, survived up to ``lower``) as the study writes them (scale factors x
+    the record's PGA, ``units`` as UDUNITS reads them)."""
+    outcomes = np.asarray(outcomes, np.int8)
+    n_record, n_level = outcomes.shape
+    capacities = np.asarray(capacities, float)
+    lower = np.where(np.isfinite(capacities), 0.98 * capacities, np.nan) if lower is None else np.asarray(lower)
+    g = "9.80665 m s-2"
+    dims = ("record", "im_level", "soil", "block", "model")
+    ratio = np.where(outcomes == OUTCOME_ROCKING, 0.6, 0.0)
+    per_cell = (slice(None), None, None, None)
+    return xr.Dataset(
+        {"outcome": (dims, outcomes[:, :, None, None, None]),
+         "peak_angle_ratio": (dims, ratio[:, :, None, None, None]),
+         "capacity_scale_factor": (("record", "soil", "block", "model"), (capacities / record_im)[per_cell]),
+         "capacity_scale_lower": (("record", "soil", "block", "model"), (lower / record_im)[per_cell]),
+         "capacity_scale_upper": (("record", "soil", "block", "model"), (1.02 * capacities / record_im)[per_cell]),
+         "capacity_runs": (("record", "soil", "block", "model"), np.full((n_record, 1, 1, 1), 5.0))},
+        coords={"record": [f"r{i}" for i in range(n_record)],
+                "im_level": ("im_level", np.arange(1.0, n_level + 1), {"units": "1"}),
+                "soil": ["clay"], "block": ["cabinet"], "model": ["winkler"],
+                "intensity": (("block", "im_level"), np.asarray(levels, float)[None, :], {"units": g}),
+                "record_im": (("record", "block"), np.full((n_record, 1), record_im), {"units": g}),
+                "block_uplift_acceleration": ("block", [0.2], {"units": g})},
+        attrs={"intensity_measure": "pga", "capacity_resolution": 0.02})
+
+
+N, R, O = OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED
+RESURRECTING_LEVELS = [0.3, 0.48, 0.6, 0.9, 1.2, 1.5]
+# first overturning stripes 0.48, 0.90 and 0.48 g (the issue's three records); r0 and r1 survive higher levels
+RESURRECTING = [[R, O, R, R, R, O], [R, R, R, O, R, O], [R, O, R, O, O, O]]
+REFINED = [0.45, 0.70, 0.40]  # each inside its first overturning gap
+
+
+def test_resurrection_is_reported_not_fitted_into_a_median_above_every_capacity(tmp_path):
+    cube = capacity_cube(RESURRECTING, REFINED, RESURRECTING_LEVELS)
+    ida = ida_dataset(cube)
+    np.testing.assert_allclose(ida.capacity.values.ravel(), REFINED)
+    assert np.all(ida.capacity.values <= ida.first_overturn_im.values)  # refined inside the first gap
+    assert ida.resurrected.values.ravel().tolist() == [1, 1, 1]
+    fragility = fragility_dataset(cube, ida=ida, n_bootstrap=20)
+    row = fragility.isel(soil=0, block=0, model=0).sel(damage_state="overturning")
+    assert row["median"].item() <= max(REFINED)
+    assert row.capacity_median.item() <= max(REFINED)
+    # the test can fail: the raw stripe counts (2, 0, 2, 1, 3 of 3 from 0.48 g) put the median above them all
+    raw = (np.asarray(RESURRECTING) == O).sum(0)
+    assert fit_binomial(np.asarray(RESURRECTING_LEVELS), raw, np.full(raw.size, 3))[0] > max(REFINED)
+    # a record counts as overturned from its first overturning level on, for every damage state
+    fraction = fragility.empirical_fraction.isel(soil=0, block=0, model=0)
+    np.testing.assert_allclose(fraction.sel(damage_state="overturning").values, [0, 2 / 3, 2 / 3, 1, 1, 1])
+    assert (fraction.sel(damage_state="rocking-0.5") >= fraction.sel(damage_state="overturning")).all()
+    overturned = fragility.outcome_probability.sel(outcome_class="overturned").isel(soil=0, block=0, model=0)
+    np.testing.assert_allclose(overturned.values, [0, 2 / 3, 2 / 3, 1, 1, 1])
+    # reported: a count per cell, a warning on the row and for the console, and the convention
+    assert int(fragility.n_resurrected.item()) == 3
+    assert "3 of 3 records survived a level above their first overturning" in row.fit_warning.item()
+    assert any("resurrection" in line for line in json.loads(fragility.attrs["fit_warnings"]))
+    assert "first overturning" in fragility.attrs["overturning_convention"]
+    table = fragility_table(fragility)
+    assert (table.n_resurrected == 3).all() and (table.im_units == "g").all()
+
+
+def test_capacity_fit_is_the_lognormal_mle_of_the_refined_capacities():
+    """Complete capacities: the closed-form MLE on ln c (mean, standard deviation with divisor n)."""
+    cube = capacity_cube(RESURRECTING, REFINED, RESURRECTING_LEVELS)
+    fragility = fragility_dataset(cube, ida=ida_dataset(cube), n_bootstrap=0)
+    row = fragility.isel(soil=0, block=0, model=0).sel(damage_state="overturning")
+    logs = np.log(REFINED)
+    assert row.capacity_median.item() == pytest.approx(np.exp(logs.mean()), rel=1e-6)
+    assert row.capacity_beta.item() == pytest.approx(logs.std(ddof=0), rel=1e-6)
+    assert row.capacity_median.attrs["units"] == "9.80665 m s-2"
+
+
+def test_censored_capacity_fit_matches_an_independent_scipy_refit():
+    """Two of eight records never overturn: right-censored at the highest intensity each survived."""
+    from scipy import optimize, stats
+
+    levels = [0.2, 0.4, 0.8, 1.6]
+    capacities = np.array([0.35, 0.5, 0.62, 0.75, 1.1, 1.45, np.nan, np.nan])
+    lower = np.where(np.isfinite(capacities), 0.98 * capacities, [0, 0, 0, 0, 0, 0, 2.1, 2.6])
+    first = [np.searchsorted(levels, c) if np.isfinite(c) else len(levels) for c in capacities]
+    outcomes = [[O if j >= f else R for j in range(len(levels))] for f in first]
+    cube = capacity_cube(outcomes, capacities, levels, lower=lower)
+    ida = ida_dataset(cube)
+    fragility = fragility_dataset(cube, ida=ida, n_bootstrap=0)
+    row = fragility.isel(soil=0, block=0, model=0).sel(damage_state="overturning")
+    refined = ida.capacity.values.ravel()
+    survived = ida.capacity_lower.values.ravel()
+    data = stats.CensoredData(uncensored=refined[np.isfinite(refined)], right=survived[~np.isfinite(refined)])
+
+    def tight(func, x0, args=(), disp=0):
+        return optimize.fmin(func, x0, args=args, xtol=1e-13, ftol=1e-15, maxiter=100000, maxfun=100000, disp=0)
+
+    beta, _, median = stats.lognorm.fit(data, floc=0, optimizer=tight)
+    assert row.capacity_median.item() == pytest.approx(median, rel=1e-6)
+    assert row.capacity_beta.item() == pytest.approx(beta, rel=1e-6)
+    assert row.capacity_median.item() > np.exp(np.nanmean(np.log(capacities)))  # censoring raises the median

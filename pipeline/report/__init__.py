@@ -37,7 +37,7 @@ from pipeline import __version__  # noqa: E402
 from pipeline.config import StudyConfig  # noqa: E402
 from pipeline.outputs import atomic_path  # noqa: E402
 from pipeline.report import figures as pages  # noqa: E402
-from pipeline.report.adapters import models_of, short_label  # noqa: E402
+from pipeline.report.adapters import models_of, record_pga_g, short_label  # noqa: E402
 from pipeline.report.layout import PAGE_SIZE, Page, add_footer, new_page  # noqa: E402
 from pipeline.report.sections import Results, limitations_items, methods_items, summary_items, title_items  # noqa: E402
 from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
@@ -95,7 +95,7 @@ def records_items(results: Results) -> list[Item]:
                  f"{float(measures.record_sa_1s[i]) / G:.3f}"] for i, m in enumerate(meta)]
     else:
         header = ["record", "event", "station", "PGA [g]"]
-        rows = [[*m, f"{float(cube.record_pga[i]) / G:.3f}"] for i, m in enumerate(meta)]
+        rows = [[*m, f"{pga:.3f}"] for m, pga in zip(meta, record_pga_g(cube))]
     return [table(header, rows)]
 
 

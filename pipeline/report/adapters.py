@@ -16,11 +16,11 @@ import numpy as np
 import pandas as pd
 
 from pipeline.damage_states import DAMAGE_STATES
+from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
 from pipeline.measures import short_label as measure_short_label
 from pipeline.models import MODELS
 from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
-from pipeline.units import STANDARD_GRAVITY
 
 OUTCOME_ROCKING, OUTCOME_FAILED = int(Outcome.ROCKING), int(Outcome.FAILED)
 
@@ -108,9 +108,9 @@ def block_levels(dataset, block) -> np.ndarray:
 
 
 def measure_label(dataset) -> str:
-    """Axis label of the intensity measure with units, e.g. 'PGA [g]'."""
+    """Axis label of the intensity measure with units, e.g. 'PGA [g]' (the file's "9.80665 m s-2" shown as g)."""
     source = dataset["intensity"] if "intensity" in dataset.variables else dataset.im_level
-    unit = source.attrs.get("units", dataset.im_level.attrs.get("units", ""))
+    unit = unit_label(source.attrs.get("units", dataset.im_level.attrs.get("units", "")))
     measure = str(dataset.attrs.get("intensity_measure", "")).lower()
     long_name = str(dataset.im_level.attrs.get("long_name", ""))
     return f"{measure_short_label(measure, long_name)} [{unit}]"  # the registry's label (pipeline.measures)
@@ -212,4 +212,15 @@ def uplift_intensity(cube, block) -> float:
     """Intensity at which the block starts to rock, in the unit of its levels (g tan(alpha) for PGA)."""
     if "block_uplift_intensity" in cube.variables:
         return float(cube.block_uplift_intensity.sel(block=block))
-    return float(cube.block_uplift_acceleration.sel(block=block)) / STANDARD_GRAVITY
+    uplift = cube.block_uplift_acceleration
+    levels = cube["intensity"] if "intensity" in cube.variables else cube.im_level
+    target = levels.attrs.get("units", "")
+    if parse_units(target) is None or parse_units(target)[1] != parse_units(file_units("m/s^2"))[1]:
+        target = file_units("m/s^2")  # levels of another quantity: the threshold in g
+    return float(convert_units(float(uplift.sel(block=block)), uplift.attrs.get("units", "m s-2"), target))
+
+
+def record_pga_g(cube) -> np.ndarray:
+    """PGA of each processed record of the cube [g], whatever unit the file states (an older cube: m/s^2)."""
+    pga = cube.record_pga
+    return np.asarray(convert_units(pga.values, pga.attrs.get("units", "m s-2"), MEASURES["pga"].cf_units()), float)

@@ -26,13 +26,13 @@ from pipeline.report.adapters import (
     friction_flag,
     measure_label,
     models_of,
+    record_pga_g,
     run_fraction,
     state_labels,
     tension_flag,
 )
 from pipeline.report.layout import pretty
 from pipeline.report.text import Item, bullet, heading, note, paragraph, table
-from pipeline.units import STANDARD_GRAVITY
 
 DEFAULT_FRICTION_COEFFICIENT = 0.5
 EXTRAPOLATION_ROWS = 30
@@ -198,7 +198,7 @@ def methods_items(results: Results) -> list[Item]:
             for b in cube.block.values]
     items.append(table(header, rows))
 
-    pga = cube.record_pga.values / STANDARD_GRAVITY
+    pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
     items += [heading("Record set and processing"),
               paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
@@ -228,7 +228,9 @@ def methods_items(results: Results) -> list[Item]:
     items += [heading("Fragility fits"),
               paragraph(f"Damage states: {'; '.join(f'{n}: {t}' for n, t in labels.items())}. Each soil × block × "
                         "model × state is fitted by maximum likelihood on the binomial counts per level (Baker 2015); "
-                        "overturning also from the per-record IDA capacities, right-censored at the highest level. "
+                        f"overturning by the {fragility.attrs.get('overturning_convention', 'outcomes as run')} "
+                        f"({int(fragility.n_resurrected.sum()) if 'n_resurrected' in fragility else 0} here); the "
+                        "refined IDA capacities are also fitted, as a check (capacity_median in fragility.csv). "
                         f"Confidence bounds ({config.confidence:.0%}) from "
                         f"{fragility.attrs.get('bootstrap_samples', '?')} "
                         f"bootstrap samples of the records (seed {fragility.attrs.get('bootstrap_seed', '?')}). States "
