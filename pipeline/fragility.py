@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import json
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,6 +43,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from pipeline.config import StudyConfig
 from pipeline.cube import (
     OUTCOME_FAILED,
     OUTCOME_NO_UPLIFT,
@@ -103,14 +105,16 @@ CAPACITY_FIT = (
 
 def first_overturn_outcomes(cube: xr.Dataset) -> xr.DataArray:
     """The cube's ``outcome`` with every level from a record's first overturning level on set to overturned
-    (``OVERTURNING_CONVENTION``); levels increase along ``im_level``."""
+    (``OVERTURNING_CONVENTION``); levels increase along ``im_level``.
+    """
     since = (cube.outcome == OUTCOME_OVERTURNED).cumsum("im_level") > 0
     return cube.outcome.where(~since, OUTCOME_OVERTURNED)
 
 
 def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
     """1.0 where a run reached the damage state, 0.0 where not, NaN where the solver failed; a record is
-    beyond every state from its first overturning level on (``first_overturn_outcomes``)."""
+    beyond every state from its first overturning level on (``first_overturn_outcomes``).
+    """
     outcome = first_overturn_outcomes(cube)
     if state.edp == "uplifted":
         reached = outcome >= OUTCOME_ROCKING
@@ -161,8 +165,9 @@ def uplift_is_rigid_threshold(model_name: str) -> bool:
 
 
 def uplift_threshold(cube: xr.Dataset, unit: str) -> np.ndarray | None:
-    """g tan(alpha) per block in the study's intensity ``unit`` (an acceleration unit ``parse_units``
-    reads), or None when the cube cannot tell or ``unit`` is no acceleration."""
+    """G tan(alpha) per block in the study's intensity ``unit`` (an acceleration unit ``parse_units``
+    reads), or None when the cube cannot tell or ``unit`` is no acceleration.
+    """
     parsed = parse_units(unit)
     if parsed is None or parsed[1] != udunits("m/s^2"):
         return None
@@ -193,7 +198,8 @@ class RowFit:
 
 def _crosses_where_data_tell(levels, exceed_severe, lower_fit, upper_fit):
     """Do two fitted curves cross between the lowest level at which the more severe state has
-    exceedances and the highest level? (Below it both are zero by the data; tails there are arithmetic.)"""
+    exceedances and the highest level? (Below it both are zero by the data; tails there are arithmetic.)
+    """
     reached = np.flatnonzero(exceed_severe > 0)
     if reached.size == 0:
         return False
@@ -208,7 +214,8 @@ def _shared_fit(levels, exceed, total, group):
 
 def noncrossing_groups(levels, exceed, total, fits, usable):
     """Merge adjacent fitted states into shared-beta groups until no two curves cross where the data
-    can tell. Returns (groups, fits) with the refitted (median, beta) of grouped states."""
+    can tell. Returns (groups, fits) with the refitted (median, beta) of grouped states.
+    """
     groups = [[s] for s in usable]
     fits = dict(fits)
     changed = True
@@ -349,7 +356,8 @@ def record_resamples(n_records, n_bootstrap, seed):
 def refined_capacities(ida: xr.Dataset | None, unit: str) -> tuple[np.ndarray, np.ndarray] | None:
     """The refined overturning capacities of ``ida.nc`` in ``unit``, (record, soil, block, model), and where
     each record that never overturned is censored: the highest intensity it was seen to survive
-    (``capacity_lower``; NaN where unknown). None without refined capacities."""
+    (``capacity_lower``; NaN where unknown). None without refined capacities.
+    """
     if ida is None or "capacity" not in ida:
         return None
     out = []
@@ -386,9 +394,35 @@ def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n
                  f"{low:.3g}-{high:.3g} {unit} of the stripe fit")
 
 
-def fragility_dataset(cube: xr.Dataset, states=None, ida=None, n_bootstrap=100, seed=0,
-                      confidence=0.90, progress=False) -> xr.Dataset:
-    """Fit every soil x block x model x damage state of a cube (see module docstring)."""
+def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None, ida: xr.Dataset | None = None,
+                      n_bootstrap: int = 100, seed: int = 0, confidence: float = 0.90,
+                      progress: bool = False) -> xr.Dataset:
+    """Fit every soil x block x model x damage state of a cube (the estimators: see the module docstring).
+
+    Parameters
+    ----------
+    cube : xarray.Dataset
+        The study cube (``cube.nc``): outcome and peak angle ratio over record x im_level x soil x block x model,
+        intensities in the units the cube states (multiples of g for accelerations).
+    states : list of DamageState, optional
+        Damage states in order of severity; default: the registry (``pipeline.damage_states.DAMAGE_STATES``).
+    ida : xarray.Dataset, optional
+        ``ida.nc``: its refined overturning capacities are fitted as the check ``capacity_median``/``capacity_beta``.
+    n_bootstrap : int
+        Record resamples for the confidence bounds of the median (0: no bounds).
+    seed : int
+        Seed of the record resampling (same seed, same bounds).
+    confidence : float
+        Two-sided confidence level of the bounds, in (0, 1).
+    progress : bool
+        Show a progress bar over the cells.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``fragility.nc``'s content: median [the cube's intensity unit], beta [-], bounds, status, fit method,
+        warnings and empirical fractions per soil x block x model x damage state.
+    """
     from tqdm.auto import tqdm
 
     states = states or list(DAMAGE_STATES.values())
@@ -535,7 +569,8 @@ def warning_summary(dataset: xr.Dataset) -> list[str]:
 
 def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
     """P(no uplift), P(rocking without overturning), P(overturning) per level, from the cube; a record is
-    overturned from its first overturning level on (``first_overturn_outcomes``)."""
+    overturned from its first overturning level on (``first_overturn_outcomes``).
+    """
     outcome = first_overturn_outcomes(cube)
     valid = outcome != OUTCOME_FAILED
     counts = [((outcome == code) & valid).sum("record") for code in
@@ -579,11 +614,30 @@ def pelicun_id(block: str, soil: str, model: str) -> str:
 
 
 def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFrame:
-    """pelicun damage-model CSV: one component per soil/block/model, LS1..LSn = the damage states in
-    order of severity. ``Demand-Directional = 1``: the demand is the scaled component itself, so pelicun
-    must not apply its non-directional factor (1.2 x the larger of two directions) to it. A state no
-    record reached leaves its LS empty and marks the component ``Incomplete`` (pelicun then skips it);
-    the ``Comment`` column says what each LS is, the studied range and which medians are extrapolated."""
+    """The pelicun damage-model table: one component per soil/block/model, LS1..LSn the damage states.
+
+    ``Demand-Directional = 1``: the demand is the scaled component itself, so pelicun must not apply its
+    non-directional factor (1.2 x the larger of two directions) to it. A state no record reached leaves its
+    LS empty and marks the component ``Incomplete`` (pelicun then skips it); the ``Comment`` column says what
+    each LS is, the studied range and which medians are extrapolated.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The fragility dataset (``fragility_dataset``).
+    period : float, optional
+        The Sa period [s], for measures that have one (it becomes part of pelicun's demand type).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per component, in pelicun's damage-model column layout (medians in g for accelerations).
+
+    Raises
+    ------
+    ConfigError
+        Two (block, soil, model) cells that map to the same pelicun component ID.
+    """
     measure = dataset.attrs.get("intensity_measure", "pga")
     registered = MEASURES.get(measure)
     demand_type, demand_unit = (registered and registered.pelicun_demand) or ("", "")
@@ -628,11 +682,40 @@ def write_csv(table: pd.DataFrame, path) -> None:
         table.to_csv(temporary, index=False, float_format="%.6g")
 
 
-def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config, output, progress=None, log=None):
+def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, output: str | Path,
+                    progress: bool | None = None,
+                    log: Callable[[str], object] | None = None) -> tuple[xr.Dataset, xr.Dataset]:
     """Fit, add the risk, and write fragility.nc, fragility.csv and fragility_pelicun.csv.
 
     The hazard curve is read (and checked against the study's intensity measure) before any fit.
     Fit warnings are printed to ``log`` (stderr by default) and kept in the dataset.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset
+        The study cube (``cube.nc``).
+    ida : xarray.Dataset
+        The IDA curves and refined capacities (``ida.nc``).
+    config : StudyConfig
+        The study: damage states, bootstrap size and seed, confidence, hazard file and design life [years].
+    output : str or pathlib.Path
+        The output folder; the three files are written atomically into it.
+    progress : bool, optional
+        Show a progress bar; default: when stderr is a terminal.
+    log : callable, optional
+        Receives one line per fit warning; default: print to stderr.
+
+    Returns
+    -------
+    fragility : xarray.Dataset
+        The fits merged with the risk (as written to ``fragility.nc``).
+    risk : xarray.Dataset
+        The annual frequency and the probability in the design life per row.
+
+    Raises
+    ------
+    ConfigError
+        A hazard curve that does not load or is for another intensity measure; clashing pelicun IDs.
     """
     log = log or (lambda message: print(message, file=sys.stderr))
     progress = sys.stderr.isatty() if progress is None else progress
