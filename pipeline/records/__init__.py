@@ -38,6 +38,7 @@ from pipeline.records import text as text_records
 from pipeline.records.components import (
     ComponentGroup,
     component_label,
+    component_labels,
     group_components,
     header_metadata,
     orientation_metadata,
