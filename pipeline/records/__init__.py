@@ -5,19 +5,20 @@ Input : a record set name from the catalogue (``far-field``, ``near-field-pulse`
 Output: ``Record`` objects (an ``obspy.Trace`` of ground acceleration [m/s^2] plus catalogue
         metadata) and, for a batch, the list of ``RecordError`` for files that could not be read.
 
-Formats: rockfrag's own readers (PEER AT2, CSMIP Volume 1, ASDF, text/CSV) sit in ``FORMATS[name] = RecordFormat(is_format,
-read_format)``, registered at the bottom of this module and tried in that order; their readers take
-the user's ``units`` and ``dt``. Every other format goes through ``obspy.read``, which detects its
-built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and third-party ones through obspy's own
-entry-point group ``obspy.plugin.waveform``: that is the one extension mechanism (the former
-``pipeline.record_formats`` group is gone). Units: from the file where it states them (PEER AT2: g;
-K-NET/KiK-net: the header's scale factor in gal; CSMIP: the data-start line; ASDF: the StationXML
-response of raw counts; text: a header such as ``acc [g]``), else the user's.
+Formats: rockfrag's own readers (PEER AT2, CSMIP Volume 1, ASDF, text/CSV) sit in
+``FORMATS[name] = RecordFormat(is_format, read_format)``, registered at the bottom of this module and
+tried in that order; their readers take the user's ``units`` and ``dt``. Every other format goes
+through ``obspy.read``, which detects its built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and
+third-party ones through obspy's own entry-point group ``obspy.plugin.waveform``: that is the one
+extension mechanism (the former ``pipeline.record_formats`` group is gone). Units: from the file where
+it states them (PEER AT2: g; K-NET/KiK-net: the header's scale factor in gal; CSMIP: the data-start
+line; ASDF: the StationXML response of raw counts; text: a header such as ``acc [g]``), else the user's.
 
 Components: a file may hold several components (CSMIP, ASDF: ``read_stream``); each becomes one ``Record``
-whose metadata say its orientation (``pipeline.records.components``). ``group_components`` groups records
-by event and station into H1, H2 and Z; verticals are marked (``Record.is_vertical``) and sit only in their
-own record sets (``three-component``), never in the horizontal ones.
+whose metadata say its orientation (``pipeline.records.components``, whose API is re-exported here).
+``group_components`` groups records by event and station into H1, H2 and Z; verticals are marked
+(``Record.is_vertical``) and sit only in their own record sets (``three-component``), never in the
+horizontal ones.
 """
 
 from __future__ import annotations
@@ -35,15 +36,11 @@ import obspy
 from pipeline.errors import ManifestError, RecordError
 from pipeline.records import asdf, csmip, peer_at2
 from pipeline.records import text as text_records
-from pipeline.records.components import (
-    ComponentGroup,
-    component_label,
-    component_labels,
-    group_components,
-    header_metadata,
-    orientation_metadata,
-    split_vertical,
-)
+from pipeline.records.components import ComponentGroup as ComponentGroup
+from pipeline.records.components import component_label, header_metadata, orientation_metadata
+from pipeline.records.components import component_labels as component_labels
+from pipeline.records.components import group_components as group_components
+from pipeline.records.components import split_vertical as split_vertical
 from pipeline.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
 from pipeline.units import STANDARD_GRAVITY, acceleration_factor
 
