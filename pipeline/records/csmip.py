@@ -114,7 +114,7 @@ def is_csmip(source) -> bool:
         return False
 
 
-def _fixed_width(lines, width) -> list[str]:
+def _fixed_width(lines: list[str], width: int) -> list[str]:
     """The non-blank fixed-width fields of ``lines`` (fields may touch: ``.4778242-999.00000``)."""
     fields = []
     for line in lines:
@@ -123,7 +123,7 @@ def _fixed_width(lines, width) -> list[str]:
     return fields
 
 
-def _numbers(fields, kind, name, line) -> list:
+def _numbers(fields: list[str], kind: type, name: str, line: int) -> list:
     try:
         return [kind(field) for field in fields]
     except ValueError:
@@ -131,7 +131,7 @@ def _numbers(fields, kind, name, line) -> list:
         raise RecordError(name, f"header value {bad!r} is not a number", line=line) from None
 
 
-def _is_number(text, kind) -> bool:
+def _is_number(text: str, kind: type) -> bool:
     try:
         kind(text)
         return True
@@ -187,7 +187,55 @@ def _channel_code(prefix: str, dip: float, azimuth: float | None, horizontal_ind
     return band + instrument + str(horizontal_index)
 
 
-def _read_channel(lines, start, name, horizontal_index):
+def _read_samples(lines: list[str], first: int, npts: int, per_line: int, width: int,
+                  name: str) -> tuple[np.ndarray, int]:
+    """The ``npts`` samples from ``lines[first]`` on, ``per_line`` fields of ``width`` characters a line.
+
+    Returns the samples (as written, float64) and the index of the line after the channel's end line.
+    """
+    n_lines = -(-npts // per_line)
+    body = lines[first:first + n_lines]
+    values = []
+    for offset, line in enumerate(body):
+        if _END.search(line):
+            raise RecordError(name, f"truncated data: {len(values)} values before the end line; the data-start "
+                              f"line says {npts}", line=first + offset + 1)
+        for column in range(per_line):
+            field = line[column * width:(column + 1) * width].strip()
+            if not field:
+                continue
+            try:
+                values.append(float(field))
+            except ValueError:
+                raise RecordError(name, f"value {field!r} is not a number; expected {npts} values in "
+                                  f"{per_line} fields of {width} characters", line=first + offset + 1) from None
+    if len(values) != npts:
+        raise RecordError(name, f"found {len(values)} values but the data-start line says {npts}",
+                          line=first + len(body))
+    end = first + n_lines
+    if end >= len(lines) or not _END.search(lines[end]):
+        raise RecordError(name, f"expected the channel's end line ('End of Data for ... Channel') after {npts} "
+                          "values", line=min(end, len(lines) - 1) + 1)
+    data = np.asarray(values, dtype=np.float64)
+    if not np.all(np.isfinite(data)):
+        raise RecordError(name, "contains NaN or infinite values; expected finite accelerations", line=first + 1)
+    return data, end + 1
+
+
+def _check_peak(text: list[str], data: np.ndarray, unit: str, name: str, line: int) -> float | None:
+    """The header's signed ``Max`` [file units], after checking the samples' peak against it to its decimals."""
+    peak = next((m for header_line in text if (m := _MAX.search(header_line))), None)
+    if peak is None or _UNIT_NAMES.get(peak.group(2).lower(), peak.group(2)) != unit:
+        return None
+    decimals = len(peak.group(1).partition(".")[2])
+    found = float(np.max(np.abs(data)))
+    if abs(found - abs(float(peak.group(1)))) > 0.5 * 10.0 ** -decimals + 1e-9:
+        raise RecordError(name, f"the samples' peak {found:.{decimals + 1}f} {unit} disagrees with the "
+                          f"header's Max = {peak.group(1)} {unit}", line=line)
+    return float(peak.group(1))
+
+
+def _read_channel(lines: list[str], start: int, name: str, horizontal_index: int) -> tuple[Trace, int]:
     """Parse the channel block starting at ``lines[start]``; returns (trace, index of the next line)."""
     text = lines[start:start + TEXT_HEADER_LINES]
     if len(text) < TEXT_HEADER_LINES:
@@ -219,60 +267,25 @@ def _read_channel(lines, start, name, horizontal_index):
         raise RecordError(name, f"text header says No. of Points = {stated.group(1)} but the data-start line "
                           f"says {npts}", line=data_index + 1)
 
-    # integer header (I5 fields) then real header (F10 fields): the lines between text header and data
+    # integer header (I5 fields, no decimal points) then real header (F10 fields): the lines in between
     between = lines[start + TEXT_HEADER_LINES:data_index]
-    integer_lines = [line for line in between if "." not in line]
-    real_lines = between[len(integer_lines):]
+    n_integer = next((i for i, line in enumerate(between) if "." in line), len(between))
+    integer_lines, real_lines = between[:n_integer], between[n_integer:]
     integers = _numbers(_fixed_width(integer_lines, INTEGER_FIELD), int, name,
                         start + TEXT_HEADER_LINES + 1)
     reals = _numbers(_fixed_width(real_lines, REAL_FIELD), float, name,
                      start + TEXT_HEADER_LINES + len(integer_lines) + 1)
 
-    n_lines = -(-npts // per_line)
-    first = data_index + 1
-    body = lines[first:first + n_lines]
-    values = []
-    for offset, line in enumerate(body):
-        if _END.search(line):
-            raise RecordError(name, f"truncated data: {len(values)} values before the end line; the data-start "
-                              f"line says {npts}", line=first + offset + 1)
-        for column in range(per_line):
-            field = line[column * width:(column + 1) * width].strip()
-            if not field:
-                continue
-            try:
-                values.append(float(field))
-            except ValueError:
-                raise RecordError(name, f"value {field!r} is not a number; expected {npts} values in "
-                                  f"{per_line} fields of {width} characters", line=first + offset + 1) from None
-    if len(values) != npts:
-        raise RecordError(name, f"found {len(values)} values but the data-start line says {npts}",
-                          line=first + len(body))
-    end = first + n_lines
-    if end >= len(lines) or not _END.search(lines[end]):
-        raise RecordError(name, f"expected the channel's end line ('End of Data for ... Channel') after {npts} "
-                          "values", line=min(end, len(lines) - 1) + 1)
-    data = np.asarray(values, dtype=np.float64)
-    if not np.all(np.isfinite(data)):
-        raise RecordError(name, "contains NaN or infinite values; expected finite accelerations", line=first + 1)
+    data, end = _read_samples(lines, data_index + 1, npts, per_line, width, name)
+    stated_peak = _check_peak(text, data, unit, name, start + 1)
 
-    peak = next((m for line in text if (m := _MAX.search(line))), None)
-    stated_peak = None
-    if peak is not None and _UNIT_NAMES.get(peak.group(2).lower(), peak.group(2)) == unit:
-        stated_peak = float(peak.group(1))
-        decimals = len(peak.group(1).partition(".")[2])
-        found = float(np.max(np.abs(data)))
-        if abs(found - abs(stated_peak)) > 0.5 * 10.0 ** -decimals + 1e-9:
-            raise RecordError(name, f"the samples' peak {found:.{decimals + 1}f} {unit} disagrees with the "
-                              f"header's Max = {peak.group(1)} {unit}", line=start + 1)
-
-    codes = _codes(text[3]) if len(text) > 3 else {}
+    codes = _codes(text[3])
     station_match = next((m for line in text if (m := _STATION.search(line))), None)
     header = AttribDict({
-        "volume": "V1", "title": text[0].strip(), "record": text[1][:54].strip(),
+        "volume": "V1", "title": text[0].strip(), "record": re.sub(r"\(.*\)\s*$", "", text[1]).strip(),
         "channel_number": int(channel_line[1].group(1)), "orientation": orientation,
         "azimuth": azimuth, "dip": dip, "vertical": dip != 0.0, "units_in_file": unit,
-        "station_name": text[5][:40].strip() if len(text) > 5 else "",
+        "station_name": re.split(r"\s{2,}", text[5].strip())[0],
         "event_id": codes.get("event_id", ""), "stated_peak": stated_peak, "npts": npts,
         "sampling_rate": rate, "integer_header": integers, "real_header": reals,
     })
@@ -292,7 +305,7 @@ def _read_channel(lines, start, name, horizontal_index):
     trace.stats.station = codes.get("station") or header.get("station_code", "")
     trace.stats.location = codes.get("location", "")
     trace.stats.channel = _channel_code(codes.get("channel_prefix", ""), dip, azimuth, horizontal_index)
-    start_time = _start_time(text[3]) if len(text) > 3 else None
+    start_time = _start_time(text[3])
     if start_time is not None:
         trace.stats.starttime = start_time
     trace.stats.units = "m/s^2"
@@ -301,7 +314,7 @@ def _read_channel(lines, start, name, horizontal_index):
     trace.stats._format = "CSMIP"
     if processing:
         trace.stats.processing = processing
-    return trace, end + 1
+    return trace, end
 
 
 def read_csmip(filename, headonly: bool = False, units: str | None = None, dt: float | None = None, **kwargs):
