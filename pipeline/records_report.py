@@ -4,6 +4,11 @@ Input : loaded ``Record`` objects and the processing recipe.
 Output: a pandas table of catalogue metadata and intensity measures of the processed records
         (``reports/records.csv``), and optionally a PNG per record: raw vs processed acceleration,
         velocity and displacement, and the 5%-damped response spectrum, all labelled with units.
+
+Each record is one component: the table's ``group`` numbers the records of one station and event
+(``pipeline.records.group_components``, counted from 1 in order of appearance) and ``axis`` says which
+component a row is (``H1``, ``H2``, ``Z`` for the vertical), so the PGA of each component of a
+three-component record reads off its rows.
 """
 
 from __future__ import annotations
@@ -19,19 +24,40 @@ from pipeline.errors import RecordError
 from pipeline.measures import intensity_measures, response_spectrum
 from pipeline.outputs import atomic_path
 from pipeline.processing import integrate, process_record
+from pipeline.records import component_labels
 from pipeline.units import STANDARD_GRAVITY
 
 TABLE_COLUMNS = {
+    "group": "group", "axis": "axis",
     "pga_m_s2": "PGA [m/s^2]", "pga_g": "PGA [g]", "pgv_m_s": "PGV [m/s]", "pgd_m": "PGD [m]",
     "arias_m_s": "Arias intensity [m/s]", "cav_m_s": "CAV [m/s]", "d5_95_s": "D5-95 [s]",
 }
 
 
-def measures_row(raw, processed) -> dict:
-    """One table row: metadata, record length and the processed record's intensity measures."""
+def measures_row(raw, processed, group: int | None = None, axis: str | None = None) -> dict:
+    """One table row: metadata, component, record length and the processed record's intensity measures.
+
+    Parameters
+    ----------
+    raw, processed : Record
+        The record as read and as processed.
+    group : int, optional
+        Number of the record's station-and-event group (``component_labels``).
+    axis : str, optional
+        The record's component in its group: ``H1``, ``H2``, ``Z``; ``raw.component`` if omitted.
+
+    Returns
+    -------
+    dict
+        Catalogue metadata, ``group``, ``axis``, ``orientation`` and ``azimuth_deg``, npts, dt [s],
+        duration [s], the intensity measures (SI), PGA [g], the raw PGA [g], QA flags and the file.
+    """
     measures = intensity_measures(processed.acceleration, processed.dt)
     row = {key: raw.metadata.get(key) for key in ("id", "event", "year", "magnitude", "station",
                                                    "component", "sets")}
+    row.update({"group": group, "axis": axis or raw.component,
+                "orientation": raw.metadata.get("orientation", "horizontal"),
+                "azimuth_deg": raw.metadata.get("azimuth_deg")})
     row.update({"npts": processed.trace.stats.npts, "dt_s": processed.dt,
                 "duration_s": processed.duration})
     row.update(measures)
@@ -87,13 +113,15 @@ def plot_record(raw, processed, path):
 
 
 def records_stage(records, recipe, output_dir, plot=False, progress=True, failures=None):
-    """Process each record, tabulate its measures, optionally plot it; returns (table, png paths).
+    """Process each record, tabulate its measures and component, optionally plot it; returns (table, png paths).
 
     A record that cannot be processed is left out; its ``RecordError`` is appended to ``failures``
     (raised if ``failures`` is None).
     """
     output_dir = Path(output_dir)
+    records = list(records)
     rows, pngs = [], []
+    labels = dict(zip((id(record) for record in records), component_labels(records)))
     for raw in tqdm(records, desc="records", unit="rec", disable=not progress):
         try:
             processed = process_record(raw, recipe)
@@ -102,7 +130,7 @@ def records_stage(records, recipe, output_dir, plot=False, progress=True, failur
                 raise
             failures.append(error)
             continue
-        rows.append(measures_row(raw, processed))
+        rows.append(measures_row(raw, processed, *labels[id(raw)]))
         if plot:
             png = output_dir / "records" / (raw.id.replace("/", "_") + ".png")
             plot_record(raw, processed, png)

@@ -53,6 +53,8 @@ def test_every_header_variant_reads_with_obspy_autodetection(variant, records_di
 
 def test_every_shipped_file_matches_catalogue(records_dir):
     for relative, row in _manifest(records_dir).items():
+        if not relative.lower().endswith(".at2"):
+            continue  # CSMIP and ASDF files: tests/test_three_component.py
         data, dt, header = parse_peer_at2(records_dir / relative)
         assert data.size == int(row["npts"]), relative
         assert np.max(np.abs(data)) / STANDARD_GRAVITY == pytest.approx(float(row["pga_g"]), abs=6e-5), relative

@@ -5,13 +5,20 @@ Input : a record set name from the catalogue (``far-field``, ``near-field-pulse`
 Output: ``Record`` objects (an ``obspy.Trace`` of ground acceleration [m/s^2] plus catalogue
         metadata) and, for a batch, the list of ``RecordError`` for files that could not be read.
 
-Formats: rockfrag's own readers (PEER AT2, text/CSV) sit in ``FORMATS[name] = RecordFormat(is_format,
-read_format)``, registered at the bottom of this module and tried in that order; their readers take
-the user's ``units`` and ``dt``. Every other format goes through ``obspy.read``, which detects its
-built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and third-party ones through obspy's own
-entry-point group ``obspy.plugin.waveform``: that is the one extension mechanism (the former
-``pipeline.record_formats`` group is gone). Units: from the file where it states them (PEER AT2: g;
-K-NET/KiK-net: the header's scale factor in gal; text: a header such as ``acc [g]``), else the user's.
+Formats: rockfrag's own readers (PEER AT2, CSMIP Volume 1, ASDF, text/CSV) sit in
+``FORMATS[name] = RecordFormat(is_format, read_format)``, registered at the bottom of this module and
+tried in that order; their readers take the user's ``units`` and ``dt``. Every other format goes
+through ``obspy.read``, which detects its built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and
+third-party ones through obspy's own entry-point group ``obspy.plugin.waveform``: that is the one
+extension mechanism (the former ``pipeline.record_formats`` group is gone). Units: from the file where
+it states them (PEER AT2: g; K-NET/KiK-net: the header's scale factor in gal; CSMIP: the data-start
+line; ASDF: the StationXML response of raw counts; text: a header such as ``acc [g]``), else the user's.
+
+Components: a file may hold several components (CSMIP, ASDF: ``read_stream``); each becomes one ``Record``
+whose metadata say its orientation (``pipeline.records.components``, whose API is re-exported here).
+``group_components`` groups records by event and station into H1, H2 and Z; verticals are marked
+(``Record.is_vertical``) and sit only in their own record sets (``three-component``), never in the
+horizontal ones.
 """
 
 from __future__ import annotations
@@ -27,8 +34,13 @@ import numpy as np
 import obspy
 
 from pipeline.errors import ManifestError, RecordError
-from pipeline.records import peer_at2
+from pipeline.records import asdf, csmip, peer_at2
 from pipeline.records import text as text_records
+from pipeline.records.components import ComponentGroup as ComponentGroup
+from pipeline.records.components import component_label, header_metadata, orientation_metadata
+from pipeline.records.components import component_labels as component_labels
+from pipeline.records.components import group_components as group_components
+from pipeline.records.components import split_vertical as split_vertical
 from pipeline.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
 from pipeline.units import STANDARD_GRAVITY, acceleration_factor
 
@@ -37,7 +49,7 @@ RECORDS_DIR = Path(os.environ.get("ROCKFRAG_RECORDS", Path(__file__).resolve().p
 
 RECORD_SUFFIXES = {".at2"}
 """File endings picked up when a folder is given, plus text records (``text.TEXT_SUFFIXES`` whose content
-is one or two numeric columns); other formats: name the files."""
+is one or two numeric columns) and CSMIP Volume 1 and ASDF files (by content); other formats: name the files."""
 
 
 class RecordFormat(NamedTuple):
@@ -70,7 +82,7 @@ def detect_format(path) -> str | None:
 
 @dataclass
 class Record:
-    """One horizontal acceleration component, in SI units.
+    """One acceleration component (horizontal, or vertical up positive), in SI units.
 
     Attributes
     ----------
@@ -79,8 +91,11 @@ class Record:
     trace : obspy.Trace
         Ground acceleration [m/s^2]; ``stats.processing`` holds the processing provenance.
     metadata : dict
-        event, year, magnitude, station, component, sets, source, sha256, file (K-NET/KiK-net files:
-        also origin_time).
+        event, year, magnitude, station, component, sets, source, sha256, file (K-NET/KiK-net and ASDF
+        files: also origin_time), and the orientation: ``orientation`` (vertical/horizontal),
+        ``azimuth_deg``, ``orientation_from``, ``channel_code`` (``components.orientation_metadata``). For a
+        component of a file holding several, ``sha256`` is the file's followed by ``#`` and the trace's SEED
+        id (the identity of the record's samples), ``file_sha256`` the file's alone.
     """
 
     id: str
@@ -102,9 +117,47 @@ class Record:
         """Record length [s]."""
         return self.dt * (self.trace.stats.npts - 1)
 
+    @property
+    def event(self) -> str:
+        """The earthquake (catalogue name, or from the file's header)."""
+        return str(self.metadata.get("event") or "")
+
+    @property
+    def station(self) -> str:
+        """The station (catalogue name; ``NET.STA`` for files with SEED codes)."""
+        return str(self.metadata.get("station") or "")
+
+    @property
+    def component(self) -> str:
+        """``H1``, ``H2``, ``Z`` (vertical), or ``H`` (a horizontal of unstated direction): see ``group_components``."""
+        return component_label(self.metadata)
+
+    @property
+    def is_vertical(self) -> bool:
+        """True for a vertical component: not a horizontal input of a study."""
+        return self.metadata.get("orientation") == "vertical"
+
     def with_trace(self, trace: obspy.Trace) -> Record:
         """A copy of this record (same id, a copy of the metadata) holding ``trace``."""
         return Record(self.id, trace, dict(self.metadata))
+
+
+def read_stream(path: str | Path, format: str | None = None, units: str | None = None,
+                dt: float | None = None) -> obspy.Stream:
+    """Read every acceleration component of a record file into an ``obspy.Stream`` in m/s^2.
+
+    Parameters and errors as ``read_record``; a CSMIP or ASDF file gives one trace per channel (their
+    orientation in ``stats.csmip`` / ``stats.asdf``), other formats one trace.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise RecordError(path, "file not found")
+    name = format if format in FORMATS else (None if format else detect_format(path))
+    if name is None and format is None and path.suffix.lower() == ".at2":
+        name = "PEER_AT2"  # not recognised, but named as AT2: the reader says what is wrong with it
+    if name is not None:
+        return FORMATS[name].read_format(path, units=units, dt=dt)
+    return obspy.Stream([_read_with_obspy(path, format, units)])
 
 
 def read_record(path: str | Path, format: str | None = None, units: str | None = None,
@@ -132,18 +185,14 @@ def read_record(path: str | Path, format: str | None = None, units: str | None =
     Raises
     ------
     RecordError
-        The file is missing, not in a readable format, or its content is invalid.
+        The file is missing, not in a readable format, its content is invalid, or it holds several
+        components (read those with ``read_stream``).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise RecordError(path, "file not found")
-    name = format if format in FORMATS else (None if format else detect_format(path))
-    if name is None and format is None and path.suffix.lower() == ".at2":
-        name = "PEER_AT2"  # not recognised, but named as AT2: the reader says what is wrong with it
-    if name is not None:
-        stream = FORMATS[name].read_format(path, units=units, dt=dt)
-        return stream[0]
-    return _read_with_obspy(path, format, units)
+    stream = read_stream(path, format, units, dt)
+    if len(stream) != 1:
+        raise RecordError(path, f"holds {len(stream)} components ({', '.join(t.id for t in stream)}); "
+                          "read them with read_stream")
+    return stream[0]
 
 
 def _read_with_obspy(path, format, units):
@@ -229,8 +278,9 @@ def unique_ids(records) -> list:
         clashing = {i for i in ids if ids.count(i) > 1}
         if not any(i in clashing and m for i, m in zip(ids, movable)):
             break
-        ids = ["/".join(Path(r.metadata["file"]).with_suffix("").parts[-depth:]) if i in clashing and m else i
-               for i, r, m in zip(ids, records, movable)]
+        ids = ["/".join([*Path(r.metadata["file"]).with_suffix("").parts[-depth:],
+                         *([r.metadata["file_trace"]] if r.metadata.get("file_trace") else [])])
+               if i in clashing and m else i for i, r, m in zip(ids, records, movable)]
     return [r if i == r.id else Record(i, r.trace, {**r.metadata, "id": i}) for i, r in zip(ids, records)]
 
 
@@ -252,22 +302,56 @@ def record_sets(records_dir=None) -> dict[str, list[str]]:
     return sets
 
 
-def _load_entry(entry: CatalogueEntry) -> Record:
-    trace = read_record(entry.path, units=entry.units)
-    return Record(entry.id, trace, entry.metadata())
+def _select_component(stream: obspy.Stream, entry: CatalogueEntry) -> obspy.Trace:
+    """The trace of a several-component file that a catalogue entry names (``station`` NET.STA, ``component``)."""
+    found = [trace for trace in stream if trace.stats.channel == entry.component
+             and entry.station in (f"{trace.stats.network}.{trace.stats.station}", trace.stats.station)]
+    if len(found) != 1:
+        raise RecordError(entry.path, f"catalogue entry {entry.id}: {len(found)} traces of station {entry.station}, "
+                          f"channel {entry.component}; expected one among {', '.join(t.id for t in stream)}")
+    return found[0]
 
 
-def _load_user_file(path: Path, units, dt=None) -> Record:
-    trace = read_record(path, units=units, dt=dt)
-    header = trace.stats.get("peer_at2") or trace.stats.get("text_record") or {}
-    metadata = {"id": path.stem, "file": str(path), "event": header.get("event", ""),
-                "year": None, "magnitude": None, "station": header.get("station", trace.stats.station),
-                "component": header.get("component", trace.stats.channel), "sets": "user",
-                "source": str(path), "units": units or header.get("units_in_file", ""),
-                "sha256": sha256_of(path)}
-    if trace.stats.get("knet"):
-        metadata.update(knet_metadata(trace.stats))
-    return Record(path.stem, trace, metadata)
+def _load_entry(entry: CatalogueEntry, streams: dict | None = None) -> Record:
+    """The catalogue entry's record; ``streams`` caches several-component files read for earlier entries."""
+    key = (str(entry.path), entry.sha256)
+    stream = streams.get(key) if streams is not None else None
+    if stream is None:
+        stream = read_stream(entry.path, units=entry.units)
+    metadata = entry.metadata()
+    if len(stream) == 1:
+        trace = stream[0]
+    else:
+        if streams is not None:
+            streams[key] = stream
+        trace = _select_component(stream, entry).copy()
+        metadata.update(file_sha256=entry.sha256, sha256=f"{entry.sha256}#{trace.id}")
+    metadata.update(orientation_metadata(trace, entry.component))
+    return Record(entry.id, trace, metadata)
+
+
+def _load_user_file(path: Path, units, dt=None) -> list[Record]:
+    """One record per component of a user's file: id the file's stem (``stem/NET.STA.LOC.CHA`` if several)."""
+    stream = read_stream(path, units=units, dt=dt)
+    digest = sha256_of(path)
+    records = []
+    for trace in stream:
+        stats = trace.stats
+        header = stats.get("peer_at2") or stats.get("text_record") or stats.get("csmip") or stats.get("asdf") or {}
+        metadata = {"id": path.stem, "file": str(path), "event": header.get("event", ""),
+                    "year": None, "magnitude": None, "station": header.get("station", stats.station),
+                    "component": header.get("component", stats.channel), "sets": "user",
+                    "source": str(path), "units": units or header.get("units_in_file", ""),
+                    "sha256": digest}
+        if stats.get("knet"):
+            metadata.update(knet_metadata(stats))
+        metadata.update(header_metadata(trace))
+        metadata.update(orientation_metadata(trace, metadata["component"]))
+        if len(stream) > 1:
+            metadata.update(id=f"{path.stem}/{trace.id}", file_sha256=digest, sha256=f"{digest}#{trace.id}",
+                            file_trace=trace.id)
+        records.append(Record(metadata["id"], trace, metadata))
+    return records
 
 
 def knet_metadata(stats) -> dict:
@@ -417,14 +501,22 @@ def load_records(selection: str | Path | Iterable[str | Path], records_dir: str 
     items = [selection] if isinstance(selection, (str, Path)) else list(selection)
     entries = {entry.id: entry for entry in catalogue(records_dir)}
     sets = record_sets(records_dir)
-    records, failures, seen, contents = [], [], set(), {}
+    records, failures, seen, contents, streams = [], [], set(), {}, {}
 
     def add(loader, key, target):
         if key in seen:
             return
         seen.add(key)
         try:
-            record = loader(target)
+            loaded = loader(target)
+        except RecordError as error:
+            failures.append(error)
+            return
+        for record in loaded if isinstance(loaded, list) else [loaded]:
+            keep(record)
+
+    def keep(record):
+        try:
             check_record(record)
         except RecordError as error:
             failures.append(error)
@@ -454,13 +546,14 @@ def load_records(selection: str | Path | Iterable[str | Path], records_dir: str 
                     seen.add(entry.id)
                     failures.append(RecordError(entry.path, problems[0].split(": ", 1)[1]))
                 else:
-                    add(_load_entry, entry.id, entry)
+                    add(lambda e: _load_entry(e, streams), entry.id, entry)
         elif Path(text).is_dir():
             files = sorted(p for p in Path(text).rglob("*")
-                           if p.suffix.lower() in RECORD_SUFFIXES or text_records.is_text_record(p))
+                           if p.suffix.lower() in RECORD_SUFFIXES or text_records.is_text_record(p)
+                           or csmip.is_csmip(p) or asdf.is_asdf(p))
             if not files:
                 raise RecordError(text, f"folder holds no record files ({', '.join(sorted(RECORD_SUFFIXES))}, "
-                                  "or text/CSV of one or two numeric columns)")
+                                  "CSMIP Volume 1, ASDF, or text/CSV of one or two numeric columns)")
             for path in files:
                 add(lambda p: _load_user_file(p, units, dt), str(path.resolve()), path)
         elif Path(text).is_file():
@@ -471,4 +564,6 @@ def load_records(selection: str | Path | Iterable[str | Path], records_dir: str 
 
 
 register_format("PEER_AT2", peer_at2.is_peer_at2, peer_at2.read_peer_at2)
+register_format("CSMIP", csmip.is_csmip, csmip.read_csmip)
+register_format("ASDF", asdf.is_asdf, asdf.read_asdf)
 register_format("TEXT", text_records.is_text_record, text_records.read_text_record)

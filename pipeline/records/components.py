@@ -1,0 +1,257 @@
+"""pipeline.records.components - a record is one component of a station's motion: H1, H2 or Z.
+
+Input : read traces (their format's header: CSMIP ``stats.csmip``, ASDF ``stats.asdf``, or only a channel
+        name) and loaded ``Record`` objects.
+Output: each record's orientation metadata (``orientation_metadata``), its component label
+        (``component_label``: ``H1``, ``H2``, ``Z``, or ``H`` for a horizontal of unstated direction), and
+        the records grouped by event and station (``group_components``) into ``ComponentGroup`` objects
+        holding H1, H2 and Z.
+
+Orientation, where it comes from:
+- CSMIP Volume 1 and ASDF files state it in their header / StationXML (``orientation_from = "header"``);
+- other formats only name the channel: a vertical is recognised by its name (SEED codes ending in ``Z``,
+  K-NET/KiK-net ``UD``, PEER ``UP``/``DWN``/``V``/``VER``/``VERT``; ``orientation_from = "channel name"``);
+- everything else is a horizontal component of unstated direction (``"assumed horizontal"``), as the
+  catalogue's FEMA P695 and PEER records are. No record of the horizontal sets is vertical (tested).
+
+Verticals are marked (``Record.is_vertical``, ``metadata["orientation"] == "vertical"``) so that a study
+that takes horizontal inputs can leave them out (``split_vertical``).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from pipeline.errors import RecordError
+
+_VERTICAL_NAME = re.compile(r"^(?:[A-Z0-9]{2}Z|Z|UD\d?|U-D|UP|DWN|DOWN|V|VER|VERT|VERTICAL)$")
+_FIRST_HORIZONTAL = {"N", "1", "NS"}
+_SECOND_HORIZONTAL = {"E", "2", "EW"}
+
+HORIZONTAL_ORDER = ("H1", "H2", "H")
+"""Order of the horizontal labels inside a group (before numbering them H1, H2, H3, ...)."""
+
+
+def is_vertical_name(name: str) -> bool:
+    """True for a channel or component name that denotes a vertical component (see the module docstring)."""
+    return bool(_VERTICAL_NAME.match(str(name or "").strip().upper()))
+
+
+def orientation_metadata(trace, component: str = "") -> dict:
+    """The orientation of ``trace``, as record metadata.
+
+    Parameters
+    ----------
+    trace : obspy.Trace
+        A read trace; ``stats.csmip`` or ``stats.asdf`` (their readers) state the orientation.
+    component : str
+        The catalogue's component name, also looked at for a vertical name.
+
+    Returns
+    -------
+    dict
+        ``orientation`` (``"vertical"`` or ``"horizontal"``), ``azimuth_deg`` (degrees clockwise from north,
+        or None), ``orientation_from`` (``"header"``, ``"channel name"`` or ``"assumed horizontal"``) and
+        ``channel_code`` (the trace's channel).
+    """
+    header = trace.stats.get("csmip") or trace.stats.get("asdf")
+    channel = str(trace.stats.channel or "")
+    if header is not None:
+        vertical, azimuth, source = bool(header["vertical"]), header.get("azimuth"), "header"
+    elif is_vertical_name(channel) or is_vertical_name(component):
+        vertical, azimuth, source = True, None, "channel name"
+    else:
+        vertical, azimuth, source = False, None, "assumed horizontal"
+    return {"orientation": "vertical" if vertical else "horizontal",
+            "azimuth_deg": None if vertical or azimuth is None else float(azimuth),
+            "orientation_from": source, "channel_code": channel}
+
+
+def component_label(metadata: dict) -> str:
+    """``Z`` for a vertical; ``H1``/``H2`` for a horizontal whose channel says N or 1 / E or 2; else ``H``."""
+    if metadata.get("orientation") == "vertical":
+        return "Z"
+    code = str(metadata.get("channel_code") or "").strip().upper()
+    if code in _FIRST_HORIZONTAL or (len(code) == 3 and code[-1] in _FIRST_HORIZONTAL):
+        return "H1"
+    if code in _SECOND_HORIZONTAL or (len(code) == 3 and code[-1] in _SECOND_HORIZONTAL):
+        return "H2"
+    return "H"
+
+
+def event_description(origin_time=None, magnitude=None, latitude=None, longitude=None, depth_km=None,
+                      fallback: str = "") -> str:
+    """``2014-08-24 10:20:44 UTC M6.02, 38.22N 122.31W, 11.1 km deep`` from what is known (else ``fallback``)."""
+    if origin_time is None:
+        return fallback
+    text = f"{origin_time.strftime('%Y-%m-%d %H:%M:%S')} UTC"
+    if magnitude is not None:
+        text += f" M{float(magnitude):g}"
+    parts = [text]
+    if latitude is not None and longitude is not None:
+        parts.append(f"{abs(latitude):.2f}{'N' if latitude >= 0 else 'S'} "
+                     f"{abs(longitude):.2f}{'E' if longitude >= 0 else 'W'}")
+    if depth_km is not None:
+        parts.append(f"{float(depth_km):.3g} km deep")
+    return ", ".join(parts)
+
+
+def header_metadata(trace) -> dict:
+    """Event, station and year of a user file's CSMIP or ASDF trace (empty for other formats).
+
+    Returns
+    -------
+    dict
+        ``event`` (ASDF: origin time, magnitude, epicentre and depth from the QuakeML; CSMIP: the header's
+        event id and record line), ``event_id``, ``station`` (``NET.STA``), ``station_name``, ``year``,
+        ``magnitude`` and, for ASDF, ``origin_time``.
+    """
+    stats = trace.stats
+    station = f"{stats.network}.{stats.station}" if stats.network else str(stats.station)
+    if stats.get("csmip"):
+        header = stats.csmip
+        record = " ".join(str(header["record"]).split())
+        event = f"event {header['event_id']}: {record}" if header.get("event_id") else record
+        return {"event": event, "event_id": header.get("event_id", ""), "station": station,
+                "station_name": header.get("station_name", ""), "year": stats.starttime.year, "magnitude": None}
+    if stats.get("asdf"):
+        header, event = stats.asdf, stats.asdf.get("event") or {}
+        origin = event.get("origin_time")
+        depth = event.get("depth_m")
+        text = event_description(origin, event.get("magnitude"), event.get("latitude"), event.get("longitude"),
+                                 None if depth is None else depth / 1000.0, fallback=header.get("event_id", ""))
+        return {"event": text, "event_id": header.get("event_id", ""), "station": station,
+                "station_name": header.get("station_name", ""),
+                "year": origin.year if origin is not None else stats.starttime.year,
+                "magnitude": event.get("magnitude"),
+                "origin_time": f"{origin.isoformat()}Z" if origin is not None else ""}
+    return {}
+
+
+@dataclass
+class ComponentGroup:
+    """The components of one station's record of one event.
+
+    Attributes
+    ----------
+    event, station : str
+        The records' ``event`` and ``station`` metadata.
+    components : dict
+        Label -> Record: ``H1``, ``H2`` (``H3``, ... if a station has more horizontals), ``Z`` (``Z2``, ...).
+    """
+
+    event: str
+    station: str
+    components: dict = field(default_factory=dict)
+
+    @property
+    def h1(self):
+        """The first horizontal component, or None."""
+        return self.components.get("H1")
+
+    @property
+    def h2(self):
+        """The second horizontal component, or None."""
+        return self.components.get("H2")
+
+    @property
+    def z(self):
+        """The vertical component (up positive), or None."""
+        return self.components.get("Z")
+
+    @property
+    def horizontals(self) -> list:
+        """The horizontal components, H1 first."""
+        return [record for label, record in self.components.items() if label.startswith("H")]
+
+    def aligned(self) -> dict:
+        """The components cut to the time window they share: label -> Record with equal start, step and length.
+
+        Returns
+        -------
+        dict
+            Label -> a copy of each record holding the samples from the latest start to the earliest end.
+
+        Raises
+        ------
+        RecordError
+            The components have different time steps, or share no time window.
+        """
+        records = list(self.components.values())
+        steps = {round(record.dt, 9) for record in records}
+        if len(steps) > 1:
+            raise RecordError(records[0].metadata.get("file") or records[0].id,
+                              f"components of {self.station} have different time steps ({sorted(steps)} s); "
+                              "resample them first")
+        start = max(record.trace.stats.starttime for record in records)
+        end = min(record.trace.stats.endtime for record in records)
+        if end <= start:
+            raise RecordError(records[0].metadata.get("file") or records[0].id,
+                              f"components of {self.station} share no time window")
+        aligned = {}
+        for label, record in self.components.items():
+            trace = record.trace.slice(start, end, nearest_sample=True).copy()
+            aligned[label] = record.with_trace(trace)
+        length = min(record.trace.stats.npts for record in aligned.values())
+        for record in aligned.values():
+            record.trace.data = record.trace.data[:length]
+        return aligned
+
+
+def group_key(record) -> tuple[str, str, str]:
+    """(event, station, sets): records are components of one motion when all three agree.
+
+    The record sets are part of the key so that two versions of one component from different sources
+    (a PEER original and its FEMA P695 export, both "Duzce, Turkey" at "Bolu") stay apart.
+    """
+    metadata = record.metadata
+    return (str(metadata.get("event") or ""), str(metadata.get("station") or ""), str(metadata.get("sets") or ""))
+
+
+def group_components(records) -> list[ComponentGroup]:
+    """Group records by event and station into H1, H2 and Z.
+
+    Parameters
+    ----------
+    records : iterable of Record
+        Loaded records, in any order.
+
+    Returns
+    -------
+    list of ComponentGroup
+        One group per (event, station, record sets), in order of first appearance. Within a group the
+        horizontals are labelled H1, H2 (H3, ...) in the order N or 1 first, E or 2 next, others after in
+        the given order; the vertical is Z (a second one Z2).
+    """
+    members: dict[tuple, list] = {}
+    for record in records:
+        members.setdefault(group_key(record), []).append(record)
+    groups = []
+    for (event, station, _sets), found in members.items():
+        horizontals = [r for r in found if component_label(r.metadata) != "Z"]
+        verticals = [r for r in found if component_label(r.metadata) == "Z"]
+        horizontals.sort(key=lambda r: HORIZONTAL_ORDER.index(component_label(r.metadata)))
+        components = {f"H{i}": record for i, record in enumerate(horizontals, start=1)}
+        components.update({("Z" if i == 1 else f"Z{i}"): record for i, record in enumerate(verticals, start=1)})
+        groups.append(ComponentGroup(event, station, components))
+    return groups
+
+
+def component_labels(records) -> list[tuple[int, str]]:
+    """(group number, label) of each record, in the order given: group numbers count from 1 (``group_components``)."""
+    where = {}
+    for number, group in enumerate(group_components(records), start=1):
+        for label, record in group.components.items():
+            where[id(record)] = (number, label)
+    return [where[id(record)] for record in records]
+
+
+def split_vertical(records) -> tuple[list, list]:
+    """(horizontal records, vertical records), each in the order given.
+
+    A study that takes horizontal inputs uses the first list; the second holds the verticals it leaves out.
+    """
+    horizontal = [record for record in records if record.metadata.get("orientation") != "vertical"]
+    vertical = [record for record in records if record.metadata.get("orientation") == "vertical"]
+    return horizontal, vertical
