@@ -227,11 +227,6 @@ class StudyConfig:
     applicability: ApplicabilitySettings = ApplicabilitySettings()
 
     @property
-    def level_unit(self) -> str:
-        """The display unit of the levels (g for accelerations, m/s for PGV)."""
-        return MEASURES[self.measure].display_unit
-
-    @property
     def relative_levels(self) -> bool:
         """True when the levels are multiples of each block's uplift intensity."""
         return self.levels_relative_to == "uplift"

@@ -206,8 +206,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
 
 
 def _level_coordinates(config, measure_name, intensity) -> dict:
-    """``im_level`` (index: multiples of uplift or absolute levels) and the per-block intensities, in the
-    measure's display unit (``Measure.cf_units``)."""
+    """``im_level`` and the per-block intensities, in the measure's display unit (``Measure.cf_units``).
+
+    ``im_level`` is an index: multiples of uplift or absolute levels.
+    """
     measure = MEASURES[config.measure]
     units = measure.cf_units()
     if config.relative_levels:

@@ -7,7 +7,10 @@ Input : the study cube (``capacity_scale_factor``: each record's adaptive overtu
         package).
 Output: ``reports/efficiency.nc`` and ``efficiency.csv``: per soil, block, model and measure the
         median capacity, its dispersion, the efficiency rank and the sufficiency p-values; and
-        ``plot_efficiency(dataset)``, a one-page figure.
+        ``plot_efficiency(dataset)``, a one-page figure. The measures have different units, so
+        ``efficiency.nc`` holds one median variable per measure, ``median_capacity_<measure>``, in
+        the units result files use for that quantity (``pipeline.measures.file_units``: multiples of
+        g for accelerations); ``efficiency.csv`` gives the median in those units and names them.
 
 No new solver run: scaling a record by lambda scales every measure with scaling exponent 1 by
 lambda, so a record's capacity in measure M is (capacity scale factor) x M(record).
@@ -32,7 +35,7 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
-from pipeline.measures import MEASURES, scaling_measures
+from pipeline.measures import MEASURES, convert_units, file_units, scaling_measures, udunits, unit_label
 from pipeline.outputs import atomic_path, write_dataset
 from pipeline.records import RECORDS_DIR
 
@@ -121,6 +124,8 @@ def efficiency_from_capacities(capacity: xr.DataArray, covariates: dict) -> xr.D
 
     capacity : (record, soil, block, model, measure) [SI], NaN where the record did not overturn;
     covariates : name -> (n_record,) record properties (see COVARIATES).
+    The median capacity of measure m is ``median_capacity_<m>`` (soil, block, model) in
+    ``median_capacity_units(m)``; every other variable runs along ``measure``.
     """
     capacity = capacity.transpose("record", "soil", "block", "model", "measure")
     log_capacity = np.log(capacity.where(capacity > 0))
@@ -131,10 +136,14 @@ def efficiency_from_capacities(capacity: xr.DataArray, covariates: dict) -> xr.D
     rank = xr.apply_ufunc(rank_ascending, dispersion, input_core_dims=[["measure"]],
                           output_core_dims=[["measure"]])
     pooled = log_capacity.stack(sample=("record", "block")).std("sample", ddof=1)
-    data_vars = {
-        "median_capacity": median.assign_attrs(long_name="median overturning capacity in the measure "
-                                                         "(geometric mean over the records that overturned)",
-                                               units="SI unit of the measure (see measure_si_unit)"),
+    data_vars = {}
+    for name in median.measure.values:
+        units, cell = median_capacity_units(name), median.sel(measure=name, drop=True)
+        values = convert_units(cell.values, udunits(MEASURES[name].si_unit), units)
+        data_vars[f"median_capacity_{name}"] = cell.copy(data=values).assign_attrs(
+            long_name=f"median overturning capacity in {name} (geometric mean over the records that overturned)",
+            units=units, measure=str(name))
+    data_vars |= {
         "dispersion": dispersion.assign_attrs(long_name="dispersion of the overturning capacity, std of ln "
                                                         "capacity (efficiency: smaller is better)", units="1"),
         "efficiency_rank": rank.assign_attrs(long_name="rank of the measure by dispersion (1 = most efficient)",
@@ -161,6 +170,23 @@ def efficiency_from_capacities(capacity: xr.DataArray, covariates: dict) -> xr.D
                      "references": "Luco & Cornell (2007) Earthquake Spectra 23(2); Makris & Vassiliou (2013); "
                                    "Dimitrakopoulos & DeJong (2012)"}
     return dataset
+
+
+def median_capacity_units(name: str) -> str:
+    """The ``units`` of ``median_capacity_<name>`` in ``efficiency.nc``.
+
+    Parameters
+    ----------
+    name : str
+        A registered measure.
+
+    Returns
+    -------
+    str
+        The units result files give the measure's SI quantity (``pipeline.measures.file_units``):
+        "9.80665 m s-2" (g) for accelerations, "m s-1" for velocities, "1" for ratios.
+    """
+    return file_units(MEASURES[name].si_unit)
 
 
 def capacities_in_measures(cube: xr.Dataset, values: xr.DataArray) -> xr.DataArray:
@@ -191,14 +217,19 @@ def sufficiency_verdict(p_values) -> str:
 
 
 def efficiency_table(dataset: xr.Dataset) -> pd.DataFrame:
-    """Long table: one row per soil, block, model and measure, best measure first."""
+    """Long table: one row per soil, block, model and measure, best measure first.
+
+    ``median_capacity`` is in the measure's ``units`` ("g", "m/s", "1"), as in ``efficiency.nc``.
+    """
     columns = ["median_capacity", "dispersion", "efficiency_rank", "n_records", "p_magnitude", "p_distance",
                "p_pulse_period"]
-    table = dataset[columns].to_dataframe().reset_index()
-    table["si_unit"] = [MEASURES[m].si_unit for m in table["measure"]]
+    median = xr.concat([dataset[f"median_capacity_{m}"] for m in dataset.measure.values], dim=dataset.measure)
+    table = dataset.assign(median_capacity=median.transpose(*dataset.dispersion.dims))[columns]
+    table = table.to_dataframe().reset_index()
+    table["units"] = [unit_label(median_capacity_units(m)) for m in table["measure"]]
     table["sufficient"] = [sufficiency_verdict(row)
                            for row in table[["p_magnitude", "p_distance", "p_pulse_period"]].to_numpy()]
-    table = table[["soil", "block", "model", "measure", "si_unit", *columns, "sufficient"]]
+    table = table[["soil", "block", "model", "measure", "units", *columns, "sufficient"]]
     return table.sort_values(["soil", "block", "model", "efficiency_rank"]).reset_index(drop=True)
 
 

@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import xarray as xr
+from tqdm.auto import tqdm
 
 from pipeline.config import StudyConfig
 from pipeline.cube import (
@@ -104,16 +105,18 @@ CAPACITY_FIT = (
 
 
 def first_overturn_outcomes(cube: xr.Dataset) -> xr.DataArray:
-    """The cube's ``outcome`` with every level from a record's first overturning level on set to overturned
-    (``OVERTURNING_CONVENTION``); levels increase along ``im_level``.
+    """The cube's ``outcome`` with every level from a record's first overturning level on set to overturned.
+
+    This is ``OVERTURNING_CONVENTION``; levels increase along ``im_level``.
     """
     since = (cube.outcome == OUTCOME_OVERTURNED).cumsum("im_level") > 0
     return cube.outcome.where(~since, OUTCOME_OVERTURNED)
 
 
 def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
-    """1.0 where a run reached the damage state, 0.0 where not, NaN where the solver failed; a record is
-    beyond every state from its first overturning level on (``first_overturn_outcomes``).
+    """1.0 where a run reached the damage state, 0.0 where not, NaN where the solver failed.
+
+    A record is beyond every state from its first overturning level on (``first_overturn_outcomes``).
     """
     outcome = first_overturn_outcomes(cube)
     if state.edp == "uplifted":
@@ -128,9 +131,9 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
 # ---------------------------------------------------------------- intensity levels of a cube
 
 def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
-    """The physical intensity of every (block, im_level) in the study's display unit, and its ``units``
-    as UDUNITS parses them ("9.80665 m s-2" for g; ``pipeline.measures.Measure.cf_units``).
+    """The physical intensity of every (block, im_level) in the study's display unit, and its ``units``.
 
+    The ``units`` are as UDUNITS parses them ("9.80665 m s-2" for g; ``pipeline.measures.Measure.cf_units``).
     Works for both cube layouts: one physical ``im_level`` coordinate shared by all blocks, or a
     dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate (``intensity``,
     or any other found by its dims and units, in any unit ``pipeline.measures.parse_units`` reads: g
@@ -165,8 +168,9 @@ def uplift_is_rigid_threshold(model_name: str) -> bool:
 
 
 def uplift_threshold(cube: xr.Dataset, unit: str) -> np.ndarray | None:
-    """G tan(alpha) per block in the study's intensity ``unit`` (an acceleration unit ``parse_units``
-    reads), or None when the cube cannot tell or ``unit`` is no acceleration.
+    """G tan(alpha) per block in the study's intensity ``unit``, or None when the cube cannot tell.
+
+    ``unit`` is an acceleration unit ``parse_units`` reads; None too when it is no acceleration.
     """
     parsed = parse_units(unit)
     if parsed is None or parsed[1] != udunits("m/s^2"):
@@ -192,13 +196,16 @@ class RowFit:
     warnings: tuple = ()
     deviance_cost: float = 0.0
 
-    def warn(self, message):
+    def warn(self, message: str) -> None:
+        """Append ``message`` to the row's warnings."""
         self.warnings = (*self.warnings, message)
 
 
 def _crosses_where_data_tell(levels, exceed_severe, lower_fit, upper_fit):
-    """Do two fitted curves cross between the lowest level at which the more severe state has
-    exceedances and the highest level? (Below it both are zero by the data; tails there are arithmetic.)
+    """Whether two fitted curves cross where the data can tell.
+
+    That is between the lowest level at which the more severe state has exceedances and the highest
+    level (below it both are zero by the data; tails there are arithmetic).
     """
     reached = np.flatnonzero(exceed_severe > 0)
     if reached.size == 0:
@@ -213,8 +220,9 @@ def _shared_fit(levels, exceed, total, group):
 
 
 def noncrossing_groups(levels, exceed, total, fits, usable):
-    """Merge adjacent fitted states into shared-beta groups until no two curves cross where the data
-    can tell. Returns (groups, fits) with the refitted (median, beta) of grouped states.
+    """Merge adjacent fitted states into shared-beta groups until no two curves cross where the data can tell.
+
+    Returns (groups, fits) with the refitted (median, beta) of grouped states.
     """
     groups = [[s] for s in usable]
     fits = dict(fits)
@@ -354,9 +362,11 @@ def record_resamples(n_records, n_bootstrap, seed):
 
 
 def refined_capacities(ida: xr.Dataset | None, unit: str) -> tuple[np.ndarray, np.ndarray] | None:
-    """The refined overturning capacities of ``ida.nc`` in ``unit``, (record, soil, block, model), and where
-    each record that never overturned is censored: the highest intensity it was seen to survive
-    (``capacity_lower``; NaN where unknown). None without refined capacities.
+    """The refined overturning capacities of ``ida.nc`` in ``unit``, and where each record is censored.
+
+    Both are (record, soil, block, model). A record that never overturned is censored at the highest
+    intensity it was seen to survive (``capacity_lower``; NaN where unknown). None without refined
+    capacities.
     """
     if ida is None or "capacity" not in ida:
         return None
@@ -373,9 +383,11 @@ def refined_capacities(ida: xr.Dataset | None, unit: str) -> tuple[np.ndarray, n
 
 def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n_records: int, unit: str,
                        capacities: list | None, top: float) -> None:
-    """The overturning row of one cell: the capacity fit of its refined capacities into ``out`` (see
-    ``CAPACITY_FIT``), and warnings on ``row`` for resurrection and for a capacity median outside the stripe
-    fit's bootstrap bounds (when the stripe fit has a spread: beta > 0 and distinct bounds).
+    """The overturning row of one cell: its capacity fit into ``out``, and warnings on ``row``.
+
+    The capacity fit is of the cell's refined capacities (see ``CAPACITY_FIT``); the warnings are for
+    resurrection and for a capacity median outside the stripe fit's bootstrap bounds (when the stripe
+    fit has a spread: beta > 0 and distinct bounds).
 
     capacities : [capacity, censor point] per record [unit] or None; top : the cell's highest level, where
     a record that never overturned is censored when its own survival is unknown.
@@ -423,8 +435,6 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         ``fragility.nc``'s content: median [the cube's intensity unit], beta [-], bounds, status, fit method,
         warnings and empirical fractions per soil x block x model x damage state.
     """
-    from tqdm.auto import tqdm
-
     states = states or list(DAMAGE_STATES.values())
     intensity, unit = intensity_levels(cube)
     measure = cube.attrs.get("intensity_measure", "")
@@ -568,8 +578,9 @@ def warning_summary(dataset: xr.Dataset) -> list[str]:
 
 
 def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
-    """P(no uplift), P(rocking without overturning), P(overturning) per level, from the cube; a record is
-    overturned from its first overturning level on (``first_overturn_outcomes``).
+    """P(no uplift), P(rocking without overturning), P(overturning) per level, from the cube.
+
+    A record is overturned from its first overturning level on (``first_overturn_outcomes``).
     """
     outcome = first_overturn_outcomes(cube)
     valid = outcome != OUTCOME_FAILED
@@ -677,7 +688,8 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
     return pd.DataFrame(rows)
 
 
-def write_csv(table: pd.DataFrame, path) -> None:
+def write_csv(table: pd.DataFrame, path: str | Path) -> None:
+    """Write ``table`` to the CSV file ``path`` atomically (6 significant digits, no index)."""
     with atomic_path(path) as temporary:
         table.to_csv(temporary, index=False, float_format="%.6g")
 

@@ -29,6 +29,7 @@ below it, so a refined capacity never exceeds ``first_overturn_im``.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -72,8 +73,9 @@ def first_crossing_im(edp, levels, threshold):
 
 
 def overturning_capacities(outcome, levels):
-    """Per record: the first overturning level, and the lowest level from which every higher level
-    overturns (no resurrection above it). NaN where the block does not overturn / still survives at
+    """Per record: the first overturning level, and the lowest level from which every higher level overturns.
+
+    The second has no resurrection above it. NaN where the block does not overturn / still survives at
     the highest level. outcome : (n_record, n_level) integer outcome codes.
     """
     overturned = outcome == OUTCOME_OVERTURNED
@@ -123,9 +125,11 @@ def _canonical(units: str) -> str:
 
 
 def adaptive_capacities(cube: xr.Dataset) -> xr.Dataset | None:
-    """Overturning capacity of every (record, soil, block, model) from the adaptive runs, with its bracket,
-    in the study's measure [the unit of the cube's ``intensity``]: scale factor x the record's measure.
-    None without them. Variables ``capacity``, ``capacity_lower`` and ``capacity_upper``."""
+    """Overturning capacity of every (record, soil, block, model) from the adaptive runs, with its bracket.
+
+    In the study's measure [the unit of the cube's ``intensity``]: scale factor x the record's measure.
+    None without adaptive runs. Variables ``capacity``, ``capacity_lower`` and ``capacity_upper``.
+    """
     if "capacity_scale_factor" not in cube:
         return None
     _, units = block_intensities(cube)
@@ -300,15 +304,15 @@ def capacity_from_stripes(scales, overturned, overturns, tolerance=0.02, max_run
 
 
 def uniform_stripe_runs(bottom, top, tolerance) -> int:
-    """Stripes per record a uniform (geometric) grid needs from ``bottom`` to ``top`` so that
-    neighbouring stripes are ``tolerance`` apart, i.e. the resolution ``capacity_from_stripes`` gives."""
+    """Stripes per record a uniform (geometric) grid needs from ``bottom`` to ``top``.
+
+    Neighbouring stripes are then ``tolerance`` apart, i.e. the resolution ``capacity_from_stripes`` gives.
+    """
     return int(math.ceil(math.log(top / bottom) / math.log(1.0 + tolerance))) + 1
 
 
-def ida_stage(cube: xr.Dataset, output) -> xr.Dataset:
+def ida_stage(cube: xr.Dataset, output: str | Path) -> xr.Dataset:
     """Compute the IDA products of a cube and write ``ida.nc`` into ``output``."""
-    from pathlib import Path
-
     dataset = ida_dataset(cube)
     write_dataset(dataset, Path(output) / "ida.nc")
     return dataset

@@ -43,7 +43,7 @@ def _log_likelihood(eta, exceed, total):
 
 
 def _score_and_weight(eta, exceed, total):
-    """d loglik / d eta and the Fisher weight n phi^2 / (Phi (1 - Phi)), computed in logs (tails)."""
+    """The score d loglik / d eta and the Fisher weight n phi^2 / (Phi (1 - Phi)), computed in logs (tails)."""
     log_phi = _log_pdf(eta)
     low, high = log_ndtr(eta), log_ndtr(-eta)
     score = exceed * np.exp(log_phi - low) - (total - exceed) * np.exp(log_phi - high)
@@ -105,11 +105,13 @@ def _starting_values(x, exceed, total):
 
 
 def separation(exceed, total):
-    """Per data set (..., n_level): True where the counts are perfectly or quasi-completely separated:
-    every level below the first exceedance has none, every level above the last survivor is fully
-    exceeded, and at most one level is mixed. The likelihood then grows as beta -> 0 and no lognormal
-    MLE exists. Also returns the index of the first level with an exceedance and of the last level
-    with a survivor."""
+    """Per data set (..., n_level): True where the counts are perfectly or quasi-completely separated.
+
+    Separated means: every level below the first exceedance has none, every level above the last
+    survivor is fully exceeded, and at most one level is mixed. The likelihood then grows as
+    beta -> 0 and no lognormal MLE exists. Also returns the index of the first level with an
+    exceedance and of the last level with a survivor.
+    """
     has_data = total > 0
     some = has_data & (exceed > 0)
     not_all = has_data & (exceed < total)

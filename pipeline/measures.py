@@ -71,8 +71,11 @@ def cav(acceleration, dt) -> float:
 
 
 def _husid(acceleration, dt) -> tuple[np.ndarray | None, np.ndarray]:
-    """The normalised Husid curve (cumulative integral of a^2, trapezoidal; None for a record without
-    energy) and the time of each sample [s]."""
+    """The normalised Husid curve and the time of each sample [s].
+
+    The curve is the cumulative integral of a^2 (trapezoidal), normalised to end at 1; None for a
+    record without energy.
+    """
     squared = np.asarray(acceleration, dtype=float) ** 2
     husid = np.concatenate([[0.0], np.cumsum(0.5 * (squared[1:] + squared[:-1]) * dt)])
     time = np.arange(husid.size) * dt
@@ -82,9 +85,11 @@ def _husid(acceleration, dt) -> tuple[np.ndarray | None, np.ndarray]:
 
 
 def significant_window(acceleration, dt, start=0.05, end=0.95) -> tuple[float, float]:
-    """Times [s] at which the Arias intensity reaches ``start`` and ``end`` of its final value (the
-    Husid curve interpolated linearly between samples); the whole record, (0, (n - 1) dt), for a record
-    without energy."""
+    """Times [s] at which the Arias intensity reaches ``start`` and ``end`` of its final value.
+
+    The Husid curve is interpolated linearly between samples; the window is the whole record,
+    (0, (n - 1) dt), for a record without energy.
+    """
     husid, time = _husid(acceleration, dt)
     if husid is None:
         return 0.0, float(time[-1])
@@ -92,8 +97,10 @@ def significant_window(acceleration, dt, start=0.05, end=0.95) -> tuple[float, f
 
 
 def significant_duration(acceleration, dt, start=0.05, end=0.95) -> float:
-    """Time between ``start`` and ``end`` fractions of the Arias intensity (D5-95 by default) [s]: the
-    length of ``significant_window``, 0 for a record without energy."""
+    """Time between ``start`` and ``end`` fractions of the Arias intensity (D5-95 by default) [s].
+
+    The length of ``significant_window``; 0 for a record without energy.
+    """
     husid, time = _husid(acceleration, dt)
     if husid is None:
         return 0.0
@@ -204,8 +211,10 @@ def intensity_measures(acceleration, dt, sa_periods=(0.2, 1.0, 2.0)) -> dict:
 
 
 def average_spectral_acceleration(acceleration, dt, low, high, damping=0.05, count=10) -> float:
-    """AvgSa [m/s^2]: geometric mean of Sa at ``count`` log-spaced periods from ``low`` to ``high`` [s]
-    (Eads et al. 2015; Kohrangi et al. 2016)."""
+    """AvgSa [m/s^2]: geometric mean of Sa at ``count`` log-spaced periods from ``low`` to ``high`` [s].
+
+    After Eads et al. (2015) and Kohrangi et al. (2016).
+    """
     if not 0 < low < high:
         raise ValueError(f"AvgSa period range {low}..{high} s; need 0 < low < high")
     spectrum = response_spectrum(acceleration, dt, np.geomspace(low, high, count), damping)
@@ -213,8 +222,7 @@ def average_spectral_acceleration(acceleration, dt, low, high, damping=0.05, cou
 
 
 def velocity_pulse(acceleration, dt) -> tuple[float, float, float]:
-    """The dominant velocity pulse: (period Tp [s], velocity amplitude v_p [m/s], acceleration
-    amplitude a_p [m/s^2]).
+    """The dominant velocity pulse: (period Tp [s], velocity v_p [m/s], acceleration a_p [m/s^2]).
 
     A deliberately simple, documented estimator (not Baker's 2007 wavelet extraction): the half
     cycle of ground velocity that holds the PGV runs between the zero crossings on either side of
@@ -289,22 +297,43 @@ class Measure:
 
     @property
     def scalable(self) -> bool:
-        """Can a study scale records to this measure (scaling exponent 1)?"""
+        """Whether a study can scale records to this measure (scaling exponent 1)."""
         return self.scaling_exponent == 1.0
 
     @property
     def uses_period(self) -> bool:
-        """Is the measure defined at the study's one oscillator ``period`` (Sa(T))?"""
+        """Whether the measure is defined at the study's one oscillator ``period`` (Sa(T))."""
         return "period" in _fields(self.label)
 
     def __call__(self, acceleration, dt, block=None, **options) -> float:
+        """The measure of one record.
+
+        Parameters
+        ----------
+        acceleration : array_like
+            Ground acceleration [m/s^2].
+        dt : float
+            Time step [s].
+        block : pipeline.blocks.Block, optional
+            The block, required for a per-block measure (ignored otherwise).
+        **options
+            The study's ``period`` [s], ``damping`` [-] and ``period_range`` ((low, high) [s]).
+
+        Returns
+        -------
+        float
+            The value in the measure's ``si_unit``.
+        """
         if self.per_block and block is None:
             raise ValueError(f"measure {self.name!r} is defined per block; pass the block")
         return float(self.function(acceleration, dt, block, _options(options)))
 
     def cf_units(self, display: bool = True) -> str:
-        """The measure's ``units`` attribute in result files, as UDUNITS parses it: the display unit
-        ("9.80665 m s-2" for g, "m s-1" for m/s; see ``udunits``) or, with ``display=False``, the SI unit."""
+        """The measure's ``units`` attribute in result files, as UDUNITS parses it.
+
+        The display unit ("9.80665 m s-2" for g, "m s-1" for m/s; see ``udunits``) or, with
+        ``display=False``, the SI unit.
+        """
         return udunits(self.si_unit, self.display_factor if display else 1.0)
 
     def describe(self, **options) -> str:
@@ -316,9 +345,12 @@ class Measure:
         return _fill(self.label, options)
 
     def label_in(self, described: str) -> str | None:
-        """The label with the options read back from ``described``, a text ``describe`` wrote (such as the
-        ``long_name`` of a cube's ``im_level``): "Sa(0.5 s)" from "intensity level: spectral acceleration
-        Sa(0.5 s, 5%)". None when ``described`` does not hold this measure's long name."""
+        """The label with the options read back from ``described``, a text ``describe`` wrote.
+
+        ``described`` is, for example, the ``long_name`` of a cube's ``im_level``: "Sa(0.5 s)" from
+        "intensity level: spectral acceleration Sa(0.5 s, 5%)". None when ``described`` does not hold
+        this measure's long name.
+        """
         pattern, named = "", set()
         for literal, field, _, _ in string.Formatter().parse(self.long_name):
             pattern += re.escape(literal)
@@ -415,9 +447,12 @@ def display_units(name: str) -> tuple[str, float]:
 
 
 def short_label(name: str, described: str = "") -> str:
-    """Short label of measure ``name`` for axes and text ("PGA", "Sa(1 s)"), its options read from
-    ``described`` (see ``Measure.label_in``). For an unknown or empty name: the label of the first
-    registered measure whose long name ``described`` holds; else the upper-case name, or "intensity"."""
+    """Short label of measure ``name`` for axes and text ("PGA", "Sa(1 s)").
+
+    Its options are read from ``described`` (see ``Measure.label_in``). For an unknown or empty name:
+    the label of the first registered measure whose long name ``described`` holds; else the upper-case
+    name, or "intensity".
+    """
     measure = MEASURES.get(name)
     for candidate in [measure] if measure is not None else MEASURES.values():
         label = candidate.label_in(described)
@@ -441,9 +476,12 @@ _UDUNITS_SPELLING = {"m/s^2": "m s-2", "m/s**2": "m s-2", "m/s2": "m s-2", "m/s"
 
 
 def udunits(unit: str, factor: float = 1.0) -> str:
-    """``unit`` (an SI unit as the registry spells it: "m/s^2", "m/s", "1", "s", ...) scaled by ``factor``, as a
-    UDUNITS ``units`` string: ``udunits("m/s^2") == "m s-2"``, ``udunits("m/s^2", STANDARD_GRAVITY) ==
-    "9.80665 m s-2"`` (g), ``udunits("1", 2.0) == "2"``."""
+    """``unit`` scaled by ``factor``, as a UDUNITS ``units`` string.
+
+    ``unit`` is an SI unit as the registry spells it ("m/s^2", "m/s", "1", "s", ...):
+    ``udunits("m/s^2") == "m s-2"``, ``udunits("m/s^2", STANDARD_GRAVITY) == "9.80665 m s-2"`` (g),
+    ``udunits("1", 2.0) == "2"``.
+    """
     base = _UDUNITS_SPELLING.get(unit, unit)
     if factor == 1.0:
         return base
@@ -451,9 +489,11 @@ def udunits(unit: str, factor: float = 1.0) -> str:
 
 
 def file_units(si_unit: str) -> str:
-    """The ``units`` of a quantity of SI unit ``si_unit`` in result files: the display unit of the first
-    registered measure of that SI unit ("9.80665 m s-2" for any acceleration: record PGAs, levels, uplift
-    thresholds), else the SI unit (``udunits``)."""
+    """The ``units`` of a quantity of SI unit ``si_unit`` in result files.
+
+    The display unit of the first registered measure of that SI unit ("9.80665 m s-2" for any
+    acceleration: record PGAs, levels, uplift thresholds), else the SI unit (``udunits``).
+    """
     for measure in MEASURES.values():
         if measure.si_unit == si_unit:
             return measure.cf_units(display=True)
@@ -461,10 +501,12 @@ def file_units(si_unit: str) -> str:
 
 
 def parse_units(units: str) -> tuple[float, str] | None:
-    """(SI value of one unit, SI unit in UDUNITS spelling) of a ``units`` attribute of an intensity-like
-    quantity: "9.80665 m s-2" -> (9.80665, "m s-2"), "m/s^2" -> (1.0, "m s-2"), "m s-1" -> (1.0, "m s-1"),
+    """(SI value of one unit, SI unit in UDUNITS spelling) of an intensity-like ``units`` attribute.
+
+    "9.80665 m s-2" -> (9.80665, "m s-2"), "m/s^2" -> (1.0, "m s-2"), "m s-1" -> (1.0, "m s-1"),
     "1" -> (1.0, "1"); "g" (files written before the UDUNITS spellings, where it meant standard gravity)
-    -> (9.80665, "m s-2"). None for anything else (an empty string included)."""
+    -> (9.80665, "m s-2"). None for anything else (an empty string included).
+    """
     text = str(units).strip()
     if not text:
         return None
@@ -499,8 +541,11 @@ def convert_units(values, units: str, to: str):
 
 
 def unit_label(units: str) -> str:
-    """The unit as tables and axes show it: the registered display or SI unit whose ``units`` string this
-    is ("9.80665 m s-2" -> "g", "m s-1" -> "m/s", "m s-2" -> "m/s^2"); else ``units`` unchanged."""
+    """The unit as tables and axes show it.
+
+    The registered display or SI unit whose ``units`` string this is ("9.80665 m s-2" -> "g",
+    "m s-1" -> "m/s", "m s-2" -> "m/s^2"); else ``units`` unchanged.
+    """
     parsed = parse_units(units)
     if parsed is None:
         return str(units)

@@ -12,8 +12,11 @@ import xarray as xr
 
 from pipeline import applicability as applicability_module
 from pipeline.answer import answer_model, answer_rows, answer_table, display_scale
+from pipeline.calibrate import check_reference, load_reference
 from pipeline.cli import _study_config, build_parser, main, run_applicability
+from pipeline.config import load_study
 from pipeline.errors import ConfigError
+from pipeline.records import load_records
 from pipeline.units import STANDARD_GRAVITY
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -187,8 +190,6 @@ def test_quiet_hides_the_answer_and_the_flag_runs_the_sweep(tiny_run, capsys, mo
 # ---------------------------------------------------------------- the shipped examples
 
 def test_the_example_study_is_one_user_block_two_soils_ten_records():
-    from pipeline.config import load_study
-
     study = load_study(ROOT / "studies" / "example.toml")
     assert [b.name for b in study.blocks] == ["cabinet"] and len(study.soils) == 2
     assert len(study.record_sets) == 10 and "winkler" in study.models
@@ -196,9 +197,6 @@ def test_the_example_study_is_one_user_block_two_soils_ten_records():
 
 
 def test_the_sample_reference_belongs_to_its_record():
-    from pipeline.calibrate import check_reference, load_reference
-    from pipeline.records import load_records
-
     reference = load_reference(ROOT / "studies" / "calibration-reference.csv")
     assert (reference.time_unit, reference.angle_unit) == ("s", "rad")
     records, _ = load_records(["DUZCE/BOL090"])

@@ -16,6 +16,7 @@ from pipeline.efficiency import (
     rank_ascending,
     write_efficiency,
 )
+from pipeline.units import STANDARD_GRAVITY
 
 N = 40
 rng = np.random.default_rng(7)
@@ -47,7 +48,11 @@ def test_dispersion_and_rank_of_known_capacities():
     cell = dataset.isel(soil=0, block=0, model=0)
     np.testing.assert_allclose(cell.dispersion.values, [0.2, 0.5, 0.3], rtol=1e-12)
     assert list(cell.efficiency_rank.values) == [1.0, 3.0, 2.0]
-    assert cell.median_capacity.sel(measure="pga").item() == pytest.approx(np.exp(1.0), rel=1e-12)
+    # the capacities are SI [m/s^2]; the file gives PGA medians in g and PGV ones in m/s
+    assert cell.median_capacity_pga.item() == pytest.approx(np.exp(1.0) / STANDARD_GRAVITY, rel=1e-12)
+    assert cell.median_capacity_pga.attrs["units"] == "9.80665 m s-2"
+    assert cell.median_capacity_pgv.item() == pytest.approx(np.exp(2.0), rel=1e-12)
+    assert cell.median_capacity_pgv.attrs["units"] == "m s-1"
 
 
 def test_sufficiency_flags_the_measure_whose_residuals_follow_magnitude():

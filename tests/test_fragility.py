@@ -9,6 +9,7 @@ import json
 import numpy as np
 import pytest
 import xarray as xr
+from scipy import optimize, stats
 from scipy.optimize import minimize
 from scipy.special import log_ndtr
 from scipy.stats import norm
@@ -19,6 +20,7 @@ from pipeline.fragility import (
     STATUS,
     curves_cross,
     fit_binomial,
+    fit_cell,
     fit_censored_capacities,
     fit_independent,
     fit_shared_beta,
@@ -157,7 +159,8 @@ def test_cube_fit_recovers_medians_and_uplift_is_the_exact_step(fitted):
     assert cell["beta"].sel(damage_state="overturning").item() == pytest.approx(0.4, rel=0.15)
     assert set(cell.status.values) <= set(STATUS)
     assert not cell.extrapolated.values.any()
-    ordered = [(medians[s], cell["beta"].sel(damage_state=s).item()) for s in ("rocking-0.2", "rocking-0.5", "overturning")]
+    ordered = [(medians[s], cell["beta"].sel(damage_state=s).item())
+               for s in ("rocking-0.2", "rocking-0.5", "overturning")]
     assert not curves_cross(np.geomspace(0.05, 3.0, 400), ordered)
     np.testing.assert_allclose(cell.outcome_probability.sum("outcome_class").values, 1.0)
 
@@ -214,7 +217,6 @@ def test_tail_overlap_below_the_first_exceedance_does_not_trigger_the_shared_fit
     rng = np.random.default_rng(1)
     e02 = rng.binomial(n, norm.cdf(np.log(levels / 0.4) / 0.15))
     e05 = np.where(levels >= 0.45, rng.binomial(n, norm.cdf(np.log(levels / 0.9) / 0.3)), 0)
-    from pipeline.fragility import fit_cell
     states = [DAMAGE_STATES["rocking-0.2"], DAMAGE_STATES["rocking-0.5"]]
     exceed = np.stack([e02, e05]).astype(float)
     rows, groups = fit_cell(levels, exceed, np.full_like(exceed, n), states)
@@ -363,10 +365,10 @@ def capacity_cube(outcomes, capacities, levels, lower=None, record_im=0.5):
         attrs={"intensity_measure": "pga", "capacity_resolution": 0.02})
 
 
-N, R, O = OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED
+N, R, OT = OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED
 RESURRECTING_LEVELS = [0.3, 0.48, 0.6, 0.9, 1.2, 1.5]
 # first overturning stripes 0.48, 0.90 and 0.48 g (the issue's three records); r0 and r1 survive higher levels
-RESURRECTING = [[R, O, R, R, R, O], [R, R, R, O, R, O], [R, O, R, O, O, O]]
+RESURRECTING = [[R, OT, R, R, R, OT], [R, R, R, OT, R, OT], [R, OT, R, OT, OT, OT]]
 REFINED = [0.45, 0.70, 0.40]  # each inside its first overturning gap
 
 
@@ -381,7 +383,7 @@ def test_resurrection_is_reported_not_fitted_into_a_median_above_every_capacity(
     assert row["median"].item() <= max(REFINED)
     assert row.capacity_median.item() <= max(REFINED)
     # the test can fail: the raw stripe counts (2, 0, 2, 1, 3 of 3 from 0.48 g) put the median above them all
-    raw = (np.asarray(RESURRECTING) == O).sum(0)
+    raw = (np.asarray(RESURRECTING) == OT).sum(0)
     assert fit_binomial(np.asarray(RESURRECTING_LEVELS), raw, np.full(raw.size, 3))[0] > max(REFINED)
     # a record counts as overturned from its first overturning level on, for every damage state
     fraction = fragility.empirical_fraction.isel(soil=0, block=0, model=0)
@@ -411,13 +413,11 @@ def test_capacity_fit_is_the_lognormal_mle_of_the_refined_capacities():
 
 def test_censored_capacity_fit_matches_an_independent_scipy_refit():
     """Two of eight records never overturn: right-censored at the highest intensity each survived."""
-    from scipy import optimize, stats
-
     levels = [0.2, 0.4, 0.8, 1.6]
     capacities = np.array([0.35, 0.5, 0.62, 0.75, 1.1, 1.45, np.nan, np.nan])
     lower = np.where(np.isfinite(capacities), 0.98 * capacities, [0, 0, 0, 0, 0, 0, 2.1, 2.6])
     first = [np.searchsorted(levels, c) if np.isfinite(c) else len(levels) for c in capacities]
-    outcomes = [[O if j >= f else R for j in range(len(levels))] for f in first]
+    outcomes = [[OT if j >= f else R for j in range(len(levels))] for f in first]
     cube = capacity_cube(outcomes, capacities, levels, lower=lower)
     ida = ida_dataset(cube)
     fragility = fragility_dataset(cube, ida=ida, n_bootstrap=0)

@@ -22,11 +22,11 @@ def constructed_cube(ratios, outcomes, levels):
 
 
 LEVELS = np.array([0.1, 0.2, 0.3, 0.4, 0.5])
-R, O, N = OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_NO_UPLIFT
+R, OT, N = OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_NO_UPLIFT
 # record 0 overturns at 0.3, survives 0.4 (resurrection) and overturns again at 0.5
 # record 1 never overturns; record 2 overturns from 0.4 on
 RATIOS = [[0.0, 0.3, 1.0, 0.6, 1.0], [0.0, 0.1, 0.2, 0.4, 0.8], [0.0, 0.2, 0.5, 1.0, 1.0]]
-OUTCOMES = [[N, R, O, R, O], [N, R, R, R, R], [N, R, R, O, O]]
+OUTCOMES = [[N, R, OT, R, OT], [N, R, R, R, R], [N, R, R, OT, OT]]
 
 
 def test_resurrection_is_represented_not_smoothed():
@@ -60,7 +60,7 @@ def test_intensity_given_response_interpolates_first_crossing():
 
 
 def test_overturning_capacities_of_a_record_that_survives_the_top():
-    first, stable = overturning_capacities(np.array([[R, O, R]]), np.array([1.0, 2.0, 3.0]))
+    first, stable = overturning_capacities(np.array([[R, OT, R]]), np.array([1.0, 2.0, 3.0]))
     assert first[0] == 2.0 and np.isnan(stable[0])
 
 

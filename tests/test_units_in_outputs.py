@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 
 import numpy as np
+import pandas as pd
 import pytest
 import xarray as xr
 
@@ -117,9 +118,7 @@ def test_every_netcdf_output_states_one_parseable_unit_per_quantity(fragility_ru
     assert {"cube.nc", "ida.nc", "fragility.nc", "showcase.nc"} <= {path.name for path in written}
     for path in written:
         with xr.open_dataset(path) as dataset:
-            # efficiency.nc: a capacity per measure along one dimension (test below)
-            skip = [name for name, variable in dataset.variables.items() if "measure" in variable.dims]
-            check_file(dataset, path.name, skip)
+            check_file(dataset, path.name)
 
 
 @pytest.mark.slow
@@ -143,14 +142,22 @@ def test_record_pgas_levels_intensities_and_fits_share_one_unit(fragility_run):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="efficiency.py (not part of this change) states median_capacity's units as "
-                                       "a sentence: one variable spans measures of different units")
 def test_efficiency_capacities_state_parseable_units(fragility_run):
     path = fragility_run / "efficiency.nc"
     if not path.exists():
         pytest.skip("no efficiency.nc in this run")
     with xr.open_dataset(path) as dataset:
-        check_file(dataset, path.name)
+        units = check_file(dataset, path.name)
+        assert units["acceleration"] == "9.80665 m s-2" and units["velocity"] == "m s-1"
+        assert dataset.median_capacity_pga_ratio.attrs["units"] == "1"
+        medians = {name: dataset[f"median_capacity_{name}"].load() for name in ("pga", "pgv", "pga_ratio")}
+    # the table gives each median in the unit the file states, and names it
+    table = pd.read_csv(fragility_run / "efficiency.csv", keep_default_na=False, na_values=[""])
+    for name, label in (("pga", "g"), ("pgv", "m/s"), ("pga_ratio", "1")):
+        rows = table[table.measure == name]
+        assert set(rows.units.astype(str)) == {label}, name
+        in_file = [medians[name].sel(soil=r.soil, block=r.block, model=r.model).item() for r in rows.itertuples()]
+        np.testing.assert_allclose(rows.median_capacity, in_file, rtol=1e-5)
 
 
 def test_a_pgv_study_keeps_velocities_and_accelerations_apart(tmp_path):
