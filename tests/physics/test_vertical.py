@@ -20,10 +20,14 @@ from functools import lru_cache
 
 import numpy as np
 import pytest
+import sympy as sp
 
 from pipeline.blocks import Block
-from pipeline.models import Outcome, SolverOptions, get_model, kernels, parameter_table, simulate, simulate_batch
+from pipeline.errors import SolverError
+from pipeline.models import (Outcome, SolverOptions, get_model, kernels, parameter_record, parameter_table, simulate,
+                             simulate_batch)
 from pipeline.models.fields import STATE_SIZE, new_summaries
+from pipeline.models.winkler import bed_force
 from pipeline.processing import process_record
 from pipeline.records import load_records
 
@@ -75,6 +79,82 @@ def sine_pulse(amplitude, period, dt=0.005, duration=6.0):
     t = np.arange(0.0, duration + dt / 2, dt)
     window = (t >= 0.2) & (t <= 0.2 + period)
     return np.where(window, amplitude * np.sin(2 * np.pi * (t - 0.2) / period), 0.0), dt
+
+
+# ---------------------------------------------------------------------------------------------
+# the bed model's equations with the base moving vertically (the pivot models':
+# tests/physics/test_equations_of_motion.py)
+# ---------------------------------------------------------------------------------------------
+
+@lru_cache(maxsize=1)
+def winkler_lagrange_accelerations():
+    """(theta'', y'') of the block on its bed with the ground moving by (x_g(t), z_g(t)), from sympy:
+    functions of (theta, theta', y, y', ag, a_v, F/m, M/m, b, h, g)."""
+    t = sp.symbols("t")
+    m, b, h, g, force, moment, ag, av = sp.symbols("m b h g F M a_g a_v", real=True)
+    theta, y = sp.Function("theta")(t), sp.Function("y")(t)
+    x_ground, z_ground = sp.Function("x_g")(t), sp.Function("z_g")(t)
+    # base centre at (x_g, z_g - y); theta > 0 tilts the block towards +x
+    x_centre = x_ground + h * sp.sin(theta)
+    z_centre = z_ground - y + h * sp.cos(theta)
+    kinetic = (m * (sp.diff(x_centre, t) ** 2 + sp.diff(z_centre, t) ** 2)
+               + m * (b**2 + h**2) / 3 * sp.diff(theta, t) ** 2) / 2
+    lagrangian = kinetic - m * g * z_centre
+    # the bed: an upward point force F at body coordinate s = M / F, height z_g - y - s sin(theta)
+    z_base_point = z_ground - y - moment / force * sp.sin(theta)
+    theta_dd, y_dd, th, thd, yy, yd = sp.symbols("theta_dd y_dd th thd yy yd")
+    replace = {sp.diff(x_ground, t, 2): ag, sp.diff(z_ground, t, 2): av, sp.diff(theta, t, 2): theta_dd,
+               sp.diff(y, t, 2): y_dd, sp.diff(theta, t): thd, sp.diff(y, t): yd}
+    equations = []
+    for q in (theta, y):
+        residual = (sp.diff(sp.diff(lagrangian, sp.diff(q, t)), t) - sp.diff(lagrangian, q)
+                    - force * sp.diff(z_base_point, q))
+        equations.append(sp.expand(residual.subs(replace).subs({theta: th, y: yy}) / m))
+    assert not any(e.has(x_ground) or e.has(z_ground) for e in equations)
+    solution = sp.solve(equations, [theta_dd, y_dd], dict=True)[0]
+    per_mass = {force: sp.Symbol("F_m") * m, moment: sp.Symbol("M_m") * m}
+    arguments = (th, thd, yy, yd, ag, av, sp.Symbol("F_m"), sp.Symbol("M_m"), b, h, g)
+    return tuple(sp.lambdify(arguments, sp.simplify(solution[q].subs(per_mass)), "math") for q in (theta_dd, y_dd))
+
+
+@pytest.mark.parametrize("bed", ["continuous", "two-spring"])
+def test_winkler_rhs_is_euler_lagrange_with_the_base_moving_vertically(bed):
+    """The compiled right-hand side under gravity g + a_v makes the Euler-Lagrange residual of the block on
+    a vertically and horizontally moving bed vanish (the bed's F, M at the state from the product's law,
+    checked against the pointwise law in test_winkler_equations.py)."""
+    theta_dd, y_dd = winkler_lagrange_accelerations()
+    rng = np.random.default_rng(22)
+    out = np.empty(STATE_SIZE)
+    loaded = 0
+    for _ in range(200):
+        block = Block(name="w", b=rng.uniform(0.2, 2.0), h=rng.uniform(0.3, 5.0), mass=rng.uniform(1e2, 1e6))
+        omega = rng.uniform(10.0, 500.0)
+        params, _ = parameter_record(get_model("winkler"), block, block.mass * omega**2, rng.uniform(0.0, 0.3),
+                                     SolverOptions(bed=bed))
+        y_static = G / omega**2
+        x = np.array([rng.uniform(-0.3, 0.3) * block.alpha, rng.normal(0, 0.5), y_static * rng.uniform(-1.0, 3.0),
+                      y_static * omega * rng.normal(0, 1.0)])
+        accel, av = rng.normal(0, 5.0), rng.normal(0, 5.0)
+        kernels.rhs(kernels.WINKLER, kernels.ROCKING, 0.0, x, accel, G + av, params, out)
+        force, moment = bed_force(x, params)
+        if force <= 0.0:
+            continue  # in flight: the residual's point force is undefined (F = 0), the flight test covers it
+        loaded += 1
+        arguments = (x[0], x[1], x[2], x[3], accel, av, force, moment, block.b, block.h, G)
+        scale = G + abs(av) + force + abs(accel) + block.h * x[1] ** 2
+        assert out[1] == pytest.approx(theta_dd(*arguments), abs=1e-10 * scale / block.h)
+        assert out[3] == pytest.approx(y_dd(*arguments), abs=1e-10 * scale)
+    assert loaded > 50
+
+
+def test_winkler_in_flight_falls_at_g_plus_a_v_relative_to_the_ground():
+    """Whole base off the bed, theta = 0 and at rest: relative to the ground the block falls at g + a_v."""
+    block = Block(name="w", b=0.5, h=1.5, mass=1000.0)
+    params, _ = parameter_record(get_model("winkler"), block, 1e8, 0.05, SolverOptions())
+    out = np.empty(STATE_SIZE)
+    x = np.array([0.0, 0.0, -0.01, 0.0])  # 1 cm above the unloaded bed
+    kernels.rhs(kernels.WINKLER, kernels.ROCKING, 0.0, x, 0.0, G - 12.0, params, out)
+    assert out[3] == pytest.approx(G - 12.0, rel=1e-14) and out[1] == 0.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -230,7 +310,6 @@ def test_batch_scales_the_vertical_with_the_horizontal(model, bed):
 
 
 def test_vertical_must_be_sampled_as_the_horizontal():
-    from pipeline.errors import SolverError
     ag, av, dt = falling_ground()
     with pytest.raises(SolverError, match="ag_vertical"):
         simulate("housner", ag, dt, BLOCK, ag_vertical=av[:-1])
@@ -276,8 +355,11 @@ def test_pivot_models_match_the_scipy_reference_with_a_vertical(model, scale):
     assert result.overturned == ref_overturned
     assert result.peak_angle == pytest.approx(ref_peak, rel=5e-3)  # requirement: 0.5 %
     assert result.peak_angle == pytest.approx(ref_peak, rel=1e-5)  # what the kernel achieves without a vertical
+    # ssi: with the spring forced by the vertical, its rest phase is integrated (at rtol 1e-6), not the closed
+    # form: measured 5e-7 s on the uplift and 4e-6 s by the 10th impact of a small cascade (Bolu x0.7),
+    # which converge to the reference with the tolerance (1e-9 s at rtol 1e-8)
     n = min(10, ref_impacts.size)
-    np.testing.assert_allclose(result.impact_times[:n], ref_impacts[:n], atol=1e-6)
+    np.testing.assert_allclose(result.impact_times[:n], ref_impacts[:n], atol=1e-6 if model == "housner" else 1e-5)
     assert without.peak_angle != pytest.approx(ref_peak, rel=1e-3)  # the vertical changes the answer
 
 
