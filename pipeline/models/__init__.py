@@ -150,9 +150,9 @@ def _ground(ag, dt):
 
 
 def _vertical(ag_vertical, ag):
-    """The vertical ground acceleration as the kernels take it: sampled as ag, or (0,) for none."""
+    """The vertical ground acceleration, sampled as ag (checked), or None."""
     if ag_vertical is None:
-        return np.empty(0)
+        return None
     ag_vertical = np.ascontiguousarray(ag_vertical, dtype=np.float64)
     if ag_vertical.shape != ag.shape:
         raise SolverError(f"ag_vertical has shape {ag_vertical.shape}; it must be sampled as ag, shape {ag.shape} "
@@ -175,11 +175,16 @@ def _time_window(ag, dt, t_end):
 
 
 def _motion(ag, dt, t_end, ag_vertical):
-    """(horizontal, vertical, number of tail samples): both components checked and cut to t_end alike."""
+    """(samples, number of tail samples): the components checked, cut to t_end and stacked as the kernels
+    take them, (1, n) or with the vertical (2, n) (rows ``kernels.HORIZONTAL``, ``kernels.VERTICAL``)."""
     ag = _ground(ag, dt)
     vertical = _vertical(ag_vertical, ag)
     ag, n_tail = _time_window(ag, dt, t_end)
-    return ag, vertical[:ag.size], n_tail
+    samples = np.empty((1 if vertical is None else 2, ag.size))
+    samples[kernels.HORIZONTAL] = ag
+    if vertical is not None:
+        samples[kernels.VERTICAL] = vertical[:ag.size]
+    return samples, n_tail
 
 
 def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=0.0, thetadot0=0.0, t_end=None,
@@ -210,15 +215,14 @@ def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=
     """
     spec = get_model(model)
     settings = SolverOptions(**options)
-    ag, vertical, n_tail = _motion(ag, dt, t_end, ag_vertical)
+    samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, [(block, k, xi)], settings)
     state = states[0]
     state[0], state[1] = float(theta0), float(thetadot0)
-    history = np.empty((ag.size + n_tail, fields.STATE_SIZE))
+    history = np.empty((samples.shape[1] + n_tail, fields.STATE_SIZE))
     impacts = np.empty(IMPACT_CAPACITY)
     summaries = new_summaries(1)
-    kernels.single_kernel(spec.kernel_code, ag, vertical, float(dt), n_tail, table, state, history, impacts,
-                          summaries)
+    kernels.single_kernel(spec.kernel_code, samples, float(dt), n_tail, table, state, history, impacts, summaries)
     return _result(spec, block, dt, summaries[0], history, impacts)
 
 
@@ -274,11 +278,11 @@ def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, ag_vertical
         ``summaries["peak_angle"]`` etc.; ``status`` holds ``Outcome`` codes.
     """
     spec = get_model(model)
-    ag, vertical, n_tail = _motion(ag, dt, t_end, ag_vertical)
+    samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, blocks_and_foundations, SolverOptions(**options))
     scales = np.ascontiguousarray(scales, dtype=np.float64)
     summaries = new_summaries((len(table), scales.size))
-    kernels.batch_kernel(spec.kernel_code, ag, vertical, float(dt), n_tail, scales, table, states, summaries)
+    kernels.batch_kernel(spec.kernel_code, samples, float(dt), n_tail, scales, table, states, summaries)
     return summaries
 
 
@@ -292,13 +296,13 @@ def simulate_histories(model, ag, dt, cases, *, ag_vertical=None, t_end=None, **
     y : ndarray (n_case, n) [m]; summaries : ``SUMMARY_DTYPE`` records (n_case,).
     """
     spec = get_model(model)
-    ag, vertical, n_tail = _motion(ag, dt, t_end, ag_vertical)
+    samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, cases, SolverOptions(**options))
-    histories = np.empty((len(table), ag.size + n_tail, fields.STATE_SIZE))
+    n_total = samples.shape[1] + n_tail
+    histories = np.empty((len(table), n_total, fields.STATE_SIZE))
     summaries = new_summaries(len(table))
-    kernels.history_batch_kernel(spec.kernel_code, ag, vertical, float(dt), n_tail, table, states, histories,
-                                 summaries)
-    return np.arange(ag.size + n_tail) * dt, histories[:, :, 0], histories[:, :, 2], summaries
+    kernels.history_batch_kernel(spec.kernel_code, samples, float(dt), n_tail, table, states, histories, summaries)
+    return np.arange(n_total) * dt, histories[:, :, 0], histories[:, :, 2], summaries
 
 
 from pipeline.models import housner as _housner  # noqa: E402  (registration at import)

@@ -13,9 +13,9 @@ the event time, after which integration restarts cleanly.
 
 Four small records travel between the functions, as scipy's rk.py passes one state and its
 ``DenseOutput`` carries one step:
-- ``GroundMotion`` (horizontal and vertical samples, dt): the input; ``ground`` and ``vertical`` are the
-  one place it is read. The vertical acts as a change of gravity, g + a_v(t), in the ground's frame
-  (``effective_gravity``); an empty vertical array is no vertical (the same numbers, bit for bit).
+- ``GroundMotion`` (the components' samples, dt): the input; ``ground`` and ``vertical`` are the one
+  place it is read. The vertical acts as a change of gravity, g + a_v(t), in the ground's frame
+  (``effective_gravity``); a motion without a vertical row gives the same numbers as before, bit for bit.
 - ``System`` (model code, phase, active pivot, parameters, ground motion): the right-hand side
   f(t, x), evaluated by ``derivatives``.
 - ``Step`` (t, h, x0, f0, x1, f1): one step and its dense output, read by event location, peak
@@ -81,6 +81,10 @@ FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= 
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
 UNKNOWN_CODE = "model kernel code not handled by pipeline.models.kernels"
 
+# rows of the ground motion's samples (``GroundMotion.samples``, what the entry points take)
+HORIZONTAL = 0  # ag [m/s^2]
+VERTICAL = 1    # a_v [m/s^2, up positive]; optional: a (1, n) motion has no vertical component
+
 # The Dormand-Prince stages k2..k7 are the rows of ``Workspace.stages``; the last one is f(t + h, x_new),
 # which the dense output and the next step reuse (first same as last).
 N_STAGES = 6
@@ -106,11 +110,12 @@ class GroundMotion(NamedTuple):
     """The ground's acceleration: linear between samples, zero after the last one (the free tail).
 
     The horizontal component is read by ``ground``, the vertical one by ``vertical``; ``derivatives``
-    hands both to the right-hand sides (the vertical as the effective gravity g + a_v).
+    hands both to the right-hand sides (the vertical as the effective gravity g + a_v). The components
+    are the rows of one array (one array, not two, travels with every ``System``: measured 15% of an
+    ssi batch's time for a second array).
     """
 
-    horizontal: np.ndarray  # (n,) [m/s^2] at t = i dt
-    vertical: np.ndarray    # (n,) [m/s^2] at t = i dt, up positive; (0,): no vertical motion
+    samples: np.ndarray     # (1 or 2, n) [m/s^2] at t = i dt: rows HORIZONTAL and, if given, VERTICAL
     dt: float               # sampling step [s]
 
 
@@ -158,34 +163,36 @@ def workspace():
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def sample(samples, index):
-    """Ground acceleration sample [m/s^2]; zero after the record (the tail of free vibration)."""
-    return samples[index] if index < samples.size else 0.0
+def sample(samples, row, index):
+    """Ground acceleration sample [m/s^2] of component ``row``; zero after the record (the tail of free
+    vibration) and for a component the motion does not have."""
+    return samples[row, index] if index < samples.shape[1] and row < samples.shape[0] else 0.0
 
 
 @njit(cache=True)
-def interpolate(samples, dt, t):
-    """A sampled ground acceleration [m/s^2] at time t [s]: linear between samples, zero after them."""
-    position = t / dt  # in samples
+def interpolate(motion, row, t):
+    """Ground acceleration [m/s^2] of component ``row`` at time t [s]: linear between samples."""
+    samples = motion.samples
+    position = t / motion.dt  # in samples
     index = int(math.floor(position))
     if index < 0:
-        return samples[0]
-    a0 = sample(samples, index)
-    return a0 + (sample(samples, index + 1) - a0) * (position - index)
+        return samples[row, 0]
+    a0 = sample(samples, row, index)
+    return a0 + (sample(samples, row, index + 1) - a0) * (position - index)
 
 
 @njit(cache=True)
 def ground(motion, t):
     """Horizontal ground acceleration [m/s^2] at time t [s] (linear between samples)."""
-    return interpolate(motion.horizontal, motion.dt, t)
+    return interpolate(motion, HORIZONTAL, t)
 
 
 @njit(cache=True)
 def vertical(motion, t):
     """Vertical ground acceleration a_v [m/s^2, up positive] at time t [s]; 0 without a vertical component."""
-    if motion.vertical.size == 0:
+    if motion.samples.shape[0] <= VERTICAL:
         return 0.0
-    return interpolate(motion.vertical, motion.dt, t)
+    return interpolate(motion, VERTICAL, t)
 
 
 @njit(cache=True)
@@ -197,22 +204,24 @@ def effective_gravity(params, motion, t):
 @njit(cache=True)
 def vertical_quiet(motion, t):
     """True when the vertical ground acceleration is zero over the whole sample interval of t."""
-    samples = motion.vertical
+    samples = motion.samples
     index = interval_of(t, motion.dt)
-    return samples.size == 0 or (sample(samples, index) == 0.0 and sample(samples, index + 1) == 0.0)
+    return sample(samples, VERTICAL, index) == 0.0 and sample(samples, VERTICAL, index + 1) == 0.0
 
 
 @njit(cache=True)
 def free_flight_time(motion, g):
     """First time [s] at which g + a_v(t) falls below zero (the ground falls faster than gravity, so
     the block leaves it); inf if never. a_v is linear between samples, so the crossing is exact."""
-    samples = motion.vertical
-    for i in range(samples.size):
-        if g + samples[i] < 0.0:
+    samples = motion.samples
+    if samples.shape[0] <= VERTICAL:
+        return math.inf
+    for i in range(samples.shape[1]):
+        if g + samples[VERTICAL, i] < 0.0:
             if i == 0:
                 return 0.0
-            before = g + samples[i - 1]
-            return (i - 1) * motion.dt + motion.dt * before / (before - (g + samples[i]))
+            before = g + samples[VERTICAL, i - 1]
+            return (i - 1) * motion.dt + motion.dt * before / (before - (g + samples[VERTICAL, i]))
     return math.inf
 
 
@@ -601,7 +610,7 @@ def rest_until_uplift(system, x, t, t_sample_end):
     the side of ag at the interval's end, where |ag| - threshold is linear: one division finds it.
     """
     motion, params, code = system.motion, system.params, system.code
-    samples, dt = motion.horizontal, motion.dt
+    samples, dt = motion.samples, motion.dt
     tan_alpha = math.tan(params["alpha"])
     a_end = ground(motion, t_sample_end)
     threshold_end = tan_alpha * support(code, params, x, effective_gravity(params, motion, t_sample_end))
@@ -609,9 +618,9 @@ def rest_until_uplift(system, x, t, t_sample_end):
         return t_sample_end, False
     index = interval_of(t, dt)
     t_start = index * dt
-    a_start = sample(samples, index)
-    slope = (sample(samples, index + 1) - a_start) / dt
-    threshold_start = tan_alpha * support(code, params, x, params["g"] + sample(motion.vertical, index))
+    a_start = sample(samples, HORIZONTAL, index)
+    slope = (sample(samples, HORIZONTAL, index + 1) - a_start) / dt
+    threshold_start = tan_alpha * support(code, params, x, params["g"] + sample(samples, VERTICAL, index))
     span = t_sample_end - t_start
     threshold_slope = (threshold_end - threshold_start) / span if span > 0.0 else 0.0
     side = 1.0 if a_end > 0 else -1.0
@@ -704,14 +713,14 @@ def ssi_bookkeeping(system, x, y_static, t, summary):
 
 
 @njit(cache=True)
-def pivot_loop(code, ag, ag_vertical, dt, n_tail, params, x, history, impact_times, summary):
+def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
     """Integrate one response of a pivot model from state x (see the module docstring).
 
     At rest the state is constant (closed form) or only the SSI vertical vibration moves; steps never
     cross a sample of the ground motion. The run stops where g + a_v first falls below zero (free flight).
     """
-    motion = GroundMotion(ag, ag_vertical, dt)
-    t_final = (ag.size + n_tail - 1) * dt
+    motion = GroundMotion(samples, dt)
+    t_final = (samples.shape[1] + n_tail - 1) * dt
     t_free_flight = free_flight_time(motion, params["g"])
     t_stop = min(t_final, t_free_flight)  # the end of the run
     alpha = params["alpha"]
@@ -898,12 +907,12 @@ def bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_t
 
 
 @njit(cache=True)
-def bed_loop(code, ag, ag_vertical, dt, n_tail, params, x, history, impact_times, summary):
+def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
     """Integrate one response of a bed model from state x; no rest phase, no impact rule (the block flies
     where g + a_v < 0 as anywhere else: its bed lets go)."""
-    motion = GroundMotion(ag, ag_vertical, dt)
+    motion = GroundMotion(samples, dt)
     system = System(code, ROCKING, 0.0, params, motion)
-    t_final = (ag.size + n_tail - 1) * dt
+    t_final = (samples.shape[1] + n_tail - 1) * dt
     work = workspace()
     state_scales(params, static_settlement(code, params), work.scale)
     f0, x_new, f1 = work.f0, work.x_new, work.stages[END_STAGE]
@@ -952,7 +961,7 @@ def bed_loop(code, ag, ag_vertical, dt, n_tail, params, x, history, impact_times
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
-        if (history.shape[0] == 0 and t > ag.size * dt and after[0] > 0.0 and after[1] > 0.0
+        if (history.shape[0] == 0 and t > samples.shape[1] * dt and after[0] > 0.0 and after[1] > 0.0
                 and settled_beyond_reach(x, params, summary["peak_angle"])):
             break  # the ground is at rest and the block can no longer reach its peak or lift (no history kept)
         if kind == EVENT_OVERTURN:
@@ -972,19 +981,18 @@ def bed_loop(code, ag, ag_vertical, dt, n_tail, params, x, history, impact_times
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def simulate_kernel(code, ag, ag_vertical, dt, n_tail, params, x0, history, impact_times, summary):
+def simulate_kernel(code, samples, dt, n_tail, params, x0, history, impact_times, summary):
     """Integrate one response.
 
     Parameters
     ----------
     code : int
         Kernel code (fields.HOUSNER, SSI or WINKLER).
-    ag : ndarray (n,)
-        Ground acceleration [m/s^2] at t = i dt.
-    ag_vertical : ndarray (n,) or (0,)
-        Vertical ground acceleration [m/s^2, up positive] at t = i dt; empty: none.
+    samples : ndarray (1 or 2, n)
+        Ground acceleration [m/s^2] at t = i dt: row HORIZONTAL, and row VERTICAL (up positive) if the
+        ground also moves vertically.
     dt : float
-        Sampling step of ag [s].
+        Sampling step [s].
     n_tail : int
         Samples of free vibration after the record (zero ground acceleration).
     params : PARAMS_DTYPE record
@@ -997,51 +1005,47 @@ def simulate_kernel(code, ag, ag_vertical, dt, n_tail, params, x0, history, impa
     summary : SUMMARY_DTYPE record, filled.
     """
     if code == WINKLER:
-        bed_loop(code, ag, ag_vertical, dt, n_tail, params, x0, history, impact_times, summary)
+        bed_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary)
     elif code == HOUSNER or code == SSI:
-        pivot_loop(code, ag, ag_vertical, dt, n_tail, params, x0, history, impact_times, summary)
+        pivot_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary)
     else:
         raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
-def single_kernel(code, ag, ag_vertical, dt, n_tail, params_table, x0, history, impact_times, summaries):
+def single_kernel(code, samples, dt, n_tail, params_table, x0, history, impact_times, summaries):
     """``simulate_kernel`` for params_table[0] into summaries[0] (records cross from Python as arrays)."""
-    simulate_kernel(code, ag, ag_vertical, dt, n_tail, params_table[0], x0, history, impact_times, summaries[0])
+    simulate_kernel(code, samples, dt, n_tail, params_table[0], x0, history, impact_times, summaries[0])
 
 
 @njit(cache=True)
-def batch_kernel(code, ag, ag_vertical, dt, n_tail, scales, params_table, initial_states, summaries):
-    """One record at each factor in ``scales`` for each parameter row (no histories); the vertical
-    component (empty: none) is scaled by the same factors as the horizontal one.
+def batch_kernel(code, samples, dt, n_tail, scales, params_table, initial_states, summaries):
+    """One record at each factor in ``scales`` for each parameter row (no histories); every component
+    (the vertical too) is scaled by the same factors.
 
     scales (n_scale,); params_table (n_case,) records; initial_states (n_case, STATE_SIZE);
     summaries (n_case, n_scale) records, filled.
     """
     empty = np.empty((0, STATE_SIZE))
     impacts = np.empty(0)
-    scaled = np.empty(ag.size)
-    scaled_vertical = np.empty(ag_vertical.size)
+    scaled = np.empty(samples.shape)
     x = np.empty(STATE_SIZE)
     for j in range(scales.size):
-        for i in range(ag.size):
-            scaled[i] = ag[i] * scales[j]
-        for i in range(ag_vertical.size):
-            scaled_vertical[i] = ag_vertical[i] * scales[j]
+        for component in range(samples.shape[0]):
+            for i in range(samples.shape[1]):
+                scaled[component, i] = samples[component, i] * scales[j]
         for row in range(params_table.shape[0]):
             for i in range(STATE_SIZE):
                 x[i] = initial_states[row, i]
-            simulate_kernel(code, scaled, scaled_vertical, dt, n_tail, params_table[row], x, empty, impacts,
-                            summaries[row, j])
+            simulate_kernel(code, scaled, dt, n_tail, params_table[row], x, empty, impacts, summaries[row, j])
 
 
 @njit(cache=True)
-def history_batch_kernel(code, ag, ag_vertical, dt, n_tail, params_table, initial_states, histories, summaries):
+def history_batch_kernel(code, samples, dt, n_tail, params_table, initial_states, histories, summaries):
     """One ground motion for each parameter row, keeping the histories (n_case, n + n_tail, STATE_SIZE)."""
     impacts = np.empty(0)
     x = np.empty(STATE_SIZE)
     for row in range(params_table.shape[0]):
         for i in range(STATE_SIZE):
             x[i] = initial_states[row, i]
-        simulate_kernel(code, ag, ag_vertical, dt, n_tail, params_table[row], x, histories[row], impacts,
-                        summaries[row])
+        simulate_kernel(code, samples, dt, n_tail, params_table[row], x, histories[row], impacts, summaries[row])

@@ -65,11 +65,10 @@ def settled_run(model, ag, dt, *, bed=None, ag_vertical=None, gravity=G, block=B
     table, states = parameter_table(spec, [(block, k, xi)], SolverOptions(**options_of(bed), **options))
     if spec.needs_foundation:
         states[0, 2] = gravity * block.mass / k
-    ag = np.ascontiguousarray(ag, dtype=float)
-    vertical = np.empty(0) if ag_vertical is None else np.ascontiguousarray(ag_vertical, dtype=float)
-    history = np.empty((ag.size, STATE_SIZE))
+    samples = np.array([ag] if ag_vertical is None else [ag, ag_vertical], dtype=float)  # kernels.GroundMotion
+    history = np.empty((samples.shape[1], STATE_SIZE))
     summaries = new_summaries(1)
-    kernels.single_kernel(spec.kernel_code, ag, vertical, float(dt), 0, table, states[0], history,
+    kernels.single_kernel(spec.kernel_code, samples, float(dt), 0, table, states[0], history,
                           np.empty(IMPACT_CAPACITY), summaries)
     return summaries[0], history
 
