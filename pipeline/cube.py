@@ -26,7 +26,8 @@ from pipeline.models.base import Outcome
 from pipeline.models.fields import FIELDS_BY_NAME
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
-OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = (int(o) for o in Outcome)
+OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = (
+    int(Outcome.NO_UPLIFT), int(Outcome.ROCKING), int(Outcome.OVERTURNED), int(Outcome.FAILED))
 OUTCOME_MEANINGS = " ".join(o.flag_meaning for o in Outcome)
 
 DIMS = ("record", "im_level", "soil", "block", "model")

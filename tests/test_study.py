@@ -109,7 +109,8 @@ def test_cube_schema_is_cf_labelled(small_cube):
     assert dict(cube.sizes) == {"record": 2, "im_level": 4, "soil": 2, "block": 3, "model": 2}
     for name, variable in cube.data_vars.items():
         assert "units" in variable.attrs and "long_name" in variable.attrs, name
-    assert cube.outcome.attrs["flag_meanings"].split() == ["no_uplift", "rocking", "overturned", "solver_failed"]
+    assert cube.outcome.attrs["flag_meanings"].split() == ["no_uplift", "rocking", "overturned", "solver_failed",
+                                                            "free_flight"]
     assert cube.im_level.attrs["units"] == "9.80665 m s-2"  # g, as UDUNITS reads it (not grams)
 
 

@@ -1,7 +1,8 @@
 """pipeline.models - stage 5: rocking solvers (Housner, the paper's SSI model, the Winkler bed).
 
-Input : a model name, ground acceleration [m/s^2] sampled at dt [s], a ``Block`` and, for models
-        with a foundation, the interface stiffness k [N/m] and damping ratio xi [-].
+Input : a model name, ground acceleration [m/s^2] sampled at dt [s] (optionally a vertical one,
+        ``ag_vertical``, same sampling, up positive), a ``Block`` and, for models with a foundation,
+        the interface stiffness k [N/m] and damping ratio xi [-].
 Output: a ``RockingResult`` (histories, peak angle, impacts, overturning, foundation checks), or for
         many scale factors and cases at once summary records (``fields.SUMMARY_DTYPE``) from
         ``simulate_batch`` and ``simulate_histories``.
@@ -148,6 +149,19 @@ def _ground(ag, dt):
     return ag
 
 
+def _vertical(ag_vertical, ag):
+    """The vertical ground acceleration, sampled as ag (checked), or None."""
+    if ag_vertical is None:
+        return None
+    ag_vertical = np.ascontiguousarray(ag_vertical, dtype=np.float64)
+    if ag_vertical.shape != ag.shape:
+        raise SolverError(f"ag_vertical has shape {ag_vertical.shape}; it must be sampled as ag, shape {ag.shape} "
+                          "[m/s^2]")
+    if not np.all(np.isfinite(ag_vertical)):
+        raise SolverError("ag_vertical contains NaN or infinite values")
+    return ag_vertical
+
+
 def _time_window(ag, dt, t_end):
     """(ground motion cut to t_end, number of tail samples): the record plus DEFAULT_TAIL by default."""
     if t_end is None:
@@ -160,7 +174,20 @@ def _time_window(ag, dt, t_end):
     return ag, max(0, n_total - ag.size)
 
 
-def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0, t_end=None,
+def _motion(ag, dt, t_end, ag_vertical):
+    """(samples, number of tail samples): the components checked, cut to t_end and stacked as the kernels
+    take them, (1, n) or with the vertical (2, n) (rows ``kernels.HORIZONTAL``, ``kernels.VERTICAL``)."""
+    ag = _ground(ag, dt)
+    vertical = _vertical(ag_vertical, ag)
+    ag, n_tail = _time_window(ag, dt, t_end)
+    samples = np.empty((1 if vertical is None else 2, ag.size))
+    samples[kernels.HORIZONTAL] = ag
+    if vertical is not None:
+        samples[kernels.VERTICAL] = vertical[:ag.size]
+    return samples, n_tail
+
+
+def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=0.0, thetadot0=0.0, t_end=None,
              **options) -> RockingResult:
     """Rocking response of ``block`` to ground acceleration ``ag`` [m/s^2] sampled at ``dt`` [s].
 
@@ -169,6 +196,11 @@ def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0
     model : str
         ``housner``, ``ssi`` (the paper's model), ``ssi-paper`` (its printed equations) or ``winkler``
         (tensionless bed); see ``MODELS``.
+    ag_vertical : array_like, optional
+        Vertical ground acceleration [m/s^2, up positive], sampled as ``ag``: gravity becomes
+        g + ag_vertical(t) in the ground's frame. Where g + ag_vertical < 0 the block is in free flight:
+        the pivot models (housner, ssi) stop there with ``Outcome.FREE_FLIGHT``; winkler flies on.
+        None (default) and zeros give the same numbers.
     k, xi : float
         Interface stiffness [N/m] (winkler: the bed's total vertical stiffness K) and damping ratio
         [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m)).
@@ -183,14 +215,14 @@ def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0
     """
     spec = get_model(model)
     settings = SolverOptions(**options)
-    ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
+    samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, [(block, k, xi)], settings)
     state = states[0]
     state[0], state[1] = float(theta0), float(thetadot0)
-    history = np.empty((ag.size + n_tail, fields.STATE_SIZE))
+    history = np.empty((samples.shape[1] + n_tail, fields.STATE_SIZE))
     impacts = np.empty(IMPACT_CAPACITY)
     summaries = new_summaries(1)
-    kernels.single_kernel(spec.kernel_code, ag, float(dt), n_tail, table, state, history, impacts, summaries)
+    kernels.single_kernel(spec.kernel_code, samples, float(dt), n_tail, table, state, history, impacts, summaries)
     return _result(spec, block, dt, summaries[0], history, impacts)
 
 
@@ -221,18 +253,22 @@ def _result(spec, block, dt, summary, history, impacts):
         n_flights=int(summary["n_flights"]), airborne_time=float(summary["airborne_time"]),
         peak_uplift=float(summary["peak_corner_uplift"]),
         peak_friction_demand=float(summary["peak_friction_demand"]),
+        time_of_free_flight=float(summary["time_of_free_flight"]),
         status=status, message=message, n_steps=int(summary["n_steps"]))
 
 
-def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, t_end=None, **options) -> np.ndarray:
+def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, ag_vertical=None, t_end=None,
+                   **options) -> np.ndarray:
     """Run one record at many scale factors for many (block, k, xi) cases in one compiled call.
 
     Parameters
     ----------
     scales : array_like, shape (n_scale,)
-        Factors applied to ``ag``.
+        Factors applied to ``ag`` (and to ``ag_vertical``: the ratio of vertical to horizontal stays).
     blocks_and_foundations : list of (Block, k, xi)
         k and xi are ignored (may be None) for rigid-base models.
+    ag_vertical : array_like, optional
+        Vertical ground acceleration [m/s^2, up positive], sampled as ``ag`` (see ``simulate``).
     **options
         ``SolverOptions`` fields (see ``simulate``).
 
@@ -242,29 +278,31 @@ def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, t_end=None,
         ``summaries["peak_angle"]`` etc.; ``status`` holds ``Outcome`` codes.
     """
     spec = get_model(model)
-    ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
+    samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, blocks_and_foundations, SolverOptions(**options))
     scales = np.ascontiguousarray(scales, dtype=np.float64)
     summaries = new_summaries((len(table), scales.size))
-    kernels.batch_kernel(spec.kernel_code, ag, float(dt), n_tail, scales, table, states, summaries)
+    kernels.batch_kernel(spec.kernel_code, samples, float(dt), n_tail, scales, table, states, summaries)
     return summaries
 
 
-def simulate_histories(model, ag, dt, cases, *, t_end=None, **options):
-    """Rotation histories of one ground motion for many (block, k, xi) cases in one compiled call.
+def simulate_histories(model, ag, dt, cases, *, ag_vertical=None, t_end=None, **options):
+    """Rotation histories of one ground motion (``ag`` and the optional ``ag_vertical``, as in ``simulate``)
+    for many (block, k, xi) cases in one compiled call.
 
     Returns
     -------
-    t : ndarray (n,) [s]; theta : ndarray (n_case, n) [rad] (NaN after overturning);
+    t : ndarray (n,) [s]; theta : ndarray (n_case, n) [rad] (NaN after overturning or free flight);
     y : ndarray (n_case, n) [m]; summaries : ``SUMMARY_DTYPE`` records (n_case,).
     """
     spec = get_model(model)
-    ag, n_tail = _time_window(_ground(ag, dt), dt, t_end)
+    samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, cases, SolverOptions(**options))
-    histories = np.empty((len(table), ag.size + n_tail, fields.STATE_SIZE))
+    n_total = samples.shape[1] + n_tail
+    histories = np.empty((len(table), n_total, fields.STATE_SIZE))
     summaries = new_summaries(len(table))
-    kernels.history_batch_kernel(spec.kernel_code, ag, float(dt), n_tail, table, states, histories, summaries)
-    return np.arange(ag.size + n_tail) * dt, histories[:, :, 0], histories[:, :, 2], summaries
+    kernels.history_batch_kernel(spec.kernel_code, samples, float(dt), n_tail, table, states, histories, summaries)
+    return np.arange(n_total) * dt, histories[:, :, 0], histories[:, :, 2], summaries
 
 
 from pipeline.models import housner as _housner  # noqa: E402  (registration at import)

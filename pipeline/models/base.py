@@ -25,6 +25,11 @@ The contract for a model (as scipy's ``integrate/_ivp/base.py`` states its own),
    ``min_support_force`` and ``time_of_tension`` so that runs past that moment can be flagged.
 7. A run that overturns is an outcome (``Outcome.OVERTURNED``), not an error; ``Outcome.FAILED``
    means the integration stopped (step or event guard).
+8. The ground may move vertically (``ag_vertical``, up positive): in the ground's frame gravity becomes
+   g + a_v(t) wherever it acts on the block's mass (the model's right-hand sides and support force take
+   that effective gravity; springs and dashpots act on relative motion and do not see it). Where
+   g + a_v(t) < 0 the ground falls faster than gravity and the block is in free flight: pivot models
+   have no flight phase and stop there with ``Outcome.FREE_FLIGHT``; bed models fly on.
 """
 
 from __future__ import annotations
@@ -41,10 +46,11 @@ class Outcome(enum.IntEnum):
     ROCKING = 1
     OVERTURNED = 2
     FAILED = 3
+    FREE_FLIGHT = 4  # g + a_v(t) < 0 under a pivot model: the run stops there (no flight phase)
 
     @property
     def flag_meaning(self) -> str:
-        return {0: "no_uplift", 1: "rocking", 2: "overturned", 3: "solver_failed"}[int(self)]
+        return {0: "no_uplift", 1: "rocking", 2: "overturned", 3: "solver_failed", 4: "free_flight"}[int(self)]
 
 
 MESSAGES = {
@@ -52,6 +58,8 @@ MESSAGES = {
     Outcome.ROCKING: "the block rocked and did not overturn",
     Outcome.OVERTURNED: "the block overturned (|theta| reached the overturning angle)",
     Outcome.FAILED: "integration stopped: too many events or steps (chatter or bad parameters)",
+    Outcome.FREE_FLIGHT: "the ground fell faster than gravity (g + a_v < 0): the block left it in free flight, "
+                         "which a pivot model does not follow; the run stops there",
 }
 
 
@@ -86,7 +94,7 @@ class RockingResult:
     peak_settlement [m], min_support_force [N] (negative: the foundation pulled, ssi only),
     time_of_tension [s] (first time it pulled; NaN if never), n_flights, airborne_time [s],
     peak_uplift [m] (highest corner above the ground), peak_friction_demand [-] (winkler),
-    status (Outcome) and message.
+    time_of_free_flight [s] (first time g + a_v < 0; NaN if never), status (Outcome) and message.
     """
 
     model: str
@@ -113,6 +121,7 @@ class RockingResult:
     airborne_time: float = 0.0
     peak_uplift: float = 0.0
     peak_friction_demand: float = 0.0
+    time_of_free_flight: float = float("nan")
     extra: dict = field(default_factory=dict)
 
     @property

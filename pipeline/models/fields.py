@@ -86,6 +86,9 @@ SUMMARY_FIELDS = (
     SummaryField("peak_corner_uplift", "m", "peak height of a base corner above the ground"),
     SummaryField("peak_friction_demand", "1",
                  "peak |H|/N, the base friction coefficient needed to prevent sliding (while N >= 0.1 m g)"),
+    SummaryField("time_of_free_flight", "s",
+                 "first time g + a_v fell below zero, the ground falling faster than gravity (pivot models stop "
+                 "there: outcome free_flight; NaN: never)"),
 )
 FIELDS_BY_NAME = {field.name: field for field in SUMMARY_FIELDS}
 

@@ -13,7 +13,9 @@ the event time, after which integration restarts cleanly.
 
 Four small records travel between the functions, as scipy's rk.py passes one state and its
 ``DenseOutput`` carries one step:
-- ``GroundMotion`` (samples, dt): the input; ``ground`` is the one place it is read.
+- ``GroundMotion`` (the components' samples, dt): the input; ``ground`` and ``vertical`` are the one
+  place it is read. The vertical acts as a change of gravity, g + a_v(t), in the ground's frame
+  (``effective_gravity``); a motion without a vertical row gives the same numbers as before, bit for bit.
 - ``System`` (model code, phase, active pivot, parameters, ground motion): the right-hand side
   f(t, x), evaluated by ``derivatives``.
 - ``Step`` (t, h, x0, f0, x1, f1): one step and its dense output, read by event location, peak
@@ -22,7 +24,8 @@ Four small records travel between the functions, as scipy's rk.py passes one sta
 
 Two time loops:
 - ``pivot_loop`` (housner, ssi, ssi-paper): the block rests until the uplift condition, rocks on one
-  corner, and at theta = 0 an impact rule switches the pivot.
+  corner, and at theta = 0 an impact rule switches the pivot. Where g + a_v(t) < 0 the ground falls
+  faster than gravity: these models have no flight phase, so the run stops there (``Outcome.FREE_FLIGHT``).
 - ``bed_loop`` (winkler): no rest phase and no impact rule; the block tilts on its bed from the first
   sample and the bed's contact law (registered in pipeline.models.contact) decides everything.
 
@@ -56,6 +59,7 @@ NO_UPLIFT = int(Outcome.NO_UPLIFT)
 ROCKING_OUTCOME = int(Outcome.ROCKING)
 OVERTURNED = int(Outcome.OVERTURNED)
 FAILED = int(Outcome.FAILED)
+FREE_FLIGHT = int(Outcome.FREE_FLIGHT)
 
 # Step control (scipy's rk.py names): the step grows by at most MAX_FACTOR, shrinks by at least
 # MIN_FACTOR, with a SAFETY margin on the optimal order-5 proposal.
@@ -76,6 +80,10 @@ MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
 UNKNOWN_CODE = "model kernel code not handled by pipeline.models.kernels"
+
+# rows of the ground motion's samples (``GroundMotion.samples``, what the entry points take)
+HORIZONTAL = 0  # ag [m/s^2]
+VERTICAL = 1    # a_v [m/s^2, up positive]; optional: a (1, n) motion has no vertical component
 
 # The Dormand-Prince stages k2..k7 are the rows of ``Workspace.stages``; the last one is f(t + h, x_new),
 # which the dense output and the next step reuse (first same as last).
@@ -101,11 +109,13 @@ E1, E3, E4, E5, E6, E7 = (71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253
 class GroundMotion(NamedTuple):
     """The ground's acceleration: linear between samples, zero after the last one (the free tail).
 
-    A vertical component (ag_vertical, same sampling) is one more field here, read by ``ground``
-    beside the horizontal one and handed to the right-hand sides by ``derivatives``.
+    The horizontal component is read by ``ground``, the vertical one by ``vertical``; ``derivatives``
+    hands both to the right-hand sides (the vertical as the effective gravity g + a_v). The components
+    are the rows of one array (one array, not two, travels with every ``System``: measured 15% of an
+    ssi batch's time for a second array).
     """
 
-    horizontal: np.ndarray  # (n,) [m/s^2] at t = i dt
+    samples: np.ndarray     # (1 or 2, n) [m/s^2] at t = i dt: rows HORIZONTAL and, if given, VERTICAL
     dt: float               # sampling step [s]
 
 
@@ -153,47 +163,96 @@ def workspace():
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def sample(samples, index):
-    """Ground acceleration sample [m/s^2]; zero after the record (the tail of free vibration)."""
-    return samples[index] if index < samples.size else 0.0
+def sample(samples, row, index):
+    """Ground acceleration sample [m/s^2] of component ``row``; zero after the record (the tail of free
+    vibration) and for a component the motion does not have."""
+    return samples[row, index] if index < samples.shape[1] and row < samples.shape[0] else 0.0
+
+
+@njit(cache=True)
+def interpolate(motion, row, t):
+    """Ground acceleration [m/s^2] of component ``row`` at time t [s]: linear between samples."""
+    samples = motion.samples
+    position = t / motion.dt  # in samples
+    index = int(math.floor(position))
+    if index < 0:
+        return samples[row, 0]
+    a0 = sample(samples, row, index)
+    return a0 + (sample(samples, row, index + 1) - a0) * (position - index)
 
 
 @njit(cache=True)
 def ground(motion, t):
     """Horizontal ground acceleration [m/s^2] at time t [s] (linear between samples)."""
-    samples = motion.horizontal
-    position = t / motion.dt  # in samples
-    index = int(math.floor(position))
-    if index < 0:
-        return samples[0]
-    a0 = sample(samples, index)
-    return a0 + (sample(samples, index + 1) - a0) * (position - index)
+    return interpolate(motion, HORIZONTAL, t)
 
 
 @njit(cache=True)
-def rhs(code, phase, sigma, x, accel, params, out):
-    """dx/dt into out for state x = [theta, theta_dot, y, y_dot] and ground acceleration ``accel``
-    [m/s^2], by the model's kernel code (and, for the pivot models, the phase and active pivot sigma)."""
+def vertical(motion, t):
+    """Vertical ground acceleration a_v [m/s^2, up positive] at time t [s]; 0 without a vertical component."""
+    if motion.samples.shape[0] <= VERTICAL:
+        return 0.0
+    return interpolate(motion, VERTICAL, t)
+
+
+@njit(cache=True)
+def effective_gravity(params, motion, t):
+    """g + a_v(t) [m/s^2]: gravity in the frame of the vertically accelerating ground."""
+    return params["g"] + vertical(motion, t)
+
+
+@njit(cache=True)
+def vertical_quiet(motion, t):
+    """True when the vertical ground acceleration is zero over the whole sample interval of t."""
+    samples = motion.samples
+    index = interval_of(t, motion.dt)
+    return sample(samples, VERTICAL, index) == 0.0 and sample(samples, VERTICAL, index + 1) == 0.0
+
+
+@njit(cache=True)
+def free_flight_time(motion, g):
+    """First time [s] at which g + a_v(t) falls below zero (the ground falls faster than gravity, so
+    the block leaves it); inf if never. a_v is linear between samples, so the crossing is exact."""
+    samples = motion.samples
+    if samples.shape[0] <= VERTICAL:
+        return math.inf
+    for i in range(samples.shape[1]):
+        if g + samples[VERTICAL, i] < 0.0:
+            if i == 0:
+                return 0.0
+            before = g + samples[VERTICAL, i - 1]
+            return (i - 1) * motion.dt + motion.dt * before / (before - (g + samples[VERTICAL, i]))
+    return math.inf
+
+
+@njit(cache=True)
+def rhs(code, phase, sigma, x, accel, gravity, params, out):
+    """dx/dt into out for state x = [theta, theta_dot, y, y_dot], horizontal ground acceleration ``accel``
+    and effective gravity ``gravity`` = g + a_v [m/s^2], by the model's kernel code (and, for the pivot
+    models, the phase and active pivot sigma)."""
     if code == HOUSNER:
         if phase == REST:
             housner_rest_rhs(out)
         else:
-            housner_rhs(sigma, x, accel, params, out)
+            housner_rhs(sigma, x, accel, gravity, params, out)
     elif code == SSI:
         if phase == REST:
-            ssi_rest_rhs(x, params, out)
+            ssi_rest_rhs(x, gravity, params, out)
         else:
-            ssi_rhs(sigma, x, accel, params, out)
+            ssi_rhs(sigma, x, accel, gravity, params, out)
     elif code == WINKLER:
-        winkler_rhs(x, accel, params, out)
+        winkler_rhs(x, accel, gravity, params, out)
     else:
         raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
 def derivatives(system, t, x, out):
-    """f(t, x) of ``system`` into out: the one place where the ground motion enters the right-hand side."""
-    rhs(system.code, system.phase, system.sigma, x, ground(system.motion, t), system.params, out)
+    """f(t, x) of ``system`` into out: the one place where the ground motion enters the right-hand side
+    (the horizontal as a ground acceleration, the vertical as the effective gravity g + a_v(t))."""
+    motion = system.motion
+    rhs(system.code, system.phase, system.sigma, x, ground(motion, t), effective_gravity(system.params, motion, t),
+        system.params, out)
 
 
 @njit(cache=True)
@@ -298,10 +357,11 @@ def hermite_derivative(step, s, i):
 
 
 @njit(cache=True)
-def support(code, params, x):
-    """Vertical support force per unit mass [m/s^2] of a pivot model at state x, by its kernel code."""
+def support(code, params, x, gravity):
+    """Vertical support force per unit mass [m/s^2] of a pivot model at rest at state x under the
+    effective gravity g + a_v [m/s^2], by its kernel code."""
     if code == HOUSNER:
-        return housner_support(params)
+        return housner_support(gravity)
     if code == SSI:
         return ssi_support(x, params)
     raise ValueError(UNKNOWN_CODE)
@@ -324,8 +384,10 @@ def event_value(kind, index, system, step, s, interpolated):
     if kind == EVENT_CONTACT:
         return contact_indicator(index, interpolated, params)
     # uplift of a pivot model: |ag| - tan(alpha) * support force per mass
-    accel = ground(system.motion, step.t + s * step.h)
-    return abs(accel) - math.tan(params["alpha"]) * support(system.code, params, interpolated)
+    t = step.t + s * step.h
+    accel = ground(system.motion, t)
+    gravity = effective_gravity(params, system.motion, t)
+    return abs(accel) - math.tan(params["alpha"]) * support(system.code, params, interpolated, gravity)
 
 
 @njit(cache=True)
@@ -486,8 +548,8 @@ def hold_rows(history, next_row, dt, t1, x):
 
 @njit(cache=True)
 def finish(history, next_row, summary, status, t):
-    """Blank the history after overturning or failure and write the outcome."""
-    if history.shape[0] > 0 and (status == OVERTURNED or status == FAILED):
+    """Blank the history after overturning, failure or free flight and write the outcome."""
+    if history.shape[0] > 0 and (status == OVERTURNED or status == FAILED or status == FREE_FLIGHT):
         for row in range(next_row, history.shape[0]):
             for i in range(STATE_SIZE):
                 history[row, i] = np.nan
@@ -513,8 +575,9 @@ def book_impact(summary, impact_times, t):
 
 
 @njit(cache=True)
-def start_summary(summary, x, min_support):
-    """Initial values of every summary field for a run starting at state x."""
+def start_summary(summary, x, min_support, t_free_flight):
+    """Initial values of every summary field for a run starting at state x; t_free_flight [s] is the
+    first time g + a_v < 0 (inf: never)."""
     summary["peak_angle"] = abs(x[0])
     summary["time_of_peak"] = 0.0
     summary["n_impacts"] = 0.0
@@ -529,6 +592,7 @@ def start_summary(summary, x, min_support):
     summary["airborne_time"] = 0.0
     summary["peak_corner_uplift"] = 0.0
     summary["peak_friction_demand"] = 0.0
+    summary["time_of_free_flight"] = t_free_flight if t_free_flight < math.inf else np.nan
 
 
 # ---------------------------------------------------------------------------------------------
@@ -536,31 +600,47 @@ def start_summary(summary, x, min_support):
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def rest_until_uplift(motion, t, t_sample_end, threshold):
-    """Closed-form rest phase inside one sample interval: the state is constant; find where |ag| first
-    beats the threshold. Returns (t_new, start_now); t_new = t_sample_end when it is not reached."""
-    samples, dt = motion.horizontal, motion.dt
+def rest_until_uplift(system, x, t, t_sample_end):
+    """Closed-form rest phase inside one sample interval: the state x is constant; find where |ag| first
+    beats the threshold tan(alpha) * support. Returns (t_new, start_now); t_new = t_sample_end when it is
+    not reached.
+
+    Both ag and the threshold are linear in time inside the interval (the rigid base's support force is
+    g + a_v; a settled spring's is constant), and |ag| is below the threshold at t, so the crossing is on
+    the side of ag at the interval's end, where |ag| - threshold is linear: one division finds it.
+    """
+    motion, params, code = system.motion, system.params, system.code
+    samples, dt = motion.samples, motion.dt
+    tan_alpha = math.tan(params["alpha"])
     a_end = ground(motion, t_sample_end)
-    if abs(a_end) <= threshold:
+    threshold_end = tan_alpha * support(code, params, x, effective_gravity(params, motion, t_sample_end))
+    if abs(a_end) <= threshold_end:
         return t_sample_end, False
     index = interval_of(t, dt)
-    a_start = sample(samples, index)
-    slope = (sample(samples, index + 1) - a_start) / dt
-    target = threshold if a_end > 0 else -threshold
+    t_start = index * dt
+    a_start = sample(samples, HORIZONTAL, index)
+    slope = (sample(samples, HORIZONTAL, index + 1) - a_start) / dt
+    threshold_start = tan_alpha * support(code, params, x, params["g"] + sample(samples, VERTICAL, index))
+    span = t_sample_end - t_start
+    threshold_slope = (threshold_end - threshold_start) / span if span > 0.0 else 0.0
+    side = 1.0 if a_end > 0 else -1.0
+    # a_start + slope s = side (threshold_start + threshold_slope s), s the time since t_start
+    rate = slope - side * threshold_slope
     t_cross = t_sample_end
-    if slope != 0.0:
-        t_cross = index * dt + (target - a_start) / slope
+    if rate != 0.0:
+        t_cross = t_start + (side * threshold_start - a_start) / rate
     return min(max(t_cross, t), t_sample_end), True
 
 
 @njit(cache=True)
-def vertical_at_rest(code, x, y_static, scale):
+def vertical_at_rest(code, x, y_static, scale, quiet):
     """True when a pivot model at rest has no vertical vibration left, so that its rest phase is the
-    closed form (``rest_until_uplift``): always on a rigid base; for ssi below AT_REST_FRACTION."""
+    closed form (``rest_until_uplift``): always on a rigid base; for ssi below AT_REST_FRACTION and while
+    the vertical ground motion is ``quiet`` (zero over the sample interval: nothing forces the spring)."""
     if code == HOUSNER:
         return True
     if code == SSI:
-        return (abs(x[2] - y_static) <= AT_REST_FRACTION * scale[2] + 1e-15
+        return quiet and (abs(x[2] - y_static) <= AT_REST_FRACTION * scale[2] + 1e-15
                 and abs(x[3]) <= AT_REST_FRACTION * scale[3])
     raise ValueError(UNKNOWN_CODE)
 
@@ -614,7 +694,8 @@ def ssi_bookkeeping(system, x, y_static, t, summary):
     died-out vertical vibration to the static equilibrium. Returns True when it snapped (f(t, x) changed)."""
     params = system.params
     snapped = False
-    if system.phase == REST and abs(x[2] - y_static) < SNAP_TO_STATIC_FRACTION * y_static \
+    if system.phase == REST and vertical_quiet(system.motion, t) \
+            and abs(x[2] - y_static) < SNAP_TO_STATIC_FRACTION * y_static \
             and abs(x[3]) < SNAP_TO_STATIC_FRACTION * y_static * params["omega"]:
         # the free vertical vibration has died out: snap to the static equilibrium so that
         # the closed-form rest phase takes over (the support force changes by < 1e-4 g)
@@ -632,14 +713,16 @@ def ssi_bookkeeping(system, x, y_static, t, summary):
 
 
 @njit(cache=True)
-def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
+def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
     """Integrate one response of a pivot model from state x (see the module docstring).
 
     At rest the state is constant (closed form) or only the SSI vertical vibration moves; steps never
-    cross a sample of the ground motion.
+    cross a sample of the ground motion. The run stops where g + a_v first falls below zero (free flight).
     """
-    motion = GroundMotion(ag, dt)
-    t_final = (ag.size + n_tail - 1) * dt
+    motion = GroundMotion(samples, dt)
+    t_final = (samples.shape[1] + n_tail - 1) * dt
+    t_free_flight = free_flight_time(motion, params["g"])
+    t_stop = min(t_final, t_free_flight)  # the end of the run
     alpha = params["alpha"]
     tan_alpha = math.tan(alpha)
     y_static = static_settlement(code, params)
@@ -656,7 +739,7 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         sigma = 1.0 if (x[0] > 0.0 or (x[0] == 0.0 and x[1] > 0.0)) else -1.0
     system = System(code, phase, sigma, params, motion)
     status = NO_UPLIFT if phase == REST else ROCKING_OUTCOME
-    start_summary(summary, x, support(code, params, x))
+    start_summary(summary, x, support(code, params, x, effective_gravity(params, motion, 0.0)), t_free_flight)
     if phase == ROCKING:
         summary["uplifted"] = 1.0
         summary["time_of_uplift"] = 0.0
@@ -668,13 +751,14 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
     h = dt * 0.25
     failed = False
     start_now = False
-    while t < t_final - SEGMENT_END_FRACTION * dt:
+    while t < t_stop - SEGMENT_END_FRACTION * dt:
         # Steps end on every sample: a kink of the piecewise-linear ground motion inside a step fools the
         # embedded error estimate (measured: 5% peak-angle errors on real records when steps spanned samples).
-        t_sample_end = (interval_of(t, dt) + 1) * dt
+        t_sample_end = min((interval_of(t, dt) + 1) * dt, t_stop)
         if system.phase == REST:
             accel = ground(motion, t)
-            if start_now or abs(accel) > tan_alpha * support(code, params, x):
+            gravity = effective_gravity(params, motion, t)
+            if start_now or abs(accel) > tan_alpha * support(code, params, x, gravity):
                 # start rocking towards the side the inertia force pushes
                 start_now = False
                 system = System(code, ROCKING, -1.0 if accel > 0 else 1.0, params, motion)
@@ -691,8 +775,8 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
                     failed = True
                     break
                 continue
-            if vertical_at_rest(code, x, y_static, work.scale):
-                t, start_now = rest_until_uplift(motion, t, t_sample_end, tan_alpha * support(code, params, x))
+            if vertical_at_rest(code, x, y_static, work.scale, vertical_quiet(motion, t)):
+                t, start_now = rest_until_uplift(system, x, t, t_sample_end)
                 if t >= t_sample_end - SEGMENT_END_FRACTION * dt:
                     t = t_sample_end  # (a crossing at the very end starts at the next interval's top)
                     start_now = False
@@ -744,7 +828,10 @@ def pivot_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
             failed = True
             break
     if not (failed or status == OVERTURNED):
-        next_row = hold_rows(history, next_row, dt, t_final, x)
+        if t_stop < t_final:
+            status = FREE_FLIGHT  # the history ends here: the state after lift-off is not followed
+        else:
+            next_row = hold_rows(history, next_row, dt, t_final, x)
     # the lifted corner of a block rocking on the other one is 2 b sin(theta) above it
     summary["peak_corner_uplift"] = 2.0 * params["b"] * math.sin(min(summary["peak_angle"], 0.5 * math.pi))
     finish(history, next_row, summary, FAILED if failed else status, t)
@@ -820,18 +907,19 @@ def bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_t
 
 
 @njit(cache=True)
-def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
-    """Integrate one response of a bed model from state x; no rest phase, no impact rule."""
-    motion = GroundMotion(ag, dt)
+def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
+    """Integrate one response of a bed model from state x; no rest phase, no impact rule (the block flies
+    where g + a_v < 0 as anywhere else: its bed lets go)."""
+    motion = GroundMotion(samples, dt)
     system = System(code, ROCKING, 0.0, params, motion)
-    t_final = (ag.size + n_tail - 1) * dt
+    t_final = (samples.shape[1] + n_tail - 1) * dt
     work = workspace()
     state_scales(params, static_settlement(code, params), work.scale)
     f0, x_new, f1 = work.f0, work.x_new, work.stages[END_STAGE]
     before = np.empty(N_CONTACT_INDICATORS)
     after = np.empty(N_CONTACT_INDICATORS)
     force, _ = bed_force(x, params)
-    start_summary(summary, x, force)
+    start_summary(summary, x, force, free_flight_time(motion, params["g"]))
     contact_indicators(x, params, before)
     if before[0] < 0.0 or before[1] < 0.0:
         summary["uplifted"] = 1.0
@@ -873,7 +961,7 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
-        if (history.shape[0] == 0 and t > ag.size * dt and after[0] > 0.0 and after[1] > 0.0
+        if (history.shape[0] == 0 and t > samples.shape[1] * dt and after[0] > 0.0 and after[1] > 0.0
                 and settled_beyond_reach(x, params, summary["peak_angle"])):
             break  # the ground is at rest and the block can no longer reach its peak or lift (no history kept)
         if kind == EVENT_OVERTURN:
@@ -893,17 +981,18 @@ def bed_loop(code, ag, dt, n_tail, params, x, history, impact_times, summary):
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
-def simulate_kernel(code, ag, dt, n_tail, params, x0, history, impact_times, summary):
+def simulate_kernel(code, samples, dt, n_tail, params, x0, history, impact_times, summary):
     """Integrate one response.
 
     Parameters
     ----------
     code : int
         Kernel code (fields.HOUSNER, SSI or WINKLER).
-    ag : ndarray (n,)
-        Ground acceleration [m/s^2] at t = i dt.
+    samples : ndarray (1 or 2, n)
+        Ground acceleration [m/s^2] at t = i dt: row HORIZONTAL, and row VERTICAL (up positive) if the
+        ground also moves vertically.
     dt : float
-        Sampling step of ag [s].
+        Sampling step [s].
     n_tail : int
         Samples of free vibration after the record (zero ground acceleration).
     params : PARAMS_DTYPE record
@@ -916,33 +1005,35 @@ def simulate_kernel(code, ag, dt, n_tail, params, x0, history, impact_times, sum
     summary : SUMMARY_DTYPE record, filled.
     """
     if code == WINKLER:
-        bed_loop(code, ag, dt, n_tail, params, x0, history, impact_times, summary)
+        bed_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary)
     elif code == HOUSNER or code == SSI:
-        pivot_loop(code, ag, dt, n_tail, params, x0, history, impact_times, summary)
+        pivot_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary)
     else:
         raise ValueError(UNKNOWN_CODE)
 
 
 @njit(cache=True)
-def single_kernel(code, ag, dt, n_tail, params_table, x0, history, impact_times, summaries):
+def single_kernel(code, samples, dt, n_tail, params_table, x0, history, impact_times, summaries):
     """``simulate_kernel`` for params_table[0] into summaries[0] (records cross from Python as arrays)."""
-    simulate_kernel(code, ag, dt, n_tail, params_table[0], x0, history, impact_times, summaries[0])
+    simulate_kernel(code, samples, dt, n_tail, params_table[0], x0, history, impact_times, summaries[0])
 
 
 @njit(cache=True)
-def batch_kernel(code, ag, dt, n_tail, scales, params_table, initial_states, summaries):
-    """One record at each factor in ``scales`` for each parameter row (no histories).
+def batch_kernel(code, samples, dt, n_tail, scales, params_table, initial_states, summaries):
+    """One record at each factor in ``scales`` for each parameter row (no histories); every component
+    (the vertical too) is scaled by the same factors.
 
     scales (n_scale,); params_table (n_case,) records; initial_states (n_case, STATE_SIZE);
     summaries (n_case, n_scale) records, filled.
     """
     empty = np.empty((0, STATE_SIZE))
     impacts = np.empty(0)
-    scaled = np.empty(ag.size)
+    scaled = np.empty(samples.shape)
     x = np.empty(STATE_SIZE)
     for j in range(scales.size):
-        for i in range(ag.size):
-            scaled[i] = ag[i] * scales[j]
+        for component in range(samples.shape[0]):
+            for i in range(samples.shape[1]):
+                scaled[component, i] = samples[component, i] * scales[j]
         for row in range(params_table.shape[0]):
             for i in range(STATE_SIZE):
                 x[i] = initial_states[row, i]
@@ -950,11 +1041,11 @@ def batch_kernel(code, ag, dt, n_tail, scales, params_table, initial_states, sum
 
 
 @njit(cache=True)
-def history_batch_kernel(code, ag, dt, n_tail, params_table, initial_states, histories, summaries):
+def history_batch_kernel(code, samples, dt, n_tail, params_table, initial_states, histories, summaries):
     """One ground motion for each parameter row, keeping the histories (n_case, n + n_tail, STATE_SIZE)."""
     impacts = np.empty(0)
     x = np.empty(STATE_SIZE)
     for row in range(params_table.shape[0]):
         for i in range(STATE_SIZE):
             x[i] = initial_states[row, i]
-        simulate_kernel(code, ag, dt, n_tail, params_table[row], x, histories[row], impacts, summaries[row])
+        simulate_kernel(code, samples, dt, n_tail, params_table[row], x, histories[row], impacts, summaries[row])

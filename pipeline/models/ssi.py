@@ -29,6 +29,13 @@ multiplication fixed in the minimal way. It does not converge to Housner.
 
 Rest phase: theta = theta' = 0 and only the vertical spring-dashpot moves. Rocking about sigma
 starts when |ag| > tan(alpha) (w^2 y + 2 xi w y'), which is g tan(alpha) at static equilibrium.
+
+With a vertical ground acceleration a_v (up positive), the base moves vertically too: in its frame
+the gravity term m g (R cos A - y) of V becomes m (g + a_v(t)) (R cos A - y) while the spring and
+dashpot act on the relative settlement y, so g is g + a_v(t) in both equations above and in the rest
+phase (test_equations_of_motion.py derives this with sympy); the uplift condition reads the spring's
+force, which the vertical motion moves.
+
 Pivot switch at theta = 0: ``consistent`` keeps theta' and the centre-of-mass velocity continuous,
 so y' jumps by 2 R sin(alpha) |theta'| (energy conserved at the switch; with xi > 0 and k -> inf
 Housner's restitution emerges); ``continuous`` keeps theta' and y' (what ODE45 on the paper's
@@ -43,20 +50,23 @@ from pipeline.models.jit import njit
 
 
 @njit(cache=True)
-def ssi_rest_rhs(x, params, out):
-    """Both corners down: only the vertical spring-dashpot moves."""
+def ssi_rest_rhs(x, gravity, params, out):
+    """Both corners down: only the vertical spring-dashpot moves (gravity: g + a_v [m/s^2])."""
     omega = params["omega"]
     out[0] = 0.0
     out[1] = 0.0
     out[2] = x[3]
-    out[3] = params["g"] - omega * omega * x[2] - 2.0 * params["xi"] * omega * x[3]
+    out[3] = gravity - omega * omega * x[2] - 2.0 * params["xi"] * omega * x[3]
 
 
 @njit(cache=True)
-def ssi_rhs(sigma, x, accel, params, out):
-    """dx/dt while rocking on pivot sigma (the equations in the module docstring)."""
+def ssi_rhs(sigma, x, accel, gravity, params, out):
+    """dx/dt while rocking on pivot sigma (the equations in the module docstring).
+
+    accel: horizontal ground acceleration [m/s^2]; gravity: g + a_v, the effective gravity [m/s^2].
+    """
     radius = params["R"]
-    g = params["g"]
+    g = gravity
     omega = params["omega"]
     kappa = params["kappa"]
     angle = sigma * params["alpha"] - x[0]  # A = sigma*alpha - theta
@@ -73,7 +83,8 @@ def ssi_rhs(sigma, x, accel, params, out):
 
 @njit(cache=True)
 def ssi_support(x, params):
-    """Force of the spring-dashpot on the block per unit mass [m/s^2] (negative: it pulls)."""
+    """Force of the spring-dashpot on the block per unit mass [m/s^2] (negative: it pulls); the vertical
+    ground motion reaches it through the state."""
     omega = params["omega"]
     return omega * omega * x[2] + 2.0 * params["xi"] * omega * x[3]
 

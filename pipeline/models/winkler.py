@@ -72,15 +72,15 @@ def accelerations_at(sin_t, cos_t, theta_dot, ag, force, moment, h, j, g):
 
 
 @njit(cache=True)
-def winkler_rhs(x, accel, params, out):
-    """dx/dt for x = [theta, theta', y, y']."""
+def winkler_rhs(x, accel, gravity, params, out):
+    """dx/dt for x = [theta, theta', y, y']; accel: horizontal ground acceleration, gravity: g + a_v [m/s^2]."""
     h = params["h"]
     b = params["b"]
     sin_t = math.sin(x[0])
     cos_t = math.cos(x[0])
     force, moment = bed_force_at(x, params, sin_t, cos_t)
     theta_acc, y_acc = accelerations_at(sin_t, cos_t, x[1], accel, force, moment, h,
-                                        (b * b + 4.0 * h * h) / 3.0, params["g"])
+                                        (b * b + 4.0 * h * h) / 3.0, gravity)
     out[0] = x[1]
     out[1] = theta_acc
     out[2] = x[3]

@@ -3,6 +3,12 @@
 It re-implements the equations of motion from scratch (Housner eq. 1; the SSI equations derived in
 pipeline/models/ssi.py) with scipy's own event location, so that the compiled kernel can be checked
 against it. Slow: for tests and benchmarks only.
+
+A vertical ground acceleration a_v(t) (up positive, linear between samples like ag) replaces G by
+G + a_v(t) wherever gravity acts on the block (the ground's frame); the spring acts on the relative
+settlement and does not see it. The rest phase is then a root search (brentq) of
+|ag| - tan(alpha) (G + a_v) on every sample interval, and the run ends where G + a_v first falls
+below zero (``free_flight_time``): the pivot models have no flight phase.
 """
 
 from __future__ import annotations
@@ -11,13 +17,31 @@ import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 G = 9.80665
 
 
+def free_flight_time(ag_vertical, dt, g=G):
+    """First time [s] at which g + a_v(t) < 0 (a_v linear between samples, zero after them); inf if never."""
+    if ag_vertical is None:
+        return math.inf
+    gravity = g + np.append(np.asarray(ag_vertical, dtype=float), 0.0)
+    below = np.flatnonzero(gravity < 0.0)
+    if not below.size:
+        return math.inf
+    i = int(below[0])
+    if i == 0:
+        return 0.0
+    return brentq(lambda t: gravity[i - 1] + (gravity[i] - gravity[i - 1]) * (t - (i - 1) * dt) / dt,
+                  (i - 1) * dt, i * dt, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+
+
 def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, switch="consistent",
-                       t_end=None, rtol=1e-10, atol=1e-12):
-    """Peak |theta| [rad], impact times [s] and whether the block overturned."""
+                       t_end=None, rtol=1e-10, atol=1e-12, ag_vertical=None):
+    """Peak |theta| [rad], impact times [s] and whether the block overturned, up to t_end or to the free
+    flight (``free_flight_time``) when ``ag_vertical`` [m/s^2, up positive, sampled as ag] takes gravity
+    below zero."""
     radius, alpha, m = block.R, block.alpha, block.mass
     p2 = 0.75 * G / radius
     omega = math.sqrt(k / m) if k else 0.0
@@ -25,22 +49,30 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
         restitution = block.housner_restitution() if model == "housner" else 1.0
     times = np.arange(ag.size) * dt
     t_end = times[-1] + 5.0 if t_end is None else t_end
+    t_end = min(t_end, free_flight_time(ag_vertical, dt))
+    vertical_samples = np.zeros(ag.size) if ag_vertical is None else np.asarray(ag_vertical, dtype=float)
+    vertical_end = (np.flatnonzero(vertical_samples)[-1] + 1) * dt if np.any(vertical_samples) else -1.0
 
     def ground(t):
         return float(np.interp(t, np.append(times, times[-1] + dt), np.append(ag, 0.0), right=0.0))
 
+    def gravity(t):
+        """G + a_v(t) [m/s^2]."""
+        return G + float(np.interp(t, np.append(times, times[-1] + dt), np.append(vertical_samples, 0.0), right=0.0))
+
     def rocking(t, x, sigma):
         a = ground(t)
+        g = gravity(t)
         angle = sigma * alpha - x[0]
         if model == "housner":
-            return [x[1], -p2 * (math.sin(angle) + a / G * math.cos(angle)), 0.0, 0.0]
-        free = G - omega**2 * x[2] - 2 * xi * omega * x[3] - radius * math.cos(angle) * x[1] ** 2
-        moment = -G * math.sin(angle) - a * math.cos(angle)
+            return [x[1], -0.75 / radius * (g * math.sin(angle) + a * math.cos(angle)), 0.0, 0.0]
+        free = g - omega**2 * x[2] - 2 * xi * omega * x[3] - radius * math.cos(angle) * x[1] ** 2
+        moment = -g * math.sin(angle) - a * math.cos(angle)
         y_acc = (free + 0.75 * math.sin(angle) * moment) / (1 - 0.75 * math.sin(angle) ** 2)
         return [x[1], 0.75 / radius * (math.sin(angle) * y_acc + moment), x[3], y_acc]
 
-    def support(x):
-        return G if model == "housner" else omega**2 * x[2] + 2 * xi * omega * x[3]
+    def support(t, x):
+        return gravity(t) if model == "housner" else omega**2 * x[2] + 2 * xi * omega * x[3]
 
     state = np.array([0.0, 0.0, G / omega**2 if omega else 0.0, 0.0])
     t = 0.0
@@ -49,17 +81,19 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
     y_static = G / omega**2 if omega else 0.0
 
     def vertical(time, x):
-        return [0.0, 0.0, x[3], G - omega**2 * x[2] - 2 * xi * omega * x[3]]
+        return [0.0, 0.0, x[3], gravity(time) - omega**2 * x[2] - 2 * xi * omega * x[3]]
 
     def uplift(time, x):
-        return abs(ground(time)) - math.tan(alpha) * support(x)
+        return abs(ground(time)) - math.tan(alpha) * support(time, x)
     uplift.terminal = True
     uplift.direction = 1
 
     while t < t_end - 1e-12:
         start = None
-        if model != "housner" and (abs(state[2] - y_static) > 1e-9 * y_static or abs(state[3]) > 1e-9 * y_static * omega):
-            # rest with a vertical vibration left over: integrate it until the uplift condition holds
+        if model != "housner" and (abs(state[2] - y_static) > 1e-9 * y_static or abs(state[3]) > 1e-9 * y_static * omega
+                                   or t < vertical_end):
+            # rest with a vertical vibration left over, or forced by the ground: integrate it until the uplift
+            # condition holds
             if uplift(t, state) > 0:
                 start = (t, -math.copysign(1.0, ground(t)))
             else:
@@ -71,16 +105,16 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
                     break
                 start = (t, -math.copysign(1.0, ground(t)))
         else:
-            # rest at static equilibrium: the support force is m g; scan the piecewise-linear ground motion
-            threshold = math.tan(alpha) * G
+            # rest at static equilibrium: the support force is m (G + a_v); scan the sample intervals of the
+            # piecewise-linear ground motion for the first t where |ag| > tan(alpha) (G + a_v)
+            def excess(time):
+                return abs(ground(time)) - math.tan(alpha) * gravity(time)
             k0 = int(math.floor(t / dt + 1e-9))
-            for i in range(k0, int(t_end / dt)):
-                a0, a1 = ground(max(t, i * dt)), ground((i + 1) * dt)
-                if abs(a1) > threshold:
-                    target = math.copysign(threshold, a1)
-                    s = max(t, i * dt) if abs(a0) > threshold else i * dt + (target - ground(i * dt)) / (
-                        (ground((i + 1) * dt) - ground(i * dt)) / dt)
-                    start = (max(s, t), -math.copysign(1.0, a1))
+            for i in range(k0, int(math.ceil(t_end / dt - 1e-9))):
+                t0, t1 = max(t, i * dt), min((i + 1) * dt, t_end)
+                if excess(t1) > 0:
+                    s = t0 if excess(t0) > 0 else brentq(excess, t0, t1, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+                    start = (max(s, t), -math.copysign(1.0, ground(s if excess(t0) > 0 else t1)))
                     break
         if start is None:
             break

@@ -99,11 +99,12 @@ def energy(theta, theta_dot, y, y_dot, b, h, mass, K, bed, g=G):
 
 
 def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g=G, theta0=0.0,
-                      thetadot0=0.0, y0=None, rtol=1e-10, overturn_angle=math.pi / 2, law=None):
+                      thetadot0=0.0, y0=None, rtol=1e-10, overturn_angle=math.pi / 2, law=None, ag_vertical=None):
     """Response of the block on the bed to ag (see the module docstring for inputs and outputs).
 
     ``law`` replaces ``bed_force`` (same signature) to study other contact laws, e.g. a dashpot that
     keeps acting out of the ground as in an OpenSees Parallel(ENT, Viscous) spring.
+    ``ag_vertical`` [m/s^2, up positive, sampled as ag]: gravity is g + a_v(t) in the ground's frame.
     """
     law = bed_force if law is None else law
     ag = np.asarray(ag, dtype=float)
@@ -113,6 +114,10 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
     ground = np.zeros(n + 1)
     ground[:min(n, ag.size)] = ag[:n]
     ground = ground.tolist()
+    vertical = np.zeros(n + 1)  # a_v, linear between samples like ag
+    if ag_vertical is not None:
+        vertical[:min(n, ag.size)] = np.asarray(ag_vertical, dtype=float)[:n]
+    vertical = vertical.tolist()
     C = 2.0 * xi * math.sqrt(K * mass)
     j = (b * b + 4.0 * h * h) / 3.0
     y_static = mass * g / K
@@ -124,12 +129,13 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
 
     def rhs_factory(i):
         t_i, a0, slope = i * dt, ground[i], (ground[i + 1] - ground[i]) / dt
+        v0, v_slope = vertical[i], (vertical[i + 1] - vertical[i]) / dt
 
         def rhs(t, x):
             theta, theta_dot, y, y_dot = x
             force, moment = law(theta, theta_dot, y, y_dot, b, K, C, bed)
             theta_dd, y_dd = accelerations(theta, theta_dot, y, a0 + slope * (t - t_i), force / mass,
-                                           moment / mass, h, j, g)
+                                           moment / mass, h, j, g + v0 + v_slope * (t - t_i))
             return [theta_dot, theta_dd, y_dot, y_dd]
         return rhs
 
