@@ -1,7 +1,8 @@
 """pipeline.models - stage 5: rocking solvers (Housner, the paper's SSI model, the Winkler bed).
 
 Input : a model name, ground acceleration [m/s^2] sampled at dt [s], a ``Block`` and, for models
-        with a foundation, the interface stiffness k [N/m] and damping ratio xi [-].
+        with a foundation, the interface stiffness k [N/m] and damping ratio xi [-] (winkler: or a target
+        restitution that calibrates xi, pipeline.models.restitution).
 Output: a ``RockingResult`` (histories, peak angle, impacts, overturning, foundation checks), or for
         many scale factors and cases at once summary records (``fields.SUMMARY_DTYPE``) from
         ``simulate_batch`` and ``simulate_histories``.
@@ -111,15 +112,19 @@ def simulate(model, ag, dt, block, *, k=None, xi=None, theta0=0.0, thetadot0=0.0
         (tensionless bed); see ``MODELS``.
     k, xi : float
         Interface stiffness [N/m] (winkler: the bed's total vertical stiffness K) and damping ratio
-        [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m)).
+        [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m); hunt-crossley: the same damping at
+        rest). winkler with ``restitution``: xi is calibrated (give none), ``result.extra["xi"]``.
     theta0, thetadot0 : float
         Initial rotation [rad] and rate [rad/s] (free rocking).
     t_end : float, optional
         End time [s]; zero ground motion after the record. Default: record + 10 s.
     **options
         ``SolverOptions`` fields: ``switch`` (ssi: consistent | continuous), ``bed`` (winkler:
-        continuous | two-spring), ``restitution`` (pivot models; Housner default 1 - 1.5 sin^2 alpha),
-        ``g``, ``overturn_angle`` [rad] (default pi/2, terminal), ``rtol``, ``atol``.
+        continuous | two-spring | hunt-crossley), ``restitution`` (pivot models: the impact
+        coefficient, Housner default 1 - 1.5 sin^2 alpha; winkler: the target effective restitution
+        < 1 of free rocking to which the bed's damping is calibrated, the continuous bed with
+        Hunt-Crossley damping; "housner" is 1 - 1.5 sin^2 alpha), ``g``, ``overturn_angle`` [rad]
+        (default pi/2, terminal), ``rtol``, ``atol``.
     """
     spec = get_model(model)
     settings = SolverOptions(**options)
