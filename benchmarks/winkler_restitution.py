@@ -27,8 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.errors import SolverError  # noqa: E402
-from pipeline.models.restitution import (calibrate_dissipation, calibrated_law, free_rocking_restitution,  # noqa: E402
-                                         reachable_range)
+from pipeline.models import restitution  # noqa: E402
 
 ALPHAS = (0.1, 0.15, 0.25, 0.4)
 XIS = {"two-spring": (0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7, 0.9),
@@ -63,7 +62,7 @@ def r_tables(print=print):
             print("  alpha  Housner | " + " ".join(f"xi={xi:<6g}" for xi in XIS[bed]) + " | xi matching Housner")
             for alpha in ALPHAS:
                 block = Block(name="r", R=2.0, alpha=alpha, mass=5000.0)
-                rs = [free_rocking_restitution(block, stiffness(block, ratio), bed, xi) for xi in XIS[bed]]
+                rs = [restitution.free_rocking_restitution(block, stiffness(block, ratio), bed, xi) for xi in XIS[bed]]
                 curves[bed, ratio, alpha] = rs
                 match = matching_xi(XIS[bed], rs, block.housner_restitution())
                 print(f"  {alpha:5.2f}  {block.housner_restitution():7.4f} | " + " ".join(f"{r:<9.4f}" for r in rs)
@@ -74,22 +73,23 @@ def r_tables(print=print):
 def calibration_table(print=print):
     """The calibration per bed: reachable range, xi of the band's edges and r at 0.3/0.6/0.9 alpha."""
     for bed in ("two-spring", "continuous"):
-        print(f"\n  {bed} bed calibrated ({calibrated_law(bed)} xi): the range of r it reaches, and r of the "
-              "calibrated bed launched to 0.3 / 0.6 / 0.9 alpha")
+        law = restitution.calibrated_law(bed)
+        print(f"\n  {bed} bed calibrated ({law} xi): the range of r it reaches, and r of the calibrated bed "
+              "launched to 0.3 / 0.6 / 0.9 alpha")
         print("  omega_v/p  alpha  Housner  range           | target  xi       r at 0.3   0.6     0.9 alpha")
         for ratio in CALIBRATION_RATIOS:
             for alpha in CALIBRATION_ALPHAS:
                 block = Block(name="r", R=2.0, alpha=alpha, mass=5000.0)
                 K = stiffness(block, ratio)
-                low, high = reachable_range(block, K, bed)
+                low, high = restitution.reachable_range(block, K, bed)
                 housner = block.housner_restitution()
                 for target in (housner, min(1.05 * housner, 0.99)):
                     try:
-                        xi = calibrate_dissipation(block, K, bed, target)
+                        xi = restitution.calibrate_dissipation(block, K, bed, target)
                     except SolverError:
                         row = "out of reach"
                     else:
-                        rs = [free_rocking_restitution(block, K, calibrated_law(bed), xi, fraction=fraction)
+                        rs = [restitution.free_rocking_restitution(block, K, law, xi, fraction=fraction)
                               for fraction in (0.3, 0.6, 0.9)]
                         row = f"{xi:<8.3g} " + " ".join(f"{r:.4f}" for r in rs)
                     print(f"  {ratio:9d}  {alpha:5.2f}  {housner:.4f}   {low:.4f}-{high:.4f}   | {target:.4f}  {row}")

@@ -26,9 +26,19 @@ from pipeline.models import fields, kernels
 from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
 from pipeline.models.contact import LAWS
 from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
-from pipeline.models.options import (BED_TYPES, DEFAULT_ATOL, DEFAULT_RTOL, DEFAULT_XI,  # noqa: F401  (the API)
-                                     DEFAULT_ZENO_FRACTION, FOUNDATION, MAX_EVENTS, SOLVER_OPTIONS, SWITCH_RULES,
-                                     SolverOptions, case_record)
+from pipeline.models.options import (  # noqa: F401  (the API)
+    BED_TYPES,
+    DEFAULT_ATOL,
+    DEFAULT_RTOL,
+    DEFAULT_XI,
+    DEFAULT_ZENO_FRACTION,
+    FOUNDATION,
+    MAX_EVENTS,
+    SOLVER_OPTIONS,
+    SWITCH_RULES,
+    SolverOptions,
+    case_record,
+)
 from pipeline.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
 from pipeline.units import STANDARD_GRAVITY
 
@@ -170,8 +180,10 @@ def _result(spec, block, dt, summary, history, impacts, params):
 
 
 def _case_extra(spec, params) -> dict:
-    """``RockingResult.extra`` of a bed model: the bed's damping ratio xi [-] and contact law (a restitution
-    target's calibrated xi, and ``hunt-crossley`` for a calibrated continuous bed); empty otherwise."""
+    """``RockingResult.extra`` of a bed model: its damping ratio xi [-] and contact law; empty otherwise.
+
+    With a restitution target these are the calibrated xi and law (``hunt-crossley`` for a continuous bed).
+    """
     if not spec.uses_bed:
         return {}
     return {"xi": float(params["xi"]), "bed": LAWS[int(params["bed"])].NAME}

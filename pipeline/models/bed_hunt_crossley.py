@@ -30,8 +30,10 @@ from __future__ import annotations
 
 import math
 
-from pipeline.models.bed_continuous import _clip
-from pipeline.models.bed_continuous import full_contact  # noqa: F401  (the same springs: same elastic energy)
+from pipeline.models.bed_continuous import (
+    _clip,
+    full_contact,  # noqa: F401  (the same springs: same elastic energy)
+)
 from pipeline.models.jit import njit
 
 NAME = "hunt-crossley"  # selects this law: simulate(..., bed="hunt-crossley"), [solver] bed

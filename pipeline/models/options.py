@@ -97,8 +97,10 @@ def check(schema: Table, values: dict) -> None:
 
 
 def pivot_restitution(model: RockingModel, block: Block, restitution: float | str | None) -> float:
-    """The impact coefficient of a pivot model for ``block``: the option as a number ("housner": Housner's
-    1 - 1.5 sin^2(alpha)), or the model's default when None."""
+    """The impact coefficient of a pivot model for ``block``.
+
+    The option as a number ("housner": Housner's 1 - 1.5 sin^2(alpha)), or the model's default when None.
+    """
     if restitution is None:
         return model.default_restitution(block)
     if restitution == HOUSNER:
@@ -107,8 +109,11 @@ def pivot_restitution(model: RockingModel, block: Block, restitution: float | st
 
 
 def case_record(model: RockingModel, block: Block, k=None, xi=None, options: SolverOptions = SolverOptions()):
-    """The kernel's parameter record and initial state [theta, theta', y, y'] (static) for one case with an
-    explicit damping ratio xi (None: ``DEFAULT_XI``); a bed model's ``restitution`` option is not read here."""
+    """The kernel's parameter record and initial state [theta, theta', y, y'] (static) for one case.
+
+    The damping ratio xi is explicit (None: ``DEFAULT_XI``); a bed model's ``restitution`` option is not read
+    here (pipeline.models.parameter_record calibrates xi to it first).
+    """
     params = fields.new_params(1)[0]
     omega = 0.0
     xi_value = 0.0

@@ -106,8 +106,10 @@ def effective_restitution(peaks: np.ndarray, alpha: float) -> np.ndarray:
 @lru_cache(maxsize=4096)
 def free_rocking_restitution(block: Block, k: float, bed: str, xi: float, g: float = STANDARD_GRAVITY,
                              fraction: float = LAUNCH_FRACTION) -> float:
-    """Effective restitution of free rocking on the bed (module docstring): the median r of the first four
-    impacts; NaN when the block overturns or makes fewer than two peaks above 0.1 alpha.
+    """Effective restitution of free rocking on the bed (module docstring).
+
+    The median r of the first four impacts; NaN when the block overturns or makes fewer than two peaks
+    above 0.1 alpha. Cached per argument set.
 
     Parameters
     ----------
@@ -192,8 +194,10 @@ def restitution_grid(block: Block, k: float, law: str, g: float = STANDARD_GRAVI
 
 
 def reachable_range(block: Block, k: float, bed: str, g: float = STANDARD_GRAVITY) -> tuple[float, float]:
-    """(lowest, highest) effective restitution [-] that a target on ``bed`` can be calibrated to (the span of r
-    over the law's xi grid; NaN, NaN when the measure is undefined at every xi)."""
+    """(lowest, highest) effective restitution [-] that a target on ``bed`` can be calibrated to.
+
+    The span of r over the law's xi grid; (NaN, NaN) when the measure is undefined at every xi.
+    """
     _, rs = restitution_grid(block, float(k), calibrated_law(bed), float(g))
     finite = [r for r in rs if math.isfinite(r)]
     return (min(finite), max(finite)) if finite else (math.nan, math.nan)
@@ -201,8 +205,9 @@ def reachable_range(block: Block, k: float, bed: str, g: float = STANDARD_GRAVIT
 
 def calibrate_dissipation(block: Block, k: float, bed: str, restitution: float | str,
                           g: float = STANDARD_GRAVITY) -> float:
-    """The damping ratio xi [-] of ``calibrated_law(bed)`` whose free rocking has effective restitution
-    ``restitution`` (module docstring; cached per block, k, bed, target and g).
+    """The damping ratio xi [-] of ``calibrated_law(bed)`` that gives free rocking the target restitution.
+
+    The calibration of the module docstring, cached per block, k, bed, target and g.
 
     Parameters
     ----------
@@ -237,8 +242,9 @@ def _calibrated(block: Block, k: float, law: str, target: float, g: float, bed: 
     where = (f"the {bed} bed (law {law}) for block {block.name!r} (K = {k:.4g} N/m, "
              f"omega_v/p = {math.sqrt(k / block.mass) / block.p(g):.0f})")
     if not finite:
-        raise SolverError(f"{where[0].upper()}{where[1:]}: the block overturns or does not rock when launched to {LAUNCH_FRACTION} alpha "
-                          f"at every xi from {xis[0]:g} to {xis[-1]:g}; its free-rocking restitution is not defined")
+        raise SolverError(f"{where[0].upper()}{where[1:]}: the block overturns or does not rock when launched to "
+                          f"{LAUNCH_FRACTION} alpha at every xi from {xis[0]:g} to {xis[-1]:g}; its free-rocking "
+                          "restitution is not defined")
     low, high = min(rs[i] for i in finite), max(rs[i] for i in finite)
 
     band = min(BAND * target, LOSS_BAND * (1.0 - target))
@@ -277,7 +283,7 @@ def _calibrated(block: Block, k: float, law: str, target: float, g: float, bed: 
 
 
 def _root(measure, value: float, low: float, high: float) -> float | None:
-    """xi in [low, high] where measure(xi) = value (brentq), or None when the measure is undefined there."""
+    """The xi in [low, high] where measure(xi) = value (brentq), or None when the measure is undefined there."""
     def gap(xi: float) -> float:
         r = measure(xi)
         if not math.isfinite(r):
@@ -295,9 +301,10 @@ def _root(measure, value: float, low: float, high: float) -> float | None:
 
 
 def radiation_damping(block: Block, soil: SoilClass) -> float:
-    """Damping ratio xi [-] of the vertical mode from Lysmer's analog: a dashpot rho V_La per unit footprint
-    area, V_La = 3.4 V_s / (pi (1 - nu)), V_s = sqrt(G / rho), on the eq. 19 stiffness K:
-    xi = rho V_La A / (2 sqrt(K m)).
+    """Damping ratio xi [-] of the vertical mode from Lysmer's analog.
+
+    A dashpot rho V_La per unit footprint area, V_La = 3.4 V_s / (pi (1 - nu)), V_s = sqrt(G / rho), on the
+    eq. 19 stiffness K: xi = rho V_La A / (2 sqrt(K m)).
 
     Parameters
     ----------
