@@ -2,7 +2,8 @@
 
 Input : a model name, ground acceleration [m/s^2] sampled at dt [s] (optionally a vertical one,
         ``ag_vertical``, same sampling, up positive), a ``Block`` and, for models with a foundation,
-        the interface stiffness k [N/m] and damping ratio xi [-].
+        the interface stiffness k [N/m] and damping ratio xi [-] (winkler: or a target restitution that
+        calibrates xi, pipeline.models.restitution).
 Output: a ``RockingResult`` (histories, peak angle, impacts, overturning, foundation checks), or for
         many scale factors and cases at once summary records (``fields.SUMMARY_DTYPE``) from
         ``simulate_batch`` and ``simulate_histories``.
@@ -16,30 +17,35 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import replace
 
 import numpy as np
 
 from pipeline.blocks import Block
-from pipeline.errors import ConfigError, SolverError
+from pipeline.errors import SolverError
 from pipeline.models import fields, kernels
 from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
-from pipeline.models.contact import BED_LAWS
+from pipeline.models.contact import LAWS
 from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
+from pipeline.models.options import (  # noqa: F401  (the API)
+    BED_TYPES,
+    DEFAULT_ATOL,
+    DEFAULT_RTOL,
+    DEFAULT_XI,
+    DEFAULT_ZENO_FRACTION,
+    FOUNDATION,
+    MAX_EVENTS,
+    SOLVER_OPTIONS,
+    SWITCH_RULES,
+    SolverOptions,
+    case_record,
+)
+from pipeline.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
 from pipeline.units import STANDARD_GRAVITY
-from pipeline.validation import Nullable, Number, Table, Text
 
 MODELS: dict[str, RockingModel] = {}
 
-SWITCH_RULES = {"consistent": fields.SWITCH_CONSISTENT, "continuous": fields.SWITCH_CONTINUOUS}
-BED_TYPES = BED_LAWS  # the winkler bed's contact laws, registered in pipeline.models.contact
-
-DEFAULT_RTOL = 1e-6  # relative error per step; peak angles agree with scipy at 1e-10 to ~1e-6
-DEFAULT_ATOL = 1e-7  # absolute error per step, as a fraction of alpha, alpha*p, y_static, y_static*omega
-DEFAULT_XI = 0.05
-DEFAULT_ZENO_FRACTION = 1e-6  # excursions below this fraction of alpha end the rocking
 DEFAULT_TAIL = 10.0  # s of free vibration after the record
-MAX_EVENTS = 200_000
 IMPACT_CAPACITY = 10_000
 
 
@@ -54,77 +60,22 @@ def get_model(name: str) -> RockingModel:
         raise SolverError(f"unknown model {name!r}; valid models are: {', '.join(MODELS)}") from None
 
 
-@dataclass(frozen=True)
-class SolverOptions:
-    """Settings shared by every case of a call (validated once)."""
-
-    switch: str = "consistent"        # ssi pivot-switch rule: consistent | continuous
-    bed: str = "continuous"           # winkler bed: continuous | two-spring
-    restitution: float | None = None  # pivot models; None = the model's default for the block
-    g: float = STANDARD_GRAVITY
-    overturn_angle: float = math.pi / 2
-    rtol: float = DEFAULT_RTOL
-    atol: float = DEFAULT_ATOL
-
-    def __post_init__(self):
-        _check(SOLVER_OPTIONS, vars(self))
-
-
-SOLVER_OPTIONS = Table({
-    "switch": Text(tuple(SWITCH_RULES)),
-    "bed": Text(tuple(BED_TYPES)),
-    "restitution": Nullable(Number(0.0, 1.0)),
-    "g": Number(0.0, low_open=True, unit="m/s^2"),
-    "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
-    "rtol": Number(0.0, 1.0, low_open=True, high_open=True),
-    "atol": Number(0.0, 1.0, low_open=True, high_open=True),
-})
-"""The schema of ``SolverOptions`` (pipeline.validation)."""
-FOUNDATION = Table({"k": Number(0.0, low_open=True, unit="N/m"), "xi": Number(0.0, 1.0, high_open=True)})
-"""The schema of a foundation's interface stiffness k and damping ratio xi."""
-
-
-def _check(schema: Table, values: dict) -> None:
-    """Check solver arguments against ``schema``: a value out of range is a ``SolverError`` naming it."""
-    try:
-        schema.check(values, "", None)
-    except ConfigError as error:
-        raise SolverError(str(error)) from None
-
-
 def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options=SolverOptions()):
-    """The kernel's parameter record and initial state [theta, theta', y, y'] (static) for one case."""
-    params = fields.new_params(1)[0]
-    omega = 0.0
-    xi_value = 0.0
-    y0 = 0.0
-    if model.needs_foundation:
+    """The kernel's parameter record and initial state [theta, theta', y, y'] (static) for one case.
+
+    A bed model (winkler) given ``options.restitution`` calibrates its bed's dissipation to that target
+    (``restitution.calibrate_dissipation``, cached per block, stiffness, bed and target): xi is then an
+    output, and the bed ``continuous`` takes its Hunt-Crossley damping (``restitution.calibrated_law``).
+    """
+    if model.uses_bed and options.restitution is not None:
+        if xi is not None:
+            raise SolverError(f"model {model.name!r}: give xi or restitution, not both (a restitution target "
+                              f"calibrates xi; restitution = {options.restitution!r}, xi = {xi!r})")
         if k is None:
             raise SolverError(f"model {model.name!r} needs the interface stiffness k [N/m]")
-        xi_value = DEFAULT_XI if xi is None else xi
-        _check(FOUNDATION, {"k": k, "xi": xi_value})
-        omega = math.sqrt(k / block.mass)
-        y0 = options.g / omega**2  # static equilibrium: never drop the block onto an unloaded bed
-    restitution = options.restitution
-    if restitution is None:
-        restitution = model.default_restitution(block)
-    params["R"] = block.R
-    params["alpha"] = block.alpha
-    params["b"] = block.b
-    params["h"] = block.h
-    params["g"] = options.g
-    params["kappa"] = model.kappa
-    params["omega"] = omega
-    params["xi"] = xi_value
-    params["restitution"] = restitution
-    params["switch"] = SWITCH_RULES[options.switch]
-    params["bed"] = BED_TYPES[options.bed]
-    params["overturn"] = options.overturn_angle
-    params["rtol"] = options.rtol
-    params["atol"] = options.atol
-    params["zeno"] = DEFAULT_ZENO_FRACTION * block.alpha
-    params["max_events"] = MAX_EVENTS
-    return params, np.array([0.0, 0.0, y0, 0.0])
+        xi = calibrate_dissipation(block, k, options.bed, options.restitution, g=options.g)
+        options = replace(options, bed=calibrated_law(options.bed), restitution=None)
+    return case_record(model, block, k, xi, options)
 
 
 def parameter_table(model: RockingModel, cases, options: SolverOptions):
@@ -203,15 +154,19 @@ def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=
         None (default) and zeros give the same numbers.
     k, xi : float
         Interface stiffness [N/m] (winkler: the bed's total vertical stiffness K) and damping ratio
-        [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m)).
+        [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m); hunt-crossley: the same damping at
+        rest). winkler with ``restitution``: xi is calibrated (give none), ``result.extra["xi"]``.
     theta0, thetadot0 : float
         Initial rotation [rad] and rate [rad/s] (free rocking).
     t_end : float, optional
         End time [s]; zero ground motion after the record. Default: record + 10 s.
     **options
         ``SolverOptions`` fields: ``switch`` (ssi: consistent | continuous), ``bed`` (winkler:
-        continuous | two-spring), ``restitution`` (pivot models; Housner default 1 - 1.5 sin^2 alpha),
-        ``g``, ``overturn_angle`` [rad] (default pi/2, terminal), ``rtol``, ``atol``.
+        continuous | two-spring | hunt-crossley), ``restitution`` (pivot models: the impact
+        coefficient, Housner default 1 - 1.5 sin^2 alpha; winkler: the target effective restitution
+        < 1 of free rocking to which the bed's damping is calibrated, the continuous bed with
+        Hunt-Crossley damping; "housner" is 1 - 1.5 sin^2 alpha), ``g``, ``overturn_angle`` [rad]
+        (default pi/2, terminal), ``rtol``, ``atol``.
     """
     spec = get_model(model)
     settings = SolverOptions(**options)
@@ -223,10 +178,10 @@ def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=
     impacts = np.empty(IMPACT_CAPACITY)
     summaries = new_summaries(1)
     kernels.single_kernel(spec.kernel_code, samples, float(dt), n_tail, table, state, history, impacts, summaries)
-    return _result(spec, block, dt, summaries[0], history, impacts)
+    return _result(spec, block, dt, summaries[0], history, impacts, table[0])
 
 
-def _result(spec, block, dt, summary, history, impacts):
+def _result(spec, block, dt, summary, history, impacts, params):
     status = Outcome(int(summary["status"]))
     n_impacts = int(summary["n_impacts"])
     min_support = float(summary["min_support_force"]) * block.mass
@@ -254,7 +209,17 @@ def _result(spec, block, dt, summary, history, impacts):
         peak_uplift=float(summary["peak_corner_uplift"]),
         peak_friction_demand=float(summary["peak_friction_demand"]),
         time_of_free_flight=float(summary["time_of_free_flight"]),
-        status=status, message=message, n_steps=int(summary["n_steps"]))
+        status=status, message=message, n_steps=int(summary["n_steps"]), extra=_case_extra(spec, params))
+
+
+def _case_extra(spec, params) -> dict:
+    """``RockingResult.extra`` of a bed model: its damping ratio xi [-] and contact law; empty otherwise.
+
+    With a restitution target these are the calibrated xi and law (``hunt-crossley`` for a continuous bed).
+    """
+    if not spec.uses_bed:
+        return {}
+    return {"xi": float(params["xi"]), "bed": LAWS[int(params["bed"])].NAME}
 
 
 def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, ag_vertical=None, t_end=None,
@@ -315,4 +280,5 @@ register(_ssi.PAPER_MODEL)
 register(_winkler.MODEL)
 
 __all__ = ["BED_TYPES", "MODELS", "Outcome", "RockingResult", "SUMMARY_DTYPE", "SUMMARY_FIELDS", "SWITCH_RULES",
-           "SolverOptions", "get_model", "register", "simulate", "simulate_batch", "simulate_histories"]
+           "SolverOptions", "calibrate_dissipation", "get_model", "radiation_damping", "register", "simulate",
+           "simulate_batch", "simulate_histories"]

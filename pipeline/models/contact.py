@@ -29,7 +29,7 @@ as arguments, so the dispatch is an if/elif on the integer law code, written out
 
 from __future__ import annotations
 
-from pipeline.models import bed_continuous, bed_two_spring
+from pipeline.models import bed_continuous, bed_hunt_crossley, bed_two_spring
 from pipeline.models.jit import njit
 
 # contact indicators every law reports (see the module docstring)
@@ -38,8 +38,9 @@ N_CONTACT_INDICATORS = 4
 # ---- the registration: one code per law, and its module (which names it and holds its hooks) ----
 CONTINUOUS = 0  # Kelvin-Voigt bed spread over the footprint width
 TWO_SPRING = 1  # Kelvin-Voigt springs at the two corners
+HUNT_CROSSLEY = 2  # the continuous bed's springs with Hunt-Crossley damping (vanishing with the penetration)
 
-LAWS = {CONTINUOUS: bed_continuous, TWO_SPRING: bed_two_spring}
+LAWS = {CONTINUOUS: bed_continuous, TWO_SPRING: bed_two_spring, HUNT_CROSSLEY: bed_hunt_crossley}
 BED_LAWS = {law.NAME: code for code, law in LAWS.items()}  # option name (SolverOptions.bed) -> law code
 
 UNREGISTERED = "bed contact law code not registered in pipeline.models.contact"
@@ -55,6 +56,8 @@ def bed_force_at(x, params, sin_t, cos_t):
         return bed_continuous.force(x, params, sin_t, cos_t)
     if law == TWO_SPRING:
         return bed_two_spring.force(x, params, sin_t, cos_t)
+    if law == HUNT_CROSSLEY:
+        return bed_hunt_crossley.force(x, params, sin_t, cos_t)
     raise ValueError(UNREGISTERED)
 
 
@@ -66,6 +69,8 @@ def contact_indicator(index, x, params):
         return bed_continuous.indicator(index, x, params)
     if law == TWO_SPRING:
         return bed_two_spring.indicator(index, x, params)
+    if law == HUNT_CROSSLEY:
+        return bed_hunt_crossley.indicator(index, x, params)
     raise ValueError(UNREGISTERED)
 
 
@@ -77,6 +82,8 @@ def contact_indicators(x, params, out):
         bed_continuous.indicators(x, params, out)
     elif law == TWO_SPRING:
         bed_two_spring.indicators(x, params, out)
+    elif law == HUNT_CROSSLEY:
+        bed_hunt_crossley.indicators(x, params, out)
     else:
         raise ValueError(UNREGISTERED)
 
@@ -89,4 +96,6 @@ def bed_full_contact(x, params, sin_t):
         return bed_continuous.full_contact(x, params, sin_t)
     if law == TWO_SPRING:
         return bed_two_spring.full_contact(x, params, sin_t)
+    if law == HUNT_CROSSLEY:
+        return bed_hunt_crossley.full_contact(x, params, sin_t)
     raise ValueError(UNREGISTERED)

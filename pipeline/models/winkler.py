@@ -3,8 +3,9 @@
 Input : block (b, h, m), the bed's total vertical stiffness K [N/m] (eq. 19, as for ``ssi``), its
         damping ratio xi [-] relative to the vertical mode (total dashpot C = 2 xi sqrt(K m)) and the
         bed's contact law, a registered law of pipeline.models.contact: ``continuous`` (K spread
-        uniformly over the footprint width 2b, bed_continuous.py) or ``two-spring`` (K/2 and C/2 at
-        each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model, bed_two_spring.py).
+        uniformly over the footprint width 2b, bed_continuous.py), ``two-spring`` (K/2 and C/2 at
+        each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model, bed_two_spring.py)
+        or ``hunt-crossley`` (the continuous springs with Hunt-Crossley damping, bed_hunt_crossley.py).
 Output: registered model ``winkler`` and its compiled physics: ``bed_force``, ``accelerations``,
         ``winkler_rhs``, ``settled_beyond_reach``, ``friction_demand``.
 
@@ -12,8 +13,8 @@ Why: the paper's model puts one linear spring-dashpot under the active pivot, an
 the block down whenever it rebounds, which real ground cannot do. Here every point of the base
 carries pressure = max(0, k delta + c delta') while it is in the ground (delta > 0) and nothing
 otherwise: the contact opens by itself, the block tilts elastically before it uplifts, it can leave
-the ground entirely (flight), and impacts dissipate through the bed's dashpots - no restitution
-coefficient is needed.
+the ground entirely (flight), and impacts dissipate through the bed's damping - no impact rule (a
+restitution can instead be the target to which pipeline.models.restitution calibrates xi).
 
 Coordinates: theta (> 0 tilts towards +x: the +b corner presses in) and y, the settlement of the
 base centre (positive down; static y = m g / K). No sliding: the base centre follows the ground
@@ -130,5 +131,5 @@ MODEL = RockingModel(
     uplift_is_rigid_threshold=False,
     default_restitution=lambda block: 1.0,
     label="Winkler bed, tensionless",
-    description="rigid block on a tensionless viscoelastic Winkler bed (continuous or two springs); "
-                "the bed never pulls, impacts dissipate through its dashpots")
+    description="rigid block on a tensionless viscoelastic Winkler bed (continuous, two springs or "
+                "Hunt-Crossley); the bed never pulls, impacts dissipate through its damping")

@@ -3,7 +3,7 @@ Winkler bed), written from /work/helpers/WINKLER-SPEC.md and not from the compil
 
 Input : ground acceleration ag [m/s^2] sampled at dt [s] (linear between samples, zero after the
         record), block half-width b and half-height h [m], mass [kg], total bed stiffness K [N/m],
-        damping ratio xi [-] of the vertical mode, bed "continuous" or "two-spring", end time [s],
+        damping ratio xi [-] of the vertical mode, bed "continuous", "two-spring" or "hunt-crossley", end time [s],
         optional initial tilt theta0 [rad], rate thetadot0 [rad/s] and settlement y0 [m] (default m g / K).
 Output: ``reference_winkler`` returns a dict: t [s], theta [rad], theta_dot [rad/s], y [m] (settlement of
         the base centre, positive down), y_dot [m/s] on the sample grid; peak_angle [rad], uplifted,
@@ -13,6 +13,13 @@ How: scipy solve_ivp (DOP853, rtol 1e-10) one sample interval at a time, so the 
 piecewise-linear ground motion are step boundaries; terminal events at every change of the contact
 law (a corner entering or leaving the ground, a corner's pressure reaching zero) so the kinks and
 jumps of the bed force are step boundaries too. Slow: tests and benchmarks only.
+
+The "hunt-crossley" bed (issue 18), from its formula: the continuous bed's springs k = K/2b with the
+damping of Hunt & Crossley (1975) in the linear-spring form of Marhefka & Orin (1999), pressure
+q(s) = max(0, k delta (1 + c delta')) while delta > 0, c = lambda/K = 2 xi omega / g (the damping of the
+settled bed equals the Kelvin-Voigt bed's C = 2 xi sqrt(K m)); integrated by two-point Gauss-Legendre
+quadrature (exact: q is quadratic in s) over the interval where delta > 0 and 1 + c delta' > 0; events
+where a corner's 1 + c delta' crosses zero.
 """
 
 from __future__ import annotations
@@ -51,6 +58,8 @@ def bed_force(theta, theta_dot, y, y_dot, b, K, C, bed):
                 force += spring
                 moment += s * spring
         return force, moment
+    if bed == "hunt-crossley":
+        return hunt_crossley_force(sin_t, cos_t, theta_dot, y, y_dot, b, K, C)
     if bed != "continuous":
         raise ValueError(f"bed {bed!r}")
     k_l, c_l = K / (2.0 * b), C / (2.0 * b)
@@ -62,6 +71,24 @@ def bed_force(theta, theta_dot, y, y_dot, b, K, C, bed):
         return 0.0, 0.0
     d1, d2, d3 = upper - lower, (upper**2 - lower**2) / 2.0, (upper**3 - lower**3) / 3.0
     return p0 * d1 + p1 * d2, p0 * d2 + p1 * d3
+
+
+def hunt_crossley_force(sin_t, cos_t, theta_dot, y, y_dot, b, K, lam):
+    """Force [N] and moment [N m] about the base centre of q(s) = max(0, (K/2b) delta (1 + (lam/K) delta')),
+    delta = y + s sin(theta) > 0, delta' = y' + s cos(theta) theta'. On the interval where both factors are
+    positive q is quadratic in s and q s cubic, so two-point Gauss-Legendre quadrature is exact."""
+    c = lam / K
+    lower, upper = _positive_part(-b, b, y, sin_t)
+    lower, upper = _positive_part(lower, upper, 1.0 + c * y_dot, c * cos_t * theta_dot)
+    if upper <= lower:
+        return 0.0, 0.0
+    middle, half = 0.5 * (upper + lower), 0.5 * (upper - lower)
+    force = moment = 0.0
+    for s in (middle - half / math.sqrt(3.0), middle + half / math.sqrt(3.0)):
+        q = K / (2.0 * b) * (y + s * sin_t) * (1.0 + c * (y_dot + s * cos_t * theta_dot))
+        force += half * q
+        moment += half * q * s
+    return max(force, 0.0), moment
 
 
 def accelerations(theta, theta_dot, y, ag, force_over_m, moment_over_m, h, j, g=G):
@@ -118,14 +145,16 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
     if ag_vertical is not None:
         vertical[:min(n, ag.size)] = np.asarray(ag_vertical, dtype=float)[:n]
     vertical = vertical.tolist()
-    C = 2.0 * xi * math.sqrt(K * mass)
+    C = 2.0 * xi * math.sqrt(K * mass)  # the dashpot; for "hunt-crossley" its lambda = K c, c = 2 xi omega_v / g
     j = (b * b + 4.0 * h * h) / 3.0
     y_static = mass * g / K
     omega_v = math.sqrt(K / mass)
+    if bed == "hunt-crossley":
+        C = K * 2.0 * xi * omega_v / g
     alpha = math.atan2(b, h)
     p = math.sqrt(0.75 * g / math.hypot(b, h))
     atol = 1e-2 * rtol * np.array([alpha, alpha * p, y_static, y_static * omega_v])
-    damping_time = C / K  # p(s) / k = delta + (C/K) delta_dot has the sign of the pressure
+    damping_time = C / K  # p(s) / k = delta + (C/K) delta_dot has the sign of the pressure (hunt-crossley: c)
 
     def rhs_factory(i):
         t_i, a0, slope = i * dt, ground[i], (ground[i + 1] - ground[i]) / dt
@@ -143,6 +172,8 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
         return lambda t, x: x[2] + s * math.sin(x[0])
 
     def corner_pressure(s):
+        if bed == "hunt-crossley":  # where 1 + c delta' at the corner crosses zero (times y_static: metres)
+            return lambda t, x: y_static * (1.0 + damping_time * (x[3] + s * math.cos(x[0]) * x[1]))
         return lambda t, x: x[2] + s * math.sin(x[0]) + damping_time * (x[3] + s * math.cos(x[0]) * x[1])
 
     def corner_rate(s):
