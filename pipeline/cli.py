@@ -151,7 +151,7 @@ def _study_config(args, applicability=None):
     if applicability:
         overrides["applicability"] = applicability
     config = load_study(args.study, overrides or None)
-    return config, Path(args.output) if args.output else config.output
+    return config, Path(args.output) if getattr(args, "output", None) else config.output
 
 
 def _executor_options(args) -> dict:
@@ -407,6 +407,25 @@ def command_applicability(args) -> int:
     return 0
 
 
+def command_study(args) -> int:
+    """``rockfrag study``: check a study file; with ``--keys``, every key with its value, range and unit."""
+    from pipeline.config import study_keys
+
+    config, output = _study_config(args)
+    if args.keys:
+        rows = study_keys(config)
+        width = max(len(key) for key, *_ in rows)
+        print(f"{'key':<{width}}  value (this study) | allowed | note (pipeline/defaults.toml)")
+        for key, value, allowed, note in rows:
+            print(f"{key:<{width}}  {value or '-'} | {allowed}" + (f" | {note}" if note else ""))
+        print("NAME: a table name of your own, e.g. [blocks.cabinet]; units SI unless stated (levels of PGA/Sa in g)")
+        return 0
+    print(f"study '{config.name}' ({config.source}) is valid: {len(config.blocks)} blocks, {len(config.soils)} soils, "
+          f"{len(config.models)} models, record sets {', '.join(config.record_sets)}; output {output}. "
+          "rockfrag study --keys lists every key.")
+    return 0
+
+
 # ---------------------------------------------------------------- the parser
 
 def build_parser() -> argparse.ArgumentParser:
@@ -492,6 +511,14 @@ def build_parser() -> argparse.ArgumentParser:
     applicability.add_argument("--tolerance", type=POSITIVE, default=None,
                                help="allowed |SSI/Housner - 1| (study default 0.1)")
     applicability.set_defaults(handler=command_applicability)
+
+    study_command = commands.add_parser("study", parents=[study],
+                                        help="check a study file (nothing is run or written); --keys lists every "
+                                             "study key with its value, allowed range and unit")
+    study_command.add_argument("--keys", action="store_true",
+                               help="print every study key: its value in this study, what it must be (type, range, "
+                                    "unit) and the shipped defaults' note")
+    study_command.set_defaults(handler=command_study, writes_output=False)
     return parser
 
 
@@ -561,7 +588,7 @@ def _output_folder(args) -> Path | None:
     """The folder the command writes to: --output, else the study's study.output."""
     if getattr(args, "output", None) is not None:
         return Path(args.output)
-    if not hasattr(args, "study"):
+    if not hasattr(args, "study") or not getattr(args, "writes_output", True):
         return None
     return _study_config(args)[1]
 
@@ -607,6 +634,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("rockfrag: interrupted; files already written are complete", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of our output went away (`rockfrag study --keys | head`): not an error
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except OSError as error:
         problem = _file_problem(error)
         if problem is None:

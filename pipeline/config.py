@@ -37,7 +37,19 @@ from pipeline.measures import MEASURES, scaling_measures
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
 from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
-from pipeline.validation import Checked, Either, Flag, Interval, NamedTables, Names, Number, Numbers, Table, Text
+from pipeline.validation import (
+    Checked,
+    Either,
+    Flag,
+    Interval,
+    NamedTables,
+    Names,
+    Number,
+    Numbers,
+    Table,
+    Text,
+    schema_keys,
+)
 from pipeline.validation import shown as _shown
 
 LEVEL_REFERENCES = ("", "uplift")
@@ -61,8 +73,10 @@ def _table(fields: dict) -> Table:
 TEXT = Text()
 SOIL_TABLE = _table({**SOIL_RANGES, "why": TEXT})
 # Types only: the ranges of a block are Block's own (pipeline/blocks.py), reported with the user's field.
-BLOCK_TABLE = _table({key: Number() for key in ("b", "h", "R", "alpha", "mass", "E_b", "footprint_area",
-                                                "soil_depth")} | {"why": TEXT})
+BLOCK_UNITS = {"b": "m", "h": "m", "R": "m", "alpha": "rad", "mass": "kg", "E_b": "Pa", "footprint_area": "m^2",
+               "soil_depth": "m"}
+"""The keys of a block table and their SI units (b, h: half-width and half-height)."""
+BLOCK_TABLE = _table({key: Number(unit=unit) for key, unit in BLOCK_UNITS.items()} | {"why": TEXT})
 LEVEL = Number(0, 1e3, low_open=True)
 """An intensity level (g or m/s), or a multiple of a block's uplift intensity."""
 LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, integer=True),
@@ -498,3 +512,45 @@ def load_study(path: str | Path | None = None, overrides: dict | None = None) ->
         validate(overrides, "command line")
         merged = _merge(merged, _user_blocks(default, overrides))
     return study_from_dict(merged, source)
+
+
+def study_keys(config: StudyConfig | None = None) -> list[tuple[str, str, str, str]]:
+    """Every study key with its value, what it must be, and the shipped file's note (units, choices).
+
+    Parameters
+    ----------
+    config : StudyConfig, optional
+        A loaded study: its values fill the value column; default: the shipped default study.
+
+    Returns
+    -------
+    list of (key, value, allowed, note)
+        ``key`` dotted as in the study file (``intensity.levels``; ``NAME`` for a table name of your own),
+        ``value`` the study's value ("" if unset), ``allowed`` the schema's type, range and unit, ``note``
+        the comment of that key in ``pipeline/defaults.toml`` (where the shipped file states units and choices).
+    """
+    raw = (config or load_study()).raw
+    notes = _default_notes()
+    rows = []
+    for key, allowed in schema_keys(SCHEMA):
+        value: object = raw
+        for part in key.split("."):
+            value = value.get(part) if isinstance(value, dict) else None
+        rows.append((key, "" if value is None else json.dumps(value, default=str), allowed, notes.get(key, "")))
+    return rows
+
+
+def _default_notes() -> dict[str, str]:
+    """The end-of-line comments of ``pipeline/defaults.toml`` by dotted key (``# key = ...`` lines included)."""
+    notes, table = {}, ""
+    for line in files("pipeline").joinpath("defaults.toml").read_text().splitlines():
+        text = line.strip().lstrip("# ").strip() if line.lstrip().startswith("# ") else line.strip()
+        if text.startswith("[") and text.endswith("]") and "=" not in text:
+            table = text.strip("[]").split(".")[0]
+            table = f"{table}.NAME" if "." in text else table
+            continue
+        if "=" in text and "#" in text.split("=", 1)[1]:
+            key = text.split("=", 1)[0].strip()
+            if key.replace("_", "").isalnum():
+                notes[f"{table}.{key}" if table else key] = text.split("=", 1)[1].split("#", 1)[1].strip()
+    return notes

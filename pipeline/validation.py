@@ -283,6 +283,32 @@ class Checked:
         return self.function(value, field, source)
 
 
+def schema_keys(spec: Any, prefix: str = "") -> list[tuple[str, str]]:
+    """Every key a schema accepts, as (dotted key, what its value must be), in declaration order.
+
+    Parameters
+    ----------
+    spec : schema object
+        A ``Table`` (walked key by key), ``NamedTables`` (its keys shown under ``PREFIX.NAME``), ``Either``
+        (both forms) or a leaf (``Number``, ``Text``, ...).
+    prefix : str
+        The dotted key of ``spec`` ("" at the top level).
+
+    Returns
+    -------
+    list of (str, str)
+        One row per leaf key: its dotted name and ``describe()`` of its spec (type, range, unit).
+    """
+    if isinstance(spec, Table):
+        return [row for key, item in spec.fields.items()
+                for row in schema_keys(item, f"{prefix}.{key}" if prefix else key)]
+    if isinstance(spec, NamedTables):
+        return schema_keys(spec.table, f"{prefix}.NAME")
+    if isinstance(spec, Either):
+        return [(prefix, spec.as_list.describe())] + schema_keys(spec.as_tables, prefix)
+    return [(prefix, spec.describe())]
+
+
 def unknown_key(key: str, allowed, what: str = "key", hint: str = "") -> str:
     """The reason for an unknown key: ``unknown key (did you mean 'x'?); allowed: ...``.
 

@@ -1,0 +1,54 @@
+"""``rockfrag study``: a study file checked without running anything, and ``--keys``, every key documented."""
+
+import tomllib
+from importlib.resources import files
+
+from pipeline.cli import main
+from pipeline.config import SCHEMA, load_study, study_keys
+from pipeline.validation import schema_keys
+
+
+def _leaf_keys(table: dict, prefix: str = "") -> set[str]:
+    """The dotted leaf keys of a TOML table, block and soil names replaced by NAME."""
+    keys = set()
+    for key, value in table.items():
+        dotted = f"{prefix}.{key}" if prefix else key
+        if prefix in ("blocks", "soils_custom", "blocks_custom", "damage_states"):
+            dotted = f"{prefix}.NAME"
+        if isinstance(value, dict) and key != "levels":
+            keys |= _leaf_keys(value, dotted)
+        else:
+            keys.add(dotted)
+    return keys
+
+
+def test_keys_lists_every_key_of_the_shipped_study_with_what_it_must_be(capsys):
+    assert main(["study", "--keys"]) == 0
+    printed = capsys.readouterr().out
+    listed = {line.split()[0] for line in printed.splitlines()[1:-1]}
+    shipped = _leaf_keys(tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text()))
+    assert shipped <= listed, f"keys of defaults.toml missing from --keys: {sorted(shipped - listed)}"
+    assert listed == {key for key, _ in schema_keys(SCHEMA)}
+    line = next(line for line in printed.splitlines() if line.startswith("hazard.design_life "))
+    assert "50.0" in line and "[years]" in line  # its value, its range with the unit
+
+
+def test_keys_show_the_studys_own_values_and_units(tmp_path):
+    study = tmp_path / "s.toml"
+    study.write_text('soils = ["clay"]\n[intensity]\ndamping = 0.03\n')
+    rows = {key: (value, allowed) for key, value, allowed, _ in study_keys(load_study(study))}
+    assert rows["soils"][0] == '["clay"]' and rows["intensity.damping"][0] == "0.03"
+    assert rows["blocks.NAME.mass"][1].endswith("[kg]") and rows["blocks.NAME.E_b"][1].endswith("[Pa]")
+
+
+def test_study_checks_a_file_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    study = tmp_path / "s.toml"
+    study.write_text('soils = ["clay"]\n')
+    assert main(["study", str(study)]) == 0
+    assert "is valid" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]  # no output folder, no lock
+    study.write_text('[intensity]\ndampnig = 0.03\n')
+    assert main(["study", str(study)]) == 2
+    error = capsys.readouterr().err
+    assert error.count("\n") == 1 and "dampnig" in error and "did you mean 'damping'" in error
