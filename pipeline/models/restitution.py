@@ -139,7 +139,7 @@ def free_rocking_restitution(block: Block, k: float, bed: str, xi: float, g: flo
     n_samples = int(round(DURATION / SAMPLE_STEP)) + 1
     history = np.empty((n_samples, fields.STATE_SIZE))
     summaries = fields.new_summaries(1)
-    kernels.single_kernel(WINKLER.kernel_code, np.zeros(2), dt, n_samples - 2, table, state, history, np.empty(0),
+    kernels.single_kernel(WINKLER.kernel_code, np.zeros((1, 2)), dt, n_samples - 2, table, state, history, np.empty(0),
                           summaries)
     if not np.all(np.isfinite(history[:, 0])):
         return math.nan  # overturned or failed
