@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from pipeline.blocks import Block
 from pipeline.errors import SolverError
@@ -50,10 +52,12 @@ IMPACT_CAPACITY = 10_000
 
 
 def register(model: RockingModel) -> None:
+    """Add ``model`` to ``MODELS`` under its name (a new model is one module and one call)."""
     MODELS[model.name] = model
 
 
 def get_model(name: str) -> RockingModel:
+    """The registered model called ``name``; a ``SolverError`` listing the valid names otherwise."""
     try:
         return MODELS[name]
     except (KeyError, TypeError):
@@ -126,8 +130,10 @@ def _time_window(ag, dt, t_end):
 
 
 def _motion(ag, dt, t_end, ag_vertical):
-    """(samples, number of tail samples): the components checked, cut to t_end and stacked as the kernels
-    take them, (1, n) or with the vertical (2, n) (rows ``kernels.HORIZONTAL``, ``kernels.VERTICAL``)."""
+    """(samples, number of tail samples): the components checked, cut to t_end and stacked for the kernels.
+
+    The samples are (1, n), or with the vertical (2, n) (rows ``kernels.HORIZONTAL``, ``kernels.VERTICAL``).
+    """
     ag = _ground(ag, dt)
     vertical = _vertical(ag_vertical, ag)
     ag, n_tail = _time_window(ag, dt, t_end)
@@ -138,8 +144,9 @@ def _motion(ag, dt, t_end, ag_vertical):
     return samples, n_tail
 
 
-def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=0.0, thetadot0=0.0, t_end=None,
-             **options) -> RockingResult:
+def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical: ArrayLike | None = None,
+             k: float | None = None, xi: float | None = None, theta0: float = 0.0, thetadot0: float = 0.0,
+             t_end: float | None = None, **options: float | str | None) -> RockingResult:
     """Rocking response of ``block`` to ground acceleration ``ag`` [m/s^2] sampled at ``dt`` [s].
 
     Parameters
@@ -147,26 +154,70 @@ def simulate(model, ag, dt, block, *, ag_vertical=None, k=None, xi=None, theta0=
     model : str
         ``housner``, ``ssi`` (the paper's model), ``ssi-paper`` (its printed equations) or ``winkler``
         (tensionless bed); see ``MODELS``.
-    ag_vertical : array_like, optional
+    ag : array_like, shape (n,)
+        Horizontal ground acceleration [m/s^2]: at least 2 samples, all finite.
+    dt : float
+        Sampling interval of ``ag`` [s], > 0.
+    block : Block
+        The block (half-width b and half-height h [m], mass [kg]; pipeline.blocks).
+    ag_vertical : array_like, shape (n,), optional
         Vertical ground acceleration [m/s^2, up positive], sampled as ``ag``: gravity becomes
         g + ag_vertical(t) in the ground's frame. Where g + ag_vertical < 0 the block is in free flight:
         the pivot models (housner, ssi) stop there with ``Outcome.FREE_FLIGHT``; winkler flies on.
         None (default) and zeros give the same numbers.
-    k, xi : float
-        Interface stiffness [N/m] (winkler: the bed's total vertical stiffness K) and damping ratio
-        [-] (xi defaults to 0.05; winkler: c_total = 2 xi sqrt(K m); hunt-crossley: the same damping at
-        rest). winkler with ``restitution``: xi is calibrated (give none), ``result.extra["xi"]``.
-    theta0, thetadot0 : float
-        Initial rotation [rad] and rate [rad/s] (free rocking).
+    k : float, optional
+        Interface stiffness [N/m], > 0 (winkler: the bed's total vertical stiffness K). Required by the
+        models with a foundation (ssi, ssi-paper, winkler); housner ignores it.
+    xi : float, optional
+        Damping ratio of the foundation [-], from 0 to below 1 (hunt-crossley bed: up to 10); default 0.05
+        (``DEFAULT_XI``). winkler: c_total = 2 xi sqrt(K m); hunt-crossley: the same damping at rest.
+        winkler with a ``restitution`` target: give none, xi is calibrated and returned in
+        ``result.extra["xi"]``. housner ignores it.
+    theta0 : float
+        Initial rotation [rad] (free rocking); default 0.
+    thetadot0 : float
+        Initial rotation rate [rad/s]; default 0.
     t_end : float, optional
-        End time [s]; zero ground motion after the record. Default: record + 10 s.
-    **options
-        ``SolverOptions`` fields: ``switch`` (ssi: consistent | continuous), ``bed`` (winkler:
-        continuous | two-spring | hunt-crossley), ``restitution`` (pivot models: the impact
-        coefficient, Housner default 1 - 1.5 sin^2 alpha; winkler: the target effective restitution
-        < 1 of free rocking to which the bed's damping is calibrated, the continuous bed with
-        Hunt-Crossley damping; "housner" is 1 - 1.5 sin^2 alpha), ``g``, ``overturn_angle`` [rad]
-        (default pi/2, terminal), ``rtol``, ``atol``.
+        End time [s], >= 0; zero ground motion after the record, and a t_end inside the record cuts it.
+        Default: the record + 10 s (``DEFAULT_TAIL``).
+    **options : float or str or None
+        ``SolverOptions`` fields:
+        ``switch`` (ssi): the pivot-switch rule, ``consistent`` (default) or ``continuous``;
+        ``bed`` (winkler): the bed's contact law, ``continuous`` (default), ``two-spring`` or
+        ``hunt-crossley`` (``BED_TYPES``);
+        ``restitution`` [-]: pivot models, the impact coefficient from 0 to 1 (default: Housner's
+        1 - 1.5 sin^2 alpha for housner, 1 for ssi, whose spring-dashpot dissipates); winkler, the target
+        effective restitution < 1 of free rocking to which the bed's damping is calibrated (the continuous
+        bed then takes Hunt-Crossley damping; pipeline.models.restitution); ``"housner"`` is
+        1 - 1.5 sin^2 alpha of the block;
+        ``g`` [m/s^2]: gravity, default 9.80665;
+        ``overturn_angle`` [rad]: the |theta| of overturning (terminal), up to pi/2 (default);
+        ``rtol`` and ``atol`` [-]: the error per step, relative and as a fraction of each state's scale
+        (defaults 1e-6 and 1e-7).
+
+    Returns
+    -------
+    RockingResult
+        Histories at the sample times (t [s], theta [rad], theta_dot [rad/s], y [m] and y_dot [m/s],
+        NaN after overturning, free flight or failure), peaks, impacts, uplift and foundation checks in SI
+        units, the ``Outcome`` as ``status``; bed models: the damping ratio and contact law used in
+        ``extra``.
+
+    Raises
+    ------
+    SolverError
+        An unknown model; ``ag`` not 1-D with 2 finite samples or more; ``dt`` <= 0 or ``t_end`` < 0;
+        ``ag_vertical`` not sampled as ``ag`` or not finite; no ``k`` for a model with a foundation, or
+        ``k``, ``xi`` or an option out of range; winkler given both ``xi`` and ``restitution``, or a
+        ``restitution`` target its bed cannot reach.
+    TypeError
+        An option that is not a ``SolverOptions`` field.
+
+    Warns
+    -----
+    UserWarning
+        ssi's foundation spring went into tension (real ground cannot pull): the results past that moment
+        are not physical.
     """
     spec = get_model(model)
     settings = SolverOptions(**options)
@@ -222,25 +273,50 @@ def _case_extra(spec, params) -> dict:
     return {"xi": float(params["xi"]), "bed": LAWS[int(params["bed"])].NAME}
 
 
-def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, ag_vertical=None, t_end=None,
-                   **options) -> np.ndarray:
+def simulate_batch(model: str, ag: ArrayLike, dt: float, scales: ArrayLike,
+                   blocks_and_foundations: Sequence[tuple[Block, float | None, float | None]], *,
+                   ag_vertical: ArrayLike | None = None, t_end: float | None = None,
+                   **options: float | str | None) -> np.ndarray:
     """Run one record at many scale factors for many (block, k, xi) cases in one compiled call.
 
     Parameters
     ----------
+    model : str
+        A name in ``MODELS`` (see ``simulate``).
+    ag : array_like, shape (n,)
+        Horizontal ground acceleration [m/s^2] at scale factor 1: at least 2 samples, all finite.
+    dt : float
+        Sampling interval of ``ag`` [s], > 0.
     scales : array_like, shape (n_scale,)
-        Factors applied to ``ag`` (and to ``ag_vertical``: the ratio of vertical to horizontal stays).
-    blocks_and_foundations : list of (Block, k, xi)
-        k and xi are ignored (may be None) for rigid-base models.
-    ag_vertical : array_like, optional
-        Vertical ground acceleration [m/s^2, up positive], sampled as ``ag`` (see ``simulate``).
-    **options
-        ``SolverOptions`` fields (see ``simulate``).
+        Factors [-] applied to ``ag`` (and to ``ag_vertical``: the ratio of vertical to horizontal stays).
+    blocks_and_foundations : sequence of (Block, k, xi)
+        The cases: a block, the interface stiffness k [N/m] and the damping ratio xi [-] (None: 0.05), as
+        in ``simulate``. k and xi are ignored (may be None) for rigid-base models; with a winkler
+        ``restitution`` target xi must be None (it is calibrated per case).
+    ag_vertical : array_like, shape (n,), optional
+        Vertical ground acceleration [m/s^2, up positive] at scale factor 1, sampled as ``ag`` (see
+        ``simulate``).
+    t_end : float, optional
+        End time [s], >= 0 (see ``simulate``). Default: the record + 10 s.
+    **options : float or str or None
+        ``SolverOptions`` fields, as in ``simulate``: ``switch`` (ssi), ``bed`` (winkler's contact law),
+        ``restitution`` [-] (pivot models: the impact coefficient; winkler: the target to which each
+        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``.
 
     Returns
     -------
     ndarray of ``fields.SUMMARY_DTYPE`` records, shape (n_case, n_scale)
-        ``summaries["peak_angle"]`` etc.; ``status`` holds ``Outcome`` codes.
+        ``summaries["peak_angle"]`` etc., in the units of ``SUMMARY_FIELDS`` except ``min_support_force``,
+        which is per unit mass here [m/s^2] (times the block's mass: [N]); ``status`` holds ``Outcome``
+        codes.
+
+    Raises
+    ------
+    SolverError
+        No case; an unknown model; invalid ``ag``, ``dt``, ``t_end`` or ``ag_vertical``; a case or option
+        out of range (as in ``simulate``).
+    TypeError
+        An option that is not a ``SolverOptions`` field.
     """
     spec = get_model(model)
     samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
@@ -251,14 +327,50 @@ def simulate_batch(model, ag, dt, scales, blocks_and_foundations, *, ag_vertical
     return summaries
 
 
-def simulate_histories(model, ag, dt, cases, *, ag_vertical=None, t_end=None, **options):
-    """Rotation histories of one ground motion (``ag`` and the optional ``ag_vertical``, as in ``simulate``)
-    for many (block, k, xi) cases in one compiled call.
+def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tuple[Block, float | None, float | None]],
+                       *, ag_vertical: ArrayLike | None = None, t_end: float | None = None,
+                       **options: float | str | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Rotation and settlement histories of one ground motion for many (block, k, xi) cases in one compiled call.
+
+    Parameters
+    ----------
+    model : str
+        A name in ``MODELS`` (see ``simulate``).
+    ag : array_like, shape (n,)
+        Horizontal ground acceleration [m/s^2]: at least 2 samples, all finite.
+    dt : float
+        Sampling interval of ``ag`` [s], > 0.
+    cases : sequence of (Block, k, xi)
+        The cases: a block, the interface stiffness k [N/m] and the damping ratio xi [-] (None: 0.05), as
+        in ``simulate``; k and xi are ignored (may be None) for rigid-base models.
+    ag_vertical : array_like, shape (n,), optional
+        Vertical ground acceleration [m/s^2, up positive], sampled as ``ag`` (see ``simulate``).
+    t_end : float, optional
+        End time [s], >= 0 (see ``simulate``). Default: the record + 10 s.
+    **options : float or str or None
+        ``SolverOptions`` fields, as in ``simulate``: ``switch`` (ssi), ``bed`` (winkler's contact law),
+        ``restitution`` [-] (pivot models: the impact coefficient; winkler: the target to which each
+        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``.
 
     Returns
     -------
-    t : ndarray (n,) [s]; theta : ndarray (n_case, n) [rad] (NaN after overturning or free flight);
-    y : ndarray (n_case, n) [m]; summaries : ``SUMMARY_DTYPE`` records (n_case,).
+    t : ndarray, shape (n_t,)
+        Sample times [s] from 0, step ``dt``.
+    theta : ndarray, shape (n_case, n_t)
+        Rotation [rad]; NaN after overturning, free flight or failure.
+    y : ndarray, shape (n_case, n_t)
+        Settlement [m], positive down, of the active pivot (ssi) or the base centre (winkler); zeros for
+        housner; NaN as theta.
+    summaries : ndarray of ``fields.SUMMARY_DTYPE`` records, shape (n_case,)
+        As from ``simulate_batch`` (``min_support_force`` per unit mass [m/s^2]).
+
+    Raises
+    ------
+    SolverError
+        No case; an unknown model; invalid ``ag``, ``dt``, ``t_end`` or ``ag_vertical``; a case or option
+        out of range (as in ``simulate``).
+    TypeError
+        An option that is not a ``SolverOptions`` field.
     """
     spec = get_model(model)
     samples, n_tail = _motion(ag, dt, t_end, ag_vertical)

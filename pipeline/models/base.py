@@ -42,6 +42,8 @@ import numpy as np
 
 
 class Outcome(enum.IntEnum):
+    """Outcome of one run, stored as a number in the summaries' ``status`` field and the cube."""
+
     NO_UPLIFT = 0
     ROCKING = 1
     OVERTURNED = 2
@@ -50,6 +52,7 @@ class Outcome(enum.IntEnum):
 
     @property
     def flag_meaning(self) -> str:
+        """The outcome's CF ``flag_meanings`` word (``no_uplift``, ``rocking``, ...)."""
         return {0: "no_uplift", 1: "rocking", 2: "overturned", 3: "solver_failed", 4: "free_flight"}[int(self)]
 
 
@@ -65,6 +68,14 @@ MESSAGES = {
 
 @dataclass(frozen=True)
 class RockingModel:
+    """A registered rocking model: what a caller asks of it instead of comparing names.
+
+    ``kernel_code`` dispatches the model in the compiled kernels (``fields.HOUSNER`` ...);
+    ``default_restitution(block)`` gives the impact coefficient [-] when no ``restitution`` option is set;
+    the flags say which inputs it reads (a foundation's k and xi, restitution, switch rule, bed law) and
+    which checks apply (``can_pull``: its foundation spring can go into tension).
+    """
+
     name: str
     kernel_code: int
     kappa: float  # m R^2 / I_O of the pivot equation: 3/4 from I_O = 4/3 m R^2; p^2 = kappa g / R
@@ -126,4 +137,5 @@ class RockingResult:
 
     @property
     def success(self) -> bool:
+        """False when the integration stopped on its guards (``Outcome.FAILED``)."""
         return self.status != Outcome.FAILED

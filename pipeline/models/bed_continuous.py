@@ -88,9 +88,11 @@ def indicators(x, params, out):
 
 @njit(cache=True)
 def full_contact(x, params, sin_t):
-    """The bed while the whole base is in the ground, per unit mass: (small-tilt rocking stiffness about
-    the base centre K b^2 / 3m [m^2/s^2], elastic energy [m^2/s^2]); the energy is
-    int_{-b}^{b} 1/2 (K/2b) (y + s sin)^2 ds / m = K/2m (y^2 + b^2 sin^2 / 3)."""
+    """The bed while the whole base is in the ground, per unit mass: (rocking stiffness, elastic energy).
+
+    The small-tilt rocking stiffness about the base centre is K b^2 / 3m [m^2/s^2]; the elastic energy
+    [m^2/s^2] is int_{-b}^{b} 1/2 (K/2b) (y + s sin)^2 ds / m = K/2m (y^2 + b^2 sin^2 / 3).
+    """
     stiffness = params["omega"] * params["omega"]  # K/m
     b = params["b"]
     return (stiffness * b * b * (1.0 / 3.0),

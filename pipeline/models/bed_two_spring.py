@@ -43,9 +43,11 @@ def force(x, params, sin_t, cos_t):
 
 @njit(cache=True)
 def full_contact(x, params, sin_t):
-    """The springs while both corners are in the ground, per unit mass: (small-tilt rocking stiffness
-    about the base centre K b^2 / m [m^2/s^2], elastic energy [m^2/s^2]); the energy is
-    K/4m ((y - b sin)^2 + (y + b sin)^2) = K/2m (y^2 + b^2 sin^2)."""
+    """The springs while both corners are in the ground, per unit mass: (rocking stiffness, elastic energy).
+
+    The small-tilt rocking stiffness about the base centre is K b^2 / m [m^2/s^2]; the elastic energy
+    [m^2/s^2] is K/4m ((y - b sin)^2 + (y + b sin)^2) = K/2m (y^2 + b^2 sin^2).
+    """
     stiffness = params["omega"] * params["omega"]  # K/m
     b = params["b"]
     return stiffness * b * b, 0.5 * stiffness * (x[2] * x[2] + b * b * sin_t * sin_t)

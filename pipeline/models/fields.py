@@ -59,6 +59,8 @@ PARAMS_DTYPE = np.dtype([
 
 @dataclass(frozen=True)
 class SummaryField:
+    """One summary field: its name, CF units and long name (the numba record and the cube's metadata)."""
+
     name: str
     units: str
     long_name: str

@@ -41,8 +41,10 @@ def housner_rest_rhs(out):
 
 @njit(cache=True)
 def housner_support(gravity):
-    """Vertical force of the rigid base on the block at rest per unit mass [m/s^2]: the effective gravity
-    g + a_v, whatever the state."""
+    """Vertical force of the rigid base on the block at rest per unit mass [m/s^2].
+
+    It is the effective gravity g + a_v, whatever the state.
+    """
     return gravity
 
 

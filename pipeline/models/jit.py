@@ -11,6 +11,7 @@ import os
 
 if os.environ.get("PIPELINE_NO_NUMBA", "") not in ("", "0"):
     def njit(*args, **kwargs):
+        """Stand-in for numba's ``njit``: returns the function unchanged (``@njit`` and ``@njit(...)``)."""
         if args and callable(args[0]):
             return args[0]
         return lambda function: function

@@ -44,8 +44,19 @@ import numpy as np
 
 from pipeline.models.base import Outcome
 from pipeline.models.contact import N_CONTACT_INDICATORS, contact_indicator, contact_indicators
-from pipeline.models.fields import (EVENT_CONTACT, EVENT_IMPACT, EVENT_NONE, EVENT_OVERTURN, EVENT_SETTLE,
-                                    EVENT_UPLIFT, HOUSNER, SSI, STATE_SIZE, SWITCH_CONSISTENT, WINKLER)
+from pipeline.models.fields import (
+    EVENT_CONTACT,
+    EVENT_IMPACT,
+    EVENT_NONE,
+    EVENT_OVERTURN,
+    EVENT_SETTLE,
+    EVENT_UPLIFT,
+    HOUSNER,
+    SSI,
+    STATE_SIZE,
+    SWITCH_CONSISTENT,
+    WINKLER,
+)
 from pipeline.models.housner import housner_rest_rhs, housner_rhs, housner_support
 from pipeline.models.jit import njit
 from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
@@ -164,8 +175,10 @@ def workspace():
 
 @njit(cache=True)
 def sample(samples, row, index):
-    """Ground acceleration sample [m/s^2] of component ``row``; zero after the record (the tail of free
-    vibration) and for a component the motion does not have."""
+    """Ground acceleration sample [m/s^2] of component ``row``.
+
+    Zero after the record (the tail of free vibration) and for a component the motion does not have.
+    """
     return samples[row, index] if index < samples.shape[1] and row < samples.shape[0] else 0.0
 
 
@@ -197,7 +210,7 @@ def vertical(motion, t):
 
 @njit(cache=True)
 def effective_gravity(params, motion, t):
-    """g + a_v(t) [m/s^2]: gravity in the frame of the vertically accelerating ground."""
+    """Effective gravity g + a_v(t) [m/s^2]: gravity in the frame of the vertically accelerating ground."""
     return params["g"] + vertical(motion, t)
 
 
@@ -211,8 +224,11 @@ def vertical_quiet(motion, t):
 
 @njit(cache=True)
 def free_flight_time(motion, g):
-    """First time [s] at which g + a_v(t) falls below zero (the ground falls faster than gravity, so
-    the block leaves it); inf if never. a_v is linear between samples, so the crossing is exact."""
+    """First time [s] at which g + a_v(t) falls below zero; inf if never.
+
+    The ground then falls faster than gravity, so the block leaves it. a_v is linear between samples, so
+    the crossing is exact.
+    """
     samples = motion.samples
     if samples.shape[0] <= VERTICAL:
         return math.inf
@@ -227,9 +243,11 @@ def free_flight_time(motion, g):
 
 @njit(cache=True)
 def rhs(code, phase, sigma, x, accel, gravity, params, out):
-    """dx/dt into out for state x = [theta, theta_dot, y, y_dot], horizontal ground acceleration ``accel``
-    and effective gravity ``gravity`` = g + a_v [m/s^2], by the model's kernel code (and, for the pivot
-    models, the phase and active pivot sigma)."""
+    """dx/dt into out for state x = [theta, theta_dot, y, y_dot], by the model's kernel code.
+
+    ``accel`` is the horizontal ground acceleration and ``gravity`` the effective gravity g + a_v [m/s^2];
+    the pivot models also read the phase and the active pivot sigma.
+    """
     if code == HOUSNER:
         if phase == REST:
             housner_rest_rhs(out)
@@ -248,8 +266,10 @@ def rhs(code, phase, sigma, x, accel, gravity, params, out):
 
 @njit(cache=True)
 def derivatives(system, t, x, out):
-    """f(t, x) of ``system`` into out: the one place where the ground motion enters the right-hand side
-    (the horizontal as a ground acceleration, the vertical as the effective gravity g + a_v(t))."""
+    """f(t, x) of ``system`` into out: the one place where the ground motion enters the right-hand side.
+
+    The horizontal enters as a ground acceleration, the vertical as the effective gravity g + a_v(t).
+    """
     motion = system.motion
     rhs(system.code, system.phase, system.sigma, x, ground(motion, t), effective_gravity(system.params, motion, t),
         system.params, out)
@@ -257,8 +277,9 @@ def derivatives(system, t, x, out):
 
 @njit(cache=True)
 def dopri_step(system, t, x, h, work):
-    """One Dormand-Prince step of length h from (t, x), with ``work.f0`` = f(t, x): fills ``work.x_new``,
-    ``work.error`` and the stages, whose last row is f(t + h, x_new).
+    """One Dormand-Prince step of length h from (t, x), with ``work.f0`` = f(t, x).
+
+    Fills ``work.x_new``, ``work.error`` and the stages, whose last row is f(t + h, x_new).
 
     k2..k7 are the stages in the notation of Hairer, Norsett & Wanner (table 5.2).
     """
@@ -358,8 +379,10 @@ def hermite_derivative(step, s, i):
 
 @njit(cache=True)
 def support(code, params, x, gravity):
-    """Vertical support force per unit mass [m/s^2] of a pivot model at rest at state x under the
-    effective gravity g + a_v [m/s^2], by its kernel code."""
+    """Vertical support force per unit mass [m/s^2] of a pivot model at rest, by its kernel code.
+
+    At state x under the effective gravity ``gravity`` = g + a_v [m/s^2].
+    """
     if code == HOUSNER:
         return housner_support(gravity)
     if code == SSI:
@@ -369,8 +392,9 @@ def support(code, params, x, gravity):
 
 @njit(cache=True)
 def event_value(kind, index, system, step, s, interpolated):
-    """The event function of ``kind`` (and contact indicator ``index``) on the step's interpolant at
-    fraction s; a sign change is the event.
+    """The event function of ``kind`` (and contact indicator ``index``) on the step's interpolant at fraction s.
+
+    A sign change is the event.
 
     interpolated : (STATE_SIZE,) scratch for the interpolated state (the event loops never allocate).
     """
@@ -421,9 +445,10 @@ def locate(kind, index, system, step, interpolated):
 
 @njit(cache=True)
 def refine_event(kind, index, system, step, s_guess, work):
-    """Take the step to the event found on the interpolant, then sharpen the event time on the real
-    solution (Illinois method on the step length: the cubic interpolant alone is only 4th-order
-    accurate, which long steps would feel).
+    """Take the step to the event found on the interpolant, then sharpen the event time on the real solution.
+
+    Illinois method on the step length: the cubic interpolant alone is only 4th-order accurate, which
+    long steps would feel.
 
     On entry ``step`` is the full step, whose x1, f1 are ``work.x_new`` and the last stage; on return
     these hold the step to the event (on its far side or at it). Returns that step's length.
@@ -503,8 +528,11 @@ def static_settlement(code, params):
 
 @njit(cache=True)
 def state_scales(params, y_static, scale):
-    """Absolute-error scales of [theta, theta_dot, y, y_dot] into scale: alpha, alpha p, the static
-    settlement and its rate (floored for a rigid base). Returns p^2 of the model's own pivot equation."""
+    """Absolute-error scales of [theta, theta_dot, y, y_dot] into ``scale``; returns p^2 [1/s^2].
+
+    The scales are alpha, alpha p, the static settlement and its rate (floored for a rigid base); p^2 is
+    that of the model's own pivot equation.
+    """
     p_squared = params["kappa"] * params["g"] / params["R"]
     scale[0] = params["alpha"]
     scale[1] = params["alpha"] * math.sqrt(p_squared)
@@ -576,8 +604,10 @@ def book_impact(summary, impact_times, t):
 
 @njit(cache=True)
 def start_summary(summary, x, min_support, t_free_flight):
-    """Initial values of every summary field for a run starting at state x; t_free_flight [s] is the
-    first time g + a_v < 0 (inf: never)."""
+    """Initial values of every summary field for a run starting at state x.
+
+    t_free_flight [s] is the first time g + a_v < 0 (inf: never).
+    """
     summary["peak_angle"] = abs(x[0])
     summary["time_of_peak"] = 0.0
     summary["n_impacts"] = 0.0
@@ -601,9 +631,10 @@ def start_summary(summary, x, min_support, t_free_flight):
 
 @njit(cache=True)
 def rest_until_uplift(system, x, t, t_sample_end):
-    """Closed-form rest phase inside one sample interval: the state x is constant; find where |ag| first
-    beats the threshold tan(alpha) * support. Returns (t_new, start_now); t_new = t_sample_end when it is
-    not reached.
+    """Closed-form rest phase inside one sample interval; returns (t_new, start_now).
+
+    The state x is constant; find where |ag| first beats the threshold tan(alpha) * support; t_new =
+    t_sample_end when it is not reached.
 
     Both ag and the threshold are linear in time inside the interval (the rigid base's support force is
     g + a_v; a settled spring's is constant), and |ag| is below the threshold at t, so the crossing is on
@@ -634,9 +665,12 @@ def rest_until_uplift(system, x, t, t_sample_end):
 
 @njit(cache=True)
 def vertical_at_rest(code, x, y_static, scale, quiet):
-    """True when a pivot model at rest has no vertical vibration left, so that its rest phase is the
-    closed form (``rest_until_uplift``): always on a rigid base; for ssi below AT_REST_FRACTION and while
-    the vertical ground motion is ``quiet`` (zero over the sample interval: nothing forces the spring)."""
+    """True when a pivot model at rest has no vertical vibration left.
+
+    Its rest phase is then the closed form (``rest_until_uplift``): always on a rigid base; for ssi below
+    AT_REST_FRACTION and while the vertical ground motion is ``quiet`` (zero over the sample interval:
+    nothing forces the spring).
+    """
     if code == HOUSNER:
         return True
     if code == SSI:
@@ -674,8 +708,11 @@ def pivot_event(system, step, interpolated):
 
 @njit(cache=True)
 def pivot_impact(system, x, zeno_speed, t, impact_times, summary):
-    """Impact at theta = 0: restitution and pivot switch by the model's rule; returns (phase, sigma) after
-    it (rocking on the other pivot, or at rest when the next excursion would be below the Zeno angle)."""
+    """Impact at theta = 0: restitution and pivot switch by the model's rule; returns (phase, sigma) after it.
+
+    The block rocks on the other pivot after it, or rests when the next excursion would be below the Zeno
+    angle.
+    """
     params = system.params
     book_impact(summary, impact_times, t)
     x[0] = 0.0
@@ -690,8 +727,11 @@ def pivot_impact(system, x, zeno_speed, t, impact_times, summary):
 
 @njit(cache=True)
 def ssi_bookkeeping(system, x, y_static, t, summary):
-    """After a step of the ssi model: book the support force, tension and settlement; at rest, snap a
-    died-out vertical vibration to the static equilibrium. Returns True when it snapped (f(t, x) changed)."""
+    """After a step of the ssi model: book the support force, tension and settlement.
+
+    At rest, snap a died-out vertical vibration to the static equilibrium. Returns True when it snapped
+    (f(t, x) changed).
+    """
     params = system.params
     snapped = False
     if system.phase == REST and vertical_quiet(system.motion, t) \
@@ -908,8 +948,10 @@ def bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_t
 
 @njit(cache=True)
 def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
-    """Integrate one response of a bed model from state x; no rest phase, no impact rule (the block flies
-    where g + a_v < 0 as anywhere else: its bed lets go)."""
+    """Integrate one response of a bed model from state x.
+
+    No rest phase, no impact rule (the block flies where g + a_v < 0 as anywhere else: its bed lets go).
+    """
     motion = GroundMotion(samples, dt)
     system = System(code, ROCKING, 0.0, params, motion)
     t_final = (samples.shape[1] + n_tail - 1) * dt
@@ -1020,8 +1062,9 @@ def single_kernel(code, samples, dt, n_tail, params_table, x0, history, impact_t
 
 @njit(cache=True)
 def batch_kernel(code, samples, dt, n_tail, scales, params_table, initial_states, summaries):
-    """One record at each factor in ``scales`` for each parameter row (no histories); every component
-    (the vertical too) is scaled by the same factors.
+    """One record at each factor in ``scales`` for each parameter row (no histories).
+
+    Every component (the vertical too) is scaled by the same factors.
 
     scales (n_scale,); params_table (n_case,) records; initial_states (n_case, STATE_SIZE);
     summaries (n_case, n_scale) records, filled.

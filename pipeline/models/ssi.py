@@ -83,8 +83,10 @@ def ssi_rhs(sigma, x, accel, gravity, params, out):
 
 @njit(cache=True)
 def ssi_support(x, params):
-    """Force of the spring-dashpot on the block per unit mass [m/s^2] (negative: it pulls); the vertical
-    ground motion reaches it through the state."""
+    """Force of the spring-dashpot on the block per unit mass [m/s^2] (negative: it pulls).
+
+    The vertical ground motion reaches it through the state.
+    """
     omega = params["omega"]
     return omega * omega * x[2] + 2.0 * params["xi"] * omega * x[3]
 

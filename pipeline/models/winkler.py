@@ -90,11 +90,13 @@ def winkler_rhs(x, accel, gravity, params, out):
 
 @njit(cache=True)
 def settled_beyond_reach(x, params, peak_angle):
-    """True when, with the ground at rest and the base in full contact, the block can no longer reach its
-    recorded peak angle nor lift a corner: its energy above the settled state is below a quarter of the
-    elastic energy of either (small-tilt stiffness of the bed, K_r - m g h). The bed only dissipates, so
-    the rest of the response cannot change the peak angle, uplift or flights; the batch kernels (which
-    keep no history) stop there."""
+    """True when the settled block can no longer reach its recorded peak angle nor lift a corner.
+
+    That is, with the ground at rest and the base in full contact, its energy above the settled state is
+    below a quarter of the elastic energy of either (small-tilt stiffness of the bed, K_r - m g h). The
+    bed only dissipates, so the rest of the response cannot change the peak angle, uplift or flights; the
+    batch kernels (which keep no history) stop there.
+    """
     b = params["b"]
     h = params["h"]
     g = params["g"]

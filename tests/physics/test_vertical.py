@@ -24,8 +24,16 @@ import sympy as sp
 
 from pipeline.blocks import Block
 from pipeline.errors import SolverError
-from pipeline.models import (Outcome, SolverOptions, get_model, kernels, parameter_record, parameter_table, simulate,
-                             simulate_batch)
+from pipeline.models import (
+    Outcome,
+    SolverOptions,
+    get_model,
+    kernels,
+    parameter_record,
+    parameter_table,
+    simulate,
+    simulate_batch,
+)
 from pipeline.models.fields import STATE_SIZE, new_summaries
 from pipeline.models.winkler import bed_force
 from pipeline.processing import process_record

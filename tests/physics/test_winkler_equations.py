@@ -37,7 +37,8 @@ def lagrange_accelerations():
     x_centre = x_ground + h * sp.sin(theta)
     z_centre = -y + h * sp.cos(theta)
     inertia_centre = m * (b**2 + h**2) / 3  # rectangle 2b x 2h about its centroid
-    kinetic = (m * (sp.diff(x_centre, t) ** 2 + sp.diff(z_centre, t) ** 2) + inertia_centre * sp.diff(theta, t) ** 2) / 2
+    kinetic = (m * (sp.diff(x_centre, t) ** 2 + sp.diff(z_centre, t) ** 2)
+               + inertia_centre * sp.diff(theta, t) ** 2) / 2
     lagrangian = kinetic - m * g * z_centre
     # the bed: an upward point force f at body coordinate s is equivalent to F = f, M = f s
     s = moment / force

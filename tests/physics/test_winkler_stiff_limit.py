@@ -86,8 +86,9 @@ def sine_pulse(amplitude, period, cycles, dt=1e-3):
 @pytest.mark.parametrize("amplitude, period, cycles", [(2.0, 0.5, 1), (5.0, 0.5, 1), (1.5, 1.0, 2), (3.0, 0.4, 3)])
 def test_two_spring_peak_angles_approach_housner_under_pulses(amplitude, period, cycles):
     """At xi = 0.3 (whose effective r tends to Housner's, test above) the peak angle under sine pulses
-    (amplitude in units of g tan(alpha); the peak comes after 1 to 5 impacts) tends to Housner's as K grows: within 1% at omega/p = 3000,
-    and closer than at omega/p = 100 (the residual is the base-centre tie, see the spec)."""
+    (amplitude in units of g tan(alpha); the peak comes after 1 to 5 impacts) tends to Housner's as K grows:
+    within 1% at omega/p = 3000, and closer than at omega/p = 100 (the residual is the base-centre tie, see
+    the spec)."""
     block = Block(name="pulse", R=2.0, alpha=0.25, mass=5000.0)
     ag = sine_pulse(amplitude * block.uplift_acceleration(), period, cycles)
     housner = simulate("housner", ag, 1e-3, block, t_end=6.0)
