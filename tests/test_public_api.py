@@ -55,8 +55,8 @@ def test_public_function_has_numpydoc_sections(function):
     parameters = _section(doc, "Parameters")
     assert parameters is not None, f"{function.__qualname__}: no 'Parameters' section"
     assert _section(doc, "Returns") is not None, f"{function.__qualname__}: no 'Returns' section"
-    described = {name.strip().lstrip("*") for line in re.findall(r"^(\*{0,2}\w[\w, *]*?)(?: :|$)", parameters, flags=re.M)
-                 for name in line.split(",")}
+    names = re.findall(r"^(\*{0,2}\w[\w, *]*?)(?: :|$)", parameters, flags=re.M)  # "a, b : int" lines
+    described = {name.strip().lstrip("*") for line in names for name in line.split(",")}
     missing = [name for name in inspect.signature(function).parameters
                if name not in described and name.lstrip("*") not in described]
     assert not missing, f"{function.__qualname__}: parameters not described in 'Parameters': {missing}"
