@@ -25,7 +25,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if "small_pipeline" in getattr(item, "fixturenames", ()) and not item.get_closest_marker("xdist_group"):
             item.add_marker(pytest.mark.xdist_group(PIPELINE_GROUP))
-    if getattr(config.option, "dist", "no") != "no":
+    if hasattr(config, "workerinput"):  # an xdist worker (each collects the same list, sorted the same way)
         items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 

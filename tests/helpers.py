@@ -99,8 +99,8 @@ def consumer_python(name: str) -> Path:
     if (venv / ".installed").is_file() and python.is_file():
         return python
     log = ROOT / f".venv-{name}.log"
-    reason = (f"the {name} environment {venv.name} is not built (make consumers"
-              + (f"; its last build failed, see {log.name})" if log.is_file() else ")"))
+    reason = (f"the {name} environment {venv.name} is not built: make consumers"
+              + (f" (the last build's log: {log.name})" if log.is_file() else ""))
     if os.environ.get(CONSUMERS_REQUIRED) == "required":
         pytest.fail(reason)
     pytest.skip(reason)
