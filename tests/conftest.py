@@ -17,6 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 RECORDS = ROOT / "records"
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the xdist_group marks
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Put every test that uses ``small_pipeline`` in one xdist group, so that one worker runs the pipeline
     (``--dist loadgroup``; a test that forgets the mark cannot make the other worker run it again). Under xdist,
