@@ -40,7 +40,7 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 	      && if [ -f tests/consumers/$*.no-deps.txt ]; then \
 	           .venv-$*/bin/python -m pip install --no-deps -r tests/consumers/$*.no-deps.txt; fi \
 	      && .venv-$*/bin/python -m pip install -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
-	then touch $@; else echo "the $* consumer environment failed to build: see .venv-$*.log" >&2; fi
+	then touch $@; else echo "the $* consumer environment failed to build: see .venv-$*.log" >&2; exit 1; fi
 
 consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun) of the round-trip tests
 
@@ -50,9 +50,10 @@ warm: $(STAMP)
 	$(BIN)/python -m compileall -q pipeline tests > /dev/null
 	$(BIN)/python -m tests.warm_kernels
 
-# The main environment, the kernel cache and the consumer environments are built side by side (-j2).
+# The main environment, the kernel cache and the consumer environments are built side by side (-j2); only a
+# failed main environment stops here (make -q: is the stamp up to date).
 test:  ## run every test (physics verification and consumer round trips included) on all cores
-	@$(MAKE) --no-print-directory -j2 -k warm consumers || test -f $(STAMP)
+	@$(MAKE) --no-print-directory -j2 -k warm consumers || $(MAKE) --no-print-directory -q $(STAMP)
 	ROCKFRAG_CONSUMERS=required $(PYTEST)
 
 test-fast: warm  ## the tests without the `slow` ones, for while you work (consumer round trips if built)
