@@ -21,12 +21,14 @@ help:  ## list the targets
 	@echo "rockfrag make targets:"
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /  make \1\t/' | expand -t 20
 
-# pip compiles the installed modules on one core; compileall does it on every core (-j 0). The compiled files
-# matter: where PYTHONDONTWRITEBYTECODE is set, every test process would compile its imports again.
+# Bytecode is written on first import (--no-compile: pip would compile every installed module on one core,
+# about half the install time). PYTHONDONTWRITEBYTECODE would make every test process compile its imports again
+# (minutes of CPU in make test), so the targets here do not pass it on.
+unexport PYTHONDONTWRITEBYTECODE
+
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --no-compile -e '.[test]'
-	$(BIN)/python -m compileall -q -j 0 $(VENV)/lib > /dev/null
 	touch $(STAMP)
 
 install: $(STAMP)  ## create .venv and install rockfrag with its test tools
@@ -38,16 +40,15 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 	@rm -rf .venv-$* && echo "building the $* consumer environment .venv-$* (log: .venv-$*.log)"
 	@if { $(PYTHON) -m venv .venv-$* \
 	      && if [ -f tests/consumers/$*.no-deps.txt ]; then \
-	           .venv-$*/bin/python -m pip install --no-deps -r tests/consumers/$*.no-deps.txt; fi \
-	      && .venv-$*/bin/python -m pip install -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
+	           .venv-$*/bin/python -m pip install --no-compile --no-deps -r tests/consumers/$*.no-deps.txt; fi \
+	      && .venv-$*/bin/python -m pip install --no-compile -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
 	then touch $@; else echo "the $* consumer environment failed to build: see .venv-$*.log" >&2; exit 1; fi
 
 consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun) of the round-trip tests
 
 # Compiles the numba kernels into their on-disk cache once, so that the test workers load them instead of
-# each compiling them (about 25 s of CPU in a fresh clone, a second when cached); our modules' bytecode too.
+# each compiling them (about 25 s of CPU in a fresh clone, a second when cached).
 warm: $(STAMP)
-	$(BIN)/python -m compileall -q pipeline tests > /dev/null
 	$(BIN)/python -m tests.warm_kernels
 
 # The main environment, the kernel cache and the consumer environments are built side by side (-j2); only a
