@@ -7,24 +7,63 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 ROCKFRAG := $(BIN)/rockfrag
 REPORTS := reports
+# pytest-xdist workers of the test targets (auto: one per core); `make test WORKERS=0` runs in one process.
+WORKERS ?= auto
+PYTEST := $(BIN)/python -m pytest -n $(WORKERS) --dist loadgroup
+# Consumer environments (tests/consumers/README.md): .venv-NAME from tests/consumers/NAME.txt.
+CONSUMERS := $(patsubst tests/consumers/%.txt,%,$(filter-out %.no-deps.txt,$(wildcard tests/consumers/*.txt)))
+CONSUMER_STAMPS := $(CONSUMERS:%=.venv-%/.installed)
 
 .DEFAULT_GOAL := help
-.PHONY: help install test records cube fragility bench clean
+.PHONY: help install consumers warm lint test test-fast records cube fragility bench clean
 
 help:  ## list the targets
 	@echo "rockfrag make targets:"
-	@grep -E '^[a-z]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z]+):.*## /  make \1\t/' | expand -t 20
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed -E 's/^([a-z-]+):.*## /  make \1\t/' | expand -t 20
+
+# Bytecode is written on first import (--no-compile: pip would compile every installed module on one core,
+# about half the install time). PYTHONDONTWRITEBYTECODE would make every test process compile its imports again
+# (minutes of CPU in make test), so the targets here do not pass it on.
+unexport PYTHONDONTWRITEBYTECODE
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet --no-compile -e '.[test]'
 	touch $(STAMP)
 
 install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 
-test: $(STAMP)  ## run the test suite (physics verification included)
-	$(BIN)/python -m pytest
+# A consumer environment never stops make: a failed build leaves no stamp, and the test that needs it fails
+# under `make test` (ROCKFRAG_CONSUMERS=required) with the log's name, after every other test has run.
+.SECONDEXPANSION:
+.venv-%/.installed: tests/consumers/%.txt $$(wildcard tests/consumers/$$*.no-deps.txt)
+	@rm -rf .venv-$* && echo "building the $* consumer environment .venv-$* (log: .venv-$*.log)"
+	@if { $(PYTHON) -m venv .venv-$* \
+	      && if [ -f tests/consumers/$*.no-deps.txt ]; then \
+	           .venv-$*/bin/python -m pip install --no-compile --no-deps -r tests/consumers/$*.no-deps.txt; fi \
+	      && .venv-$*/bin/python -m pip install --no-compile -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
+	then touch $@; else echo "the $* consumer environment failed to build: see .venv-$*.log" >&2; exit 1; fi
+
+consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun) of the round-trip tests
+
+# Compiles the numba kernels into their on-disk cache once, so that the test workers load them instead of
+# each compiling them (about 25 s of CPU in a fresh clone, a second when cached).
+warm: $(STAMP)
+	$(BIN)/python -m tests.warm_kernels
+
+# The main environment, the kernel cache and the consumer environments are built side by side (-j2); only a
+# failed main environment stops here (make -q: is the stamp up to date).
+test:  ## run every test (physics verification and consumer round trips included) on all cores
+	@$(MAKE) --no-print-directory -j2 -k warm consumers || $(MAKE) --no-print-directory -q $(STAMP)
+	$(BIN)/ruff check .
+	ROCKFRAG_CONSUMERS=required $(PYTEST)
+
+test-fast: warm  ## the tests without the `slow` ones, for while you work (consumer round trips if built)
+	$(BIN)/ruff check .
+	$(PYTEST) -m "not slow"
+
+lint: $(STAMP)  ## the style gate alone: ruff (pyflakes, pycodestyle at 120 characters, import order, numpy docstrings)
+	$(BIN)/ruff check .
 
 records: $(STAMP)  ## intensity-measure table and per-record plots of all shipped records
 	$(ROCKFRAG) records --set all --plot --output $(REPORTS)
@@ -38,6 +77,6 @@ cube: $(STAMP)  ## run the default study into reports/cube.nc (resumes after an 
 bench: $(STAMP)  ## solver and study benchmarks (prints figures; not part of the tests)
 	$(BIN)/python benchmarks/run.py
 
-clean:  ## remove generated reports, caches and the virtual environment
-	rm -rf $(REPORTS) $(VENV) .pytest_cache .hypothesis build *.egg-info
+clean:  ## remove generated reports, caches and the virtual environments
+	rm -rf $(REPORTS) $(VENV) .venv-* .pytest_cache .hypothesis build *.egg-info
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +

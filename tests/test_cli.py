@@ -7,6 +7,7 @@ import subprocess
 import sys
 
 import pandas as pd
+import pytest
 
 from pipeline.cli import main
 
@@ -57,6 +58,7 @@ def test_bad_study_exits_2_with_the_field(tmp_path):
     assert not (tmp_path / "out" / "cube.nc").exists()
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_is_one_line(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text('soils = ["rock"]\n[study]\nrecord_sets = ["bolu"]\n[intensity]\nlevels = [0.5]\n')

@@ -1,6 +1,6 @@
-"""README examples run as printed: the Python blocks execute, every `rockfrag` line parses with the
-real command-line parser, and every `make` target named exists. (The outputs table is checked against
-what `rockfrag fragility` writes in tests/test_report.py, which already runs the pipeline.)"""
+"""README examples run as printed: the Python blocks execute (on one shipped record), every `rockfrag` line
+parses with the real command-line parser, every `make` target named exists, and the outputs table names what
+`rockfrag fragility` writes, checked on the session's small pipeline run (fixture ``small_pipeline``)."""
 
 from __future__ import annotations
 
@@ -76,7 +76,7 @@ def test_readme_says_where_rockfrag_lives():
     assert ".venv/bin/rockfrag" in README
 
 
-def outputs_table():
+def outputs_table() -> dict[str, str]:
     """{file cell: written-by cell} of the README's outputs table."""
     section = README.split("## Outputs", 1)[1].split("\n## ", 1)[0]
     rows = {}
@@ -92,3 +92,20 @@ def test_outputs_table_names_a_command_for_every_file():
     assert rows, "outputs table not found"
     for name, writer in rows.items():
         assert "rockfrag" in writer, f"{name}: no command named in the 'written by' column"
+
+
+@pytest.mark.slow
+def test_outputs_table_matches_what_fragility_writes(small_pipeline):
+    claimed, not_claimed = [], []
+    for cell, writer in outputs_table().items():
+        cell = re.sub(r"\{(\w+),\w+\}", r"\1", cell)  # calibration.{json,csv} -> calibration.json
+        names = [name.strip("` ").rstrip("/") for name in cell.split(",")]
+        (claimed if "rockfrag fragility" in writer else not_claimed).extend(names)
+    assert "cube.nc" in claimed and "records.csv" in not_claimed
+    output = small_pipeline.output
+    for name in claimed:
+        found = list(output.glob(name))
+        assert found and all(p.is_dir() or p.stat().st_size > 0 for p in found), f"README: fragility writes {name}"
+    for name in not_claimed:
+        assert not list(output.glob(name)), f"README says only another command writes {name}"
+    assert not list(output.glob(".*.part"))

@@ -1,10 +1,10 @@
 """Report: one numbered A4 document with its HTML twin, written only from result files; the pages show
-only what the study ran; the limitations come from the run; the README's outputs table is true."""
+only what the study ran; the limitations come from the run. The pipeline runs once per session (fixture
+``small_pipeline`` in conftest.py); the README's outputs table is checked against it in test_readme.py."""
 
 from __future__ import annotations
 
 import re
-import warnings
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -12,30 +12,7 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from pipeline.cli import main
-
-from .test_readme import outputs_table
-from .test_study import SMALL
-
 A4_LANDSCAPE_POINTS = (842, 595)  # 297 x 210 mm
-REPORT_TABLE = """
-[report]
-title = "Rocking fragility of the yard equipment"
-project = "Harbour crane upgrade"
-author = "A. Engineer"
-"""
-
-
-@pytest.fixture(scope="module")
-def pipeline_output(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("pipeline")
-    study = folder / "study.toml"
-    study.write_text(SMALL + "\n[fragility]\nbootstrap = 5\n" + REPORT_TABLE)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        status = main(["fragility", str(study), "--output", str(folder / "reports"), "--no-progress", "--serial"])
-    assert status == 0
-    return folder / "reports", study, caught
 
 
 def _datasets(output):
@@ -47,25 +24,9 @@ def _datasets(output):
 
 
 @pytest.mark.slow
-def test_outputs_table_matches_what_fragility_writes(pipeline_output):
-    output, _, _ = pipeline_output
-    claimed, not_claimed = [], []
-    for cell, writer in outputs_table().items():
-        cell = re.sub(r"\{(\w+),\w+\}", r"\1", cell)  # calibration.{json,csv} -> calibration.json
-        names = [name.strip("` ").rstrip("/") for name in cell.split(",")]
-        (claimed if "rockfrag fragility" in writer else not_claimed).extend(names)
-    assert "cube.nc" in claimed and "records.csv" in not_claimed
-    for name in claimed:
-        found = list(output.glob(name))
-        assert found and all(p.is_dir() or p.stat().st_size > 0 for p in found), f"README: fragility writes {name}"
-    for name in not_claimed:
-        assert not list(output.glob(name)), f"README says only another command writes {name}"
-    assert not list(output.glob(".*.part"))
-
-
 @pytest.mark.slow
-def test_every_netcdf_file_of_the_run_is_compressed(pipeline_output):
-    output, _, _ = pipeline_output
+def test_every_netcdf_file_of_the_run_is_compressed(small_pipeline):
+    output, _, _ = small_pipeline
     written = sorted(path.name for path in output.glob("*.nc"))
     assert {"cube.nc", "ida.nc", "fragility.nc", "showcase.nc", "applicability.nc", "efficiency.nc"} <= set(written)
     for name in written:
@@ -75,9 +36,8 @@ def test_every_netcdf_file_of_the_run_is_compressed(pipeline_output):
         assert plain == [], f"{name}: numeric variables written without zlib: {plain}"
 
 
-@pytest.mark.slow
-def test_one_numbered_a4_document_with_an_html_twin(pipeline_output):
-    output, _, _ = pipeline_output
+def test_one_numbered_a4_document_with_an_html_twin(small_pipeline):
+    output, _, _ = small_pipeline
     pdf = (output / "report.pdf").read_bytes()
     pages = len(re.findall(rb"/Type\s*/Page[^s]", pdf))
     boxes = {tuple(round(float(v)) for v in box.split()[2:])
@@ -97,8 +57,8 @@ def test_one_numbered_a4_document_with_an_html_twin(pipeline_output):
 
 
 @pytest.mark.slow
-def test_title_project_author_and_sections_from_the_study(pipeline_output):
-    output, _, _ = pipeline_output
+def test_title_project_author_and_sections_from_the_study(small_pipeline):
+    output, _, _ = small_pipeline
     html = (output / "report.html").read_text()
     for text in ("Rocking fragility of the yard equipment", "Harbour crane upgrade", "A. Engineer"):
         assert text in html
@@ -110,21 +70,24 @@ def test_title_project_author_and_sections_from_the_study(pipeline_output):
 
 
 @pytest.mark.slow
-def test_no_figure_warning_and_no_open_figures(pipeline_output):
-    _, _, caught = pipeline_output
+def test_no_figure_warning_and_no_open_figures(small_pipeline):
+    _, _, caught = small_pipeline
     assert not [w for w in caught if "More than 20 figures" in str(w.message)]
     assert plt.get_fignums() == []
 
 
 @pytest.mark.slow
-def test_report_reads_results_and_never_simulates(pipeline_output, monkeypatch, tmp_path):
+def test_report_reads_results_and_never_simulates(small_pipeline, monkeypatch, tmp_path):
+    """Drawn again from the result files alone, every solver forbidden, the report is byte for byte the one the
+    fragility run drew from its datasets in memory: no creation dates, nothing but the files (the run time, which
+    the title page states, is passed back)."""
     import shutil
 
     import pipeline.models as models
     from pipeline.config import load_study
     from pipeline.report import report_stage
 
-    output, study, _ = pipeline_output
+    output, study, _ = small_pipeline
 
     def forbidden(*args, **kwargs):
         raise AssertionError("the report ran a solver")
@@ -133,12 +96,17 @@ def test_report_reads_results_and_never_simulates(pipeline_output, monkeypatch, 
         monkeypatch.setattr(models, name, forbidden)
     copy = tmp_path / "copy"
     shutil.copytree(output, copy)
+    for name in ("report.pdf", "report.html"):
+        (copy / name).unlink()
+    shutil.rmtree(copy / "figures")
+    html = (output / "report.html").read_text()
+    runtime = re.search(r"Run time of the pipeline run that wrote this report: (\d+) s", html)
     opened = _datasets(copy)
-    first, _ = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
-                            progress=False)
-    second, _ = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
-                             progress=False)
-    assert first.read_bytes() == second.read_bytes()  # no creation dates: the same results, the same file
+    pdf, pngs = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
+                             runtime_s=float(runtime.group(1)) if runtime else float("nan"), progress=False)
+    assert pdf.read_bytes() == (output / "report.pdf").read_bytes()
+    assert (copy / "report.html").read_text() == html
+    assert [png.read_bytes() for png in pngs] == [(output / "figures" / png.name).read_bytes() for png in pngs]
     assert plt.get_fignums() == []
 
 
@@ -154,10 +122,10 @@ def _results(output, study, **changes):
 
 
 @pytest.mark.slow
-def test_pages_cover_only_the_study(pipeline_output):
+def test_pages_cover_only_the_study(small_pipeline):
     from pipeline.report import plan
 
-    output, study, _ = pipeline_output
+    output, study, _ = small_pipeline
     results = _results(output, study)
     names = [page.name for page in plan(results)]
     blocks = list(results.cube.block.values)
@@ -171,12 +139,12 @@ def test_pages_cover_only_the_study(pipeline_output):
 
 
 @pytest.mark.slow
-def test_figure_pages_rigid_base_once_legend_outside_shared_scales(pipeline_output):
+def test_figure_pages_rigid_base_once_legend_outside_shared_scales(small_pipeline):
     from pipeline.report import figures
     from pipeline.report.adapters import models_of
     from pipeline.report.layout import PAGE_SIZE
 
-    output, study, _ = pipeline_output
+    output, study, _ = small_pipeline
     results = _results(output, study)
     block = str(results.cube.block.values[0])
     page = figures.ida_page(results.ida, block, "")
@@ -194,7 +162,8 @@ def test_figure_pages_rigid_base_once_legend_outside_shared_scales(pipeline_outp
     assert len(theta_axes) == results.cube.sizes["soil"]
     assert len({a.get_ylim() for a in theta_axes}) == 1  # one scale for the compared panels
     start, end = theta_axes[0].get_xlim()
-    window = (float(results.showcase.attrs["strong_motion_start_s"]), float(results.showcase.attrs["strong_motion_end_s"]))
+    attrs = results.showcase.attrs
+    window = (float(attrs["strong_motion_start_s"]), float(attrs["strong_motion_end_s"]))
     assert window[0] - 5 <= start <= window[0] and window[1] <= end <= window[1] + 10
     assert end - start < float(results.showcase.time.values[-1])  # cropped, not the whole record
     _assert_legend_outside(page)
@@ -253,7 +222,8 @@ def test_tension_flag_not_applicable_is_not_counted():
     cube = _fake_cube(flags)
     assert run_fraction(cube, tension_flag(cube), model_info("housner")) is None
     fraction = run_fraction(cube, tension_flag(cube), model_info("ssi"))
-    assert float(fraction.sel(soil="rock", block="b")) == pytest.approx(0.2) and float(fraction.sel(soil="clay", block="b")) == 0.0
+    assert float(fraction.sel(soil="rock", block="b")) == pytest.approx(0.2)
+    assert float(fraction.sel(soil="clay", block="b")) == 0.0
 
 
 def test_tension_falls_back_to_negative_support_force():
@@ -317,10 +287,11 @@ def test_text_pages_split_long_tables_with_their_header():
 
 
 def test_showcase_record_is_bolu_or_the_named_one():
-    from pipeline.config import study_from_dict
-    from pipeline.showcase import showcase_record_id
     import tomllib
     from importlib.resources import files
+
+    from pipeline.config import study_from_dict
+    from pipeline.showcase import showcase_record_id
 
     defaults = tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text())
     config = study_from_dict(defaults)
@@ -331,8 +302,8 @@ def test_showcase_record_is_bolu_or_the_named_one():
 
 
 @pytest.mark.slow
-def test_showcase_file_has_units_and_one_case_per_rigid_model(pipeline_output):
-    output, study, _ = pipeline_output
+def test_showcase_file_has_units_and_one_case_per_rigid_model(small_pipeline):
+    output, study, _ = small_pipeline
     showcase = _datasets(output)["showcase"]
     for name, variable in showcase.data_vars.items():
         assert variable.attrs.get("units") and variable.attrs.get("long_name"), name

@@ -22,34 +22,9 @@ from pipeline.processing import process_record
 from pipeline.records import load_records
 from pipeline.soils import soil_block_stiffness
 from pipeline.study import run_study
+from tests.helpers import SMALL_STUDY
 
-SMALL = """
-soils = ["sand", "rock"]
-models = ["housner", "ssi"]
-[study]
-name = "small"
-record_sets = ["bolu"]
-[intensity]
-levels = [0.1, 0.3, 0.6, 1.0]
-[blocks.paper]
-R = 9.39
-alpha = 0.44
-mass = 326197.0
-E_b = 210e9
-footprint_area = 8.0
-soil_depth = 2.0
-[blocks.slender-cabinet]
-b = 0.3
-h = 1.5
-mass = 2000.0
-E_b = 200e9
-footprint_area = 0.48
-soil_depth = 1.0
-[blocks.squat-machinery]
-b = 1.5
-h = 2.0
-mass = 30000.0
-"""
+SMALL = SMALL_STUDY  # tests/helpers.py: the same study runs the session pipeline (conftest small_pipeline)
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,9 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import sys
 import tomllib
+from collections import Counter
 from pathlib import Path
 
 import pytest
@@ -24,8 +26,12 @@ from tests.reliability_helpers import at2_text, error_lines
 
 FUZZ = settings(derandomize=True, database=None, deadline=None,
                 suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
-COUNTS = {"at2": 450, "at2_with_good": 20, "recipe": 250, "study": 220, "csv": 160}
+COUNTS = {"at2": 450, "at2_with_good": 20, "recipe": 250, "study": 220, "csv": 160, "binary_study": 30}
 """Examples per fuzz test (sum >= 1,000: the issue's floor)."""
+RAN: Counter = Counter()
+"""Inputs each fuzz test really ran in this process: its first line counts one (checked by the last test)."""
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("fuzz")]  # in order on one worker: the count runs last
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -129,6 +135,7 @@ def corrupt_at2(draw) -> bytes:
 @settings(FUZZ, max_examples=COUNTS["at2"])
 @given(content=corrupt_at2(), suffix=st.sampled_from([".AT2", ".at2"]))
 def test_fuzz_corrupt_at2_alone_is_a_user_error(workspace, content, suffix):
+    RAN["at2"] += 1
     folder, _ = workspace
     path = folder / f"corrupt{suffix}"
     path.write_bytes(content)
@@ -140,6 +147,7 @@ def test_fuzz_corrupt_at2_alone_is_a_user_error(workspace, content, suffix):
 @settings(FUZZ, max_examples=COUNTS["at2_with_good"])
 @given(content=corrupt_at2())
 def test_fuzz_corrupt_at2_next_to_a_good_one_is_skipped(workspace, content):
+    RAN["at2_with_good"] += 1
     folder, good = workspace
     path = good.parent / "corrupt.AT2"
     path.write_bytes(content)
@@ -168,7 +176,9 @@ def _toml_value(value) -> str:
     if isinstance(value, str):
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(value, float):
-        return repr(value) if math.isfinite(value) else ("nan" if math.isnan(value) else ("inf" if value > 0 else "-inf"))
+        if math.isfinite(value):
+            return repr(value)
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
     if isinstance(value, list):
         return "[" + ", ".join(_toml_value(v) for v in value) + "]"
     if isinstance(value, dict):
@@ -260,6 +270,7 @@ def corrupt_recipe(draw) -> bytes:
 @settings(FUZZ, max_examples=COUNTS["recipe"])
 @given(content=corrupt_recipe())
 def test_fuzz_corrupt_recipe_is_a_user_error(workspace, content):
+    RAN["recipe"] += 1
     folder, good = workspace
     path = folder / "recipe.toml"
     path.write_bytes(content)
@@ -338,6 +349,7 @@ def corrupt_study(draw) -> bytes:
 @settings(FUZZ, max_examples=COUNTS["study"])
 @given(content=corrupt_study())
 def test_fuzz_corrupt_study_is_a_user_error(workspace, content):
+    RAN["study"] += 1
     folder, _ = workspace
     path = folder / "study.toml"
     path.write_bytes(content)
@@ -382,6 +394,7 @@ def corrupt_reference(draw) -> bytes:
 @settings(FUZZ, max_examples=COUNTS["csv"])
 @given(content=corrupt_reference())
 def test_fuzz_corrupt_calibration_reference_is_a_user_error(workspace, content):
+    RAN["csv"] += 1
     folder, good = workspace
     path = folder / "reference.csv"
     path.write_bytes(content)
@@ -391,17 +404,37 @@ def test_fuzz_corrupt_calibration_reference_is_a_user_error(workspace, content):
     assert str(path) in stderr
 
 
-def test_the_fuzz_covers_at_least_a_thousand_inputs():
-    assert sum(COUNTS.values()) >= 1000
-
-
-@settings(FUZZ, max_examples=30)
+@settings(FUZZ, max_examples=COUNTS["binary_study"])
 @given(content=st.binary(max_size=200))
 def test_fuzz_binary_study_file_is_a_user_error(workspace, content):
     """A binary study file (issue 13); wrongly typed values are rows of test_reliability_issue_list."""
+    RAN["binary_study"] += 1
     folder, _ = workspace
     path = folder / "binary.toml"
     path.write_bytes(b"\x00\xff" + content)
     status, stderr = run_cli(["run", path, "--output", folder / "out", "--serial", "--no-progress"])
     assert_clean_failure(status, stderr, allowed=(2,))
     assert str(path) in stderr
+
+
+FUZZ_TESTS = {"at2": test_fuzz_corrupt_at2_alone_is_a_user_error,
+              "at2_with_good": test_fuzz_corrupt_at2_next_to_a_good_one_is_skipped,
+              "recipe": test_fuzz_corrupt_recipe_is_a_user_error, "study": test_fuzz_corrupt_study_is_a_user_error,
+              "csv": test_fuzz_corrupt_calibration_reference_is_a_user_error,
+              "binary_study": test_fuzz_binary_study_file_is_a_user_error}
+
+
+def test_the_fuzz_ran_at_least_a_thousand_inputs(request):
+    """Counts what the fuzz tests above really ran (RAN), not what they ask for: each selected one ran its
+    COUNTS inputs through the CLI, and when all are selected, at least 1,000 together. Last in the module, which
+    pytest runs in order (under xdist the module is one group, on one worker)."""
+    module = sys.modules[__name__]
+    selected = {item.name for item in request.session.items if getattr(item, "module", None) is module}
+    expected = {kind: COUNTS[kind] for kind, test in FUZZ_TESTS.items() if test.__name__ in selected}
+    if not expected:
+        pytest.skip("no fuzz test selected: nothing to count")
+    ran = {kind: RAN[kind] for kind in expected}
+    elsewhere = "ran in another process? (xdist: --dist loadgroup)" if 0 in ran.values() else ""
+    assert ran == expected, elsewhere
+    if len(expected) == len(FUZZ_TESTS):
+        assert sum(RAN.values()) >= 1000

@@ -107,6 +107,7 @@ def rigid_launch_rate(fraction, block=BLOCK):
                      / inertia_corner)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("solver", SOLVERS)
 @pytest.mark.parametrize("bed, omega_over_p", [("continuous", 30), ("continuous", 300), ("two-spring", 30),
                                                 ("two-spring", 300)])
