@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import xarray as xr
@@ -227,8 +228,10 @@ def test_the_report_plans_the_vertical_pages(vertical_run):
     limitations = " ".join(item.text for item in limitations_items(results))
     assert "Free flight (vertical component)" in limitations and "runs" in limitations
     figure = vertical_page(effect, "slender-cabinet", "caption")
-    assert len(figure.axes) == 2
-    figure.clf()
+    try:
+        assert len(figure.axes) == 2
+    finally:
+        plt.close(figure)
 
 
 def test_a_horizontal_study_leaves_verticals_out(tmp_path):

@@ -35,6 +35,7 @@ from pipeline.report.text import Item, heading, note, paragraph, table
 IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (as on the IDA pages)
 MOST_FLEW = 0.5  # a level's median IDA point is not drawn where more than this share of the runs flew
 MAX_SOILS = 3  # soil columns of the figure page (the softest, ..., the stiffest)
+FLIGHT_MARKERS = ("x", "+", "1", "2")  # the free-flight share of each model, in the outcome colour of free flight
 
 
 @dataclass(frozen=True)
@@ -160,7 +161,8 @@ def vertical_page(effect: VerticalEffect, block, caption):
             share = cell(flew.to_dataset(name="f"), model, block, soil)["f"].values
             if np.nansum(share) > 0:
                 bottom.plot(levels, share, color=OUTCOME_COLOURS["free_flight"], ls=":", lw=2.0,
-                            marker="x", ms=4, label="share of runs in free flight (with the vertical)")
+                            marker=FLIGHT_MARKERS[models.index(model) % len(FLIGHT_MARKERS)], ms=5,
+                            label=f"{panel_label(model)}: share of runs in free flight (with the vertical)")
         top.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
         top.set_xlim(0, IDA_CAP * 1.05)
         top.set_title(f"median IDA curve on {soil}", fontsize=9)
