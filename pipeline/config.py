@@ -99,7 +99,7 @@ SCHEMA = Table({
     "damage_states": NamedTables(_damage_state_table()),
     "study": _table({"name": Text(nonempty=True), "record_sets": Names('["far-field"]'), "processing": TEXT,
                      "output": Text(nonempty=True),
-                     "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"),
+                     "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"), "vertical": Flag(),
                      # report metadata, read by pipeline.report
                      "title": TEXT, "project": TEXT, "author": TEXT}),
     "intensity": _table({"measure": Text(scaling_measures()), "period": Number(0.01, 20.0, unit="s"),
@@ -209,6 +209,9 @@ class StudyConfig:
         Time step of the user's one-column text records [s]; None: from the files.
     applicability : ApplicabilitySettings
         The soil-stiffness sweep (``[applicability]``).
+    vertical : bool
+        ``[study] vertical``: each horizontal component runs with its station's vertical component (g + a_v(t)
+        in every model) and, for comparison, without it (pipeline.study). False: horizontal components only.
     """
 
     name: str
@@ -239,6 +242,7 @@ class StudyConfig:
     record_units: str = ""
     record_dt: float | None = None  # time step of one-column text records [s]; None: from the files
     applicability: ApplicabilitySettings = ApplicabilitySettings()
+    vertical: bool = False  # apply each record's vertical component (and compare with the run without it)
 
     @property
     def relative_levels(self) -> bool:
@@ -441,7 +445,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)),
         bootstrap=int(fragility.get("bootstrap", 100)), seed=int(fragility.get("seed", 0)),
         confidence=float(fragility.get("confidence", 0.9)),
-        record_units=study.get("units", ""), record_dt=study.get("dt"),
+        record_units=study.get("units", ""), record_dt=study.get("dt"), vertical=bool(study.get("vertical", False)),
         applicability=ApplicabilitySettings(
             g_range=tuple(float(g) for g in sweep.get("g_range", defaults.g_range)),
             n_g=int(sweep.get("n_g", defaults.n_g)),

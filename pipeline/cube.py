@@ -6,6 +6,11 @@ Output: an ``xarray.Dataset`` following CF-1.12 (every variable with ``units`` a
         ``outcome`` with ``flag_values``/``flag_meanings``), written atomically as compressed netCDF4
         (``reports/cube.nc``) that plain ``xarray.open_dataset`` reads.
 
+Vertical component: every cube says per record whether the record's vertical component was applied
+(``vertical_applied``, with the vertical's id and PGA), and in its ``vertical`` attribute whether the study
+applied verticals. A study with ``[study] vertical = true`` writes two cubes of the same records, levels and
+scale factors: ``cube.nc`` with the verticals and ``COMPARISON_CUBE`` without them (pipeline.study).
+
 Units: one per quantity in the file, as UDUNITS parses it (``pipeline.measures.file_units``). Every
 acceleration (levels, ``intensity``, ``record_pga``, ``block_uplift_acceleration``, ``record_im`` of an
 acceleration measure) is in multiples of g, written "9.80665 m s-2" (UDUNITS reads "g" as grams);
@@ -26,9 +31,16 @@ from pipeline.models.base import Outcome
 from pipeline.models.fields import FIELDS_BY_NAME
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
-OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED = (
-    int(Outcome.NO_UPLIFT), int(Outcome.ROCKING), int(Outcome.OVERTURNED), int(Outcome.FAILED))
+OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = (
+    int(Outcome.NO_UPLIFT), int(Outcome.ROCKING), int(Outcome.OVERTURNED), int(Outcome.FAILED),
+    int(Outcome.FREE_FLIGHT))
 OUTCOME_MEANINGS = " ".join(o.flag_meaning for o in Outcome)
+
+COMPARISON_CUBE = "cube_without_vertical.nc"
+"""The second cube of a ``[study] vertical = true`` study: the same records, levels and scale factors, the
+horizontal components alone (the report compares it with ``cube.nc``)."""
+VERTICAL_APPLIED, VERTICAL_NOT_APPLIED = "applied", "not applied"
+"""Values of a cube's ``vertical`` attribute."""
 
 DIMS = ("record", "im_level", "soil", "block", "model")
 
@@ -64,6 +76,7 @@ VARIABLES = {
     "n_flights": ("n_flights", _bed),
     "airborne_time": ("airborne_time", _bed),
     "peak_friction_demand": ("peak_friction_demand", _bed),
+    "time_of_free_flight": ("time_of_free_flight", _always),
 }
 
 
@@ -97,7 +110,8 @@ DERIVED_ATTRIBUTES = {
 
 
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
-               intensity=None, capacities=None, capacity_stats=None) -> xr.Dataset:
+               intensity=None, capacities=None, capacity_stats=None, verticals=None,
+               vertical_applied=False) -> xr.Dataset:
     """Assemble the labelled cube.
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
@@ -106,7 +120,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     interface stiffness [N/m]; provenance : dict of JSON-able facts; intensity : (n_block, n_level)
     physical intensity of every level [SI] (default: the absolute levels); capacities : (4, n_record,
     n_soil, n_block, n_model) adaptive overturning capacity, bracket and extra runs as scale factors
-    (pipeline.study.gather_capacities) or None; capacity_stats : its run accounting.
+    (pipeline.study.gather_capacities) or None; capacity_stats : its run accounting; verticals : the
+    processed vertical component of each record (a Record, or None where it has none), or None when the
+    study takes no verticals; vertical_applied : whether the runs applied those verticals (the cube's
+    ``vertical_applied`` flag per record, and its ``vertical`` attribute).
 
     Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
     with ``levels.relative_to = "uplift"``, else the levels in the measure's display unit. The physical
@@ -148,6 +165,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                 ("capacity_scale_upper", "smallest scale factor found to overturn"),
                 ("capacity_runs", "solver runs added to the stripes to refine the capacity"))):
             data_vars[name] = (capacity_dims, capacities[index], {"long_name": long_name, "units": "1"})
+    vertical_flag, vertical_coords = _vertical_variables(records, verticals, vertical_applied, g_factor,
+                                                         acceleration_units)
+    data_vars["vertical_applied"] = vertical_flag
     data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
                                         {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
     coords = {
@@ -163,6 +183,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                              {"long_name": "component"}),
         "record_pga": ("record", [float(np.max(np.abs(r.acceleration))) / g_factor for r in records],
                        {"long_name": "PGA of the processed record", "units": acceleration_units}),
+        **vertical_coords,
         "record_im": (("record", "block"), record_im / measure.display_factor,
                       {"long_name": f"{measure_name} of the processed record", "units": measure.cf_units()}),
         "soil_shear_modulus": ("soil", [s.shear_modulus for s in config.soils],
@@ -202,8 +223,30 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                       "'A Simplified Mechanical Model for Rocking Structures on Compliant Foundations'; "
                       "tensionless Winkler bed (Psycharis & Jennings 1983; Chopra & Yim 1985)",
         "winkler_bed": config.bed,
+        "vertical": VERTICAL_APPLIED if vertical_applied else VERTICAL_NOT_APPLIED,
     }
     return dataset
+
+
+def _vertical_variables(records, verticals, applied, g_factor, acceleration_units) -> tuple[tuple, dict]:
+    """Per record: whether its vertical component was applied, the vertical's id and its PGA [g].
+
+    Returns the flag variable and the two coordinates (beside ``record_pga``).
+    """
+    verticals = list(verticals) if verticals is not None else [None] * len(records)
+    flags = np.array([int(applied and vertical is not None) for vertical in verticals], dtype=np.int8)
+    pgas = [float(np.max(np.abs(v.acceleration))) / g_factor if v is not None else np.nan for v in verticals]
+    flag = ("record", flags, {
+        "long_name": "the record's vertical component was applied: gravity g + a_v(t) in every model",
+        "units": "1", "flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": "horizontal_only with_vertical"})
+    return flag, {
+        "record_vertical": ("record", [v.id if v is not None else "" for v in verticals],
+                            {"long_name": "record id of the vertical component of the record's station "
+                                          "(empty: none in the study)"}),
+        "record_vertical_pga": ("record", pgas, {
+            "long_name": "PGA of the processed vertical component (NaN: none in the study)",
+            "units": acceleration_units}),
+    }
 
 
 def _level_coordinates(config, measure_name, intensity) -> dict:

@@ -47,6 +47,7 @@ from tqdm.auto import tqdm
 from pipeline.config import StudyConfig
 from pipeline.cube import (
     OUTCOME_FAILED,
+    OUTCOME_FREE_FLIGHT,
     OUTCOME_NO_UPLIFT,
     OUTCOME_OVERTURNED,
     OUTCOME_ROCKING,
@@ -114,18 +115,27 @@ def first_overturn_outcomes(cube: xr.Dataset) -> xr.DataArray:
 
 
 def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
-    """1.0 where a run reached the damage state, 0.0 where not, NaN where the solver failed.
+    """1.0 where a run reached the damage state, 0.0 where not, NaN where unknown.
 
     A record is beyond every state from its first overturning level on (``first_overturn_outcomes``).
+    Unknown: the solver failed, or the run stopped in free flight (``free_flight``: g + a_v < 0 under a
+    pivot model, which has no flight phase) before it could tell. Such a run did leave the ground, so it
+    counts as uplifted; it reached a rocking state when its response before the stop already did (peak
+    values only grow), else it is unknown; whether it would have overturned is unknown. The fits count
+    the known runs only (censored), level by level.
     """
     outcome = first_overturn_outcomes(cube)
+    flight = outcome == OUTCOME_FREE_FLIGHT
     if state.edp == "uplifted":
-        reached = outcome >= OUTCOME_ROCKING
+        reached = outcome >= OUTCOME_ROCKING  # rocking, overturned or free flight (failed: masked below)
+        known = outcome != OUTCOME_FAILED
     elif state.edp == "overturned":
         reached = outcome == OUTCOME_OVERTURNED
+        known = (outcome != OUTCOME_FAILED) & ~flight
     else:
         reached = (cube[state.edp] >= state.threshold) | (outcome == OUTCOME_OVERTURNED)
-    return reached.astype(float).where(outcome != OUTCOME_FAILED)
+        known = (outcome != OUTCOME_FAILED) & (~flight | reached)
+    return reached.astype(float).where(known)
 
 
 # ---------------------------------------------------------------- intensity levels of a cube

@@ -45,7 +45,7 @@ from tqdm import tqdm
 from pipeline import __version__
 from pipeline.blocks import Block
 from pipeline.checkpoints import CheckpointStore
-from pipeline.cube import build_cube
+from pipeline.cube import COMPARISON_CUBE, build_cube
 from pipeline.errors import PipelineError, RecordError
 from pipeline.executors import check_workers, make_executor, pool_executor, run_tasks
 from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
@@ -56,7 +56,7 @@ from pipeline.models.base import Outcome
 from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
 from pipeline.outputs import write_dataset
 from pipeline.processing import ProcessingRecipe, load_recipe, process_records
-from pipeline.records import Record, load_records
+from pipeline.records import Record, group_components, load_records, split_vertical
 from pipeline.soils import soil_block_stiffness
 
 
@@ -119,32 +119,82 @@ def capacity_key(key, resolution) -> str:
     return f"{key}-capacity-{resolution:g}"
 
 
-def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolution):
-    """[capacity, lower, upper, extra runs] of one cell as scale factors (see capacity_from_stripes)."""
+class _FreeFlight(Exception):
+    """A refining run ended in free flight: whether it would have overturned is unknown."""
+
+
+def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolution, ag_vertical=None):
+    """[capacity, lower, upper, extra runs] of one cell as scale factors (see capacity_from_stripes).
+
+    Free flight (a pivot model stopped where g + a_v < 0, ``Outcome.FREE_FLIGHT``) says nothing about
+    overturning. The stripes from the first free-flight stripe on are left out: a record that overturned
+    below it is bracketed as usual, and a refining run that ends in free flight stops the refinement with
+    the bracket found so far (``_bracket_so_far``). A record that did not overturn below its first
+    free-flight stripe has no capacity (NaN), censored at the highest stripe it survived below it
+    (``lower``; NaN if none). Without free flight this is exactly ``capacity_from_stripes``.
+    """
     _, model, block, k, xi = job
+    seen = []  # (scale, overturned) of each refining run
 
     def overturns(scale):
-        result = simulate_batch(model, acceleration, dt, [scale], [(block, k, xi)], t_end=t_end, **options)
-        return int(result[0, 0]["status"]) == int(Outcome.OVERTURNED)
+        result = simulate_batch(model, acceleration, dt, [scale], [(block, k, xi)], ag_vertical=ag_vertical,
+                                t_end=t_end, **options)
+        status = int(result[0, 0]["status"])
+        if status == int(Outcome.FREE_FLIGHT):
+            raise _FreeFlight
+        seen.append((scale, status == int(Outcome.OVERTURNED)))
+        return seen[-1][1]
 
-    overturned = summary["status"].astype(int) == int(Outcome.OVERTURNED)
-    return np.array(capacity_from_stripes(scales, overturned, overturns, tolerance=resolution), dtype=float)
+    status = summary["status"].astype(int)
+    overturned = status == int(Outcome.OVERTURNED)
+    scales = np.asarray(scales, float)
+    flights = np.flatnonzero(status == int(Outcome.FREE_FLIGHT))
+    if flights.size:
+        scales, overturned = scales[:flights[0]], overturned[:flights[0]]
+        if not overturned.any():
+            return np.array([np.nan, scales[-1] if scales.size else np.nan, np.nan, 0.0])
+    try:
+        return np.array(capacity_from_stripes(scales, overturned, overturns, tolerance=resolution), dtype=float)
+    except _FreeFlight:
+        return _bracket_so_far(scales, overturned, seen)
+
+
+def _bracket_so_far(scales, overturned, seen) -> np.ndarray:
+    """[capacity, lower, upper, runs] from the stripes and the refining runs before one ended in free flight.
+
+    upper: the lowest scale seen to overturn (the first overturning stripe or a refining run below it);
+    lower: the highest scale seen to survive below it. No overturning seen: NaN capacity, censored at the
+    highest survival. runs: the refining runs, the free-flight one included.
+    """
+    hits = np.flatnonzero(overturned)
+    stripes = [(float(scale), False) for scale in scales[:hits[0] if hits.size else scales.size]]
+    if hits.size:
+        stripes.append((float(scales[hits[0]]), True))
+    runs = [*stripes, *seen]
+    upper = min((scale for scale, over in runs if over), default=np.nan)
+    below = [scale for scale, over in runs if not over and not scale >= upper]
+    lower = max(below, default=np.nan)
+    capacity = 0.5 * (lower + upper)
+    return np.array([capacity, lower, upper, float(len(seen) + 1)])
 
 
 def _hash(payload) -> str:
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:40]
 
 
-def cells_for_record(record, config, recipe, block_scales=None) -> list[Cell]:
+def cells_for_record(record, config, recipe, block_scales=None, vertical=None) -> list[Cell]:
     """The cells of one record with their checkpoint keys.
 
     ``block_scales`` holds the record's scale factors per block, (n_level, n_block), part of each
-    cell's key.
+    cell's key. ``vertical`` (``vertical_key``; a ``[study] vertical = true`` study only) says whether and
+    which vertical component the cells apply; None (horizontal-only studies) leaves the keys as they were.
     """
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
               "solver": {**solver_options(config), "tail": config.tail, "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
+    if vertical is not None:
+        common["vertical"] = vertical
     cells = []
     for block_index, block in enumerate(config.blocks):
         block_spec = {k: v for k, v in asdict(block).items() if k not in ("name", "description")}
@@ -161,15 +211,28 @@ def cells_for_record(record, config, recipe, block_scales=None) -> list[Cell]:
     return cells
 
 
+def vertical_key(record, vertical, applied) -> dict:
+    """The part of a cell's checkpoint key that says whether and which vertical component it applies.
+
+    ``record`` and ``vertical`` are the processed horizontal and vertical components, cut to the window they
+    share (``StudyRecords``); that window is part of the key since it changes the processed samples.
+    """
+    stats = record.trace.stats
+    return {"applied": bool(applied),
+            "component": vertical.metadata.get("sha256", vertical.id) if applied else None,
+            "window": [str(stats.starttime), int(stats.npts), float(stats.delta)]}
+
+
 def solver_options(config) -> dict:
     """The study's solver settings as ``simulate_batch`` keywords (pipeline.models.SolverOptions)."""
     return {"switch": config.switch, "bed": config.bed, "overturn_angle": config.overturn_angle}
 
 
-def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0):
+def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0, ag_vertical=None):
     """Pure task function (runs in a worker): summaries for each job.
 
-    jobs : list of (key, model, block, k, xi); options : ``solver_options``.
+    jobs : list of (key, model, block, k, xi); options : ``solver_options``; ag_vertical : the record's
+    vertical component [m/s^2, up positive], sampled as ``acceleration`` and scaled by the same factors, or None.
     Returns {key: summary records (n_scale,)} and, when ``capacity_resolution`` > 0,
     {capacity_key(key): [capacity, lower, upper, runs]} (scale factors).
     """
@@ -180,13 +243,13 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
         by_model.setdefault(model, []).append((key, block, k, xi))
     for model, group in by_model.items():
         summaries = simulate_batch(model, acceleration, dt, scales, [(b, k, xi) for _, b, k, xi in group],
-                                   t_end=t_end, **options)
+                                   ag_vertical=ag_vertical, t_end=t_end, **options)
         for (key, *_), summary in zip(group, summaries):
             results[key] = summary
     if capacity_resolution > 0:
         for job in jobs:
             results[capacity_key(job[0], capacity_resolution)] = cell_capacity(
-                acceleration, dt, scales, results[job[0]], job, options, t_end, capacity_resolution)
+                acceleration, dt, scales, results[job[0]], job, options, t_end, capacity_resolution, ag_vertical)
     return results
 
 
@@ -210,11 +273,17 @@ class StudyRecords:
         The records that could not be read or processed, each with its one-line reason.
     recipe : pipeline.processing.ProcessingRecipe
         The processing recipe applied (part of every cell's checkpoint key and of the outputs' hashes).
+    verticals : list of pipeline.records.Record, or None
+        ``[study] vertical = true``: the processed vertical component of each record's station (up
+        positive), in the order of ``records``; each record and its vertical are cut to the window they
+        share (``ComponentGroup.aligned``) before processing, so they have one start, time step and
+        length. None in a horizontal-only study.
     """
 
     records: list[Record]
     failures: list[RecordError]
     recipe: ProcessingRecipe
+    verticals: list[Record] | None = None
 
 
 def study_records(config, log=print) -> StudyRecords:
@@ -222,19 +291,22 @@ def study_records(config, log=print) -> StudyRecords:
 
     Every stage that needs the study's records (study, showcase, applicability, efficiency) takes them
     from here, so ``rockfrag fragility`` reads and processes them once. A record that cannot be read or
-    processed is skipped and reported (``log``); the others go on.
+    processed is skipped and reported (``log``); the others go on. Vertical components are never
+    horizontal inputs: a horizontal-only study leaves them out (one line to ``log``); a ``[study] vertical
+    = true`` study pairs each horizontal with its station's vertical (``pair_verticals``) and skips, with
+    its reason, a horizontal that has none.
 
     Parameters
     ----------
     config : pipeline.config.StudyConfig
-        The study (record sets, record units and dt, processing recipe).
+        The study (record sets, record units and dt, processing recipe, ``vertical``).
     log : callable
         Receives one line per skipped record.
 
     Returns
     -------
     StudyRecords
-        The processed records, the skipped ones with their reasons, and the recipe.
+        The processed records (and their verticals), the skipped ones with their reasons, and the recipe.
 
     Raises
     ------
@@ -244,13 +316,96 @@ def study_records(config, log=print) -> StudyRecords:
     recipe = load_recipe(config.processing or None)
     raw_records, failures = load_records(list(config.record_sets), units=config.record_units or None,
                                          dt=config.record_dt)
-    processed, processing_failures = process_records(raw_records, recipe)
+    if config.vertical:
+        pairs, pairing_failures = pair_verticals(raw_records)
+        failures = [*failures, *pairing_failures]
+        processed, verticals, processing_failures = _process_pairs(pairs, recipe)
+    else:
+        raw_records, left_out = split_vertical(raw_records)
+        if left_out:
+            log(f"rockfrag: {len(left_out)} vertical component{'s' if len(left_out) > 1 else ''} left out "
+                f"(horizontal inputs only; [study] vertical = true applies them): "
+                f"{', '.join(r.id for r in left_out)}")
+        processed, processing_failures = process_records(raw_records, recipe)
+        verticals = None
     failures = [*failures, *processing_failures]
     for failure in failures:
         log(f"rockfrag: skipped {failure}")
     if not processed:
         raise PipelineError("no record could be read; nothing to run")
-    return StudyRecords(processed, failures, recipe)
+    return StudyRecords(processed, failures, recipe, verticals)
+
+
+def pair_verticals(records) -> tuple[list[tuple[Record, Record]], list[RecordError]]:
+    """Each horizontal component with its station's vertical, both cut to the window they share.
+
+    Parameters
+    ----------
+    records : list of pipeline.records.Record
+        Read (unprocessed) records; components of one station and event are grouped by
+        ``group_components``.
+
+    Returns
+    -------
+    pairs : list of (Record, Record)
+        (horizontal, vertical) in the order of the horizontals, each cut by ``ComponentGroup.aligned``
+        (same start, time step and length); horizontals of one station share one vertical object.
+    failures : list of pipeline.errors.RecordError
+        One per horizontal without a vertical among ``records``, or whose components share no window or
+        time step.
+    """
+    horizontals, _ = split_vertical(records)
+    group_of = {}
+    for group in group_components(records):
+        for label, record in group.components.items():
+            group_of[id(record)] = (group, label)
+    aligned, pairs, failures = {}, [], []
+    for record in horizontals:
+        group, label = group_of[id(record)]
+        where = record.metadata.get("file") or record.id
+        if group.z is None:
+            failures.append(RecordError(where, f"record {record.id}: no vertical component of station "
+                                               f"{group.station or '?'} ({group.event or 'event unknown'}) "
+                                               "among the study's records; [study] vertical = true needs one "
+                                               "(add it to record_sets, or set vertical = false)"))
+            continue
+        try:
+            if id(group) not in aligned:
+                aligned[id(group)] = group.aligned()
+        except RecordError as error:
+            failures.append(RecordError(where, f"record {record.id}: {error.reason}"))
+            continue
+        pairs.append((aligned[id(group)][label], aligned[id(group)]["Z"]))
+    return pairs, failures
+
+
+def _process_pairs(pairs, recipe):
+    """Process each (horizontal, vertical) pair with the recipe, each vertical once.
+
+    Returns (horizontals, verticals, failures); a pair whose horizontal or vertical cannot be processed
+    is skipped with the reason.
+    """
+    done = {}
+    horizontals, verticals, failures = [], [], []
+    for horizontal, vertical in pairs:
+        if id(vertical) not in done:
+            done[id(vertical)] = process_records([vertical], recipe)
+        processed_vertical, vertical_failures = done[id(vertical)]
+        processed, own_failures = process_records([horizontal], recipe)
+        if own_failures:
+            failures += own_failures
+        elif vertical_failures:
+            failures.append(RecordError(horizontal.metadata.get("file") or horizontal.id,
+                                        f"record {horizontal.id}: its vertical {vertical.id} cannot be processed "
+                                        f"({vertical_failures[0].reason})"))
+        elif processed[0].trace.stats.npts != processed_vertical[0].trace.stats.npts:
+            failures.append(RecordError(horizontal.metadata.get("file") or horizontal.id,
+                                        f"record {horizontal.id}: processing left it and its vertical {vertical.id} "
+                                        "with different lengths"))
+        else:
+            horizontals.append(processed[0])
+            verticals.append(processed_vertical[0])
+    return horizontals, verticals, failures
 
 
 def _scalable(records, record_im, log):
@@ -292,12 +447,17 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     started = time.perf_counter()
     loaded = loaded or study_records(config, warn)
     records, failures, recipe = loaded.records, list(loaded.failures), loaded.recipe
+    verticals = loaded.verticals
+    if config.vertical and verticals is None:
+        raise PipelineError("[study] vertical = true, but the records were read without their verticals "
+                            "(pipeline.study.study_records of a horizontal-only study)")
     record_im = record_intensities(records, config)
     keep, unscalable = _scalable(records, record_im, warn)
     failures += unscalable
     if not keep:
         raise PipelineError(f"no record has a positive intensity measure {config.measure}; nothing to run")
     records, record_im = [records[i] for i in keep], record_im[keep]
+    verticals = [verticals[i] for i in keep] if verticals is not None else None
     record_pga = np.array([pga(r.acceleration) for r in records])
     intensity = level_intensities(config, record_im, record_pga)
     scale_factors = study_scale_factors(intensity, record_im)
@@ -306,19 +466,24 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
     n_levels = len(config.levels)
     store = CheckpointStore(output / ".checkpoints", log=warn)
-    all_cells = [cells_for_record(record, config, recipe, scale_factors[index])
-                 for index, record in enumerate(records)]
-    keys = [c.key for cells in all_cells for c in cells]
+    variants = (True, False) if config.vertical else (False,)  # with the vertical (cube.nc), then without it
+    all_cells = {variant: [cells_for_record(record, config, recipe, scale_factors[index],
+                                            vertical_key(record, verticals[index], variant) if config.vertical
+                                            else None)
+                           for index, record in enumerate(records)] for variant in variants}
+    keys = [c.key for variant in variants for cells in all_cells[variant] for c in cells]
     results = store.load_verified(keys, (n_levels,), SUMMARY_DTYPE)
     if resolution > 0:
         results.update(store.load_verified([capacity_key(k, resolution) for k in keys], (4,), np.float64))
-    tasks = block_tasks(all_cells, results, config, stiffness, resolution)
-    n_cells = sum(len(c) for c in all_cells)
-    n_missing = sum(len(jobs) for _, _, jobs in tasks)
+    tasks = [(*task, variant) for variant in variants
+             for task in block_tasks(all_cells[variant], results, config, stiffness, resolution)]
+    n_cells = len(keys)
+    n_missing = sum(len(task[2]) for task in tasks)
     runs_total = n_missing * n_levels
     log(f"study '{config.name}': {len(records)} records x {n_levels} levels x {len(config.soils)} soils x "
-        f"{len(config.blocks)} blocks x {len(config.models)} models; {n_cells - n_missing} of {n_cells} "
-        f"cells from checkpoints, {runs_total} runs to do")
+        f"{len(config.blocks)} blocks x {len(config.models)} models"
+        f"{' x 2 (with and without the vertical component)' if config.vertical else ''}; "
+        f"{n_cells - n_missing} of {n_cells} cells from checkpoints, {runs_total} runs to do")
 
     lost = []
     if tasks:
@@ -333,12 +498,14 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
             lost = run_tasks(tasks,
                              lambda task: (records[task[0]].acceleration, records[task[0]].dt,
                                            scale_factors[task[0], :, task[1]], task[2], solver_options(config),
-                                           config.tail, resolution),
+                                           config.tail, resolution,
+                                           verticals[task[0]].acceleration if task[3] else None),
                              lambda: make_executor(compute_cells, workers, scheduler, dask_workers), keep_result,
-                             describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}",
+                             describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}"
+                                                   f"{', with its vertical' if task[3] else ''}",
                              isolate=None if scheduler or dask_workers else lambda: pool_executor(compute_cells, 1))
     if lost:
-        lost_indices = {index for index, _, _ in lost}
+        lost_indices = {task[0] for task in lost}
         for index in sorted(lost_indices):
             record = records[index]
             failure = RecordError(record.metadata.get("file") or record.id,
@@ -352,9 +519,42 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                                 "finished cells are kept, rerun to continue")
         # the levels stay those of the whole record set (relative levels use its median)
         records, record_im, scale_factors = [records[i] for i in kept], record_im[kept], scale_factors[kept]
-        all_cells = [all_cells[i] for i in kept]
+        verticals = [verticals[i] for i in kept] if verticals is not None else None
+        all_cells = {variant: [cells[i] for i in kept] for variant, cells in all_cells.items()}
 
-    summaries = new_summaries((len(records), n_levels, len(config.soils), len(config.blocks), len(config.models)))
+    provenance = {"processing": recipe.as_dict(),
+                  "processing_steps": {r.id: list(r.trace.stats.get("processing", [])) for r in records}}
+    cubes = {}
+    for variant in variants:
+        summaries = _gather_summaries(all_cells[variant], results, config, len(records), n_levels)
+        capacities, stats = gather_capacities(all_cells[variant], results, config, intensity, resolution)
+        if stats:
+            log(f"capacities to {resolution:.0%}{' without the vertical' if config.vertical and not variant else ''}"
+                f": {stats['capacity_runs']} refining runs over {stats['grid_runs']} stripe runs; uniform stripes "
+                f"of the same resolution would need {stats['uniform_runs']} runs "
+                f"({stats['runs_saved_fraction']:.0%} saved)")
+        cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
+                                     intensity=intensity, capacities=capacities, capacity_stats=stats,
+                                     verticals=verticals, vertical_applied=variant), stats)
+    dataset, capacity_stats = cubes[variants[0]]
+    if config.vertical:  # the comparison first: a cube.nc on disk always has its comparison beside it
+        comparison = cubes[False][0]
+        comparison.attrs["title"] += " without the vertical components (compare with cube.nc)"
+        write_dataset(comparison, output / COMPARISON_CUBE)
+        dataset.attrs["vertical_comparison"] = COMPARISON_CUBE
+    write_dataset(dataset, output / "cube.nc")
+    elapsed = time.perf_counter() - started
+    statistics = {"runs_computed": runs_total, "cells_reused": n_cells - n_missing, "cells": n_cells,
+                  "seconds": elapsed, "failures": [str(f) for f in failures],
+                  "checkpoints_quarantined": [str(p) for p in store.quarantined], **capacity_stats}
+    if config.vertical:
+        statistics["comparison"] = output / COMPARISON_CUBE
+    return dataset, statistics
+
+
+def _gather_summaries(all_cells, results, config, n_records, n_levels) -> np.ndarray:
+    """The summary records of every cell, (record, level, soil, block, model); rigid-base cells on every soil."""
+    summaries = new_summaries((n_records, n_levels, len(config.soils), len(config.blocks), len(config.models)))
     for r, cells in enumerate(all_cells):
         for cell in cells:
             model_index = config.models.index(cell.model)
@@ -363,21 +563,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                 summaries[r, :, :, cell.block_index, model_index] = result[:, None]
             else:
                 summaries[r, :, cell.soil_index, cell.block_index, model_index] = result
-    capacities, capacity_stats = gather_capacities(all_cells, results, config, intensity, resolution)
-    if capacity_stats:
-        log(f"capacities to {resolution:.0%}: {capacity_stats['capacity_runs']} refining runs over "
-            f"{capacity_stats['grid_runs']} stripe runs; uniform stripes of the same resolution would need "
-            f"{capacity_stats['uniform_runs']} runs ({capacity_stats['runs_saved_fraction']:.0%} saved)")
-    provenance = {"processing": recipe.as_dict(),
-                  "processing_steps": {r.id: list(r.trace.stats.get("processing", [])) for r in records}}
-    dataset = build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
-                         intensity=intensity, capacities=capacities, capacity_stats=capacity_stats)
-    write_dataset(dataset, output / "cube.nc")
-    elapsed = time.perf_counter() - started
-    statistics = {"runs_computed": runs_total, "cells_reused": n_cells - n_missing, "cells": n_cells,
-                  "seconds": elapsed, "failures": [str(f) for f in failures],
-                  "checkpoints_quarantined": [str(p) for p in store.quarantined], **capacity_stats}
-    return dataset, statistics
+    return summaries
 
 
 def block_tasks(all_cells, available, config, stiffness, resolution) -> list:

@@ -10,8 +10,9 @@ Output: ``report.pdf`` (A4 landscape, every page numbered, contents on page 2),
         results give the same files.
 
 Page order: title, contents, summary, methods, limitations, records, showcase record, IDA, fragility,
-outcomes, applicability, measure efficiency. Pages for blocks, soils, models and records come from
-the result files, so only what the study ran is shown.
+outcomes, vertical component (a ``[study] vertical = true`` study: ``cube_without_vertical.nc`` beside
+``cube.nc``; pipeline.report.vertical), applicability, measure efficiency. Pages for blocks, soils, models
+and records come from the result files, so only what the study ran is shown.
 """
 
 from __future__ import annotations
@@ -35,12 +36,14 @@ from tqdm import tqdm  # noqa: E402
 
 from pipeline import __version__  # noqa: E402
 from pipeline.config import StudyConfig  # noqa: E402
+from pipeline.damage_states import damage_states_from_config  # noqa: E402
 from pipeline.outputs import atomic_path  # noqa: E402
 from pipeline.report import figures as pages  # noqa: E402
 from pipeline.report.adapters import models_of, record_pga_g, short_label  # noqa: E402
 from pipeline.report.layout import PAGE_SIZE, Page, add_footer, new_page  # noqa: E402
 from pipeline.report.sections import Results, limitations_items, methods_items, summary_items, title_items  # noqa: E402
 from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
+from pipeline.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
 from pipeline.units import STANDARD_GRAVITY  # noqa: E402
 
 PNG_DPI = 100
@@ -152,6 +155,16 @@ def plan(results: Results) -> list[Page]:
                                caption="Solid: probability that the block uplifts (rocks or overturns); dashed: "
                                        "probability that it overturns; between them it rocks without "
                                        "overturning."))
+    if results.vertical is not None:
+        planned += _text_pages("vertical", "Vertical component", "Vertical component: medians with and without it",
+                               vertical_items(results.vertical))
+        for block in blocks:
+            planned.append(_figure(f"vertical-{block}", "Vertical component", f"Vertical component: block '{block}'",
+                                   vertical_page, results.vertical, block,
+                                   caption="The same records at the same levels: solid with the vertical component, "
+                                           "dashed without it. Top: median θmax/α over the runs not stopped in free "
+                                           "flight (not drawn where most flew). Bottom: points, fraction overturned "
+                                           "among the known runs (filled: with); lines, lognormal fits."))
     if any(m.rigid_base for m in models) and any(not m.rigid_base for m in models):
         planned.append(_figure("applicability", "Applicability", "Applicability of the rigid-base model",
                                pages.applicability_page, cube,
@@ -369,8 +382,9 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
         The risk variables (``pipeline.risk.risk_dataset``), merged into ``fragility`` when they are a
         separate dataset; None when ``fragility`` holds them or there is no risk.
     output : str or os.PathLike
-        The study's output folder: ``showcase.nc``, ``efficiency.nc`` and ``applicability.nc`` are read
-        from it when present, and the report is written to it.
+        The study's output folder: ``showcase.nc``, ``efficiency.nc``, ``applicability.nc`` and, when
+        ``cube`` applied the vertical components, ``cube_without_vertical.nc`` are read from it when present,
+        and the report is written to it.
     runtime_s : float, optional
         Wall time of the pipeline run [s], stated on the title page; NaN leaves it out.
     applicability : xarray.Dataset, optional
@@ -394,8 +408,10 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
     efficiency = _open_optional(output / "efficiency.nc")
     if applicability is None:
         applicability = _open_optional(output / "applicability.nc")
+    comparison = open_comparison(cube, output)
+    vertical = None if comparison is None else vertical_effect(cube, comparison, damage_states_from_config(config.raw))
     results = Results(config, cube, ida, fragility, output, showcase=_open_optional(output / "showcase.nc"),
-                      applicability=applicability, efficiency=efficiency, runtime_s=runtime_s)
+                      applicability=applicability, efficiency=efficiency, runtime_s=runtime_s, vertical=vertical)
     settings = results.settings
     footer = " · ".join(str(part) for part in (settings.get("project"), results.title, f"study '{config.name}'")
                         if part)

@@ -22,7 +22,8 @@ from pipeline.models import MODELS
 from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
 
-OUTCOME_ROCKING, OUTCOME_FAILED = int(Outcome.ROCKING), int(Outcome.FAILED)
+OUTCOME_ROCKING, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = int(Outcome.ROCKING), int(Outcome.FAILED), \
+    int(Outcome.FREE_FLIGHT)
 
 
 @dataclass(frozen=True)
@@ -224,3 +225,8 @@ def record_pga_g(cube) -> np.ndarray:
     """PGA of each processed record of the cube [g], whatever unit the file states (an older cube: m/s^2)."""
     pga = cube.record_pga
     return np.asarray(convert_units(pga.values, pga.attrs.get("units", "m s-2"), MEASURES["pga"].cf_units()), float)
+
+
+def vertical_applied(cube) -> bool:
+    """True when the cube's runs applied the records' vertical components (``[study] vertical = true``)."""
+    return "vertical_applied" in cube and bool(int(cube.vertical_applied.sum()))

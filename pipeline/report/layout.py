@@ -36,7 +36,8 @@ MODEL_STYLES = [dict(color="#d62728", ls="-", lw=1.4), dict(color="#1f77b4", ls=
                 dict(color="#2ca02c", ls=":", lw=1.6), dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4)]
 FRACTILE_STYLES = {0.16: dict(color="#1f77b4", ls="--", lw=1.5), 0.5: dict(color="black", ls="-", lw=2.2),
                    0.84: dict(color="#d62728", ls=":", lw=1.8)}
-OUTCOME_COLOURS = {"no_uplift": "#c7e9c0", "rocking": "#fdae6b", "overturned": "#d7301f"}
+OUTCOME_COLOURS = {"no_uplift": "#c7e9c0", "rocking": "#fdae6b", "overturned": "#d7301f",
+                   "free_flight": "#6baed6"}  # free flight: g + a_v < 0 stopped a pivot model (vertical component)
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from pipeline.config import StudyConfig
 from pipeline.fragility import STATUS
 from pipeline.report.adapters import (
     OUTCOME_FAILED,
+    OUTCOME_FREE_FLIGHT,
     block_levels,
     cell,
     extrapolation,
@@ -30,9 +31,11 @@ from pipeline.report.adapters import (
     run_fraction,
     state_labels,
     tension_flag,
+    vertical_applied,
 )
 from pipeline.report.layout import pretty
 from pipeline.report.text import Item, bullet, heading, note, paragraph, table
+from pipeline.report.vertical import VerticalEffect
 
 DEFAULT_FRICTION_COEFFICIENT = 0.5
 EXTRAPOLATION_ROWS = 30
@@ -51,6 +54,7 @@ class Results:
     applicability: xr.Dataset | None = None
     efficiency: xr.Dataset | None = None
     runtime_s: float = float("nan")  # wall time of the pipeline run [s]; NaN: not stated
+    vertical: VerticalEffect | None = None  # [study] vertical = true: the runs with and without the verticals
 
     @property
     def settings(self) -> dict:
@@ -166,6 +170,23 @@ def _processing_text(cube):
     return "; ".join(steps) or "not recorded in the cube"
 
 
+def _vertical_outcome(cube) -> str:
+    if not vertical_applied(cube):
+        return "; the vertical ground motion is not applied (horizontal components only)"
+    return ("; with the vertical component, free flight (g + a_v < 0: the pivot models stop there; censored "
+            "in the fits, see Limitations)")
+
+
+def _vertical_records(cube) -> str:
+    """The records' vertical components, when the runs applied them."""
+    if not vertical_applied(cube):
+        return ""
+    pga = np.asarray(cube.record_vertical_pga.values, float)
+    return (f"Each runs with its station's vertical component (PGA {np.nanmin(pga):.3g} to {np.nanmax(pga):.3g} g), "
+            "cut to the window the components share and processed alike, scaled by the record's factor; the same "
+            "records without it are compared on the pages 'Vertical component'. ")
+
+
 def methods_items(results: Results) -> list[Item]:
     """The methods pages: models, soils and blocks, records and processing, scaling, fits, hazard and risk."""
     config, cube, fragility = results.config, results.cube, results.fragility
@@ -183,7 +204,7 @@ def methods_items(results: Results) -> list[Item]:
         f"All models: planar rocking of a rigid block; the base does not slide; "
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
         f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
-        f"failed integration (excluded from the fits)."))
+        f"failed integration (excluded from the fits){_vertical_outcome(cube)}."))
     stiffness = cube.interface_stiffness
     header = ["soil", "G_s [MPa]", "E_d [MPa]", "ξ [-]"] + [f"k, {b} [N/m]" for b in cube.block.values]
     rows = [[str(soil), _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
@@ -203,7 +224,7 @@ def methods_items(results: Results) -> list[Item]:
     items += [heading("Record set and processing"),
               paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
                         f"from {events} earthquake{'s' if events != 1 else ''}; PGA of the processed records "
-                        f"{pga.min():.3g} to {pga.max():.3g} g. "
+                        f"{pga.min():.3g} to {pga.max():.3g} g. {_vertical_records(cube)}"
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
                         "files and each record's processing steps are stored in cube.nc.")]
 
@@ -339,6 +360,7 @@ def limitations_items(results: Results) -> list[Item]:
     if unfitted:
         items.append(note(f"{unfitted} curves could not be fitted (too few exceedances): no median is given."))
 
+    items += free_flight_items(cube, models)
     items.append(heading("Solver"))
     failed = (cube.outcome == OUTCOME_FAILED)
     if int(failed.sum()) == 0:
@@ -349,4 +371,27 @@ def limitations_items(results: Results) -> list[Item]:
             if share > 0:
                 items.append(paragraph(f"{model.label}: {_percent(share)} of the runs stopped (too many events or "
                                        "steps); they are left out of the fits."))
+    return items
+
+
+def free_flight_items(cube, models) -> list[Item]:
+    """The limitations' free-flight count: runs stopped where g + a_v < 0, per model, soil and block."""
+    if not vertical_applied(cube):
+        return []
+    items = [heading("Free flight (vertical component)")]
+    flag = (cube.outcome == OUTCOME_FREE_FLIGHT).where(cube.outcome != OUTCOME_FAILED)
+    total = int((cube.outcome == OUTCOME_FREE_FLIGHT).sum())
+    if total == 0:
+        return items + [paragraph("g + a_v(t) stayed above zero in every run: no block was thrown off the ground.")]
+    items.append(paragraph(
+        f"Where g + a_v(t) < 0 the ground falls faster than gravity and the block leaves it. The pivot models have "
+        f"no flight phase and stop there (outcome free_flight, {total} runs); the Winkler bed flies on. The fits "
+        "count such a run as uplifted, as reaching a rocking state only if it did before the stop, and as unknown "
+        "for overturning (censored). Fraction of runs in free flight:"))
+    for model in models:
+        fraction = run_fraction(cube, flag, model)
+        if fraction is None or float(fraction.max()) == 0:
+            continue
+        items.append(paragraph(f"{model.label}: {_percent(float(fraction.mean()))} of the runs."))
+        items.append(_fraction_table(fraction, cube.soil.values, cube.block.values))
     return items
