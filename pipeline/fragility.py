@@ -590,10 +590,11 @@ def warning_summary(dataset: xr.Dataset) -> list[str]:
 def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
     """P(no uplift), P(rocking without overturning), P(overturning) per level, from the cube.
 
-    A record is overturned from its first overturning level on (``first_overturn_outcomes``).
+    A record is overturned from its first overturning level on (``first_overturn_outcomes``). Failed runs and
+    runs stopped in free flight before any overturning (their overturning is unknown) are left out of the total.
     """
     outcome = first_overturn_outcomes(cube)
-    valid = outcome != OUTCOME_FAILED
+    valid = (outcome != OUTCOME_FAILED) & (outcome != OUTCOME_FREE_FLIGHT)
     counts = [((outcome == code) & valid).sum("record") for code in
               (OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED)]
     total = valid.sum("record")

@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import OUTCOME_FAILED, OUTCOME_OVERTURNED
+from pipeline.cube import OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED
 from pipeline.measures import convert_units, parse_units, udunits
 from pipeline.outputs import write_dataset
 
@@ -95,12 +95,14 @@ def overturning_capacities(outcome, levels):
 def resurrected(outcome) -> np.ndarray:
     """1 where a record survived a level above its first overturning level (resurrection), else 0.
 
-    outcome : (..., n_level) integer outcome codes over increasing levels; a failed run is no survival.
+    outcome : (..., n_level) integer outcome codes over increasing levels; a failed run is no survival, nor
+    is a run stopped in free flight (g + a_v < 0: whether it would have overturned is unknown).
     Returns an int8 array of shape (...,).
     """
-    overturned = np.asarray(outcome) == OUTCOME_OVERTURNED
+    outcome = np.asarray(outcome)
+    overturned = outcome == OUTCOME_OVERTURNED
     after_first = np.cumsum(overturned, axis=-1) > 0
-    survived = ~overturned & (np.asarray(outcome) != OUTCOME_FAILED)
+    survived = ~overturned & (outcome != OUTCOME_FAILED) & (outcome != OUTCOME_FREE_FLIGHT)
     return np.any(after_first & survived, axis=-1).astype(np.int8)
 
 

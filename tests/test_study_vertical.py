@@ -375,3 +375,13 @@ def test_a_refining_run_in_free_flight_stops_with_the_bracket_so_far(monkeypatch
     # a hunt above the stripes that meets free flight: no capacity, censored at the highest survival
     result, calls = _capacity(monkeypatch, [1.0, 2.0], [rock, rock], lambda s: fly if s >= 2.5 else rock)
     assert math.isnan(result[0]) and math.isnan(result[2]) and result[1] == max(s for s in [2.0, *calls] if s < 2.5)
+
+
+def test_a_free_flight_is_neither_a_resurrection_nor_counted_in_the_outcome_classes():
+    from pipeline.cube import OUTCOME_FREE_FLIGHT, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+    from pipeline.ida import resurrected
+
+    flown = np.array([[OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FREE_FLIGHT]])
+    survived = np.array([[OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_ROCKING]])
+    assert resurrected(flown).tolist() == [0] and resurrected(survived).tolist() == [1]
+    assert OUTCOME_NO_UPLIFT != OUTCOME_FREE_FLIGHT
