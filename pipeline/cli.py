@@ -23,6 +23,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.errors import PipelineError
 from pipeline.locking import output_lock
+from pipeline.validation import did_you_mean
 
 EXIT_USER_ERROR = 2
 EXIT_PARTIAL = 1
@@ -331,7 +332,8 @@ def _calibration_bed(args, config) -> dict:
     from pipeline.models import BED_TYPES, get_model
 
     if args.bed is not None and args.bed not in BED_TYPES:
-        raise PipelineError(f"--bed {args.bed!r} unknown; valid: {', '.join(BED_TYPES)}")
+        raise PipelineError(f"--bed {args.bed!r} unknown{did_you_mean(args.bed, BED_TYPES)}; valid: "
+                            f"{', '.join(BED_TYPES)}")
     if not get_model(args.model).uses_bed:
         if args.bed is not None:
             raise PipelineError(f"--bed {args.bed}: model {args.model!r} has no bed; --bed applies to winkler")
@@ -346,20 +348,22 @@ def command_calibrate(args) -> int:
     config, output = _study_config(args)
     blocks = {b.name: b for b in config.blocks}
     if args.block not in blocks:
-        raise PipelineError(f"unknown block {args.block!r}; blocks of the study: {', '.join(blocks)}")
+        raise PipelineError(f"--block: unknown block {args.block!r}{did_you_mean(args.block, blocks)}; blocks of "
+                            f"the study: {', '.join(blocks)}")
     block = blocks[args.block]
+    soil_g = args.soil_g
+    if soil_g is None and args.soil:  # the names first: they cost nothing to check
+        soils = {s.name: s for s in config.soils}
+        if args.soil not in soils:
+            raise PipelineError(f"--soil: unknown soil {args.soil!r}{did_you_mean(args.soil, soils)}; soils of the "
+                                f"study: {', '.join(soils)}")
+        soil_g = soils[args.soil].shear_modulus
     bed_option = _calibration_bed(args, config)
     reference = load_reference(args.reference, args.time_unit, args.angle_unit)
     print(reference.describe_units())
     record, ag = _ground_motion(args, config)
     check_reference(reference.time, reference.rotation, (len(ag) - 1) * record.dt, record.dt,
                     source=str(args.reference), time_unit=reference.time_unit)
-    soil_g = args.soil_g
-    if soil_g is None and args.soil:
-        soils = {s.name: s for s in config.soils}
-        if args.soil not in soils:
-            raise PipelineError(f"unknown soil {args.soil!r}; soils of the study: {', '.join(soils)}")
-        soil_g = soils[args.soil].shear_modulus
     for option, (low, high) in (("--k-range", args.k_range), ("--xi-range", args.xi_range)):
         if not low < high:
             raise PipelineError(f"{option} {low:g} {high:g}: MIN must be below MAX")

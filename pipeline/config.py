@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from pipeline.blocks import Block
-from pipeline.damage_states import DamageState, damage_states_from_config
+from pipeline.damage_states import EDPS, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.hazard import hazard_for
 from pipeline.measures import MEASURES, scaling_measures
@@ -48,6 +48,7 @@ from pipeline.validation import (
     Numbers,
     Table,
     Text,
+    did_you_mean,
     schema_keys,
 )
 from pipeline.validation import shown as _shown
@@ -87,7 +88,8 @@ LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, in
 
 def _damage_state_table() -> Table:
     keys = [f.name for f in dataclasses.fields(DamageState) if f.name != "name"]
-    return Table({key: Number(0, low_open=True) if key == "threshold" else TEXT for key in keys})
+    kinds = {"threshold": Number(0, low_open=True), "edp": Text(tuple(EDPS))}
+    return Table({key: kinds.get(key, TEXT) for key in keys})
 
 
 SCHEMA = Table({
@@ -366,7 +368,8 @@ def _soil(name, data, source) -> SoilClass:
 def _select(kind, names, available, source):
     unknown = [n for n in names if n not in available]
     if unknown:
-        raise ConfigError(kind, f"unknown {kind[:-1]} {unknown[0]!r}; available: {', '.join(available)}", source)
+        raise ConfigError(kind, f"unknown {kind[:-1]} {unknown[0]!r}{did_you_mean(unknown[0], available)}; "
+                          f"available: {', '.join(available)}", source)
     if len(set(names)) != len(names):
         raise ConfigError(kind, f"{[n for n in names if names.count(n) > 1][0]!r} named twice", source)
     return tuple(available[n] for n in names)
