@@ -136,8 +136,21 @@ def _study_config(args, applicability=None):
     One rule for every command: an option left out takes the study's value (``--set``:
     study.record_sets, ``--output``: study.output, ``--processing``: study.processing, ``--units`` and
     ``--dt``: study.units and study.dt); without a study file, the shipped defaults.
+
+    The study is loaded once per command (cached on ``args``: ``main`` asks for the output folder before the
+    command runs), and each plausibility warning of ``--force`` is shown once however often it is loaded.
     """
+    key = repr(sorted((applicability or {}).items()))
+    cache = args.__dict__.setdefault("loaded_studies", {})
+    if key not in cache:
+        cache[key] = _load_study_once(args, applicability)
+    return cache[key]
+
+
+def _load_study_once(args, applicability):
+    """``_study_config`` without its cache; repeats no plausibility warning an earlier load of ``args`` gave."""
     from pipeline.config import load_study
+    from pipeline.plausibility import PlausibilityWarning
 
     study = {}
     if getattr(args, "record_set", None):
@@ -151,7 +164,16 @@ def _study_config(args, applicability=None):
         overrides["checks"] = {"plausibility": "warn"}
     if applicability:
         overrides["applicability"] = applicability
-    config = load_study(args.study, overrides or None)
+    shown = args.__dict__.setdefault("plausibility_warned", set())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PlausibilityWarning)
+        config = load_study(args.study, overrides or None)
+    for warning in caught:
+        text = str(warning.message)
+        if issubclass(warning.category, PlausibilityWarning) and text in shown:
+            continue
+        shown.add(text)
+        warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     return config, Path(args.output) if getattr(args, "output", None) else config.output
 
 
@@ -522,6 +544,9 @@ def build_parser() -> argparse.ArgumentParser:
     study_command.add_argument("--keys", action="store_true",
                                help="print every study key: its value in this study, what it must be (type, range, "
                                     "unit) and the shipped defaults' note")
+    study_command.add_argument("--force", action="store_true",
+                               help="accept blocks or soils that look physically implausible (one warning each), "
+                                    "as run and fragility do")
     study_command.set_defaults(handler=command_study, writes_output=False)
     return parser
 
