@@ -446,10 +446,45 @@ def command_study(args) -> int:
             print(f"{key:<{width}}  {value or '-'} | {allowed}" + (f" | {note}" if note else ""))
         print("NAME: a table name of your own, e.g. [blocks.cabinet]; units SI unless stated (levels of PGA/Sa in g)")
         return 0
+    check_record_selection(config.record_sets, "study.record_sets", config.source)
     print(f"study '{config.name}' ({config.source}) is valid: {len(config.blocks)} blocks, {len(config.soils)} soils, "
-          f"{len(config.models)} models, record sets {', '.join(config.record_sets)}; output {output}. "
-          "rockfrag study --keys lists every key.")
+          f"{len(config.models)} models, record sets {', '.join(config.record_sets)} (found; the records themselves "
+          f"are read by rockfrag records); output {output}. rockfrag study --keys lists every key.")
     return 0
+
+
+def check_record_selection(selection, field: str = "study.record_sets", source: str | None = None) -> None:
+    """Check that every record set, record id, folder and file of a selection exists, without reading a record.
+
+    Parameters
+    ----------
+    selection : iterable of str
+        Record set names, catalogue record ids, folders or files (``study.record_sets``, ``--set``).
+    field : str
+        The field named in the error.
+    source : str, optional
+        The study file (or "command line") named in the error.
+
+    Raises
+    ------
+    ConfigError
+        The first name that is no set, id, folder or file ("not found", with a did-you-mean), or a catalogue
+        record whose file is missing.
+    """
+    from pipeline.errors import ConfigError
+    from pipeline.records import catalogue, record_sets
+
+    sets, entries = record_sets(), {entry.id: entry for entry in catalogue()}
+    for text in selection:
+        text = str(text)
+        if text in sets or text in entries:
+            missing = [entries[i].path for i in sets.get(text, [text]) if not Path(entries[i].path).is_file()]
+            if missing:
+                raise ConfigError(field, f"{text!r}: catalogue file {missing[0]} not found ({len(missing)} missing)",
+                                  source)
+        elif not Path(text).exists():
+            raise ConfigError(field, f"{text!r} not found{did_you_mean(text, [*sets, *entries])}: not a record set "
+                              f"({', '.join(sorted(sets))}), a record id, a folder or a file", source)
 
 
 # ---------------------------------------------------------------- the parser

@@ -52,3 +52,22 @@ def test_study_checks_a_file_and_writes_nothing(tmp_path, capsys, monkeypatch):
     assert main(["study", str(study)]) == 2
     error = capsys.readouterr().err
     assert error.count("\n") == 1 and "dampnig" in error and "did you mean 'damping'" in error
+
+
+def test_study_checks_that_the_record_selection_exists(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    study = tmp_path / "s.toml"
+    for selection, fragments in (("far-feild", ["'far-feild' not found", "did you mean 'far-field'?"]),
+                                 ("PEER/NO_SUCH_RECORD", ["'PEER/NO_SUCH_RECORD' not found"]),
+                                 ("mine/cabinet.csv", ["'mine/cabinet.csv' not found"])):
+        study.write_text(f'[study]\nrecord_sets = ["{selection}"]\n')
+        assert main(["study", str(study)]) == 2
+        error = capsys.readouterr().err
+        assert error.count("\n") == 1 and "study.record_sets" in error, error
+        assert all(fragment in error for fragment in fragments), error
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "cabinet.csv").write_text("0.0\n")
+    assert main(["study", str(study)]) == 0
+    assert "found; the records themselves are read by rockfrag records" in capsys.readouterr().out
+    study.write_text('[study]\nrecord_sets = ["far-field", "PEER/elCentro"]\n')
+    assert main(["study", str(study)]) == 0
