@@ -441,9 +441,9 @@ def command_study(args) -> int:
     if args.keys:
         rows = study_keys(config)
         width = max(len(key) for key, *_ in rows)
-        print(f"{'key':<{width}}  value (this study) | allowed | note (pipeline/defaults.toml)")
-        for key, value, allowed, note in rows:
-            print(f"{key:<{width}}  {value or '-'} | {allowed}" + (f" | {note}" if note else ""))
+        print(f"{'key':<{width}}  value (this study) | default (shipped) | allowed | note (pipeline/defaults.toml)")
+        for key, value, default, allowed, note in rows:
+            print(f"{key:<{width}}  {value or '-'} | {default or '-'} | {allowed}" + (f" | {note}" if note else ""))
         print("NAME: a table name of your own, e.g. [blocks.cabinet]; units SI unless stated (levels of PGA/Sa in g)")
         return 0
     check_record_selection(config.record_sets, "study.record_sets", config.source)
