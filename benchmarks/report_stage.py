@@ -22,6 +22,10 @@ from pipeline.report import report_stage  # noqa: E402
 
 def main(output, study=None, workers=None):
     output = Path(output)
+    missing = [name for name in ("cube.nc", "ida.nc", "fragility.nc") if not (output / name).is_file()]
+    if missing:
+        raise SystemExit(f"report_stage: {output} has no {', '.join(missing)}; run `make fragility` first (or "
+                         "`rockfrag fragility STUDY --output DIR` and give DIR)")
     config = load_study(study or None)
     datasets = {}
     for name in ("cube", "ida", "fragility"):

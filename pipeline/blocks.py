@@ -15,9 +15,22 @@ from pipeline.errors import ConfigError
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number
 
+BLOCK_RANGES: dict[str, Number] = {
+    "b": Number(0, 1e4, low_open=True, unit="m"),
+    "h": Number(0, 1e4, low_open=True, unit="m"),
+    "R": Number(0, 1e4, low_open=True, unit="m"),
+    "alpha": Number(0, math.pi / 2 - 1e-6, low_open=True, unit="rad"),
+    "mass": Number(0, 1e10, low_open=True, unit="kg"),
+    "E_b": Number(0, 1e13, low_open=True, unit="Pa"),
+    "footprint_area": Number(0, 1e8, low_open=True, unit="m^2"),
+    "soil_depth": Number(0, 1e4, low_open=True, unit="m"),
+}
+"""What each number of a block must be (SI units; b, h: half-width and half-height): checked by ``Block`` and
+by the study schema (pipeline.config), and listed by ``rockfrag study --keys``."""
 
-def _check(name, value, low, high, unit, low_open=True):
-    return Number(low, high, low_open=low_open, unit=unit).check(value, name, None)
+
+def _check(name: str, value: object, key: str) -> float:
+    return BLOCK_RANGES[key].check(value, name, None)
 
 
 def geometry_conflict(name: str, b: float | None, h: float | None, R: float | None,
@@ -106,22 +119,22 @@ class Block:
         if not (geometry_bh or geometry_ra):
             raise ConfigError(f"block {self.name}", "give either b and h, or R and alpha")
         if geometry_bh:
-            b = _check(f"block {self.name}.b", self.b, 0, 1e4, "m")
-            h = _check(f"block {self.name}.h", self.h, 0, 1e4, "m")
+            b = _check(f"block {self.name}.b", self.b, "b")
+            h = _check(f"block {self.name}.h", self.h, "h")
             object.__setattr__(self, "R", math.hypot(b, h))
             object.__setattr__(self, "alpha", math.atan2(b, h))
         else:
-            radius = _check(f"block {self.name}.R", self.R, 0, 1e4, "m")
-            alpha = _check(f"block {self.name}.alpha", self.alpha, 0, math.pi / 2 - 1e-6, "rad")
+            radius = _check(f"block {self.name}.R", self.R, "R")
+            alpha = _check(f"block {self.name}.alpha", self.alpha, "alpha")
             object.__setattr__(self, "b", radius * math.sin(alpha))
             object.__setattr__(self, "h", radius * math.cos(alpha))
-        _check(f"block {self.name}.mass", self.mass, 0, 1e10, "kg")
-        _check(f"block {self.name}.E_b", self.E_b, 0, 1e13, "Pa")
-        _check(f"block {self.name}.soil_depth", self.soil_depth, 0, 1e4, "m")
+        _check(f"block {self.name}.mass", self.mass, "mass")
+        _check(f"block {self.name}.E_b", self.E_b, "E_b")
+        _check(f"block {self.name}.soil_depth", self.soil_depth, "soil_depth")
         if self.footprint_area is None:
             # plane model: footprint 2b wide and 1 m deep out of plane
             object.__setattr__(self, "footprint_area", 2.0 * self.b * 1.0)
-        _check(f"block {self.name}.footprint_area", self.footprint_area, 0, 1e8, "m^2")
+        _check(f"block {self.name}.footprint_area", self.footprint_area, "footprint_area")
 
     def p(self, g=STANDARD_GRAVITY) -> float:
         """Frequency parameter p = sqrt(3g / (4R)) [rad/s] (paper eq. 3)."""

@@ -23,6 +23,7 @@ from pathlib import Path
 from pipeline import __version__
 from pipeline.errors import PipelineError
 from pipeline.locking import output_lock
+from pipeline.validation import did_you_mean
 
 EXIT_USER_ERROR = 2
 EXIT_PARTIAL = 1
@@ -135,8 +136,21 @@ def _study_config(args, applicability=None):
     One rule for every command: an option left out takes the study's value (``--set``:
     study.record_sets, ``--output``: study.output, ``--processing``: study.processing, ``--units`` and
     ``--dt``: study.units and study.dt); without a study file, the shipped defaults.
+
+    The study is loaded once per command (cached on ``args``: ``main`` asks for the output folder before the
+    command runs), and each plausibility warning of ``--force`` is shown once however often it is loaded.
     """
+    key = repr(sorted((applicability or {}).items()))
+    cache = args.__dict__.setdefault("loaded_studies", {})
+    if key not in cache:
+        cache[key] = _load_study_once(args, applicability)
+    return cache[key]
+
+
+def _load_study_once(args, applicability):
+    """``_study_config`` without its cache; repeats no plausibility warning an earlier load of ``args`` gave."""
     from pipeline.config import load_study
+    from pipeline.plausibility import PlausibilityWarning
 
     study = {}
     if getattr(args, "record_set", None):
@@ -150,7 +164,16 @@ def _study_config(args, applicability=None):
         overrides["checks"] = {"plausibility": "warn"}
     if applicability:
         overrides["applicability"] = applicability
-    config = load_study(args.study, overrides or None)
+    shown = args.__dict__.setdefault("plausibility_warned", set())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PlausibilityWarning)
+        config = load_study(args.study, overrides or None)
+    for warning in caught:
+        text = str(warning.message)
+        if issubclass(warning.category, PlausibilityWarning) and text in shown:
+            continue
+        shown.add(text)
+        warnings.warn_explicit(warning.message, warning.category, warning.filename, warning.lineno)
     return config, Path(args.output) if getattr(args, "output", None) else config.output
 
 
@@ -331,7 +354,8 @@ def _calibration_bed(args, config) -> dict:
     from pipeline.models import BED_TYPES, get_model
 
     if args.bed is not None and args.bed not in BED_TYPES:
-        raise PipelineError(f"--bed {args.bed!r} unknown; valid: {', '.join(BED_TYPES)}")
+        raise PipelineError(f"--bed {args.bed!r} unknown{did_you_mean(args.bed, BED_TYPES)}; valid: "
+                            f"{', '.join(BED_TYPES)}")
     if not get_model(args.model).uses_bed:
         if args.bed is not None:
             raise PipelineError(f"--bed {args.bed}: model {args.model!r} has no bed; --bed applies to winkler")
@@ -346,20 +370,22 @@ def command_calibrate(args) -> int:
     config, output = _study_config(args)
     blocks = {b.name: b for b in config.blocks}
     if args.block not in blocks:
-        raise PipelineError(f"unknown block {args.block!r}; blocks of the study: {', '.join(blocks)}")
+        raise PipelineError(f"--block: unknown block {args.block!r}{did_you_mean(args.block, blocks)}; blocks of "
+                            f"the study: {', '.join(blocks)}")
     block = blocks[args.block]
+    soil_g = args.soil_g
+    if soil_g is None and args.soil:  # the names first: they cost nothing to check
+        soils = {s.name: s for s in config.soils}
+        if args.soil not in soils:
+            raise PipelineError(f"--soil: unknown soil {args.soil!r}{did_you_mean(args.soil, soils)}; soils of the "
+                                f"study: {', '.join(soils)}")
+        soil_g = soils[args.soil].shear_modulus
     bed_option = _calibration_bed(args, config)
     reference = load_reference(args.reference, args.time_unit, args.angle_unit)
     print(reference.describe_units())
     record, ag = _ground_motion(args, config)
     check_reference(reference.time, reference.rotation, (len(ag) - 1) * record.dt, record.dt,
                     source=str(args.reference), time_unit=reference.time_unit)
-    soil_g = args.soil_g
-    if soil_g is None and args.soil:
-        soils = {s.name: s for s in config.soils}
-        if args.soil not in soils:
-            raise PipelineError(f"unknown soil {args.soil!r}; soils of the study: {', '.join(soils)}")
-        soil_g = soils[args.soil].shear_modulus
     for option, (low, high) in (("--k-range", args.k_range), ("--xi-range", args.xi_range)):
         if not low < high:
             raise PipelineError(f"{option} {low:g} {high:g}: MIN must be below MAX")
@@ -415,15 +441,50 @@ def command_study(args) -> int:
     if args.keys:
         rows = study_keys(config)
         width = max(len(key) for key, *_ in rows)
-        print(f"{'key':<{width}}  value (this study) | allowed | note (pipeline/defaults.toml)")
-        for key, value, allowed, note in rows:
-            print(f"{key:<{width}}  {value or '-'} | {allowed}" + (f" | {note}" if note else ""))
+        print(f"{'key':<{width}}  value (this study) | default (shipped) | allowed | note (pipeline/defaults.toml)")
+        for key, value, default, allowed, note in rows:
+            print(f"{key:<{width}}  {value or '-'} | {default or '-'} | {allowed}" + (f" | {note}" if note else ""))
         print("NAME: a table name of your own, e.g. [blocks.cabinet]; units SI unless stated (levels of PGA/Sa in g)")
         return 0
+    check_record_selection(config.record_sets, "study.record_sets", config.source)
     print(f"study '{config.name}' ({config.source}) is valid: {len(config.blocks)} blocks, {len(config.soils)} soils, "
-          f"{len(config.models)} models, record sets {', '.join(config.record_sets)}; output {output}. "
-          "rockfrag study --keys lists every key.")
+          f"{len(config.models)} models, record sets {', '.join(config.record_sets)} (found; the records themselves "
+          f"are read by rockfrag records); output {output}. rockfrag study --keys lists every key.")
     return 0
+
+
+def check_record_selection(selection, field: str = "study.record_sets", source: str | None = None) -> None:
+    """Check that every record set, record id, folder and file of a selection exists, without reading a record.
+
+    Parameters
+    ----------
+    selection : iterable of str
+        Record set names, catalogue record ids, folders or files (``study.record_sets``, ``--set``).
+    field : str
+        The field named in the error.
+    source : str, optional
+        The study file (or "command line") named in the error.
+
+    Raises
+    ------
+    ConfigError
+        The first name that is no set, id, folder or file ("not found", with a did-you-mean), or a catalogue
+        record whose file is missing.
+    """
+    from pipeline.errors import ConfigError
+    from pipeline.records import catalogue, record_sets
+
+    sets, entries = record_sets(), {entry.id: entry for entry in catalogue()}
+    for text in selection:
+        text = str(text)
+        if text in sets or text in entries:
+            missing = [entries[i].path for i in sets.get(text, [text]) if not Path(entries[i].path).is_file()]
+            if missing:
+                raise ConfigError(field, f"{text!r}: catalogue file {missing[0]} not found ({len(missing)} missing)",
+                                  source)
+        elif not Path(text).exists():
+            raise ConfigError(field, f"{text!r} not found{did_you_mean(text, [*sets, *entries])}: not a record set "
+                              f"({', '.join(sorted(sets))}), a record id, a folder or a file", source)
 
 
 # ---------------------------------------------------------------- the parser
@@ -518,6 +579,9 @@ def build_parser() -> argparse.ArgumentParser:
     study_command.add_argument("--keys", action="store_true",
                                help="print every study key: its value in this study, what it must be (type, range, "
                                     "unit) and the shipped defaults' note")
+    study_command.add_argument("--force", action="store_true",
+                               help="accept blocks or soils that look physically implausible (one warning each), "
+                                    "as run and fragility do")
     study_command.set_defaults(handler=command_study, writes_output=False)
     return parser
 

@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.blocks import Block
-from pipeline.damage_states import DamageState, damage_states_from_config
+from pipeline.blocks import BLOCK_RANGES, Block
+from pipeline.damage_states import EDPS, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.hazard import hazard_for
 from pipeline.measures import MEASURES, scaling_measures
@@ -48,6 +48,7 @@ from pipeline.validation import (
     Numbers,
     Table,
     Text,
+    did_you_mean,
     schema_keys,
 )
 from pipeline.validation import shown as _shown
@@ -72,11 +73,8 @@ def _table(fields: dict) -> Table:
 
 TEXT = Text()
 SOIL_TABLE = _table({**SOIL_RANGES, "why": TEXT})
-# Types only: the ranges of a block are Block's own (pipeline/blocks.py), reported with the user's field.
-BLOCK_UNITS = {"b": "m", "h": "m", "R": "m", "alpha": "rad", "mass": "kg", "E_b": "Pa", "footprint_area": "m^2",
-               "soil_depth": "m"}
-"""The keys of a block table and their SI units (b, h: half-width and half-height)."""
-BLOCK_TABLE = _table({key: Number(unit=unit) for key, unit in BLOCK_UNITS.items()} | {"why": TEXT})
+# The ranges of a block are Block's own (pipeline/blocks.py BLOCK_RANGES), declared once for both.
+BLOCK_TABLE = _table({**BLOCK_RANGES, "why": TEXT})
 LEVEL = Number(0, 1e3, low_open=True)
 """An intensity level (g or m/s), or a multiple of a block's uplift intensity."""
 LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, integer=True),
@@ -87,7 +85,8 @@ LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, in
 
 def _damage_state_table() -> Table:
     keys = [f.name for f in dataclasses.fields(DamageState) if f.name != "name"]
-    return Table({key: Number(0, low_open=True) if key == "threshold" else TEXT for key in keys})
+    kinds = {"threshold": Number(0, low_open=True), "edp": Text(tuple(EDPS))}
+    return Table({key: kinds.get(key, TEXT) for key in keys})
 
 
 SCHEMA = Table({
@@ -370,7 +369,8 @@ def _soil(name, data, source) -> SoilClass:
 def _select(kind, names, available, source):
     unknown = [n for n in names if n not in available]
     if unknown:
-        raise ConfigError(kind, f"unknown {kind[:-1]} {unknown[0]!r}; available: {', '.join(available)}", source)
+        raise ConfigError(kind, f"unknown {kind[:-1]} {unknown[0]!r}{did_you_mean(unknown[0], available)}; "
+                          f"available: {', '.join(available)}", source)
     if len(set(names)) != len(names):
         raise ConfigError(kind, f"{[n for n in names if names.count(n) > 1][0]!r} named twice", source)
     return tuple(available[n] for n in names)
@@ -518,8 +518,8 @@ def load_study(path: str | Path | None = None, overrides: dict | None = None) ->
     return study_from_dict(merged, source)
 
 
-def study_keys(config: StudyConfig | None = None) -> list[tuple[str, str, str, str]]:
-    """Every study key with its value, what it must be, and the shipped file's note (units, choices).
+def study_keys(config: StudyConfig | None = None) -> list[tuple[str, str, str, str, str]]:
+    """Every study key with its value, the shipped default, what it must be, and the shipped file's note.
 
     Parameters
     ----------
@@ -528,26 +528,38 @@ def study_keys(config: StudyConfig | None = None) -> list[tuple[str, str, str, s
 
     Returns
     -------
-    list of (key, value, allowed, note)
+    list of (key, value, default, allowed, note)
         ``key`` dotted as in the study file (``intensity.levels``; ``NAME`` for a table name of your own),
-        ``value`` the study's value ("" if unset), ``allowed`` the schema's type, range and unit, ``note``
-        the comment of that key in ``pipeline/defaults.toml`` (where the shipped file states units and choices).
+        ``value`` the study's value and ``default`` the shipped default study's (JSON; "" if unset), ``allowed``
+        the schema's type, range and unit, ``note`` the comment of that key in ``pipeline/defaults.toml`` (where
+        the shipped file states units and choices; a comment continued on the lines below is joined).
     """
-    raw = (config or load_study()).raw
+    shipped = load_study().raw
+    raw = config.raw if config is not None else shipped
     notes = _default_notes()
-    rows = []
-    for key, allowed in schema_keys(SCHEMA):
-        value: object = raw
-        for part in key.split("."):
-            value = value.get(part) if isinstance(value, dict) else None
-        rows.append((key, "" if value is None else json.dumps(value, default=str), allowed, notes.get(key, "")))
-    return rows
+    return [(key, _value_at(raw, key), _value_at(shipped, key), allowed, notes.get(key, ""))
+            for key, allowed in schema_keys(SCHEMA)]
+
+
+def _value_at(raw: dict, key: str) -> str:
+    """The value of a dotted key in a study dict as JSON, or "" if it is not set."""
+    value: object = raw
+    for part in key.split("."):
+        value = value.get(part) if isinstance(value, dict) else None
+    return "" if value is None else json.dumps(value, default=str)
 
 
 def _default_notes() -> dict[str, str]:
-    """The end-of-line comments of ``pipeline/defaults.toml`` by dotted key (``# key = ...`` lines included)."""
-    notes, table = {}, ""
+    """The end-of-line comments of ``pipeline/defaults.toml`` by dotted key (``# key = ...`` lines included).
+
+    A comment continued on the next lines (indented lines holding only a comment) is joined to it.
+    """
+    notes, table, last = {}, "", None
     for line in files("pipeline").joinpath("defaults.toml").read_text().splitlines():
+        if last and line[:1].isspace() and line.lstrip().startswith("#"):
+            notes[last] = f"{notes[last]} {line.strip().lstrip('#').strip()}".strip()
+            continue
+        last = None
         text = line.strip().lstrip("# ").strip() if line.lstrip().startswith("# ") else line.strip()
         if text.startswith("[") and text.endswith("]") and "=" not in text:
             table = text.strip("[]").split(".")[0]
@@ -556,5 +568,6 @@ def _default_notes() -> dict[str, str]:
         if "=" in text and "#" in text.split("=", 1)[1]:
             key = text.split("=", 1)[0].strip()
             if key.replace("_", "").isalnum():
-                notes[f"{table}.{key}" if table else key] = text.split("=", 1)[1].split("#", 1)[1].strip()
+                last = f"{table}.{key}" if table else key
+                notes[last] = text.split("=", 1)[1].split("#", 1)[1].strip()
     return notes

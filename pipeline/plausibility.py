@@ -10,7 +10,8 @@ Output: one line per implausible value, naming the value with its unit, its cons
 
 A check is one function ``(block, soil, foundation) -> str | None`` registered with
 ``@plausibility_check(name, field)`` in ``CHECKS``, in the order the checks are tried: the moduli and
-sizes whose unit slips they name come before the settlement and frequency they cause. A block given
+sizes whose unit slips they name come before the density, settlement and frequency they cause (b and h
+in mm are a size slip, not a mass one: the density check stays silent then). A block given
 both ways (R and b/h) is refused when it is built (``pipeline.blocks.geometry_conflict``): after that
 the keys given are no longer known.
 """
@@ -32,6 +33,10 @@ MIN_MODULUS = 1.0e6
 DENSITY_RANGE = (5.0, 8000.0)
 """Plausible mass per bounding volume (footprint area x 2h) [kg/m^3]: from hollow cabinets and crane
 frames (a few tens) to solid steel (7850), with room on both sides."""
+
+MAX_HALF_SIZE = 100.0
+"""Largest plausible half-width b or half-height h [m] (a block 200 m tall is a building, not a rocking block):
+beyond it b and h were most likely given in mm or cm."""
 
 MAX_FOOTPRINT_DEPTH = 50.0
 """Largest depth out of plane of the footprint, footprint_area / 2b, as a multiple of the block's
@@ -118,6 +123,33 @@ def _mass_slip(block: Block, density: float) -> str:
     return "check mass [kg], footprint_area [m^2] and h [m]"
 
 
+def _length_slip(block: Block) -> str:
+    """``did you mean mm (b = 0.5 m, h = 1 m)?``: the unit that brings b and h nearest a 1 m block."""
+    largest = max(block.b, block.h)
+    fits = [(abs(math.log10(largest / factor)), unit, factor) for unit, factor in (("mm", 1e3), ("cm", 1e2))
+            if largest / factor <= MAX_HALF_SIZE]
+    if not fits:
+        return "give the half-width b and half-height h in m"
+    _, unit, factor = min(fits)
+    return f"did you mean {unit} (b = {block.b / factor:g} m, h = {block.h / factor:g} m)?"
+
+
+def _area_slip(block: Block) -> str:
+    """``did you mean 800000 mm^2 = 0.8 m^2?``: the unit giving a base nearest a square 2b x 2b.
+
+    Of the units that give a plausible base, the one whose depth out of plane is nearest the block's width
+    2b, not merely the first that passes.
+    """
+    width = 2.0 * block.b
+    fits = [(abs(math.log10(block.footprint_area / factor / width / width)), unit, factor)
+            for unit, factor in (("cm^2", 1e4), ("mm^2", 1e6))
+            if block.footprint_area / factor / width <= MAX_FOOTPRINT_DEPTH * _size(block)]
+    if not fits:
+        return "give the base area in m^2 (2b times the depth out of plane)"
+    _, unit, factor = min(fits)
+    return f"did you mean {block.footprint_area:g} {unit} = {block.footprint_area / factor:g} m^2?"
+
+
 def _foundation_slip(block: Block, soil: SoilClass) -> str:
     """The inputs of k = (A/H) / (1/G_s + 1/E_b) and m g, with their units, to check."""
     return (f"check mass = {block.mass:g} kg, E_b = {block.E_b:g} Pa, soil {soil.name!r} shear_modulus = "
@@ -156,6 +188,16 @@ def soil_modulus(block: Block, soil: SoilClass, found: Foundation) -> str | None
             f"{found.settlement:.3g} m under block {block.name!r}): {slip}")
 
 
+@plausibility_check("size", "blocks.{block}")
+def block_size(block: Block, soil: SoilClass, found: Foundation) -> str | None:
+    """Half-width or half-height over 100 m: lengths in mm or cm written as m (tried before the density)."""
+    if max(block.b, block.h) <= MAX_HALF_SIZE:
+        return None
+    return (f"block {block.name!r}: half-width b = {block.b:g} m and half-height h = {block.h:g} m make a block "
+            f"{2 * block.b:g} m wide and {2 * block.h:g} m tall, over {MAX_HALF_SIZE:g} m (Housner's p = "
+            f"{block.p():.3g} rad/s): {_length_slip(block)}")
+
+
 @plausibility_check("footprint", "blocks.{block}.footprint_area")
 def footprint(block: Block, soil: SoilClass, found: Foundation) -> str | None:
     """A footprint far larger than the block's base: an area in cm^2 or mm^2 written as m^2."""
@@ -163,10 +205,7 @@ def footprint(block: Block, soil: SoilClass, found: Foundation) -> str | None:
     depth = block.footprint_area / width
     if depth <= MAX_FOOTPRINT_DEPTH * _size(block):
         return None
-    slip = next((f"did you mean {block.footprint_area:g} {unit} = {block.footprint_area / factor:g} m^2?"
-                 for unit, factor in (("cm^2", 1e4), ("mm^2", 1e6))
-                 if block.footprint_area / factor / width <= MAX_FOOTPRINT_DEPTH * _size(block)),
-                "give the base area in m^2 (2b times the depth out of plane)")
+    slip = _area_slip(block)
     return (f"block {block.name!r}: footprint_area = {block.footprint_area:g} m^2 is a base {width:g} m wide and "
             f"{depth:.3g} m deep, over {MAX_FOOTPRINT_DEPTH:g} x the block's size {_size(block):g} m (k = "
             f"{found.stiffness:.3g} N/m, a nearly rigid bed with omega_v/p = {found.frequency_ratio:.3g}): {slip}")
@@ -177,7 +216,7 @@ def density(block: Block, soil: SoilClass, found: Foundation) -> str | None:
     """Mass per bounding volume above steel's density or below a hollow cabinet's: kg vs t or g."""
     rho = _density(block)
     low, high = DENSITY_RANGE
-    if low <= rho <= high:
+    if low <= rho <= high or block_size(block, soil, found):  # b and h in mm: the mass is not to blame
         return None
     volume = f"footprint_area x 2h = {block.footprint_area:g} m^2 x {2 * block.h:g} m"
     if rho < low:

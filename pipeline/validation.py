@@ -18,7 +18,7 @@ import difflib
 import json
 import math
 import numbers
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -87,7 +87,7 @@ class Text:
         if not isinstance(value, str):
             raise ConfigError(field, f"{shown(value)}; must be a string{allowed}", source)
         if self.choices and value not in self.choices:
-            raise ConfigError(field, f"{value!r} unknown{allowed}", source)
+            raise ConfigError(field, f"{value!r} unknown{did_you_mean(value, self.choices)}{allowed}", source)
         if self.nonempty and not value.strip():
             raise ConfigError(field, "empty; must be a non-empty string", source)
         return value
@@ -323,9 +323,36 @@ def unknown_key(key: str, allowed, what: str = "key", hint: str = "") -> str:
     hint : str
         More advice, after the did-you-mean, e.g. `` (top-level keys ... come first)``.
     """
-    close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.75)
-    close_hint = f" (did you mean {close[0]!r}?)" if close else ""
-    return f"unknown {what}{close_hint}{hint}; allowed: {', '.join(sorted(allowed)) or 'none'}"
+    return f"unknown {what}{did_you_mean(key, allowed)}{hint}; allowed: {', '.join(sorted(allowed)) or 'none'}"
+
+
+DID_YOU_MEAN_CUTOFF = 0.7
+"""How close (difflib ratio, 0-1) a choice must be to what the user wrote to be suggested."""
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """`` (did you mean 'winkler'?)`` for the choice closest to ``word``, or '' if none is close.
+
+    The one did-you-mean of the package: study keys and names (models, soils, blocks, measures,
+    damage-state EDPs), command-line options and record selections.
+
+    Parameters
+    ----------
+    word : str
+        What the user wrote.
+    choices : iterable of str
+        The valid names.
+
+    Returns
+    -------
+    str
+        The hint with a leading space, ready to append to a message; '' if no choice is within
+        ``DID_YOU_MEAN_CUTOFF`` or ``word`` is not a string.
+    """
+    if not isinstance(word, str):
+        return ""
+    close = difflib.get_close_matches(word, [str(choice) for choice in choices], n=1, cutoff=DID_YOU_MEAN_CUTOFF)
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def shown(value: Any) -> str:

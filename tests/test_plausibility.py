@@ -65,6 +65,11 @@ def _refused(path) -> ConfigError:
      ["1.39e+06 kg/m^3, above steel's 7850 kg/m^3", "did you mean 2e+06 g = 2000 kg?"]),
     ({"footprint_area": 4800.0}, None, "blocks.cabinet.footprint_area",
      ["footprint_area = 4800 m^2", "8e+03 m deep", "did you mean 4800 cm^2 = 0.48 m^2?"]),
+    ({"footprint_area": 800000.0}, None, "blocks.cabinet.footprint_area",
+     ["footprint_area = 800000 m^2", "did you mean 800000 mm^2 = 0.8 m^2?"]),
+    ({"b": 500.0, "h": 1000.0}, None, "blocks.cabinet",
+     ["b = 500 m and half-height h = 1000 m", "1000 m wide and 2000 m tall", "did you mean mm (b = 0.5 m, h = 1 m)?"]),
+    ({"b": 30.0, "h": 150.0}, None, "blocks.cabinet", ["did you mean cm (b = 0.3 m, h = 1.5 m)?"]),
     ({"soil_depth": 1000.0}, None, "blocks.cabinet.soil_depth",
      ["soil_depth = 1000 m", "static settlement 1.1 m on clay", "did you mean 1000 mm = 1 m?"]),
     ({}, {"shear_modulus": 50.0}, "soils_custom.loam.shear_modulus",
@@ -175,6 +180,12 @@ def test_checks_are_registered_in_order_with_a_field_each():
     names = [check.name for check in CHECKS]
     assert names[:2] == ["block modulus", "soil modulus"] and names[-2:] == ["settlement", "frequency ratio"]
     assert all("{block}" in check.field or "{soil}" in check.field for check in CHECKS)
+
+
+def test_lengths_in_mm_are_a_size_slip_not_a_mass_one():
+    found = implausibilities([_cabinet(b=500.0, h=1000.0)], [SOILS["clay"]])
+    assert [field for field, _ in found] == ["blocks.cabinet"], found
+    assert "mass" not in found[0][1] and " t = " not in found[0][1]
 
 
 def test_load_study_alone_refuses_a_unit_slip(tmp_path):

@@ -44,6 +44,7 @@ from pipeline.models.options import (  # noqa: F401  (the API)
 )
 from pipeline.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
 from pipeline.units import STANDARD_GRAVITY
+from pipeline.validation import did_you_mean
 
 MODELS: dict[str, RockingModel] = {}
 
@@ -61,7 +62,8 @@ def get_model(name: str) -> RockingModel:
     try:
         return MODELS[name]
     except (KeyError, TypeError):
-        raise SolverError(f"unknown model {name!r}; valid models are: {', '.join(MODELS)}") from None
+        raise SolverError(f"unknown model {name!r}{did_you_mean(name, MODELS)}; valid models are: "
+                          f"{', '.join(MODELS)}") from None
 
 
 def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options=SolverOptions()):

@@ -23,7 +23,6 @@ horizontal ones.
 
 from __future__ import annotations
 
-import difflib
 import math
 import os
 from dataclasses import dataclass, field
@@ -43,6 +42,7 @@ from pipeline.records.components import group_components as group_components
 from pipeline.records.components import split_vertical as split_vertical
 from pipeline.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
 from pipeline.units import STANDARD_GRAVITY, acceleration_factor
+from pipeline.validation import did_you_mean
 
 RECORDS_DIR = Path(os.environ.get("ROCKFRAG_RECORDS", Path(__file__).resolve().parents[2] / "records"))
 """Folder holding the shipped records and ``MANIFEST.csv`` (override with $ROCKFRAG_RECORDS)."""
@@ -434,12 +434,6 @@ def _duplicate_of(record, kept) -> Record | None:
 
 # ---------------------------------------------------------------- selections that name nothing
 
-def _did_you_mean(word: str, choices) -> str:
-    """`` (did you mean 'far-field'?)`` for the closest choice, or '' (the study keys' cutoff, 0.75)."""
-    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.75)
-    return f" (did you mean {close[0]!r}?)" if close else ""
-
-
 def _looks_like_a_path(text: str) -> bool:
     """A selection written as a file or folder (a separator, a suffix, or ``.``/``~`` first)."""
     return "/" in text or os.sep in text or bool(Path(text).suffix) or text.startswith((".", "~"))
@@ -448,12 +442,12 @@ def _looks_like_a_path(text: str) -> bool:
 def _unknown_selection(text: str, sets, entries) -> Exception:
     """The error for a selection that is no set, id, folder or file: "not found" for a path."""
     names = [*sets, *entries]
-    hint = _did_you_mean(text, names)
+    hint = did_you_mean(text, names)
     if not hint and _looks_like_a_path(text):
         path = Path(text)
         if path.parent.is_dir():
             siblings = [p.name for p in path.parent.iterdir()]
-            near = _did_you_mean(path.name, siblings)
+            near = did_you_mean(path.name, siblings)
             folder = "the current folder" if str(path.parent) == "." else str(path.parent)
             where = near or f"; no such file or folder in {folder}"
         else:
