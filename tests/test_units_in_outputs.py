@@ -11,7 +11,6 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from pipeline.cli import main
 from pipeline.config import load_study
 from pipeline.measures import (
     MEASURES,
@@ -103,13 +102,9 @@ def test_the_measure_registry_derives_every_units_string():
 
 
 @pytest.fixture(scope="module")
-def fragility_run(tmp_path_factory):
-    """`rockfrag fragility` on the small study (absolute levels in g, adaptive capacities)."""
-    folder = tmp_path_factory.mktemp("units")
-    study = folder / "study.toml"
-    study.write_text(SMALL + "\n[fragility]\nbootstrap = 5\n")
-    assert main(["fragility", str(study), "--output", str(folder / "reports"), "--no-progress", "--serial"]) == 0
-    return folder / "reports"
+def fragility_run(small_pipeline):
+    """The session's shared `rockfrag fragility` run of the small study (absolute levels in g, capacities)."""
+    return small_pipeline.output
 
 
 @pytest.mark.slow
