@@ -97,6 +97,20 @@ def worker_pool(max_workers: int | None) -> ProcessPoolExecutor:
     return ProcessPoolExecutor(max_workers=max_workers, initializer=die_with_parent, initargs=(os.getpid(),))
 
 
+DASK_CONNECT_SECONDS = 10.0
+"""How long ``--scheduler tcp://...`` waits for the scheduler [s]; ``ROCKFRAG_DASK_CONNECT_TIMEOUT`` overrides."""
+
+
+def connect_timeout() -> float:
+    """Seconds to wait for a dask scheduler: ``ROCKFRAG_DASK_CONNECT_TIMEOUT`` if set (> 0), else 10 s."""
+    value = os.environ.get("ROCKFRAG_DASK_CONNECT_TIMEOUT", "")
+    try:
+        seconds = float(value)
+    except ValueError:
+        return DASK_CONNECT_SECONDS
+    return seconds if seconds > 0 else DASK_CONNECT_SECONDS
+
+
 def shutdown_pool(pool: ProcessPoolExecutor, wait: bool = True, timeout: float = POOL_EXIT_SECONDS) -> None:
     """Shut a process pool down; with ``wait``, its workers are gone when this returns.
 
@@ -193,7 +207,7 @@ def dask_executor(function: Callable[..., Any], scheduler: str | None = None,
     cluster = None
     if scheduler:
         try:
-            client = Client(scheduler, timeout="10s")
+            client = Client(scheduler, timeout=f"{connect_timeout():g}s")
         except (OSError, TimeoutError, ValueError) as error:
             raise PipelineError(f"cannot connect to the dask scheduler at {scheduler!r} ({error}); "
                                 "expected the address of a running scheduler, e.g. tcp://host:8786") from None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import sys
@@ -63,7 +64,8 @@ def test_unreachable_scheduler_is_one_line(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text('soils = ["rock"]\n[study]\nrecord_sets = ["bolu"]\n[intensity]\nlevels = [0.5]\n')
     result = subprocess.run([sys.executable, "-m", "pipeline", "run", str(study), "--output", str(tmp_path / "out"),
-                             "--scheduler", "tcp://127.0.0.1:9", "--no-progress"], capture_output=True, text=True)
+                             "--scheduler", "tcp://127.0.0.1:9", "--no-progress"], capture_output=True, text=True,
+                            env={**os.environ, "ROCKFRAG_DASK_CONNECT_TIMEOUT": "1"})  # 10 s by default
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "cannot connect to the dask scheduler" in result.stderr
 
