@@ -10,8 +10,7 @@ UV     := $(BIN)/uv
 REPORTS := reports
 # pytest-xdist workers of the test targets (auto: one per core); `make test WORKERS=0` runs in one process.
 WORKERS ?= auto
-# ROCKFRAG_WARM_KERNELS: the numba kernels compile once while the workers start (tests/conftest.py).
-PYTEST := ROCKFRAG_WARM_KERNELS=1 $(BIN)/python -m pytest -n $(WORKERS) --dist loadgroup
+PYTEST := $(BIN)/python -m pytest -n $(WORKERS) --dist loadgroup
 # Consumer environments (tests/consumers/README.md): .venv-NAME from tests/consumers/NAME.txt.
 CONSUMERS := $(patsubst tests/consumers/%.txt,%,$(filter-out %.no-deps.txt,$(wildcard tests/consumers/*.txt)))
 CONSUMER_STAMPS := $(CONSUMERS:%=.venv-%/.installed)
@@ -51,19 +50,19 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 
 consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun) of the round-trip tests
 
-# Compiles the numba kernels into their on-disk cache (about 25 s in a fresh clone, a second when cached). The test
-# targets need not call it: under them pytest compiles the kernels while its workers start (tests/conftest.py).
+# Compiles the numba kernels into their on-disk cache once, so that the test workers load them instead of
+# each compiling them (about 25 s of CPU in a fresh clone, a second when cached).
 warm: $(STAMP)
 	$(BIN)/python -m tests.warm_kernels
 
-# The main environment and the consumer environments are built side by side (-j2); only a failed main environment
-# stops here (make -q: is the stamp up to date).
+# The main environment, the kernel cache and the consumer environments are built side by side (-j2); only a
+# failed main environment stops here (make -q: is the stamp up to date).
 test:  ## run every test (physics verification and consumer round trips included) on all cores
-	@$(MAKE) --no-print-directory -j2 -k $(STAMP) consumers || $(MAKE) --no-print-directory -q $(STAMP)
+	@$(MAKE) --no-print-directory -j2 -k warm consumers || $(MAKE) --no-print-directory -q $(STAMP)
 	$(BIN)/ruff check .
 	ROCKFRAG_CONSUMERS=required $(PYTEST)
 
-test-fast: $(STAMP)  ## the tests without the `slow` ones, for while you work (consumer round trips if built)
+test-fast: warm  ## the tests without the `slow` ones, for while you work (consumer round trips if built)
 	$(BIN)/ruff check .
 	$(PYTEST) -m "not slow"
 

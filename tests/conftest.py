@@ -3,10 +3,6 @@ Collection hooks: tests of the small pipeline run share one xdist worker; under 
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -19,44 +15,6 @@ matplotlib.use("Agg")
 
 ROOT = Path(__file__).resolve().parents[1]
 RECORDS = ROOT / "records"
-
-
-WARM_ENV = "ROCKFRAG_WARM_KERNELS"
-"""Set by ``make test``/``make test-fast``: the pytest-xdist controller compiles the numba kernels in a subprocess
-(tests/warm_kernels.py) while the workers start and collect, and the workers wait for it before the first test,
-so that they load the kernels from the on-disk cache instead of each compiling them (about 25 s of CPU each)."""
-WARM_DONE = "ROCKFRAG_WARM_DONE_FILE"
-
-
-def pytest_configure(config: pytest.Config) -> None:
-    """Under xdist with ``ROCKFRAG_WARM_KERNELS=1``, start compiling the kernels before the workers exist."""
-    if os.environ.get(WARM_ENV) != "1" or hasattr(config, "workerinput") or not config.getoption("numprocesses",
-                                                                                                  None):
-        return
-    done = Path(config.rootpath) / ".pytest-warm-done"
-    done.unlink(missing_ok=True)
-    os.environ[WARM_DONE] = str(done)  # the workers inherit it
-    script = f"import pathlib, tests.warm_kernels as w; w.warm(); pathlib.Path({str(done)!r}).touch()"
-    config._rockfrag_warm = subprocess.Popen([sys.executable, "-c", script], cwd=config.rootpath)
-
-
-def pytest_unconfigure(config: pytest.Config) -> None:
-    """The controller's warm-up has ended (it normally has long before) and its marker file is removed."""
-    process = getattr(config, "_rockfrag_warm", None)
-    if process is not None:
-        process.wait()
-        Path(os.environ[WARM_DONE]).unlink(missing_ok=True)
-
-
-@pytest.fixture(scope="session", autouse=True)
-def _kernels_compiled():
-    """In a worker of a warmed run, wait (at most 10 min) until the controller's compile has finished."""
-    done = os.environ.get(WARM_DONE)
-    if done and os.environ.get("PYTEST_XDIST_WORKER"):
-        deadline = time.monotonic() + 600
-        while not Path(done).exists() and time.monotonic() < deadline:
-            time.sleep(0.2)
-    yield
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the xdist_group marks
