@@ -33,7 +33,6 @@ so ``obspy.read("CICCC.RAW")`` detects the format by itself.
 from __future__ import annotations
 
 import math
-import os
 import re
 
 import numpy as np
@@ -41,6 +40,7 @@ from obspy import Stream, Trace, UTCDateTime
 from obspy.core.util import AttribDict
 
 from pipeline.errors import RecordError
+from pipeline.records.sources import HEAD_BYTES, read_head, read_source
 from pipeline.units import acceleration_factor
 
 V1_MARKER = "UNCORRECTED ACCELEROGRAM DATA"
@@ -56,7 +56,6 @@ REAL_FIELD = 10
 HEADER_SEARCH_LINES = 40
 """The data-start line must come within this many lines after the text header."""
 
-_HEAD_BYTES = 4096
 _LINE_BREAK = re.compile(r"\r*\n|\r")
 _CHANNEL = re.compile(r"^\s*Chan\s+(\d+)\s*:\s*(.*?)\s*$", re.IGNORECASE)
 _DEGREES = re.compile(r"^(\d+(?:\.\d*)?)\s*Deg", re.IGNORECASE)
@@ -76,19 +75,8 @@ _UNIT_NAMES = {"g": "g", "cm/sec2": "cm/s^2", "cm/sec/sec": "cm/s^2", "cm/s2": "
 
 def _read_text(source) -> tuple[str, str]:
     """The file's text and a name for messages; ``source`` is a path or a binary file object."""
-    if hasattr(source, "read"):
-        position = source.tell() if hasattr(source, "tell") else None
-        data = source.read()
-        if position is not None:
-            source.seek(position)
-        name = getattr(source, "name", "<file object>")
-    else:
-        with open(source, "rb") as handle:
-            data = handle.read()
-        name = os.fspath(source)
-    if isinstance(data, str):
-        return data, name
-    if b"\x00" in data[:_HEAD_BYTES]:
+    data, name = read_source(source)
+    if b"\x00" in data[:HEAD_BYTES]:
         raise RecordError(name, "file is binary (contains NUL bytes); expected a CSMIP Volume 1 text file")
     return data.decode("latin-1"), name
 
@@ -96,18 +84,10 @@ def _read_text(source) -> tuple[str, str]:
 def is_csmip(source) -> bool:
     """True if ``source`` (path or binary file object) starts like a CSMIP Volume 1 file. Never raises."""
     try:
-        if hasattr(source, "read"):
-            position = source.tell()
-            head = source.read(_HEAD_BYTES)
-            source.seek(position)
-        else:
-            with open(source, "rb") as handle:
-                head = handle.read(_HEAD_BYTES)
-        if isinstance(head, str):
-            head = head.encode("latin-1")
-        if not head or b"\x00" in head:
+        head = read_head(source)
+        if not head:
             return False
-        lines = _LINE_BREAK.split(head.decode("latin-1"))
+        lines = _LINE_BREAK.split(head)
         return (lines[0].strip().upper().startswith(V1_MARKER)
                 and any(_CHANNEL.match(line) for line in lines[1:TEXT_HEADER_LINES]))
     except Exception:  # detection must never raise, whatever the input (obspy contract)

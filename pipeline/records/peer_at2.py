@@ -14,7 +14,6 @@ so ``obspy.read("x.AT2")`` detects the format by itself.
 from __future__ import annotations
 
 import math
-import os
 import re
 
 import numpy as np
@@ -22,6 +21,7 @@ from obspy import Stream, Trace
 from obspy.core.util import AttribDict
 
 from pipeline.errors import RecordError
+from pipeline.records.sources import HEAD_BYTES, read_head, read_source
 from pipeline.units import acceleration_factor
 
 HEADER_SEARCH_LINES = 10
@@ -36,25 +36,9 @@ _FILTER_TEXT = re.compile(r"SEC\s*,?\s*(.+)$", re.IGNORECASE)
 # Lines end in LF, CRLF, a lone CR, or CR CR LF (ARL360.at2); each of these is one line break.
 _LINE_BREAK = re.compile(r"\r*\n|\r")
 
-_HEAD_BYTES = 4096
-
 
 def _split_lines(text: str) -> list[str]:
     return _LINE_BREAK.split(text)
-
-
-def _read_bytes(source) -> tuple[bytes, str]:
-    """Return the file's bytes and a name for messages; ``source`` is a path or a binary file."""
-    if hasattr(source, "read"):
-        position = source.tell() if hasattr(source, "tell") else None
-        data = source.read()
-        if position is not None:
-            source.seek(position)
-        if isinstance(data, str):
-            data = data.encode("latin-1")
-        return data, getattr(source, "name", "<file object>")
-    with open(source, "rb") as handle:
-        return handle.read(), os.fspath(source)
 
 
 def _find_npts_dt(lines):
@@ -69,19 +53,8 @@ def _find_npts_dt(lines):
 def is_peer_at2(source) -> bool:
     """True if ``source`` (path or binary file object) looks like a PEER AT2 file. Never raises."""
     try:
-        if hasattr(source, "read"):
-            position = source.tell()
-            head = source.read(_HEAD_BYTES)
-            source.seek(position)
-        else:
-            with open(source, "rb") as handle:
-                head = handle.read(_HEAD_BYTES)
-        if isinstance(head, str):
-            head = head.encode("latin-1")
-        if not head or b"\x00" in head:
-            return False
-        lines = _split_lines(head.decode("latin-1"))
-        return _find_npts_dt(lines) is not None
+        head = read_head(source)
+        return bool(head) and _find_npts_dt(_split_lines(head)) is not None
     except Exception:  # detection must never raise, whatever the input (obspy contract)
         return False
 
@@ -170,10 +143,10 @@ def parse_peer_at2(source, headonly: bool = False):
         NPTS/DT line, missing or non-positive DT, non-numeric or non-finite values, and fewer or
         more values than NPTS.
     """
-    raw, name = _read_bytes(source)
+    raw, name = read_source(source)
     if not raw.strip():
         raise RecordError(name, "file is empty; expected a PEER AT2 header and acceleration values")
-    if b"\x00" in raw[:_HEAD_BYTES]:
+    if b"\x00" in raw[:HEAD_BYTES]:
         raise RecordError(name, "file is binary (contains NUL bytes); expected a PEER AT2 text file")
     try:
         text = raw.decode("utf-8")
