@@ -34,7 +34,9 @@ from pipeline.damage_states import EDPS, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.hazard import hazard_for
 from pipeline.measures import MEASURES, scaling_measures
-from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES
+from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
+from pipeline.models.options import HOUSNER
+from pipeline.models.variants import DEFAULT_BAND, band_variants
 from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
 from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
 from pipeline.validation import (
@@ -52,6 +54,10 @@ from pipeline.validation import (
     schema_keys,
 )
 from pipeline.validation import shown as _shown
+
+BAND = "band"
+"""``[solver] restitution = "band"``: each bed model runs at the edges and centre of ``restitution_band``
+(pipeline.models.variants)."""
 
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
@@ -109,7 +115,10 @@ SCHEMA = Table({
                          "period_range": Interval(Number(0.01, 20.0, unit="s"))}),
     "solver": _table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
                       "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
-                      "bed": Text(tuple(BED_TYPES))}),
+                      "bed": Text(tuple(BED_TYPES)),
+                      "restitution": Checked(lambda value, field, source: _restitution(value, field, source),
+                                             f"{BAND!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
+                      "restitution_band": Interval(Number(0.5, 1.5), strict=False)}),
     "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
     "fragility": _table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                          "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
@@ -126,6 +135,13 @@ SCHEMA = Table({
     }),
 })
 """Every key a study file may hold, with its type and range."""
+
+
+def _restitution(value, field, source):
+    """``[solver] restitution``: "band", "housner", "" (the soil's damping ratio) or a number in (0, 1)."""
+    if isinstance(value, str):
+        return Text((BAND, HOUSNER, "")).check(value, field, source)
+    return Number(0.0, 1.0, low_open=True, high_open=True).check(value, field, source)
 
 
 def validate(data: dict, source: str) -> None:
@@ -181,7 +197,14 @@ class StudyConfig:
     soils, blocks, models : tuple
         The ``SoilClass`` and ``Block`` objects and the model names that run.
     switch, bed : str
-        ssi pivot-switch rule (consistent | continuous) and winkler bed (continuous | two-spring).
+        ssi pivot-switch rule (consistent | continuous) and winkler bed law (two-spring | continuous |
+        hunt-crossley).
+    restitution : str or float
+        The bed models' restitution target (``[solver] restitution``): "band" (``models`` then holds each bed
+        model's band variants, ``winkler-low``/``-centre``/``-high``), "housner", a number, or "" (no target:
+        the bed's damping ratio is the soil's ``damping_ratio``).
+    restitution_band : (float, float)
+        The band's edges as multiples of Housner's restitution (each capped at 0.99).
     tail : float
         Free vibration simulated after the record [s].
     overturn_angle : float
@@ -242,6 +265,13 @@ class StudyConfig:
     record_dt: float | None = None  # time step of one-column text records [s]; None: from the files
     applicability: ApplicabilitySettings = ApplicabilitySettings()
     vertical: bool = False  # apply each record's vertical component (and compare with the run without it)
+    restitution: str | float = ""  # bed models' restitution target: "band", "housner", a number, "" (none)
+    restitution_band: tuple[float, float] = DEFAULT_BAND  # edges as multiples of Housner's r
+
+    @property
+    def calibrates_bed(self) -> bool:
+        """True when the bed models' damping is calibrated to a restitution target (not the soil's xi)."""
+        return self.restitution != ""
 
     @property
     def relative_levels(self) -> bool:
@@ -421,6 +451,10 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
     soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
     models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
+    restitution = solver.get("restitution", "")
+    if restitution == BAND:
+        models = tuple(variant for name in models
+                       for variant in (band_variants(name) if get_model(name).uses_bed else [name]))
     library = {name: _block("blocks_custom", name, spec, source)
                for name, spec in data.get("blocks_custom", {}).items()}
     if "blocks" not in data:
@@ -441,6 +475,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         period_range=_period_range(intensity.get("period_range")),
         soils=soils, blocks=blocks, models=models,
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
+        restitution=restitution, restitution_band=tuple(solver.get("restitution_band", DEFAULT_BAND)),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
         hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)),
         bootstrap=int(fragility.get("bootstrap", 100)), seed=int(fragility.get("seed", 0)),

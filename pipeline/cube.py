@@ -26,7 +26,7 @@ import xarray as xr
 
 from pipeline import __version__
 from pipeline.measures import MEASURES, file_units, parse_units
-from pipeline.models import get_model
+from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
 from pipeline.models.fields import FIELDS_BY_NAME
 
@@ -111,7 +111,7 @@ DERIVED_ATTRIBUTES = {
 
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
                intensity=None, capacities=None, capacity_stats=None, verticals=None,
-               vertical_applied=False) -> xr.Dataset:
+               vertical_applied=False, calibration=None) -> xr.Dataset:
     """Assemble the labelled cube.
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
@@ -170,13 +170,14 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     data_vars["vertical_applied"] = vertical_flag
     data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
                                         {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
+    data_vars.update(_calibration_variables(calibration, model_names, stiffness.shape))
     coords = {
         "record": ("record", [r.id for r in records], {"long_name": "record id (records/MANIFEST.csv)"}),
         **_level_coordinates(config, measure_name, intensity),
         "soil": ("soil", [s.name for s in config.soils], {"long_name": "soil class"}),
         "block": ("block", [b.name for b in config.blocks], {"long_name": "block"}),
         "model": ("model", model_names, {"long_name": "rocking model"}),
-        "model_label": ("model", [get_model(name).label for name in model_names], {"long_name": "rocking model"}),
+        "model_label": ("model", [model_label(name) for name in model_names], {"long_name": "rocking model"}),
         "record_event": ("record", [str(r.metadata.get("event", "")) for r in records], {"long_name": "earthquake"}),
         "record_station": ("record", [str(r.metadata.get("station", "")) for r in records], {"long_name": "station"}),
         "record_component": ("record", [str(r.metadata.get("component", "")) for r in records],
@@ -223,9 +224,36 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                       "'A Simplified Mechanical Model for Rocking Structures on Compliant Foundations'; "
                       "tensionless Winkler bed (Psycharis & Jennings 1983; Chopra & Yim 1985)",
         "winkler_bed": config.bed,
+        "restitution": str(config.restitution),
+        "restitution_band": json.dumps(list(config.restitution_band)),
         "vertical": VERTICAL_APPLIED if vertical_applied else VERTICAL_NOT_APPLIED,
     }
     return dataset
+
+
+CALIBRATION_VARIABLES = {
+    "restitution_requested": "effective restitution of free rocking asked of the bed (restitution band or target)",
+    "restitution_target": "effective restitution the bed's damping is calibrated to (the requested one, or the "
+                          "nearest the bed reaches)",
+    "damping_ratio_calibrated": "damping ratio xi of the bed calibrated to the restitution target",
+}
+
+
+def _calibration_variables(calibration, model_names, shape) -> dict:
+    """The bed models' restitution targets and calibrated damping per (soil, block, model); NaN elsewhere."""
+    if calibration is None:
+        return {}
+    arrays = {name: np.full((*shape, len(model_names)), np.nan) for name in CALIBRATION_VARIABLES}
+    for v, model in enumerate(calibration.variants):
+        m = model_names.index(model)
+        arrays["restitution_requested"][..., m] = calibration.requested[..., v]
+        arrays["restitution_target"][..., m] = calibration.target[..., v]
+        arrays["damping_ratio_calibrated"][..., m] = calibration.xi[..., v]
+    out = {name: (("soil", "block", "model"), arrays[name], {"long_name": long_name, "units": "1"})
+           for name, long_name in CALIBRATION_VARIABLES.items()}
+    out["restitution_reachable"] = (("soil", "block", "bound"), calibration.reachable, {
+        "long_name": "lowest and highest effective restitution the bed's calibrated law reaches", "units": "1"})
+    return out
 
 
 def _vertical_variables(records, verticals, applied, g_factor, acceleration_units) -> tuple[tuple, dict]:

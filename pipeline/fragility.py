@@ -70,6 +70,7 @@ from pipeline.lognormal_fit import (  # noqa: F401
 )
 from pipeline.measures import MEASURES, convert_units, parse_units, udunits, unit_label
 from pipeline.models import MODELS
+from pipeline.models.variants import BAND_ROLES, split_variant
 from pipeline.outputs import atomic_path, write_dataset
 from pipeline.risk import risk_dataset
 from pipeline.units import STANDARD_GRAVITY
@@ -537,7 +538,7 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
                    "outcome_class": ["no_uplift", "rocking", "overturned"],
                    "intensity": (("block", "im_level"), intensity, {
                        "long_name": f"intensity of each level ({measure})", "units": unit})})
-    dataset = xr.Dataset(data_vars, coords=coords)
+    dataset = with_recommended(xr.Dataset(data_vars, coords=coords))
     warnings = warning_summary(dataset)
     dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag lognormal fragility functions",
                      "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", ""),
@@ -551,6 +552,100 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
                      "references": "Baker (2015) Efficient analytical fragility function fitting using "
                                    "dynamic structural analysis. Earthquake Spectra 31(1)"}
     return dataset
+
+
+# ---------------------------------------------------------------- the recommended curve
+
+RECOMMENDED = "recommended"
+"""The model coordinate of the recommended curves: the admissible bed model over its restitution band."""
+BAND_COMBINATION = (
+    "recommended = the admissible tensionless-bed model over the restitution band (pipeline.models.variants): "
+    "median and beta_record_to_record are the band centre's fit; beta_model is the spread of the median over "
+    "the band, taken as uniform in ln(median) between the edges' medians: |ln(m_high / m_low)| / (2 sqrt(3)); "
+    "beta = sqrt(beta_record_to_record^2 + beta_model^2) (FEMA P-58's combination of record-to-record and "
+    "modelling dispersions). mixture_gap is the largest difference, over the studied range, between this "
+    "lognormal and the equal-weight mixture of the three variants' curves.")
+UNIFORM_SPREAD = 2.0 * np.sqrt(3.0)  # the standard deviation of a uniform variable is its range / (2 sqrt 3)
+
+
+def band_models(models: list[str]) -> dict[str, str] | None:
+    """{role: model name} of the first bed model with all three band variants in ``models``, else None."""
+    by_base = {}
+    for name in models:
+        base, role = split_variant(name)
+        if role is not None:
+            by_base.setdefault(base, {})[role] = name
+    return next((roles for roles in by_base.values() if set(roles) == set(BAND_ROLES)), None)
+
+
+def _band_dispersion(low: np.ndarray, centre: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """beta_model from the band's medians: the edges' spread; one edge missing: twice its distance to the centre."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        both = np.abs(np.log(high / low)) / UNIFORM_SPREAD
+        one = 2.0 * np.abs(np.log(np.where(np.isfinite(low), low, high) / centre)) / UNIFORM_SPREAD
+    return np.where(np.isfinite(low) & np.isfinite(high), both, one)
+
+
+def _mixture_gap(dataset: xr.Dataset, band: dict, median, beta) -> np.ndarray:
+    """Max |lognormal(median, beta) - mean of the band's three curves| over each block's studied range."""
+    grid = np.geomspace(dataset.studied_im_min.values, dataset.studied_im_max.values, 200)  # (point, block)
+    x = grid[:, None, :, None]  # (point, soil, block, state)
+    curves = [lognormal_cdf(x, dataset["median"].sel(model=name).values[None],
+                            dataset.beta.sel(model=name).values[None]) for name in band.values()]
+    with np.errstate(invalid="ignore"):
+        gap = np.abs(lognormal_cdf(x, median[None], beta[None]) - np.mean(curves, axis=0))
+    return np.where(np.isfinite(median), np.nanmax(np.where(np.isfinite(gap), gap, -np.inf), axis=0), np.nan)
+
+
+def with_recommended(dataset: xr.Dataset) -> xr.Dataset:
+    """The fits with the recommended rows first (model ``recommended``) and the beta split on every row.
+
+    Every row gains ``beta_record_to_record`` and ``beta_model`` (for a single model: its fitted beta and 0);
+    with a restitution band the recommended rows combine its three variants (``BAND_COMBINATION``). Without a
+    band the dataset only gains the two columns.
+    """
+    dataset = dataset.assign(
+        beta_record_to_record=dataset.beta.assign_attrs(
+            long_name="record-to-record dispersion: the fitted lognormal beta"),
+        beta_model=xr.zeros_like(dataset.beta).where(np.isfinite(dataset.beta)).assign_attrs(
+            long_name="model dispersion over the restitution band (0: a single model)", units="1"))
+    band = band_models([str(m) for m in dataset.model.values])
+    if band is None:
+        return dataset
+    per_model = [name for name in dataset.data_vars if "model" in dataset[name].dims]
+    centre = dataset[per_model].sel(model=band["centre"])
+    medians = {role: dataset["median"].sel(model=name).values for role, name in band.items()}
+    beta_model = _band_dispersion(medians["low"], medians["centre"], medians["high"])
+    beta_model = np.where(np.isfinite(medians["centre"]), beta_model, np.nan)
+    beta_rtr = centre.beta.values
+    known = np.isfinite(beta_model)
+    beta = np.where(known, np.sqrt(beta_rtr ** 2 + np.where(known, beta_model, 0.0) ** 2), beta_rtr)
+    warning = np.where(np.isfinite(medians["centre"]) & ~known,
+                       "neither edge of the restitution band reached the state in the studied range: beta_model "
+                       "unknown, beta is the record-to-record part only", "")
+    row = centre.copy()
+    row["beta"] = (centre.beta.dims, beta, dataset.beta.attrs)
+    row["beta_record_to_record"] = (centre.beta.dims, beta_rtr, dataset.beta_record_to_record.attrs)
+    row["beta_model"] = (centre.beta.dims, beta_model, dataset.beta_model.attrs)
+    for name in ("beta_low", "beta_high"):  # the bootstrap bounds are of a single model's beta
+        row[name] = row[name].where(False)
+    row["fit_method"] = row.fit_method.where(~np.isfinite(centre["median"]), "band-centre-p58")
+    row["fit_warning"] = (centre.fit_warning.dims, np.array(
+        ["; ".join(part for part in (str(a), str(b)) if part) for a, b in
+         zip(centre.fit_warning.values.ravel(), warning.ravel())]).reshape(warning.shape))
+    row = row.expand_dims(model=[RECOMMENDED])
+    if "model_label" in dataset.coords:
+        row = row.assign_coords(model_label=("model", ["recommended: tensionless bed over the restitution band"]))
+    combined = xr.concat([row, dataset[per_model]], dim="model", data_vars="all", coords="minimal",
+                         compat="override", join="override")
+    combined = combined.merge(dataset.drop_vars(per_model).drop_dims("model", errors="ignore"), compat="override")
+    gap = np.full(combined.beta.shape, np.nan)
+    gap[0] = _mixture_gap(dataset, band, medians["centre"], beta)
+    combined["mixture_gap"] = (combined.beta.dims, gap, {
+        "long_name": "recommended rows: largest |P(lognormal) - P(mixture of the band's three curves)| over the "
+                     "studied range", "units": "1"})
+    combined.attrs["recommended"] = BAND_COMBINATION
+    return combined
 
 
 def warning_summary(dataset: xr.Dataset) -> list[str]:
@@ -602,7 +697,8 @@ def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
     return stacked.transpose("outcome_class", "im_level", "soil", "block", "model")
 
 
-TABLE_COLUMNS = ["median", "beta", "status", "extrapolated", "fit_method", "median_low", "median_high", "beta_low",
+TABLE_COLUMNS = ["median", "beta", "beta_record_to_record", "beta_model", "status", "extrapolated", "fit_method",
+                 "median_low", "median_high", "beta_low",
                  "beta_high", "gof_p_value", "gof_max_error", "noncrossing_deviance_cost", "capacity_median",
                  "capacity_beta", "fit_warning"]
 

@@ -51,9 +51,10 @@ from pipeline.executors import check_workers, make_executor, pool_executor, run_
 from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
 from pipeline.locking import output_lock
 from pipeline.measures import MEASURES, pga
-from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, get_model, simulate_batch
+from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, calibrated_law, get_model, simulate_batch
 from pipeline.models.base import Outcome
 from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
+from pipeline.models.variants import BandCalibration, calibrate_models, split_variant
 from pipeline.outputs import write_dataset
 from pipeline.processing import ProcessingRecipe, load_recipe, process_records
 from pipeline.records import Record, group_components, load_records, split_vertical
@@ -204,9 +205,11 @@ def cells_for_record(record, config, recipe, block_scales=None, vertical=None) -
             if get_model(model).is_rigid_base:
                 cells.append(Cell(_hash({**common, "block": block_spec, "model": model}), block_index, None, model))
                 continue
+            dissipation = restitution_key(config, model)
             for soil_index, soil in enumerate(config.soils):
                 soil_spec = {k: v for k, v in asdict(soil).items() if k not in ("name", "description")}
-                cells.append(Cell(_hash({**common, "block": block_spec, "soil": soil_spec, "model": model}),
+                cells.append(Cell(_hash({**common, "block": block_spec, "soil": soil_spec, "model": model,
+                                         **dissipation}),
                                   block_index, soil_index, model))
     return cells
 
@@ -223,9 +226,51 @@ def vertical_key(record, vertical, applied) -> dict:
             "window": [str(stats.starttime), int(stats.npts), float(stats.delta)]}
 
 
+def restitution_key(config, model) -> dict:
+    """The part of a bed model's checkpoint key that says how its damping is set (empty: the soil's xi)."""
+    if not (config.calibrates_bed and get_model(model).uses_bed):
+        return {}
+    role = split_variant(model)[1]
+    return {"restitution": config.restitution, "band": list(config.restitution_band) if role else None}
+
+
 def solver_options(config) -> dict:
-    """The study's solver settings as ``simulate_batch`` keywords (pipeline.models.SolverOptions)."""
-    return {"switch": config.switch, "bed": config.bed, "overturn_angle": config.overturn_angle}
+    """The study's solver settings as ``simulate_batch`` keywords (pipeline.models.SolverOptions).
+
+    With a restitution target the bed runs the law its damping was calibrated with
+    (``restitution.calibrated_law``: the continuous bed takes Hunt-Crossley damping).
+    """
+    bed = calibrated_law(config.bed) if config.calibrates_bed else config.bed
+    return {"switch": config.switch, "bed": bed, "overturn_angle": config.overturn_angle}
+
+
+def bed_calibration(config, stiffness) -> BandCalibration | None:
+    """The calibrated damping of every bed model on every (soil, block), or None without a restitution target.
+
+    A band variant whose target the bed cannot reach runs at the nearest reachable one; the study lists
+    those (``calibration_lines``) and the cube keeps both (pipeline.models.variants).
+    """
+    models = [name for name in config.models if get_model(name).uses_bed]
+    if not (config.calibrates_bed and models):
+        return None
+    return calibrate_models(list(config.blocks), [soil.name for soil in config.soils], stiffness, models,
+                            config.restitution, config.restitution_band, config.bed)
+
+
+def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
+    """One line per (block, variant) whose band target was moved into the bed's reachable range."""
+    if calibration is None:
+        return []
+    lines = []
+    for b, block in enumerate(config.blocks):
+        for v, model in enumerate(calibration.variants):
+            moved = [s for s in range(len(config.soils)) if calibration.moved[s, b, v]]
+            if moved:
+                where = ", ".join(f"{config.soils[s].name} {calibration.target[s, b, v]:.3f}" for s in moved)
+                lines.append(f"rockfrag: {model}, block {block.name}: the bed cannot reach the band's "
+                             f"r = {calibration.requested[moved[0], b, v]:.3f}; it runs at the nearest r it reaches "
+                             f"({where})")
+    return lines
 
 
 def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0, ag_vertical=None):
@@ -240,7 +285,7 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
     t_end = (acceleration.size - 1) * dt + tail
     by_model = {}
     for key, model, block, k, xi in jobs:
-        by_model.setdefault(model, []).append((key, block, k, xi))
+        by_model.setdefault(get_model(model).name, []).append((key, block, k, xi))
     for model, group in by_model.items():
         summaries = simulate_batch(model, acceleration, dt, scales, [(b, k, xi) for _, b, k, xi in group],
                                    ag_vertical=ag_vertical, t_end=t_end, **options)
@@ -253,11 +298,11 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
     return results
 
 
-def _warm_up(models):
+def _warm_up(models, options):
     """Compile (or load from the on-disk cache) the kernels once before starting workers."""
     block = Block(name="warm-up", R=1.0, alpha=0.2, mass=1.0)
-    for model in models:
-        simulate_batch(model, np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)])
+    for model in {get_model(name).name for name in models}:
+        simulate_batch(model, np.zeros(3), 0.01, [1.0], [(block, 1e4, 0.05)], **options)
 
 
 @dataclass(frozen=True)
@@ -463,6 +508,9 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     scale_factors = study_scale_factors(intensity, record_im)
     resolution = config.capacity_resolution
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
+    calibration = bed_calibration(config, stiffness)
+    for line in calibration_lines(config, calibration):
+        warn(line)
 
     n_levels = len(config.levels)
     store = CheckpointStore(output / ".checkpoints", log=warn)
@@ -476,7 +524,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     if resolution > 0:
         results.update(store.load_verified([capacity_key(k, resolution) for k in keys], (4,), np.float64))
     tasks = [(*task, variant) for variant in variants
-             for task in block_tasks(all_cells[variant], results, config, stiffness, resolution)]
+             for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration)]
     n_cells = len(keys)
     n_missing = sum(len(task[2]) for task in tasks)
     runs_total = n_missing * n_levels
@@ -487,7 +535,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
     lost = []
     if tasks:
-        _warm_up(config.models)
+        _warm_up(config.models, solver_options(config))
         with tqdm(total=runs_total, unit="run", desc="study", disable=not progress, smoothing=0.1) as bar:
             def keep_result(task, computed):
                 for key, summary in computed.items():
@@ -535,6 +583,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                 f"({stats['runs_saved_fraction']:.0%} saved)")
         cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
+                                     calibration=calibration,
                                      verticals=verticals, vertical_applied=variant), stats)
     dataset, capacity_stats = cubes[variants[0]]
     if config.vertical:  # the comparison first: a cube.nc on disk always has its comparison beside it
@@ -566,12 +615,19 @@ def _gather_summaries(all_cells, results, config, n_records, n_levels) -> np.nda
     return summaries
 
 
-def block_tasks(all_cells, available, config, stiffness, resolution) -> list:
+def block_tasks(all_cells, available, config, stiffness, resolution, calibration=None) -> list:
     """(record index, block index, jobs) for every record and block with cells still to run.
 
     Cells still to run are those not in ``available``, the verified checkpoints; a job is
-    (key, model, block, k, xi). Grouped by block because scale factors are per block.
+    (key, model, block, k, xi), xi the soil's damping ratio or, for a bed model with a restitution target,
+    its calibrated one (``calibration``, a ``BandCalibration``). Grouped by block because scale factors are
+    per block.
     """
+    def damping(cell):
+        if calibration is not None and cell.model in calibration.variants:
+            return float(calibration.xi[cell.soil_index, cell.block_index, calibration.variants.index(cell.model)])
+        return config.soils[cell.soil_index].damping_ratio
+
     tasks = []
     for index, cells in enumerate(all_cells):
         by_block = {}
@@ -582,7 +638,7 @@ def block_tasks(all_cells, available, config, stiffness, resolution) -> list:
         for block_index, missing in by_block.items():
             jobs = [(c.key, c.model, config.blocks[c.block_index],
                      None if c.soil_index is None else stiffness[c.soil_index, c.block_index],
-                     None if c.soil_index is None else config.soils[c.soil_index].damping_ratio)
+                     None if c.soil_index is None else damping(c))
                     for c in missing]
             tasks.append((index, block_index, jobs))
     return tasks

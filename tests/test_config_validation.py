@@ -156,14 +156,14 @@ def test_selector_mixes_presets_and_custom_blocks_in_its_order(tmp_path):
 
 
 def test_new_keys_reach_the_config(tmp_path):
-    config = _study(tmp_path, '[solver]\nbed = "two-spring"\n[study]\nunits = "gal"\ndt = 0.005\n'
+    config = _study(tmp_path, '[solver]\nbed = "continuous"\n[study]\nunits = "gal"\ndt = 0.005\n'
                               '[applicability]\nn_g = 5\nlevels = [2.0]\n'
                               '[intensity]\nlevels = { start = 0.5, stop = 6, count = 30, relative_to = "uplift" }\n')
-    assert config.bed == "two-spring" and config.record_units == "gal" and config.record_dt == 0.005
+    assert config.bed == "continuous" and config.record_units == "gal" and config.record_dt == 0.005
     assert config.applicability.n_g == 5 and config.applicability.levels == (2.0,)
     assert config.applicability.tolerance == 0.10  # the default where the table is silent
     assert config.levels_relative_to == "uplift" and len(config.levels) == 30
-    assert load_study().bed == "continuous"
+    assert load_study().bed == "two-spring"
 
 
 def test_custom_damage_state_is_accepted(tmp_path):

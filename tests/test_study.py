@@ -68,7 +68,8 @@ def test_default_study_matches_the_issue():
     config = load_study()
     assert len(config.levels) == 28 and config.measure == "pga"
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
-    assert config.models == ("housner", "ssi", "winkler") and len(config.blocks) == 3
+    assert config.models == ("housner", "ssi", "winkler-low", "winkler-centre", "winkler-high")
+    assert config.restitution == "band" and len(config.blocks) == 3
     paper = config.blocks[0]
     assert paper.R == 9.39 and paper.alpha == 0.44
     # levels are multiples of each block's uplift intensity: from below uplift to far above it

@@ -43,6 +43,7 @@ from pipeline.models.options import (  # noqa: F401  (the API)
     case_record,
 )
 from pipeline.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
+from pipeline.models.variants import BAND_LABELS, split_variant
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import did_you_mean
 
@@ -58,12 +59,27 @@ def register(model: RockingModel) -> None:
 
 
 def get_model(name: str) -> RockingModel:
-    """The registered model called ``name``; a ``SolverError`` listing the valid names otherwise."""
+    """The registered model called ``name``; a ``SolverError`` listing the valid names otherwise.
+
+    A band variant of a bed model (``winkler-low``, ``winkler-centre``, ``winkler-high``;
+    pipeline.models.variants) is that model: the variant only sets its restitution target.
+    """
+    model, role = split_variant(name) if isinstance(name, str) else (name, None)
     try:
-        return MODELS[name]
+        spec = MODELS[model]
     except (KeyError, TypeError):
         raise SolverError(f"unknown model {name!r}{did_you_mean(name, MODELS)}; valid models are: "
                           f"{', '.join(MODELS)}") from None
+    if role is not None and not spec.uses_bed:
+        raise SolverError(f"unknown model {name!r}: only a bed model has restitution-band variants")
+    return spec
+
+
+def model_label(name: str) -> str:
+    """A model's label for tables and plots; a band variant's says its place in the band."""
+    model, role = split_variant(name)
+    label = get_model(name).label
+    return f"{label}, {BAND_LABELS[role]}" if role else label
 
 
 def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options=SolverOptions()):

@@ -1,0 +1,158 @@
+"""pipeline.models.variants - a bed model run at the edges and centre of a restitution band.
+
+Input : a registered bed model (``winkler``), the band's edges as multiples of Housner's restitution
+        (``[solver] restitution_band``), the blocks, their bed stiffnesses K [N/m] per soil and the bed law.
+Output: the variant names (``winkler-low``, ``winkler-centre``, ``winkler-high``; ``band_variants``), the
+        model a variant runs (``split_variant``), and per (soil, block) the requested target, the target used
+        and the calibrated damping ratio xi of each variant (``calibrate_models``).
+
+Why a band: the restitution of a real block's impacts is measured, not free. Experiments on rigid bases
+(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollar 2017) find real blocks lose about as much as
+Housner predicts, or a few percent less; the band runs the admissible model from Housner's value
+r_H = 1 - 1.5 sin^2(alpha) to min(1.05 r_H, 0.99) and its spread is the model uncertainty of the recommended
+fragility (pipeline.fragility). The centre is the arithmetic middle of the two edges.
+
+Where a bed cannot reach an edge (``restitution.reachable_range``: a stiff two-spring bed stays within
+0.5% of Housner's value; the squat skid's bed never dissipates as much as Housner's formula for alpha 0.64),
+the target used is the nearest end of the reachable range. This is the one place a target is moved: a
+``simulate(..., restitution=r)`` call still refuses an unreachable r. Each moved target is written beside
+the requested one in the cube (``restitution_requested``, ``restitution_target``) and listed by the study.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pipeline.blocks import Block
+from pipeline.errors import SolverError
+from pipeline.models.restitution import calibrate_dissipation, calibrated_law, reachable_range, restitution_target
+from pipeline.units import STANDARD_GRAVITY
+
+BAND_ROLES = {"low": 0.0, "centre": 0.5, "high": 1.0}
+"""A variant's position in the band, from the low edge (Housner's value) to the high edge."""
+BAND_LABELS = {"low": "band low edge", "centre": "band centre", "high": "band high edge"}
+RESTITUTION_CAP = 0.99
+"""The band's edges are capped here: r = 1 would be a block that never loses energy at an impact."""
+DEFAULT_BAND = (1.0, 1.05)
+"""The band's edges as multiples of Housner's r (the experimental range on rigid bases)."""
+
+
+def variant_name(model: str, role: str) -> str:
+    """The name of ``model`` run at a band position: ``winkler-low``, ``winkler-centre``, ``winkler-high``."""
+    return f"{model}-{role}"
+
+
+def split_variant(name: str) -> tuple[str, str | None]:
+    """(model, role) of a variant name; (name, None) for a name that is not a variant."""
+    model, _, role = str(name).rpartition("-")
+    return (model, role) if model and role in BAND_ROLES else (str(name), None)
+
+
+def band_variants(model: str) -> list[str]:
+    """The variants of ``model`` a band runs, low edge first."""
+    return [variant_name(model, role) for role in BAND_ROLES]
+
+
+def band_target(block: Block, band: tuple[float, float], role: str) -> float:
+    """The restitution a variant asks for [-]: its position between the edges, each edge capped at 0.99.
+
+    Parameters
+    ----------
+    block : Block
+        The block (Housner's r from its alpha).
+    band : (float, float)
+        The edges as multiples of Housner's r.
+    role : str
+        ``low``, ``centre`` or ``high``.
+
+    Returns
+    -------
+    float
+        The requested effective restitution [-].
+    """
+    housner = block.housner_restitution()
+    low, high = (min(factor * housner, RESTITUTION_CAP) for factor in band)
+    return low + BAND_ROLES[role] * (high - low)
+
+
+@dataclass(frozen=True)
+class BandCalibration:
+    """Per (soil, block, variant): the requested restitution, the one used, and the calibrated xi [-].
+
+    Arrays of shape (n_soil, n_block, n_variant), variants in ``variants`` order.
+    """
+
+    variants: tuple[str, ...]
+    law: str
+    requested: np.ndarray
+    target: np.ndarray
+    xi: np.ndarray
+    reachable: np.ndarray  # (n_soil, n_block, 2): the bed's reachable range [-]
+
+    @property
+    def moved(self) -> np.ndarray:
+        """True where the target used differs from the requested one (outside the reachable range)."""
+        return ~np.isclose(self.requested, self.target, rtol=0, atol=1e-12)
+
+
+def calibrate_models(blocks: list[Block], soil_names: list[str], stiffness: np.ndarray, models: list[str],
+                     restitution: str | float, band: tuple[float, float], bed: str,
+                     g: float = STANDARD_GRAVITY) -> BandCalibration:
+    """Calibrate the bed's damping of every bed model (or band variant) on every (soil, block).
+
+    Parameters
+    ----------
+    blocks : list of Block
+        The study's blocks.
+    soil_names : list of str
+        The soils' names (for errors).
+    stiffness : ndarray, shape (n_soil, n_block)
+        The bed's total vertical stiffness K [N/m] of each soil under each block (eq. 19).
+    models : list of str
+        The bed models to calibrate: band variants (``band_variants``) or plain bed models.
+    restitution : str or float
+        ``[solver] restitution``: a plain bed model takes this target ("housner" or a number) and refuses it
+        where the bed cannot reach it; a band variant takes its place in ``band`` (moved into reach).
+    band : (float, float)
+        The band's edges as multiples of Housner's r.
+    bed : str
+        The bed law of the study (``[solver] bed``); calibrated with ``calibrated_law(bed)``.
+    g : float
+        Gravity [m/s^2].
+
+    Returns
+    -------
+    BandCalibration
+        Requested and used targets, calibrated xi and the reachable range of each cell.
+
+    Raises
+    ------
+    SolverError
+        A plain target the bed cannot reach on a (soil, block): the message names both and the range.
+    """
+    n_soil, n_block = stiffness.shape
+    shape = (n_soil, n_block, len(models))
+    requested, target, xi = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
+    reachable = np.full((n_soil, n_block, 2), np.nan)
+    for s in range(n_soil):
+        for b, block in enumerate(blocks):
+            k = float(stiffness[s, b])
+            low, high = reachable_range(block, k, bed, g)
+            reachable[s, b] = low, high
+            for v, name in enumerate(models):
+                role = split_variant(name)[1]
+                if role is None:
+                    wanted = used = restitution_target(block, restitution)
+                else:
+                    wanted = band_target(block, band, role)
+                    used = wanted if not math.isfinite(low) else min(max(wanted, low), high)
+                requested[s, b, v], target[s, b, v] = wanted, used
+                try:
+                    xi[s, b, v] = calibrate_dissipation(block, k, bed, used, g=g)
+                except SolverError as error:
+                    raise SolverError(f"block {block.name!r} on soil {soil_names[s]!r} (K = {k:.3g} N/m), "
+                                      f"model {name!r}: {error}") from None
+    return BandCalibration(tuple(models), calibrated_law(bed), requested, target, xi, reachable)
