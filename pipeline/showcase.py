@@ -28,6 +28,7 @@ from pipeline import __version__
 from pipeline.errors import ConfigError, PipelineError
 from pipeline.measures import intensity_measures, response_spectrum, significant_window
 from pipeline.models import get_model, simulate
+from pipeline.models.variants import calibrate_models
 from pipeline.outputs import write_dataset
 from pipeline.processing import integrate, process_record
 from pipeline.records import load_records
@@ -132,10 +133,16 @@ def simulate_cases(config, block, record):
         options = {}
         if soil is not None:
             options = dict(k=soil_block_stiffness(soil, block), xi=soil.damping_ratio)
+        if soil is not None and config.calibrates_bed and get_model(name).uses_bed:  # as the study runs it
+            calibration = calibrate_models([block], [soil.name], np.array([[options["k"]]]), [name],
+                                           config.restitution, config.restitution_band, config.bed)
+            options.update(xi=float(calibration.xi[0, 0, 0]), bed=calibration.law)
+        else:
+            options["bed"] = config.bed
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # tension is recorded below, not warned about
-            result = simulate(name, record.acceleration, record.dt, block, switch=config.switch, t_end=t_end,
-                              overturn_angle=config.overturn_angle, **options)
+            result = simulate(get_model(name).name, record.acceleration, record.dt, block, switch=config.switch,
+                              t_end=t_end, overturn_angle=config.overturn_angle, **options)
         time = result.t if time is None or result.t.size > time.size else time
         thetas.append(result.theta)
         if soil is None:

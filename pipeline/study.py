@@ -287,14 +287,20 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
     for key, model, block, k, xi in jobs:
         by_model.setdefault(get_model(model).name, []).append((key, block, k, xi))
     for model, group in by_model.items():
-        summaries = simulate_batch(model, acceleration, dt, scales, [(b, k, xi) for _, b, k, xi in group],
-                                   ag_vertical=ag_vertical, t_end=t_end, **options)
-        for (key, *_), summary in zip(group, summaries):
-            results[key] = summary
+        # band variants whose targets the bed reaches at the same xi (moved to one end of its range) run once
+        cases = list(dict.fromkeys((b, k, xi) for _, b, k, xi in group))
+        summaries = dict(zip(cases, simulate_batch(model, acceleration, dt, scales, cases, ag_vertical=ag_vertical,
+                                                   t_end=t_end, **options)))
+        for key, b, k, xi in group:
+            results[key] = summaries[(b, k, xi)]
     if capacity_resolution > 0:
-        for job in jobs:
-            results[capacity_key(job[0], capacity_resolution)] = cell_capacity(
-                acceleration, dt, scales, results[job[0]], job, options, t_end, capacity_resolution, ag_vertical)
+        refined = {}
+        for key, model, block, k, xi in jobs:
+            case = (get_model(model).name, block, k, xi)
+            if case not in refined:
+                refined[case] = cell_capacity(acceleration, dt, scales, results[key], (key, *case), options, t_end,
+                                              capacity_resolution, ag_vertical)
+            results[capacity_key(key, capacity_resolution)] = refined[case]
     return results
 
 

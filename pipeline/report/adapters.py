@@ -16,9 +16,10 @@ import numpy as np
 import pandas as pd
 
 from pipeline.damage_states import DAMAGE_STATES
+from pipeline.errors import SolverError
 from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
 from pipeline.measures import short_label as measure_short_label
-from pipeline.models import MODELS
+from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
 
@@ -56,10 +57,11 @@ class ModelInfo:
 
 def model_info(name: str) -> ModelInfo:
     """Label and role of a model from the registry (a model no longer registered keeps its name)."""
-    model = MODELS.get(name)
-    if model is None:
+    try:
+        model = get_model(name)  # a registered model or a restitution-band variant of one
+    except SolverError:  # e.g. the fragility's "recommended" rows, or a model no longer registered
         return ModelInfo(name, name, False, "")
-    label = model.label or f"{name}: {model.description.split(';')[0]}"
+    label = model_label(name) if model.label else f"{name}: {model.description.split(';')[0]}"
     return ModelInfo(name, label, model.is_rigid_base, model.description, model.can_pull, model.uses_bed)
 
 
