@@ -54,7 +54,7 @@ from pipeline.measures import MEASURES, pga
 from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, calibrated_law, get_model, simulate_batch
 from pipeline.models.base import Outcome
 from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
-from pipeline.models.variants import BandCalibration, calibrate_models, split_variant
+from pipeline.models.variants import BAND_XI_FLOOR, BandCalibration, calibrate_models, split_variant
 from pipeline.outputs import write_dataset
 from pipeline.processing import ProcessingRecipe, load_recipe, process_records
 from pipeline.records import Record, group_components, load_records, split_vertical
@@ -265,11 +265,18 @@ def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
     for b, block in enumerate(config.blocks):
         for v, model in enumerate(calibration.variants):
             moved = [s for s in range(len(config.soils)) if calibration.moved[s, b, v]]
+            unmeasurable = [config.soils[s].name for s in moved if not np.isfinite(calibration.target[s, b, v])]
+            moved = [s for s in moved if np.isfinite(calibration.target[s, b, v])]
+            wanted = calibration.requested[0, b, v]
             if moved:
                 where = ", ".join(f"{config.soils[s].name} {calibration.target[s, b, v]:.3f}" for s in moved)
-                lines.append(f"rockfrag: {model}, block {block.name}: the bed cannot reach the band's "
-                             f"r = {calibration.requested[moved[0], b, v]:.3f}; it runs at the nearest r it reaches "
-                             f"({where})")
+                lines.append(f"rockfrag: {model}, block {block.name}: the bed (xi >= {BAND_XI_FLOOR}) cannot reach "
+                             f"the band's r = {wanted:.3f}; it runs at the nearest r it reaches ({where})")
+            if unmeasurable:
+                lines.append(f"rockfrag: {model}, block {block.name}: free rocking on {', '.join(unmeasurable)} loses "
+                             f"more at every xi >= {BAND_XI_FLOOR} than the restitution measure resolves (at least "
+                             f"about Housner's r = {block.housner_restitution():.3f}); it runs at xi = "
+                             f"{BAND_XI_FLOOR}")
     return lines
 
 

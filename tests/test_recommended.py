@@ -21,6 +21,7 @@ from pipeline.fragility import RECOMMENDED, fragility_dataset, fragility_table
 from pipeline.models import get_model, model_label
 from pipeline.models.restitution import free_rocking_restitution
 from pipeline.models.variants import (
+    BAND_XI_FLOOR,
     RESTITUTION_CAP,
     band_target,
     band_variants,
@@ -81,7 +82,8 @@ def test_reachable_band_targets_are_hit_by_free_rocking_within_one_percent():
     stiffness = _stiffness(PAPER, ["clay", "rock"])
     calibration = calibrate_models([PAPER], ["clay", "rock"], stiffness, band_variants("winkler"), "band",
                                    (1.0, 1.05), "two-spring")
-    assert not calibration.moved.any()  # the paper block's bed reaches the whole band on clay and rock
+    assert not calibration.moved[0].any()  # on clay the paper block's bed reaches the whole band ...
+    assert calibration.moved[1].tolist() == [[False, True, True]]  # ... on rock only Housner's value
     for s in range(2):
         for v in range(3):
             measured = free_rocking_restitution(PAPER, float(stiffness[s, 0]), "two-spring",
@@ -96,8 +98,24 @@ def test_a_band_edge_the_bed_cannot_reach_runs_at_the_nearest_reachable_r_and_sa
     low, high = calibration.reachable[0, 0]
     assert calibration.requested[0, 0, 2] == pytest.approx(1.05 * CABINET.housner_restitution())
     assert calibration.requested[0, 0, 2] > high  # a stiff two-spring bed stays near Housner's value
+    assert high == pytest.approx(CABINET.housner_restitution(), abs=0.005)
     assert calibration.target[0, 0, 2] == pytest.approx(high)
     assert calibration.moved[0, 0].tolist() == [False, True, True]
+    assert calibration.xi.min() >= BAND_XI_FLOOR  # not the bouncing regime below it
+    # the bed really rocks at the target it says it runs at
+    assert free_rocking_restitution(CABINET, float(stiffness[0, 0]), "two-spring", float(calibration.xi[0, 0, 2])) \
+        == pytest.approx(calibration.target[0, 0, 2], rel=0.01)
+
+
+def test_a_squat_block_whose_restitution_the_measure_cannot_resolve_runs_at_the_floor_with_a_nan_target():
+    skid = Block(name="skid", b=1.5, h=2.0, mass=30000.0, E_b=30e9, footprint_area=6.0, soil_depth=1.5)
+    stiffness = _stiffness(skid, ["clay"])
+    calibration = calibrate_models([skid], ["clay"], stiffness, band_variants("winkler"), "band", (1.0, 1.05),
+                                   "two-spring")
+    assert np.isnan(calibration.target).all() and calibration.moved.all()
+    assert np.all(calibration.xi == BAND_XI_FLOOR)
+    # at that xi the free rocking really decays below the measure's floor: fewer than two peaks above 0.1 alpha
+    assert np.isnan(free_rocking_restitution(skid, float(stiffness[0, 0]), "two-spring", BAND_XI_FLOOR))
 
 
 def test_a_single_target_the_bed_cannot_reach_is_an_error_naming_block_and_soil():

@@ -193,18 +193,28 @@ def restitution_grid(block: Block, k: float, law: str, g: float = STANDARD_GRAVI
     return tuple(float(xi) for xi in xis), tuple(free_rocking_restitution(block, k, law, float(xi), g) for xi in xis)
 
 
-def reachable_range(block: Block, k: float, bed: str, g: float = STANDARD_GRAVITY) -> tuple[float, float]:
+def _floored(grid: tuple[tuple, tuple], xi_floor: float | None) -> tuple[tuple, tuple]:
+    """The grid points at xi >= ``xi_floor`` (all of them for None)."""
+    if xi_floor is None:
+        return grid
+    keep = [i for i, xi in enumerate(grid[0]) if xi >= xi_floor]
+    return tuple(grid[0][i] for i in keep), tuple(grid[1][i] for i in keep)
+
+
+def reachable_range(block: Block, k: float, bed: str, g: float = STANDARD_GRAVITY,
+                    xi_floor: float | None = None) -> tuple[float, float]:
     """(lowest, highest) effective restitution [-] that a target on ``bed`` can be calibrated to.
 
-    The span of r over the law's xi grid; (NaN, NaN) when the measure is undefined at every xi.
+    The span of r over the law's xi grid (from ``xi_floor`` up, if given); (NaN, NaN) when the measure is
+    undefined at every xi.
     """
-    _, rs = restitution_grid(block, float(k), calibrated_law(bed), float(g))
+    _, rs = _floored(restitution_grid(block, float(k), calibrated_law(bed), float(g)), xi_floor)
     finite = [r for r in rs if math.isfinite(r)]
     return (min(finite), max(finite)) if finite else (math.nan, math.nan)
 
 
 def calibrate_dissipation(block: Block, k: float, bed: str, restitution: float | str,
-                          g: float = STANDARD_GRAVITY) -> float:
+                          g: float = STANDARD_GRAVITY, xi_floor: float | None = None) -> float:
     """The damping ratio xi [-] of ``calibrated_law(bed)`` that gives free rocking the target restitution.
 
     The calibration of the module docstring, cached per block, k, bed, target and g.
@@ -221,6 +231,9 @@ def calibrate_dissipation(block: Block, k: float, bed: str, restitution: float |
         Target effective restitution [-] (below 1), or "housner" (1 - 1.5 sin^2(alpha)).
     g : float
         Gravity [m/s^2].
+    xi_floor : float, optional
+        Search xi only from this value up (the study's band: below it a block bounces on a stiff bed and r
+        jumps between grid points; pipeline.models.variants).
 
     Returns
     -------
@@ -232,12 +245,14 @@ def calibrate_dissipation(block: Block, k: float, bed: str, restitution: float |
     SolverError
         A target >= 1, or outside the range the law reaches on this bed (the message names the range).
     """
-    return _calibrated(block, float(k), calibrated_law(bed), restitution_target(block, restitution), float(g), bed)
+    return _calibrated(block, float(k), calibrated_law(bed), restitution_target(block, restitution), float(g), bed,
+                       xi_floor)
 
 
 @lru_cache(maxsize=4096)
-def _calibrated(block: Block, k: float, law: str, target: float, g: float, bed: str) -> float:
-    xis, rs = restitution_grid(block, k, law, g)
+def _calibrated(block: Block, k: float, law: str, target: float, g: float, bed: str,
+                xi_floor: float | None = None) -> float:
+    xis, rs = _floored(restitution_grid(block, k, law, g), xi_floor)
     finite = [i for i, r in enumerate(rs) if math.isfinite(r)]
     where = (f"the {bed} bed (law {law}) for block {block.name!r} (K = {k:.4g} N/m, "
              f"omega_v/p = {math.sqrt(k / block.mass) / block.p(g):.0f})")
