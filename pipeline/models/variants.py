@@ -102,9 +102,7 @@ class BandCalibration:
 
     @property
     def moved(self) -> np.ndarray:
-        """True where the target used differs from the requested one (outside the reachable range, or NaN:
-        not measurable).
-        """
+        """True where the target used is not the requested one (outside the reachable range, or NaN)."""
         return ~np.isclose(self.requested, self.target, rtol=0, atol=MOVED_TOLERANCE)
 
 
