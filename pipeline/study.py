@@ -115,6 +115,15 @@ def study_scale_factors(intensity, record_im) -> np.ndarray:
     return intensity.T[None, :, :] / record_im[:, None, :]
 
 
+def refines_capacity(model: str) -> bool:
+    """Whether a model's cells refine their overturning capacities: all but a restitution band's edges.
+
+    The recommended curve is the band centre's fit; the edges give only its model dispersion (from their
+    stripe fits), so their capacity runs would check a curve no output publishes.
+    """
+    return split_variant(model)[1] not in ("low", "high")
+
+
 def capacity_key(key, resolution) -> str:
     """Checkpoint key of a cell's adaptive overturning capacity."""
     return f"{key}-capacity-{resolution:g}"
@@ -303,6 +312,8 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
     if capacity_resolution > 0:
         refined = {}
         for key, model, block, k, xi in jobs:
+            if not refines_capacity(model):
+                continue
             case = (get_model(model).name, block, k, xi)
             if case not in refined:
                 refined[case] = cell_capacity(acceleration, dt, scales, results[key], (key, *case), options, t_end,
@@ -535,7 +546,9 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     keys = [c.key for variant in variants for cells in all_cells[variant] for c in cells]
     results = store.load_verified(keys, (n_levels,), SUMMARY_DTYPE)
     if resolution > 0:
-        results.update(store.load_verified([capacity_key(k, resolution) for k in keys], (4,), np.float64))
+        refining = [c.key for variant in variants for cells in all_cells[variant] for c in cells
+                    if refines_capacity(c.model)]
+        results.update(store.load_verified([capacity_key(k, resolution) for k in refining], (4,), np.float64))
     tasks = [(*task, variant) for variant in variants
              for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration)]
     n_cells = len(keys)
@@ -645,7 +658,8 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
     for index, cells in enumerate(all_cells):
         by_block = {}
         for cell in cells:
-            done = cell.key in available and (resolution <= 0 or capacity_key(cell.key, resolution) in available)
+            done = cell.key in available and (resolution <= 0 or not refines_capacity(cell.model)
+                                              or capacity_key(cell.key, resolution) in available)
             if not done:
                 by_block.setdefault(cell.block_index, []).append(cell)
         for block_index, missing in by_block.items():
@@ -671,15 +685,17 @@ def gather_capacities(all_cells, available, config, intensity, resolution):
     extra = 0
     for r, cells in enumerate(all_cells):
         for cell in cells:
+            if not refines_capacity(cell.model):
+                continue
             result = available[capacity_key(cell.key, resolution)]
             soils = slice(None) if cell.soil_index is None else cell.soil_index
             capacities[:, r, soils, cell.block_index, config.models.index(cell.model)] = result[:, None] \
                 if cell.soil_index is None else result
             extra += int(result[3])
-    n_cells = sum(len(c) for c in all_cells)
+    n_cells = sum(refines_capacity(c.model) for cells in all_cells for c in cells)
     n_levels = intensity.shape[1]
-    uniform = sum(uniform_stripe_runs(intensity[b, 0], intensity[b, -1], resolution)
-                  for cells in all_cells for b in (c.block_index for c in cells))
+    uniform = sum(uniform_stripe_runs(intensity[c.block_index, 0], intensity[c.block_index, -1], resolution)
+                  for cells in all_cells for c in cells if refines_capacity(c.model))
     grid = n_cells * n_levels
     return capacities, {"capacity_runs": extra, "grid_runs": grid, "uniform_runs": uniform,
                         "capacity_resolution": resolution,
