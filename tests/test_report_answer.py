@@ -131,3 +131,24 @@ def test_the_recommended_rows_answer_when_present():
                                           (1e-7, "<0.01%"), (0.9996, ">99%"), (float("nan"), "-")])
 def test_probabilities_are_rounded_to_what_they_support(value, shown):
     assert percent(value) == shown
+
+
+def test_the_study_states_the_limits_and_return_periods(tmp_path):
+    from pipeline.config import load_study
+    from pipeline.errors import ConfigError
+
+    study = tmp_path / "s.toml"
+    study.write_text('[hazard]\nreturn_periods = [100.0, 2475.0]\n[decision]\nmax_probability_in_life = '
+                     '{ overturning = 0.02 }\n')
+    raw = load_study(study).raw
+    assert raw["hazard"]["return_periods"] == [100.0, 2475.0]
+    assert raw["decision"]["max_probability_in_life"] == {"overturning": 0.02, "rocking-0.5": 0.10}  # merged
+    for text, field in (('[decision]\nmax_probability_in_life = { toppling = 0.01 }\n',
+                         "decision.max_probability_in_life.toppling"),
+                        ('[decision]\nmax_probability_in_life = { overturning = 2.0 }\n',
+                         "decision.max_probability_in_life.overturning"),
+                        ('[hazard]\nreturn_periods = [0.5]\n', "hazard.return_periods[0]")):
+        study.write_text(text)
+        with pytest.raises(ConfigError) as error:
+            load_study(study)
+        assert error.value.field == field
