@@ -465,6 +465,16 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
     groups: dict[str, list[SoilAnswer]] = {}
     for soil in answer.soils:
         groups.setdefault(soil.verdict, []).append(soil)
+    def exceeded(soils) -> str:
+        reasons = []
+        for state in dict.fromkeys(r.state for s in soils for r in s.states if r.exceeds):
+            values = [r.probability_in_life for s in soils for r in s.states if r.state == state and r.exceeds]
+            limit = next(r.limit for s in soils for r in s.states if r.state == state)
+            shown = percent(min(values)) if len(values) == 1 else f"{percent(min(values))} to {percent(max(values))}"
+            reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
+                           f"{percent(limit)} limit")
+        return "; ".join(reasons)
+
     parts = []
     for verdict in (CHECK_SLIDING, ANCHOR, NO_ACTION):
         soils = groups.get(verdict, [])
@@ -472,23 +482,15 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
             continue
         where = "on " + _and([s.soil for s in soils])
         if verdict == ANCHOR:
-            reasons = []
-            for state in dict.fromkeys(r.state for s in soils for r in s.states if r.exceeds):
-                values = [r.probability_in_life for s in soils for r in s.states if r.state == state and r.exceeds]
-                limit = next(r.limit for s in soils for r in s.states if r.state == state)
-                shown = percent(min(values)) if len(values) == 1 else \
-                    f"{percent(min(values))} to {percent(max(values))}"
-                reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
-                               f"{percent(limit)} limit")
-            parts.append(f"anchor it {where} ({'; '.join(reasons)})")
+            parts.append(f"anchor it {where} ({exceeded(soils)})")
         elif verdict == CHECK_SLIDING:
             shares = [s.sliding_share for s in soils]
             shown = percent(min(shares)) if len(shares) == 1 else f"{percent(min(shares))} to {percent(max(shares))}"
-            also = " and anchoring it against rocking: its rocking alone exceeds a limit" \
-                if any(r.exceeds for s in soils for r in s.states) else ""
-            parts.append(f"check sliding{also} {where} ({shown} of the runs up to the "
-                         f"{answer.return_periods[-1]:,.0f}-year intensity need more base friction than assumed: the "
-                         "block would slide, which the rocking results do not describe)")
+            text = (f"check sliding {where} ({shown} of the runs up to the {answer.return_periods[-1]:,.0f}-year "
+                    "intensity need more base friction than assumed: the block would slide, which the rocking "
+                    "results do not describe)")
+            rocking = exceeded(soils)
+            parts.append(text + (f", and anchor it against rocking there ({rocking})" if rocking else ""))
         else:
             parts.append(f"no action {where}")
     lead = (f"With the shipped example hazard curve (not this site's: the study must name the site's curve), the "
