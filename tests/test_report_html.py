@@ -72,3 +72,13 @@ def test_every_page_leads_back_to_the_contents_and_sections_have_anchors(small_p
     answers = [body for _, body in sections if "<h2>Answer:" in body]
     assert answers and all("<img" not in body and "<table>" in body for body in answers)  # text, not images
     assert int(contents) == len(answers) + 2  # title, the answer pages, then the contents
+
+
+def test_a_missing_chromium_fails_under_make_test_with_the_install_command(monkeypatch):
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    monkeypatch.setenv(CONSUMERS_REQUIRED, "required")
+    with pytest.raises(pytest.fail.Exception, match=INSTALL):
+        chromium()
+    monkeypatch.delenv(CONSUMERS_REQUIRED)
+    with pytest.raises(pytest.skip.Exception, match=INSTALL):
+        chromium()
