@@ -1,32 +1,56 @@
-"""pipeline.answer - the answer of a study in the terminal: overturning per block and soil.
+"""pipeline.answer - the answer of a study: in the terminal, and on the report's answer pages.
 
 Input : the fragility dataset (``fragility.nc``, with the risk variables of pipeline.risk merged in, as
-        ``fragility_stage`` returns and writes it) and the paths of the main outputs.
-Output: a short text table, one row per block and soil, that ``rockfrag fragility`` prints at its end
-        (``--quiet`` suppresses it): the overturning median of the answer model with its bootstrap
-        bounds and beta, the probability of overturning in the design life when a hazard curve was
-        used, and where the full results are.
+        ``fragility_stage`` returns and writes it) and the paths of the main outputs; for the answer pages
+        also the site's hazard curve (pipeline.hazard), the return periods and the verdict limits of the
+        study (``[hazard] return_periods``, ``[decision]``), the largest recorded intensity of each block
+        and the share of runs that would slide.
+Output: ``answer_table``, a short text table, one row per block and soil, that ``rockfrag fragility``
+        prints at its end (``--quiet`` suppresses it): the overturning median of the answer model with its
+        bootstrap bounds and beta, the probability of overturning in the design life when a hazard curve
+        was used, and where the full results are. ``block_answers``: per block and soil, the intensity at
+        each return period, P(each damage state) there with its band, the annual frequency and the
+        probability in the design life of each state, and the verdict ("anchor", "check sliding",
+        "no action"); ``verdict_sentence`` says it in words (pipeline.report draws it).
 
-The answer model is the first of ``ANSWER_MODELS`` the study ran: ``winkler``, the admissible
-tensionless bed, until a recommended model exists. The median is the fragility's own (the lognormal
-MLE over the stripes, ``median`` in fragility.nc and fragility.csv). Accelerations are shown in g,
-whatever unit the file states them in; other measures keep their unit.
+The answer model is the first of ``ANSWER_MODELS`` the study ran: the ``recommended`` rows (the
+tensionless bed over the experimental restitution band, its model spread in beta) when the fragility
+stage wrote them, else ``winkler``, the admissible tensionless bed. The median is the fragility's own
+(the lognormal MLE over the stripes, ``median`` in fragility.nc and fragility.csv). Accelerations are
+shown in g, whatever unit the file states them in; other measures keep their unit.
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from pipeline.hazard import EXAMPLE_HAZARD
+from pipeline.fragility import RECOMMENDED
+from pipeline.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
+from pipeline.lognormal_fit import lognormal_cdf
+from pipeline.risk import annual_frequency as risk_annual_frequency
+from pipeline.risk import probability_in_life as risk_probability_in_life
 from pipeline.units import STANDARD_GRAVITY
 
-ANSWER_MODELS = ("winkler", "ssi", "ssi-paper", "housner")
+ANSWER_MODELS = (RECOMMENDED, "winkler-centre", "winkler", "ssi", "ssi-paper", "housner")
 """Models the answer is given for, in order of preference: the first one the study ran is used."""
+
+DEFAULT_RETURN_PERIODS = (475.0, 975.0, 2475.0)
+"""Return periods [years] of the answer pages when the study gives none (10%, 5%, 2% in 50 years)."""
+
+DEFAULT_LIMITS = {"overturning": 0.01, "rocking-0.5": 0.10}
+"""``[decision] max_probability_in_life`` when the study gives none (pipeline/defaults.toml says why)."""
+
+DEFAULT_SLIDING_SHARE = 0.10
+"""``[decision] max_sliding_share`` when the study gives none."""
+
+ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT = "anchor", "check sliding", "no action", "no verdict"
+"""The verdicts of the answer pages (NO_VERDICT: no hazard curve for the study's measure)."""
 
 ANSWER_STATE = "overturning"
 """The damage state of the answer (pipeline.fragility's overturning state)."""
@@ -174,4 +198,309 @@ def answer_table(fragility: xr.Dataset, outputs: Sequence[Path | str] = ()) -> s
     return "\n".join(lines)
 
 
-__all__ = ["ANSWER_MODELS", "ANSWER_STATE", "answer_model", "answer_rows", "answer_table", "display_scale"]
+# ---------------------------------------------------------------- the answer pages: return periods and verdicts
+
+def intensity_at_frequency(hazard: HazardCurve, frequency: float) -> float:
+    """The intensity whose annual frequency of exceedance is ``frequency`` [1/yr].
+
+    The inverse of ``pipeline.hazard.hazard_frequency``: log-log interpolation, power laws beyond both ends.
+
+    Parameters
+    ----------
+    hazard : HazardCurve
+        The site's curve (intensities increasing, frequencies decreasing).
+    frequency : float
+        Annual frequency of exceedance [1/yr], e.g. 1/475.
+
+    Returns
+    -------
+    float
+        The intensity in the curve's unit.
+    """
+    x, y = np.log(hazard.intensity), np.log(hazard.annual_frequency)
+    target = np.log(frequency)
+    if target < y[-1]:  # rarer than the last point: the last segment's power law
+        return float(np.exp(x[-1] + (target - y[-1]) * (x[-1] - x[-2]) / (y[-1] - y[-2])))
+    if target > y[0]:
+        return float(np.exp(x[0] + (target - y[0]) * (x[1] - x[0]) / (y[1] - y[0])))
+    return float(np.exp(np.interp(target, y[::-1], x[::-1])))
+
+
+@dataclass(frozen=True)
+class StateAnswer:
+    """One damage state of one block on one soil.
+
+    Attributes
+    ----------
+    state : str
+        The damage state's name.
+    at_return_periods : tuple of (float, float, float)
+        P(state | intensity) at each return period's intensity, with the low and high ends of its band
+        (from the confidence bounds of the median; NaN where there is none).
+    annual_frequency, probability_in_life : float
+        Mean annual frequency [1/yr] and probability in the design life [-] (NaN without a hazard);
+        for a state not reached below ``not_reached_below``, the upper bound P(intensity > that limit).
+    limit : float or None
+        The study's largest acceptable probability in the design life; None: the state is not judged.
+    not_reached_below : float or None
+        The largest recorded intensity when no record reached the state at any level up to it (the
+        fitted curve there would be an extrapolation by scaling); None when some record did.
+    """
+
+    state: str
+    at_return_periods: tuple
+    annual_frequency: float
+    probability_in_life: float
+    limit: float | None
+    not_reached_below: float | None
+
+    @property
+    def exceeds(self) -> bool:
+        """True when the probability in the design life is above the study's limit."""
+        return self.limit is not None and bool(np.isfinite(self.probability_in_life)) \
+            and self.probability_in_life > self.limit
+
+
+@dataclass(frozen=True)
+class SoilAnswer:
+    """One block on one soil: its states, the share of runs that would slide and the verdict."""
+
+    soil: str
+    states: tuple
+    sliding_share: float
+    verdict: str
+
+
+@dataclass(frozen=True)
+class BlockAnswer:
+    """The answer page of one block.
+
+    Attributes
+    ----------
+    block, model : str
+        The block and the model whose curves answer (``answer_model``).
+    return_periods, intensities : tuple of float
+        Return periods [years] and the site's intensity at each (shown unit); empty without a hazard.
+    soils : tuple of SoilAnswer
+    example_hazard : bool
+        The hazard is the shipped example, not the site's.
+    design_life : float
+        Years of the probability in life.
+    unit : str
+        The shown unit of the intensities (``display_scale``).
+    """
+
+    block: str
+    model: str
+    return_periods: tuple
+    intensities: tuple
+    soils: tuple
+    example_hazard: bool
+    design_life: float
+    unit: str
+
+
+def _empirical(fragility: xr.Dataset, model: str, block, soil, state) -> np.ndarray:
+    """Fraction of records reaching the state per level; the recommended rows fall back on the bed's runs."""
+    if "empirical_fraction" not in fragility:
+        return np.array([])
+    candidates = [model] + [str(m) for m in fragility.model.values if str(m).startswith("winkler")]
+    for name in candidates:
+        values = fragility.empirical_fraction.sel(model=name, block=block, soil=soil, damage_state=state).values
+        if np.isfinite(values).any():
+            return np.asarray(values, float)
+    return np.asarray(values, float)
+
+
+def _levels(fragility: xr.Dataset, block, scale: float) -> np.ndarray:
+    if "intensity" in fragility.variables and "block" in fragility["intensity"].dims:
+        return np.asarray(fragility["intensity"].sel(block=block).values, float) * scale
+    return np.asarray(fragility.im_level.values, float) * scale
+
+
+def _at(row: xr.Dataset, im: float, scale: float, levels: np.ndarray, empirical: np.ndarray):
+    """(P, low, high) at ``im`` from the row's lognormal.
+
+    Without a curve: the records' fraction at the highest level not above ``im`` (no band).
+    """
+    median, beta = float(row["median"]) * scale, float(row["beta"])
+    if np.isfinite(median) and np.isfinite(beta):
+        p = float(lognormal_cdf(im, median, beta))
+        low_median = float(row["median_low"]) * scale if "median_low" in row else np.nan
+        high_median = float(row["median_high"]) * scale if "median_high" in row else np.nan
+        if np.isfinite(low_median) and np.isfinite(high_median):
+            return p, float(lognormal_cdf(im, high_median, beta)), float(lognormal_cdf(im, low_median, beta))
+        return p, np.nan, np.nan
+    below = np.flatnonzero(levels <= im * (1 + 1e-9))
+    if below.size and empirical.size and np.isfinite(empirical[below[-1]]):
+        return float(empirical[below[-1]]), np.nan, np.nan
+    return np.nan, np.nan, np.nan
+
+
+def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
+                  return_periods: Sequence[float] = DEFAULT_RETURN_PERIODS,
+                  limits: Mapping[str, float] | None = None, design_life: float | None = None,
+                  largest_recorded: Mapping[str, float] | None = None,
+                  sliding: Mapping[tuple[str, str], float] | None = None,
+                  max_sliding_share: float = DEFAULT_SLIDING_SHARE) -> list[BlockAnswer]:
+    """The answer of every block: return-period intensities, probabilities, design-life risk, verdicts.
+
+    Parameters
+    ----------
+    fragility : xarray.Dataset
+        ``fragility.nc`` (risk variables optional: computed here from ``hazard`` where missing).
+    hazard : HazardCurve or None
+        The site's hazard curve for the study's measure (``pipeline.hazard.study_hazard``); None: no
+        return-period intensities, no risk, verdict ``NO_VERDICT``.
+    return_periods : sequence of float
+        Return periods [years].
+    limits : mapping, optional
+        Damage state -> largest acceptable probability in the design life (``DEFAULT_LIMITS``).
+    design_life : float, optional
+        Years; default the fragility's ``design_life_years`` attribute, else 50.
+    largest_recorded : mapping, optional
+        Block -> the largest intensity of the unscaled records (shown unit): below it the levels are
+        what records did; a state no record reached below it is "not reached below" it.
+    sliding : mapping, optional
+        (block, soil) -> share of the answer model's runs up to the largest return-period intensity
+        that need more base friction than the study's coefficient (NaN or absent: unknown).
+    max_sliding_share : float, optional
+        Above this share the verdict is ``CHECK_SLIDING``.
+
+    Returns
+    -------
+    list of BlockAnswer
+        One per block, in the dataset's order.
+    """
+    limits = DEFAULT_LIMITS if limits is None else dict(limits)
+    design_life = float(fragility.attrs.get("design_life_years", 50.0) if design_life is None else design_life)
+    model = answer_model(fragility)
+    scale, unit = display_scale(fragility["median"].attrs.get("units", fragility.attrs.get("intensity_unit", "")))
+    periods = tuple(float(t) for t in return_periods) if hazard is not None else ()
+    intensities = tuple(intensity_at_frequency(hazard, 1.0 / t) for t in periods)
+    states = [str(s) for s in fragility.damage_state.values]
+    answers = []
+    for block in map(str, fragility.block.values):
+        levels = _levels(fragility, block, scale)
+        credible = (largest_recorded or {}).get(block)
+        soils = []
+        for soil in map(str, fragility.soil.values):
+            rows = []
+            for state in states:
+                row = fragility.sel(model=model, block=block, soil=soil, damage_state=state)
+                empirical = _empirical(fragility, model, block, soil, state)
+                not_reached = None
+                if credible is not None and empirical.size:
+                    inside = levels <= credible * (1 + 1e-9)
+                    known = empirical[inside]
+                    if inside.any() and np.isfinite(known).any() and np.nanmax(known) == 0:
+                        not_reached = float(credible)
+                frequency = float(row["annual_frequency"]) if "annual_frequency" in row else np.nan
+                if not np.isfinite(frequency) and hazard is not None:
+                    frequency = risk_annual_frequency(float(row["median"]) * scale, float(row["beta"]), hazard)
+                if not_reached is not None and hazard is not None:  # no curve below the limit: P(im > limit)
+                    frequency = float(hazard_frequency(hazard, not_reached))
+                probability = float(risk_probability_in_life(frequency, design_life)) if np.isfinite(frequency) \
+                    else np.nan
+                rows.append(StateAnswer(state, tuple(_at(row, im, scale, levels, empirical) for im in intensities),
+                                        frequency, probability, limits.get(state), not_reached))
+            share = float((sliding or {}).get((block, soil), np.nan))
+            if hazard is None:
+                verdict = NO_VERDICT
+            elif np.isfinite(share) and share > max_sliding_share:
+                verdict = CHECK_SLIDING
+            elif any(r.exceeds for r in rows):
+                verdict = ANCHOR
+            else:
+                verdict = NO_ACTION
+            soils.append(SoilAnswer(soil, tuple(rows), share, verdict))
+        example = hazard is not None and EXAMPLE_HAZARD in hazard.source
+        answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit))
+    return answers
+
+
+def percent(value: float) -> str:
+    """A probability rounded to what it supports: "12%", "3.4%", "0.21%", "<0.01%", "-" for NaN."""
+    if value is None or not np.isfinite(value):
+        return "-"
+    if value == 0:
+        return "0%"
+    shown = 100 * value
+    if shown >= 99.5:
+        return ">99%" if value < 1 else "100%"
+    if shown >= 10:
+        return f"{shown:.0f}%"
+    if shown >= 0.01:
+        return f"{shown:.2g}%"
+    return "<0.01%"
+
+
+def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] | None = None) -> str:
+    """The verdict of one block in one sentence, grouping the soils by verdict.
+
+    Parameters
+    ----------
+    answer : BlockAnswer
+        The block's answer (``block_answers``).
+    name : str
+        The block as the client knows it ("crane portal (the paper's block)").
+    labels : mapping, optional
+        Damage state -> its words ("the block overturns").
+
+    Returns
+    -------
+    str
+        E.g. "With the shipped example hazard curve (not this site's), the verdict for the slender
+        electrical cabinet is: anchor it on clay (P(the block overturns) in 50 years 2.2%, above the 1%
+        limit); no action on rock."
+    """
+    labels = labels or {}
+    if not answer.soils:
+        return f"No verdict for the {name}: the study has no soil."
+    if answer.soils[0].verdict == NO_VERDICT:
+        return (f"No verdict for the {name}: the study has no hazard curve for its intensity measure, so no "
+                "probability in the design life; give one as [hazard] file.")
+    groups: dict[str, list[SoilAnswer]] = {}
+    for soil in answer.soils:
+        groups.setdefault(soil.verdict, []).append(soil)
+    def exceeded(soils) -> str:
+        reasons = []
+        for state in dict.fromkeys(r.state for s in soils for r in s.states if r.exceeds):
+            values = [r.probability_in_life for s in soils for r in s.states if r.state == state and r.exceeds]
+            limit = next(r.limit for s in soils for r in s.states if r.state == state)
+            shown = percent(min(values)) if len(values) == 1 else f"{percent(min(values))} to {percent(max(values))}"
+            reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
+                           f"{percent(limit)} limit")
+        return "; ".join(reasons)
+
+    parts = []
+    for verdict in (CHECK_SLIDING, ANCHOR, NO_ACTION):
+        soils = groups.get(verdict, [])
+        if not soils:
+            continue
+        where = "on " + _and([s.soil for s in soils])
+        if verdict == ANCHOR:
+            parts.append(f"anchor it {where} ({exceeded(soils)})")
+        elif verdict == CHECK_SLIDING:
+            shares = [s.sliding_share for s in soils]
+            shown = percent(min(shares)) if len(shares) == 1 else f"{percent(min(shares))} to {percent(max(shares))}"
+            text = (f"check sliding {where} ({shown} of the runs up to the {answer.return_periods[-1]:,.0f}-year "
+                    "intensity need more base friction than assumed: the block would slide, which the rocking "
+                    "results do not describe)")
+            rocking = exceeded(soils)
+            parts.append(text + (f", and anchor it against rocking there ({rocking})" if rocking else ""))
+        else:
+            parts.append(f"no action {where}")
+    lead = (f"With the shipped example hazard curve (not this site's: the study must name the site's curve), the "
+            f"verdict for the {name} is: " if answer.example_hazard else f"Verdict for the {name}: ")
+    return lead + "; ".join(parts) + "."
+
+
+def _and(words: Sequence[str]) -> str:
+    words = list(words)
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+__all__ = ["ANCHOR", "ANSWER_MODELS", "ANSWER_STATE", "CHECK_SLIDING", "NO_ACTION", "NO_VERDICT", "RECOMMENDED",
+           "BlockAnswer", "SoilAnswer", "StateAnswer", "answer_model", "answer_rows", "answer_table", "block_answers",
+           "display_scale", "intensity_at_frequency", "percent", "verdict_sentence"]

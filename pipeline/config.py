@@ -119,12 +119,19 @@ SCHEMA = Table({
                       "restitution": Checked(lambda value, field, source: _restitution(value, field, source),
                                              f"{BAND!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
                       "restitution_band": Interval(Number(0.5, 1.5), strict=False)}),
-    "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years")}),
+    "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years"),
+                      "return_periods": Numbers(Number(1.0, 1e6, unit="years"))}),  # the report's answer pages
+    "decision": _table({"max_probability_in_life": Checked(lambda value, field, source: _named(
+                            value, field, source, Number(0.0, 1.0, low_open=True)),
+                            "a table of damage state = probability, each > 0 and <= 1"),
+                        "max_sliding_share": Number(0.0, 1.0)}),  # read by pipeline.answer (verdicts)
     "fragility": _table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                          "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
     "checks": _table({"plausibility": Text(ON_IMPLAUSIBLE)}),
     "report": _table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
-                      "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True)}),
+                      "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True),
+                      "block_names": Checked(lambda value, field, source: _named(value, field, source, TEXT),
+                                             "a table of block = the name the report gives it")}),
     "applicability": _table({
         "g_range": Interval(Number(0, 1e13, low_open=True, unit="Pa"), names=("G_min", "G_max")),
         "n_g": Number(2, 200, integer=True),
@@ -142,6 +149,13 @@ def _restitution(value, field, source):
     if isinstance(value, str):
         return Text((BAND, HOUSNER, "")).check(value, field, source)
     return Number(0.0, 1.0, low_open=True, high_open=True).check(value, field, source)
+
+
+def _named(value, field, source, item):
+    """A table of any names, each value checked by ``item`` (``[decision] max_probability_in_life``)."""
+    if not isinstance(value, dict):
+        raise ConfigError(field, f"{_shown(value)}; must be a table {{ name = value }}", source)
+    return {name: item.check(entry, f"{field}.{name}", source) for name, entry in value.items()}
 
 
 def validate(data: dict, source: str) -> None:
@@ -407,11 +421,18 @@ def _select(kind, names, available, source):
 
 
 def _check_damage_states(data, source):
-    """The study's damage states as the fragility stage will read them (its own EDP list)."""
+    """The study's damage states as the fragility stage will read them (its own EDP list).
+
+    The verdict limits ``[decision] max_probability_in_life`` may name only those states.
+    """
     try:
-        damage_states_from_config(data)
+        names = [state.name for state in damage_states_from_config(data)]
     except ConfigError as error:
         raise ConfigError(error.field, error.reason, source) from None
+    for name in data.get("decision", {}).get("max_probability_in_life", {}):
+        if name not in names:
+            raise ConfigError(f"decision.max_probability_in_life.{name}", f"not a damage state of the study; "
+                              f"the states are {', '.join(names)}", source)
 
 
 def _check_hazard(path, source, measure="pga", period=None):

@@ -19,7 +19,7 @@ def _leaf_keys(table: dict, prefix: str = "") -> set[str]:
         dotted = f"{prefix}.{key}" if prefix else key
         if prefix in ("blocks", "soils_custom", "blocks_custom", "damage_states"):
             dotted = f"{prefix}.NAME"
-        if isinstance(value, dict) and key != "levels":
+        if isinstance(value, dict) and key not in ("levels", "max_probability_in_life", "block_names"):  # one key each
             keys |= _leaf_keys(value, dotted)
         else:
             keys.add(dotted)

@@ -4,15 +4,19 @@ Input : the study configuration and the datasets written by the earlier stages: 
         ``fragility.nc`` (with the risk variables), ``showcase.nc`` (record-set spectra and the showcase
         histories, written at study time by pipeline.showcase), optionally ``applicability.nc`` and
         ``efficiency.nc``. The report only reads; it never runs a solver.
-Output: ``report.pdf`` (A4 landscape, every page numbered, contents on page 2),
-        ``report.html`` (the same pages in the same order, figures embedded as PNG, a linked contents)
+Output: ``report.pdf`` (A4 landscape, every page numbered, the contents after the answer pages),
+        ``report.html`` (the same pages in the same order: text pages as HTML text, figures embedded as
+        PNG, a linked contents, an anchor per section and a way back to the contents from every page)
         and ``figures/NN-name.png`` (one per page). Neither file carries a creation date: the same
         results give the same files.
 
-Page order: title, contents, summary, methods, limitations, records, showcase record, IDA, fragility,
-outcomes, vertical component (a ``[study] vertical = true`` study: ``cube_without_vertical.nc`` beside
-``cube.nc``; pipeline.report.vertical), applicability, measure efficiency. Pages for blocks, soils, models
-and records come from the result files, so only what the study ran is shown.
+Page order: title, one answer page per block (pipeline.report.answer_page), contents, summary, methods,
+limitations, records, showcase record, IDA, fragility, outcomes, vertical component (a ``[study] vertical
+= true`` study: ``cube_without_vertical.nc`` beside ``cube.nc``; pipeline.report.vertical), applicability,
+measure efficiency, glossary, references. Pages for blocks, soils, models and records come from the
+result files, so only what the study ran is shown. Every intensity axis is logarithmic and marks the
+site's return-period intensities and, shaded, the extrapolation by scaling beyond the largest recorded
+intensity.
 """
 
 from __future__ import annotations
@@ -20,9 +24,10 @@ from __future__ import annotations
 import base64
 import html
 import io
-import math
 import multiprocessing
 import os
+import re
+import textwrap
 from dataclasses import replace
 from pathlib import Path
 
@@ -39,11 +44,13 @@ from pipeline.config import StudyConfig  # noqa: E402
 from pipeline.damage_states import damage_states_from_config  # noqa: E402
 from pipeline.outputs import atomic_path  # noqa: E402
 from pipeline.report import figures as pages  # noqa: E402
-from pipeline.report.adapters import models_of, record_pga_g, short_label  # noqa: E402
-from pipeline.report.layout import PAGE_SIZE, Page, add_footer, new_page  # noqa: E402
+from pipeline.report.adapters import block_name, models_of, record_pga_g, short_label  # noqa: E402
+from pipeline.report.answer_page import answer_items  # noqa: E402
+from pipeline.report.layout import Page, add_footer, new_page  # noqa: E402
 from pipeline.report.sections import Results, limitations_items, methods_items, summary_items, title_items  # noqa: E402
 from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
 from pipeline.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
+from pipeline.report.words import glossary_items, references_items  # noqa: E402
 from pipeline.units import STANDARD_GRAVITY  # noqa: E402
 
 PNG_DPI = 100
@@ -80,32 +87,79 @@ def title_page(results: Results) -> Page:
     return Page("title", "Title", results.title, draw, "", body + items_html(items))
 
 
-def _figure(name, section, title, function, *args, caption=""):
-    return Page(name, section, title, lambda: function(*args, caption), caption)
+def _figure(page, section, title, function, *args, caption="", **options):
+    return Page(page, section, title, lambda: function(*args, caption, **options), caption)
 
 
 def records_items(results: Results) -> list[Item]:
-    """Intensity measures of the processed records (showcase.nc), or the cube's PGA when it is absent."""
+    """Intensity measures of the processed records (showcase.nc), or the cube's PGA when it is absent.
+
+    Event and station names are shown whole: a cut name is a different station.
+    """
     cube, showcase = results.cube, results.showcase
-    meta = [(str(r), str(cube.record_event.values[i])[:26] if "record_event" in cube.coords else "",
-             str(cube.record_station.values[i])[:22] if "record_station" in cube.coords else "")
+    meta = [(str(r), str(cube.record_event.values[i]) if "record_event" in cube.coords else "",
+             str(cube.record_station.values[i]) if "record_station" in cube.coords else "")
             for i, r in enumerate(cube.record.values)]
     if showcase is not None and "record_pga" in showcase:
         measures = showcase.sel(record=cube.record.values)
         header = ["record", "event", "station", "PGA [g]", "PGV [m/s]", "Ia [m/s]", "D5-95 [s]", "Sa(1 s) [g]"]
-        rows = [[*m, f"{float(measures.record_pga[i]) / G:.3f}", f"{float(measures.record_pgv[i]):.3f}",
-                 f"{float(measures.record_arias[i]):.2f}", f"{float(measures.record_d5_95[i]):.1f}",
-                 f"{float(measures.record_sa_1s[i]) / G:.3f}"] for i, m in enumerate(meta)]
+        rows = [[*m, f"{float(measures.record_pga[i]) / G:.2f}", f"{float(measures.record_pgv[i]):.2f}",
+                 f"{float(measures.record_arias[i]):.2g}", f"{float(measures.record_d5_95[i]):.0f}",
+                 f"{float(measures.record_sa_1s[i]) / G:.2f}"] for i, m in enumerate(meta)]
     else:
         header = ["record", "event", "station", "PGA [g]"]
-        rows = [[*m, f"{pga:.3f}"] for m, pga in zip(meta, record_pga_g(cube))]
+        rows = [[*m, f"{pga:.2f}"] for m, pga in zip(meta, record_pga_g(cube))]
     return [table(header, rows)]
+
+
+CAPTIONS = {
+    "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled, the bold "
+               "lines the 16, 50 and 84% fractiles. The study scales every record to each intensity level.",
+    "showcase-processing": "Read that processing keeps the record and removes only the drift: raw (grey) and "
+                           "processed (blue); the processed displacement ends at rest.",
+    "showcase-response": "Read how the soil changes the rocking under one real record, unscaled: θ (left, one scale "
+                         "for all panels) and the vertical displacement of the foundation (right, up +); grey: the "
+                         "strong-motion window (5-95% Arias). As in the paper's Figs. 4, 7 and 10.",
+    "ida": "Read at which intensity the block starts to rock and where it overturns: thin lines, one record each; "
+           "bold, the 16/50/84% fractiles of θmax/α. Overturning is drawn at the right edge. Dotted: the site's "
+           "return-period intensities; shaded: beyond the largest recorded intensity (extrapolation by scaling). "
+           "Curves are not smoothed: a record may overturn at one level and survive a higher one (resurrection).",
+    "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
+                       "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
+                       "the fitted lognormal; band, the confidence bounds of the median; black dashed, the rigid "
+                       "base. Shaded: extrapolation by scaling.",
+    "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil, bottom the "
+                        "stiffest. Points: records; lines: fits; bands: confidence bounds. Dotted: the site's "
+                        "return-period intensities; shaded: extrapolation by scaling.",
+    "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
+                "uplifts (rocks or overturns); dashed, that it overturns; between them it rocks and stays up. "
+                "Shaded: extrapolation by scaling.",
+    "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
+                "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
+                "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
+    "applicability": "Read where the rigid-base model is good enough: inside the grey band each foundation model's "
+                     "median peak angle is within 10% of the rigid base's; runs between 1.2 and 3 times each "
+                     "block's uplift threshold; top axis: the study's soils.",
+    "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
+                           "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
+                           "green: the paper's 300-1000 MPa; solid concrete block, dashed steel block.",
+    "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
+                  "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
+                  "below the dashed line it does, and the measure alone is not enough).",
+}
+"""What each figure page lets the reader read, one caption per kind of page."""
 
 
 def plan(results: Results) -> list[Page]:
     """Every page of the report in order (contents excluded: it is made from this list)."""
     cube, ida, fragility, showcase = results.cube, results.ida, results.fragility, results.showcase
+    config = results.config
+    blocks = list(map(str, cube.block.values))
+    names = {block: block_name(config, block) for block in blocks}
     planned = [title_page(results)]
+    for answer in results.answers:
+        name = names.get(answer.block, answer.block)
+        planned += _text_pages(f"answer-{answer.block}", "Answer", f"Answer: {name}", answer_items(results, answer))
     planned += _text_pages("summary", "Summary", "Summary of the fitted fragility functions", summary_items(results))
     planned += _text_pages("methods", "Methods", "Methods and assumptions", methods_items(results))
     planned += _text_pages("limitations", "Limitations", "Limitations: where the models are outside their validity",
@@ -115,126 +169,104 @@ def plan(results: Results) -> list[Page]:
                            "PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) after processing.")
     if showcase is not None and "record_spectrum" in showcase:
         planned.append(_figure("spectra", "Records", "Response spectra of the record set", pages.spectra_page,
-                               showcase, caption="Unscaled processed records; the study scales each record to "
-                                                 "the intensity levels."))
+                               showcase, caption=CAPTIONS["spectra"]))
     if showcase is not None and "theta" in showcase:
         record = showcase.attrs["showcase_record"]
+        showcase_name = names.get(str(showcase.attrs.get("showcase_block", "")))
         planned.append(_figure("showcase-processing", "Showcase record", f"{record}: raw and processed",
-                               pages.showcase_ground_page, showcase,
-                               caption="The whole record: processing removes the drift of the integrated "
-                                       "displacement, so the record ends at rest."))
+                               pages.showcase_ground_page, showcase, caption=CAPTIONS["showcase-processing"]))
         planned.append(_figure("showcase-response", "Showcase record", f"{record}: rocking on each soil",
-                               pages.showcase_response_page, showcase,
-                               caption="Unscaled record. Time cropped to the strong motion (5-95% Arias window, "
-                                       "grey) and the rocking after it; θ panels share one scale, settlement "
-                                       "panels another. As in the paper's Figs. 4, 7 and 10."))
-    blocks = list(map(str, cube.block.values))
+                               pages.showcase_response_page, showcase, caption=CAPTIONS["showcase-response"],
+                               name=showcase_name))
     models = models_of(cube)
     soils = list(map(str, cube.soil.values))
     extremes = [soils[0], soils[-1]] if len(soils) > 1 else soils
     for block in blocks:
-        planned.append(_figure(f"ida-{block}", "IDA curves", f"IDA curves: block '{block}'", pages.ida_page, ida, block,
-                               caption="Thin lines: records; bold: fractiles of θmax/α given intensity. Overturning "
-                                       "is drawn as the flatline. Curves are not smoothed: a record may overturn "
-                                       "at one level and survive a higher one (resurrection)."))
+        planned.append(_figure(f"ida-{block}", "IDA curves", f"IDA curves: {names[block]}", pages.ida_page, ida, block,
+                               caption=CAPTIONS["ida"], marks=results.marks(block), name=names[block]))
     for block in blocks:
-        for model in (m for m in models if not m.rigid_base):
+        for model in (m for m in models_of(fragility) if not m.rigid_base):
             planned.append(_figure(f"fragility-soils-{block}-{model.name}", "Fragility",
-                                   f"Fragility by soil: block '{block}', {short_label(model)}",
+                                   f"Fragility by soil: {names[block]}, {short_label(model)}",
                                    pages.fragility_by_soil_page, fragility, block, model,
-                                   caption="Points: fraction of records reaching the state at each level; lines: "
-                                           "lognormal MLE; band: bootstrap confidence bounds of the median; black "
-                                           "dashed: the rigid-base model (the same on every soil)."))
-        planned.append(_figure(f"fragility-models-{block}", "Fragility", f"Fragility by model: block '{block}'",
+                                   caption=CAPTIONS["fragility-soils"], marks=results.marks(block), name=names[block]))
+        planned.append(_figure(f"fragility-models-{block}", "Fragility", f"Fragility by model: {names[block]}",
                                pages.fragility_by_model_page, fragility, block, extremes,
-                               caption="Top row: the softest soil of the study; bottom row: the stiffest. Points: "
-                                       "empirical fractions; lines: lognormal fits; bands: confidence bounds."))
+                               caption=CAPTIONS["fragility-models"], marks=results.marks(block), name=names[block]))
     for block in blocks:
-        planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: block '{block}'",
-                               pages.outcomes_page, fragility, block,
-                               caption="Solid: probability that the block uplifts (rocks or overturns); dashed: "
-                                       "probability that it overturns; between them it rocks without "
-                                       "overturning."))
+        planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
+                               pages.outcomes_page, fragility, block, caption=CAPTIONS["outcomes"],
+                               marks=results.marks(block), name=names[block]))
     if results.vertical is not None:
         planned += _text_pages("vertical", "Vertical component", "Vertical component: medians with and without it",
                                vertical_items(results.vertical))
         for block in blocks:
-            planned.append(_figure(f"vertical-{block}", "Vertical component", f"Vertical component: block '{block}'",
-                                   vertical_page, results.vertical, block,
-                                   caption="The same records at the same levels: solid with the vertical component, "
-                                           "dashed without it. Top: median θmax/α over the runs not stopped in free "
-                                           "flight (not drawn where most flew). Bottom: points, fraction overturned "
-                                           "among the known runs (filled: with); lines, lognormal fits."))
+            planned.append(_figure(f"vertical-{block}", "Vertical component", f"Vertical component: {names[block]}",
+                                   vertical_page, results.vertical, block, caption=CAPTIONS["vertical"],
+                                   marks=results.marks(block), name=names[block]))
     if any(m.rigid_base for m in models) and any(not m.rigid_base for m in models):
         planned.append(_figure("applicability", "Applicability", "Applicability of the rigid-base model",
-                               pages.applicability_page, cube,
-                               caption="Medians over records and levels from 1.2 to 3 times each block's uplift "
-                                       "threshold where both models rocked without overturning; top axis: the "
-                                       "study's soils."))
+                               pages.applicability_page, cube, caption=CAPTIONS["applicability"], names=names))
     if results.applicability is not None and "peak_angle_ratio_to_housner" in results.applicability:
         planned.append(_figure("applicability-sweep", "Applicability", "Rigid-base error against soil stiffness",
                                pages.sweep_page, results.applicability,
-                               caption=f"`rockfrag applicability`: median over "
-                                       f"{results.applicability.attrs.get('n_records', '?')} records that survived in "
-                                       "both models; solid: concrete block, dashed: steel block (relative "
-                                       "stiffness E_b/G_s)."))
-    efficiency = _efficiency_plotter(results)
-    if efficiency is not None:
-        planned.append(Page("efficiency", "Measure efficiency", "Efficiency of intensity measures", efficiency,
-                            "From efficiency.nc."))
+                               caption=CAPTIONS["applicability-sweep"] + f" Median over "
+                                       f"{results.applicability.attrs.get('n_records', '?')} records that survived "
+                                       "in both models.", names=names))
+    if results.efficiency is not None and "dispersion" in results.efficiency:
+        planned.append(_figure("efficiency", "Measure efficiency", "Efficiency of intensity measures",
+                               pages.efficiency_page, results.efficiency, caption=CAPTIONS["efficiency"],
+                               names=names))
+    planned += _text_pages("glossary", "Glossary", "Glossary", glossary_items())
+    planned += _text_pages("references", "References", "References", references_items())
     return planned
 
 
-def _efficiency_plotter(results):
-    if results.efficiency is None:
-        return None
-    from pipeline.efficiency import plot_efficiency  # lazy: tests/test_report.py swaps the module in sys.modules
-
-    def draw():
-        figure = plot_efficiency(results.efficiency)
-        figure = getattr(figure, "figure", figure)  # a function may return its axes
-        figure.set_size_inches(*PAGE_SIZE)
-        if figure.get_layout_engine() is not None:  # keep clear of the page footer
-            figure.get_layout_engine().set(rect=(0, 0.05, 1, 0.95))
-        return figure
-
-    return draw
+def _slug(text: str) -> str:
+    return "section-" + re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
 
 
-def contents_page(planned: list[Page], title: str) -> Page:
-    """Page 2: every section and page title with its page number (the contents itself is page 2)."""
+CONTENTS_LINES = 36  # lines per column of the contents page
+CONTENTS_WIDTH = 62  # characters per line of a contents column (two columns); longer titles wrap, never cut
+
+
+def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
+    """The contents: every section and page title with its page number (the contents itself is page ``position``).
+
+    Titles are wrapped, never cut; the HTML links every page and every section.
+    """
     rows, last = [], None
     for number, page in enumerate(planned, start=1):
-        shown = number + (1 if number > 1 else 0)  # the contents is inserted as page 2
+        shown = number + (1 if number >= position else 0)  # the contents is inserted at ``position``
         if page.section != last:
             rows.append(("section", page.section, shown))
             last = page.section
         rows.append(("page", page.title, shown))
+    lines = []
+    for kind, text, number in rows:
+        wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" else 0)) or [""]
+        lines += [(kind, line, number if index == 0 else None) for index, line in enumerate(wrapped)]
 
     def draw():
         figure = new_page("Contents")
-        per_column = 36
-        columns = max(1, math.ceil(len(rows) / per_column))
-        size = 9 if columns <= 2 else 7.5
-        step = 0.85 / min(len(rows), per_column) if rows else 0.02
-        step = min(step, 0.024)
+        columns = max(1, -(-len(lines) // CONTENTS_LINES))
+        size = 8.5 if columns <= 2 else 7
+        step = min(0.85 / min(len(lines), CONTENTS_LINES) if lines else 0.02, 0.024)
         width = 0.97 / columns
-        for index, (kind, text, number) in enumerate(rows):
-            column, line = divmod(index, per_column)
+        for index, (kind, text, number) in enumerate(lines):
+            column, line = divmod(index, CONTENTS_LINES)
             x, y = 0.02 + column * width, 0.925 - line * step
-            weight = "bold" if kind == "section" else "normal"
             indent = 0.0 if kind == "section" else 0.012
-            limit = int(130 / columns)
-            shown = text if len(text) <= limit else text[:limit - 1] + "…"
-            figure.text(x + indent, y, shown, fontsize=size, weight=weight, va="top")
-            if kind == "page":
+            figure.text(x + indent, y, text, fontsize=size, weight="bold" if kind == "section" else "normal",
+                        va="top")
+            if kind == "page" and number is not None:
                 figure.text(x + width - 0.03, y, str(number), fontsize=size, va="top", ha="right")
         return figure
 
     items = []
     for kind, text, number in rows:
         if kind == "section":
-            items.append(f"<li class='section'>{html.escape(text)}</li>")
+            items.append(f"<li class='section'><a href='#{_slug(text)}'>{html.escape(text)}</a></li>")
         else:
             items.append(f"<li><a href='#page-{number}'>{html.escape(text)}</a> <span>{number}</span></li>")
     return Page("contents", "Contents", "Contents", draw, "", "<ul class='contents'>" + "".join(items) + "</ul>")
@@ -251,21 +283,34 @@ section{border-top:1px solid #bbb;margin-top:2em;padding-top:.5em}img{width:100%
 table{border-collapse:collapse;font-size:.85em}td,th{padding:.15em .6em;border-bottom:1px solid #ddd;text-align:left}
 .note{font-style:italic;font-size:.9em}.caption{font-style:italic;color:#444}.pageno{float:right;color:#777}
 ul.contents{list-style:none;padding-left:0}ul.contents li.section{font-weight:bold;margin-top:.5em}
-ul.contents li span{color:#777}"""
+ul.contents li span{color:#777}nav.back{font-size:.85em;margin:.3em 0}.verdict{font-size:1.05em}"""
 
 
 def html_document(title: str, rendered: list[Page]) -> str:
-    """A self-contained HTML file: each page a section with an anchor, in the PDF's order."""
+    """A self-contained HTML file: each page a section with an anchor, in the PDF's order.
+
+    The first page of each section also carries the section's anchor (``section-NAME``, the contents links
+    it); every page but the contents links back to the contents. Text pages are HTML text, figure pages
+    their PNG with an alternative text.
+    """
+    contents = next((n for n, page in enumerate(rendered, start=1) if page.name == "contents"), None)
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
              f"<style>{HTML_STYLE}</style></head><body>"]
+    last = None
     for number, page in enumerate(rendered, start=1):
+        if page.section != last:
+            parts.append(f"<div id='{_slug(page.section)}'></div>")
+            last = page.section
         parts.append(f"<section id='page-{number}'><span class='pageno'>page {number} of {len(rendered)}</span>"
                      f"<h2>{html.escape(page.title)}</h2>")
+        if contents is not None and number != contents:
+            parts.append(f"<nav class='back'><a href='#page-{contents}'>Back to the contents</a></nav>")
         if page.html is not None:
             parts.append(page.html)
         else:
             encoded = base64.b64encode(page.png).decode("ascii")
-            parts.append(f"<img alt='{html.escape(page.title)}' src='data:image/png;base64,{encoded}'>")
+            alt = page.title + (f". {page.caption}" if page.caption else "")
+            parts.append(f"<img alt='{html.escape(alt, quote=True)}' src='data:image/png;base64,{encoded}'>")
         if page.caption:
             parts.append(f"<p class='caption'>{html.escape(page.caption)}</p>")
         parts.append("</section>")
@@ -351,9 +396,10 @@ def write_report(planned: list[Page], output_dir, title="rockfrag report", foote
 
 
 def build_plan(results: Results) -> list[Page]:
-    """The numbered page list: the contents inserted as page 2."""
+    """The numbered page list: the title, the answer pages, then the contents and the rest."""
     planned = plan(results)
-    return [planned[0], contents_page(planned, results.title), *planned[1:]]
+    position = 1 + next((i for i, page in enumerate(planned[1:], start=1) if page.section != "Answer"), len(planned))
+    return [*planned[:position - 1], contents_page(planned, results.title, position), *planned[position - 1:]]
 
 
 def _open_optional(path):

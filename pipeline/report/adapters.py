@@ -17,6 +17,7 @@ import pandas as pd
 
 from pipeline.damage_states import DAMAGE_STATES
 from pipeline.errors import SolverError
+from pipeline.fragility import RECOMMENDED
 from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
 from pipeline.measures import short_label as measure_short_label
 from pipeline.models import get_model, model_label
@@ -56,10 +57,19 @@ class ModelInfo:
 
 
 def model_info(name: str) -> ModelInfo:
-    """Label and role of a model from the registry (a model no longer registered keeps its name)."""
+    """Label and role of a model from the registry (a model no longer registered keeps its name).
+
+    ``recommended`` (the fragility stage's combined curve) is labelled in words; a restitution-band variant of
+    a registered model (``winkler-low``, ``winkler-centre``, ``winkler-high``) is that model, labelled with
+    its place in the band (``pipeline.models.model_label``).
+    """
+    if name == RECOMMENDED:
+        return ModelInfo(name, "Recommended (tensionless bed, restitution band)", False,
+                         "the tensionless Winkler bed over the experimental range of impact restitution, its spread "
+                         "added to the dispersion", False, True)
     try:
-        model = get_model(name)  # a registered model or a restitution-band variant of one
-    except SolverError:  # e.g. the fragility's "recommended" rows, or a model no longer registered
+        model = get_model(name)
+    except SolverError:  # a model no longer registered
         return ModelInfo(name, name, False, "")
     label = model_label(name) if model.label else f"{name}: {model.description.split(';')[0]}"
     return ModelInfo(name, label, model.is_rigid_base, model.description, model.can_pull, model.uses_bed)
@@ -232,3 +242,85 @@ def record_pga_g(cube) -> np.ndarray:
 def vertical_applied(cube) -> bool:
     """True when the cube's runs applied the records' vertical components (``[study] vertical = true``)."""
     return "vertical_applied" in cube and bool(int(cube.vertical_applied.sum()))
+
+
+def largest_recorded(cube, block) -> float:
+    """The largest intensity of the unscaled records for a block [the unit of its levels].
+
+    Below it the levels are intensities the records themselves reached; above it every run is a
+    record scaled up beyond anything it recorded (extrapolation by scaling). ``record_im`` when the cube
+    has it, else each level's intensity over its scale factor.
+    """
+    if "record_im" in cube.variables:
+        values = cube.record_im.sel(block=block) if "block" in cube.record_im.dims else cube.record_im
+        target = (cube["intensity"] if "intensity" in cube.variables else cube.im_level).attrs.get("units", "")
+        source = values.attrs.get("units", target)
+        if source and target and source != target and parse_units(source) and parse_units(target):
+            return float(np.nanmax(convert_units(np.asarray(values.values, float), source, target)))
+        return float(np.nanmax(values.values))
+    levels = block_levels(cube, block)
+    scale = cube.scale_factor.sel(block=block).transpose("record", "im_level").values
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return float(np.nanmax(np.nanmedian(levels[None, :] / scale, axis=1)))
+
+
+def scale_factor_summary(cube) -> tuple[float, float]:
+    """(median, maximum) of the factors applied to the processed records over every block and level."""
+    values = np.asarray(cube.scale_factor.values, float)
+    return float(np.nanmedian(values)), float(np.nanmax(values))
+
+
+def sliding_share(cube, models, block, soil, coefficient: float, up_to: float) -> float:
+    """Share of the runs at levels up to ``up_to`` (unit of the levels) that need more friction than ``coefficient``.
+
+    From the first of ``models`` that the cube holds and that reports the friction demand; NaN when none
+    does. At least the lowest level counts, so a block whose levels all lie above
+    ``up_to`` still gets an answer from its mildest runs.
+    """
+    if "peak_friction_demand" not in cube:
+        return float("nan")
+    names = [m for m in models if m in set(map(str, cube.model.values))]
+    levels = block_levels(cube, block)
+    keep = np.flatnonzero(levels <= up_to * (1 + 1e-9))
+    keep = keep if keep.size else np.array([0])
+    for name in names:
+        demand = cube.peak_friction_demand.sel(model=name, block=block, soil=soil).isel(im_level=keep)
+        valid = demand.notnull() & (cube.outcome.sel(model=name, block=block, soil=soil).isel(im_level=keep)
+                                    != OUTCOME_FAILED)
+        if int(valid.sum()) == 0:
+            continue
+        return float(((demand > coefficient) & valid).sum() / valid.sum())
+    return float("nan")
+
+
+def block_name(config, block) -> str:
+    """The block as a client knows it: its ``[report] block_names`` entry, else its name."""
+    names = ((config.raw.get("report") or {}).get("block_names") or {}) if config is not None else {}
+    return str(names.get(str(block)) or block)
+
+
+def block_description(config, block) -> str:
+    """The study's description of the block (its ``why``), or ""."""
+    for item in getattr(config, "blocks", ()) or ():
+        if item.name == str(block):
+            return pretty(item.description)
+    return ""
+
+
+@dataclass(frozen=True)
+class CredibleMarks:
+    """What a figure marks on a block's intensity axis (in the unit of the result files' levels).
+
+    Attributes
+    ----------
+    return_periods : tuple of float
+        Return periods [years] of the site hazard (empty: no hazard curve).
+    intensities : tuple of float
+        The site's intensity at each return period.
+    largest : float or None
+        The largest intensity the unscaled records reached; beyond it, extrapolation by scaling.
+    """
+
+    return_periods: tuple = ()
+    intensities: tuple = ()
+    largest: float | None = None

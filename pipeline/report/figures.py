@@ -8,13 +8,16 @@ Input : the opened result datasets (cube, ida, fragility, showcase, applicabilit
 from __future__ import annotations
 
 import math
+import textwrap
 
 import numpy as np
 import xarray as xr
 
 from pipeline.fragility import lognormal_cdf
+from pipeline.measures import MEASURES
 from pipeline.report.adapters import (
     OUTCOME_ROCKING,
+    CredibleMarks,
     block_levels,
     cell,
     measure_label,
@@ -25,12 +28,67 @@ from pipeline.report.adapters import (
     state_labels,
     uplift_intensity,
 )
-from pipeline.report.layout import FRACTILE_STYLES, GRID, log_axis, new_page, outside_legend, panels, soil_colour
+from pipeline.report.layout import (
+    FRACTILE_STYLES,
+    GRID,
+    log_axis,
+    log_y_axis,
+    new_page,
+    outside_legend,
+    panels,
+    pretty,
+    soil_colour,
+)
+from pipeline.report.words import plain
 from pipeline.units import STANDARD_GRAVITY
 
 G = STANDARD_GRAVITY
 IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (the flatline)
 WINDOW_BEFORE, WINDOW_AFTER = 3.0, 8.0  # s around the strong-motion window on the time axes
+
+
+MARK_COLOUR = "#6a3d9a"  # the site's return-period intensities
+EXTRAPOLATION = dict(color="0.55", alpha=0.13, lw=0, zorder=0)  # beyond the largest recorded intensity
+NO_CURVE = "no curve: "
+
+
+def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> None:
+    """Mark the site's return-period intensities and the extrapolation by scaling on an intensity axis.
+
+    Dotted labelled lines at the return-period intensities; beyond the largest recorded intensity, a
+    shade; ``along`` is the intensity axis ("x" or "y"). Call it after the axis limits are set: the
+    shading runs to the axis end.
+    """
+    if marks is None:
+        return
+    low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
+    if marks.largest is not None and np.isfinite(marks.largest) and marks.largest < high:
+        span = axis.axvspan if along == "x" else axis.axhspan
+        span(max(marks.largest, low), high, **EXTRAPOLATION, label="beyond the largest recorded intensity: "
+                                                                   "extrapolation by scaling")
+        line = axis.axvline if along == "x" else axis.axhline
+        line(marks.largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
+    for period, intensity in zip(marks.return_periods, marks.intensities):
+        if not low <= intensity <= high:
+            continue
+        line = axis.axvline if along == "x" else axis.axhline
+        line(intensity, color=MARK_COLOUR, lw=0.9, ls=":", label="site hazard at the return periods")
+        text = f"{period:,.0f} yr"
+        if along == "x":
+            axis.text(intensity, 0.98, text, transform=axis.get_xaxis_transform(), rotation=90, fontsize=6.5,
+                      color=MARK_COLOUR, ha="right", va="top")
+        else:
+            axis.text(0.98, intensity, text, transform=axis.get_yaxis_transform(), fontsize=6.5, color=MARK_COLOUR,
+                      ha="right", va="bottom")
+
+
+def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
+    """The intensity range of a block's axes: its levels, widened to show the return-period intensities."""
+    low, high = float(levels[0]), float(levels[-1])
+    if marks is not None and marks.intensities:
+        low = min(low, 0.9 * min(marks.intensities))
+        high = max(high, 1.1 * max(marks.intensities))
+    return low, high
 
 
 def _grid(n):
@@ -92,13 +150,13 @@ def _time_window(showcase):
     return max(start, 0.0), min(end, float(showcase.time.values[-1]))
 
 
-def showcase_response_page(showcase, caption):
+def showcase_response_page(showcase, caption, name: str | None = None):
     """Ground motion on top, then per soil theta(t) (left) and the foundation's settlement (right).
 
     One y-scale per column, time cropped to the strong motion.
     """
     block = showcase.attrs["showcase_block"]
-    figure = new_page(f"{showcase.attrs['showcase_record']}, block '{block}' (R = "
+    figure = new_page(f"{showcase.attrs['showcase_record']}, {name or block} (R = "
                       f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
                       "rad): rocking on each soil", caption)
     soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
@@ -135,15 +193,15 @@ def showcase_response_page(showcase, caption):
                 settle_axis.plot(showcase.time.values, showcase.settlement.values[index] * 1000,
                                  **styles[model.name])
         theta_axis.set_ylabel(f"θ [{unit}]")
-        settle_axis.set_ylabel("Δy [mm]")
+        settle_axis.set_ylabel("Δy [mm], up +")
         theta_axis.text(0.01, 0.92, soil, transform=theta_axis.transAxes, fontsize=9, weight="bold", va="top",
                         bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
         for axis in (theta_axis, settle_axis):
             axis.grid(alpha=0.3)
             axis.tick_params(labelbottom=row == len(soils) - 1)
     theta_axes[0].set_title("rocking angle θ (the rigid base is the same on every soil)", fontsize=9)
-    settle_axes[0].set_title("settlement Δy from the static position (down +; each model's reference point)",
-                             fontsize=9)
+    settle_axes[0].set_title("vertical displacement from the static position (up +, settlement −; each model's "
+                             "reference point)", fontsize=9)
     theta_axes[-1].set_xlabel("time [s]")
     settle_axes[-1].set_xlabel("time [s]")
     outside_legend(figure, [ground, *theta_axes])
@@ -154,17 +212,21 @@ def _finite_capped(values):
     return np.where(np.isfinite(values), np.minimum(values, IDA_CAP), IDA_CAP)
 
 
-def ida_page(ida, block, caption):
-    """One panel per rigid-base model and per foundation model x soil, filling the page in reading order."""
+def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
+    """One panel per rigid-base model and per foundation model x soil, filling the page in reading order.
+
+    Intensity on a log axis, the site's return-period intensities and the extrapolation by scaling marked.
+    """
     models = models_of(ida)
     soils = list(map(str, ida.soil.values))
     drawn = [(m, None) for m in models if m.rigid_base]
     drawn += [(m, soil) for m in models if not m.rigid_base for soil in soils]
     columns = min(len(drawn), 3 if len(drawn) <= 6 else 4)
     rows = math.ceil(len(drawn) / columns)
-    figure = new_page(f"IDA curves: block '{block}'", caption)
+    figure = new_page(f"IDA curves: {name or block}", caption)
     axes = panels(figure, rows, columns, sharex=True, sharey=True, gridspec_kw=dict(hspace=0.3))
     levels = block_levels(ida, block)
+    low, high = axis_range(levels, marks)
     for axis, (model, soil) in zip(axes.flat, drawn):
         picked = cell(ida, model, block, soil)
         for curve in picked.edp.transpose("record", "im_level").values:
@@ -175,8 +237,11 @@ def ida_page(ida, block, caption):
                       label=f"{float(q):.0%} fractile", **style)
         axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
         axis.set_title(short_label(model) if soil is None else f"{panel_label(model)}\non {soil}", fontsize=9)
-        axis.grid(alpha=0.3)
+        axis.grid(alpha=0.3, which="both")
         axis.set_xlim(0, IDA_CAP * 1.05)
+        log_y_axis(axis)
+        axis.set_ylim(low, high)
+        mark_intensities(axis, marks, along="y")
     axes.flat[0].plot([], [], color="0.65", lw=0.5, label="one record")
     axes.flat[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
     for index, axis in enumerate(axes.flat):
@@ -193,9 +258,16 @@ def ida_page(ida, block, caption):
     return figure
 
 
-def _fragility_series(axis, fragility, levels, picked, state, style, label):
+def _fragility_series(axis, fragility, levels, picked, state, style, label, span=None):
+    """Points and the fitted curve of one model (and soil) for one state; the reason when there is no curve.
+
+    Returns
+    -------
+    str
+        "" when the curve is drawn, else why not (the panel prints it).
+    """
     values = picked.sel(damage_state=state)
-    grid = np.geomspace(levels[0], levels[-1], 200)
+    grid = np.geomspace(*(span or (levels[0], levels[-1])), 200)
     median, beta = float(values["median"]), float(values["beta"])
     colour = style.get("color")
     axis.plot(levels, values.empirical_fraction.values, "o", ms=3, color=colour, alpha=0.75,
@@ -206,8 +278,21 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label):
         if np.isfinite(low) and np.isfinite(high) and beta > 0.05:
             axis.fill_between(grid, lognormal_cdf(grid, high, beta), lognormal_cdf(grid, low, beta),
                               color=colour, alpha=0.12, lw=0)
-    else:
-        axis.plot([], [], label=label, **style)  # listed once in the legend; the page caption explains gaps
+        return ""
+    axis.plot([], [], label=label, **style)  # listed once in the legend; the panel says why there is no curve
+    status = str(values["status"].values) if "status" in values else ""
+    reason = {"below-range": "reached by most records at the lowest level",
+              "not-reached": "not reached at any level"}.get(status, plain(status) if status else "no fit")
+    return f"{label}: {reason}"
+
+
+def _no_curve_note(axis, reasons) -> None:
+    """Say in the panel which series have points but no curve, and why."""
+    reasons = [r for r in reasons if r]
+    if reasons:
+        text = "\n".join(textwrap.fill(line, 55) for line in [NO_CURVE.rstrip(": ") + ":", *reasons])
+        axis.text(0.97, 0.5, text, transform=axis.transAxes, fontsize=6.5, va="center", ha="right",
+                  bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.9, pad=2), zorder=10)
 
 
 def _state_axes(figure, fragility, n_rows=1):
@@ -223,73 +308,82 @@ def _state_axes(figure, fragility, n_rows=1):
     return states, axes
 
 
-def _probability_axes(axes, levels, x_label: str, y_label: str) -> None:
+def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleMarks | None = None) -> None:
     """Probability against intensity on every visible panel.
 
-    Log x over the block's levels, y from 0 to 1, a grid; the y label on the first column, the x label
-    on the last row.
+    Log x over the block's levels (widened to the return-period intensities), y from 0 to 1, a grid, the
+    marks of ``mark_intensities``; the y label on the first column, the x label on the last row.
     """
+    span = axis_range(levels, marks)
     for axis in axes.flat:
         if not axis.get_visible():
             continue
         log_axis(axis)
-        axis.set_xlim(levels[0], levels[-1])
+        axis.set_xlim(*span)
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
+        mark_intensities(axis, marks, along="x")
     for axis in axes[:, 0]:
         axis.set_ylabel(y_label)
     for axis in axes[-1]:
         axis.set_xlabel(x_label)
 
 
-def fragility_by_soil_page(fragility, block, model, caption):
+def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMarks | None = None,
+                           name: str | None = None):
     """Panels per damage state; the soils in colours, rigid-base models once as the black dashed reference."""
     models = models_of(fragility)
     styles = model_styles(models)
-    figure = new_page(f"Fragility by soil: block '{block}', {short_label(model)}", caption)
+    figure = new_page(f"Fragility by soil: {name or block}, {short_label(model)}", caption)
     states, axes = _state_axes(figure, fragility)
     labels = state_labels(fragility)
     levels = block_levels(fragility, block)
+    span = axis_range(levels, marks)
     for axis, state in zip(axes.flat, states):
+        reasons = []
         for index, soil in enumerate(map(str, fragility.soil.values)):
             style = dict(styles[model.name], color=soil_colour(soil, index))
-            _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state, style,
-                              f"{panel_label(model)} on {soil}")
+            reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
+                                             style, f"{panel_label(model)} on {soil}", span))
         for reference in (m for m in models if m.rigid_base):
-            _fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
-                              styles[reference.name], short_label(reference))
+            reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
+                                             styles[reference.name], short_label(reference), span))
+        _no_curve_note(axis, reasons)
         axis.set_title(labels[state], fontsize=10)
-    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]")
+    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]", marks)
     outside_legend(figure, list(axes.flat))
     return figure
 
 
-def fragility_by_model_page(fragility, block, soils, caption):
+def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMarks | None = None,
+                            name: str | None = None):
     """Rows: the softest and stiffest soil; columns: damage states; models in their own colours and styles."""
     models = models_of(fragility)
     styles = model_styles(models)
-    figure = new_page(f"Fragility by model: block '{block}'", caption)
+    figure = new_page(f"Fragility by model: {name or block}", caption)
     states, axes = _state_axes(figure, fragility, n_rows=len(soils))
     labels = state_labels(fragility)
     levels = block_levels(fragility, block)
+    span = axis_range(levels, marks)
     for row, soil in enumerate(soils):
         for column, state in enumerate(states):
             # one soil: _state_axes lays the states out on a grid, not in one row
             axis = axes[row, column] if len(soils) > 1 else axes.flat[column]
-            for model in models:
-                _fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
-                                  styles[model.name], short_label(model))
+            reasons = [_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
+                                         styles[model.name], short_label(model), span) for model in models]
+            _no_curve_note(axis, reasons)
             axis.set_title(f"{labels[state]}\non {soil}", fontsize=9)
-    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]")
+    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]", marks)
     outside_legend(figure, list(axes.flat))
     return figure
 
 
-def outcomes_page(fragility, block, caption):
+def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
     """One panel per model: P(uplift) solid and P(overturning) dashed per soil; the gap is rocking."""
-    models = models_of(fragility)
+    models = [m for m in models_of(fragility) if m.name in set(map(str, fragility.outcome_probability.model.values))
+              and np.isfinite(fragility.outcome_probability.sel(model=m.name).values).any()]
     rows, columns = _grid(len(models))
-    figure = new_page(f"Outcomes by intensity: block '{block}'", caption)
+    figure = new_page(f"Outcomes by intensity: {name or block}", caption)
     axes = panels(figure, rows, columns, sharex=True, sharey=True)
     for axis in axes.flat[len(models):]:
         axis.set_visible(False)
@@ -308,7 +402,7 @@ def outcomes_page(fragility, block, caption):
             if soil is None or len(soils) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
         axis.set_title(short_label(model), fontsize=10)
-    _probability_axes(axes, levels, measure_label(fragility), "probability [-]")
+    _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
     axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
@@ -319,7 +413,7 @@ def outcomes_page(fragility, block, caption):
     return figure
 
 
-def applicability_page(cube, caption, limit=0.10):
+def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     """Median peak angle of each foundation model over the rigid-base reference against G_s, per block.
 
     The soils are named on the top axis.
@@ -328,7 +422,9 @@ def applicability_page(cube, caption, limit=0.10):
     reference = next(m for m in models if m.rigid_base)
     founded = [m for m in models if not m.rigid_base]
     styles = model_styles(models)
-    figure = new_page(f"Applicability of the rigid base: each foundation model over {reference.name}", caption)
+    names = names or {}
+    figure = new_page(f"Applicability of the rigid base: each foundation model over {panel_label(reference)}",
+                      caption)
     axis = panels(figure, gridspec_kw=dict(top=0.85))[0, 0]
     shear = cube.soil_shear_modulus.values / 1e6
     order = np.argsort(shear)
@@ -346,13 +442,14 @@ def applicability_page(cube, caption, limit=0.10):
             ratio = (sub.peak_angle.sel(model=model.name).where(survived).median(["record", "im_level"]) /
                      rigid_angle.where(survived).median(["record", "im_level"])).values
             axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], color=f"C{b_index % 10}",
-                      ls=styles[model.name]["ls"], lw=1.4, label=f"{block}, {model.name}")
+                      ls=styles[model.name]["ls"], lw=1.4,
+                      label=f"{names.get(str(block), block)}, {panel_label(model)}")
     axis.axhspan(1 - limit, 1 + limit, color="0.88", label=f"within ±{limit:.0%} of the rigid base", zorder=0)
     axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, label="paper's limit: G_s = 300-1000 MPa", zorder=0)
     axis.axhline(1.0, color="k", lw=0.8)
     log_axis(axis)
     axis.set_xlabel("soil shear modulus G_s [MPa]")
-    axis.set_ylabel(f"median θmax (model) / median θmax ({reference.name}) [-]")
+    axis.set_ylabel(f"median θmax (model) / median θmax ({panel_label(reference)}) [-]")
     axis.grid(alpha=0.3, which="both")
     top = axis.secondary_xaxis("top")
     top.set_xticks(shear, [str(s) for s in cube.soil.values], fontsize=8)
@@ -361,7 +458,7 @@ def applicability_page(cube, caption, limit=0.10):
     return figure
 
 
-def sweep_page(dataset, caption):
+def sweep_page(dataset, caption, names: dict | None = None):
     """The fine G_s sweep of `rockfrag applicability`: rows are the compliant models, columns the blocks."""
     tolerance = float(dataset.attrs.get("tolerance", 0.1))
     blocks = list(dataset.block.values)
@@ -382,10 +479,59 @@ def sweep_page(dataset, caption):
             axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
             axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
             axis.axhline(1.0, color="k", lw=0.7)
-            axis.set_title(f"{block}: {label}", fontsize=9)
+            axis.set_title(f"{(names or {}).get(str(block), block)}: {label}", fontsize=9)
             log_axis(axis)
             axis.set_xlabel("soil shear modulus G_s [MPa]")
             axis.grid(alpha=0.3, which="both")
         axes[row, 0].set_ylabel("median θmax model / Housner [-]")
     outside_legend(figure, [axes.flat[0]])
+    return figure
+
+
+P_FLOOR = 1e-3  # p-values below this are drawn at it: "below 0.001" is all such a number supports
+
+
+def efficiency_page(dataset, caption, names: dict | None = None):
+    """Which intensity measure predicts overturning best, from ``efficiency.nc``.
+
+    Top: the dispersion of the overturning capacity per measure and block (median over soils and
+    models, whiskers their range; smaller is better). Bottom: the sufficiency p-values against magnitude,
+    distance and pulse period (median over cells), on a log axis floored at ``P_FLOOR``.
+    """
+    names = names or {}
+    figure = new_page("Efficiency of intensity measures: which one predicts overturning best", caption)
+    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45))[:, 0]
+    measures = [str(m) for m in dataset.measure.values]
+    labels = [pretty(MEASURES[m].short_label()) if m in MEASURES else m.replace("_", " ") for m in measures]
+    blocks = list(map(str, dataset.block.values))
+    x = np.arange(len(measures))
+    width = 0.8 / max(len(blocks), 1)
+    for index, block in enumerate(blocks):
+        dispersion = dataset.dispersion.sel(block=block)
+        middle = dispersion.median(["soil", "model"]).values
+        low, high = dispersion.min(["soil", "model"]).values, dispersion.max(["soil", "model"]).values
+        top.bar(x + (index - (len(blocks) - 1) / 2) * width, middle, width, label=names.get(block, block),
+                yerr=[middle - low, high - middle], capsize=2, color=f"C{index % 10}")
+    top.set_xticks(x, labels, fontsize=8)
+    top.set_ylabel("dispersion of ln capacity [-]")
+    top.set_title("Efficiency: dispersion of the overturning capacity (smaller is better)", fontsize=10)
+    top.grid(alpha=0.3, axis="y")
+    for name, marker, what in (("p_magnitude", "o", "p-value against magnitude"),
+                               ("p_distance", "s", "p-value against distance"),
+                               ("p_pulse_period", "^", "p-value against pulse period")):
+        if name not in dataset:
+            continue
+        p = dataset[name].median(["soil", "model", "block"]).values
+        bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, label=what)
+    bottom.axhline(0.05, color="k", lw=0.8, ls="--", label="0.05: below it the measure is not sufficient")
+    bottom.set_yscale("log")
+    bottom.set_ylim(P_FLOOR * 0.7, 1.5)
+    bottom.set_yticks([P_FLOOR, 0.01, 0.05, 0.1, 1.0], ["≤ 0.001", "0.01", "0.05", "0.1", "1"])
+    bottom.minorticks_off()
+    bottom.set_xticks(x, labels, fontsize=8)
+    bottom.set_ylabel("p-value, median over cells [-]")
+    bottom.set_title("Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake?",
+                     fontsize=10)
+    bottom.grid(alpha=0.3, axis="y")
+    outside_legend(figure, [top, bottom])
     return figure

@@ -108,6 +108,14 @@ def log_axis(axis) -> None:
     axis.xaxis.set_minor_formatter(NullFormatter())
 
 
+def log_y_axis(axis) -> None:
+    """Log y axis with plain-number tick labels at 1, 2, 5 x 10^n (the intensity axis of the IDA pages)."""
+    axis.set_yscale("log")
+    axis.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.yaxis.set_minor_formatter(NullFormatter())
+
+
 def soil_colour(soil: str, index: int) -> str:
     """The colour of a soil: its own for the shipped soils, else the ``index``-th of matplotlib's cycle."""
     return SOIL_COLOURS.get(soil, f"C{index % 10}")

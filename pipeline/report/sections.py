@@ -10,25 +10,45 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from pipeline import __version__
+from pipeline.answer import (
+    DEFAULT_LIMITS,
+    DEFAULT_RETURN_PERIODS,
+    DEFAULT_SLIDING_SHARE,
+    BlockAnswer,
+    answer_model,
+    block_answers,
+    display_scale,
+    intensity_at_frequency,
+    percent,
+)
 from pipeline.config import StudyConfig
-from pipeline.fragility import STATUS
+from pipeline.errors import PipelineError
+from pipeline.hazard import HazardCurve, study_hazard
 from pipeline.report.adapters import (
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
+    CredibleMarks,
     block_levels,
+    block_name,
     cell,
     extrapolation,
     friction_flag,
+    largest_recorded,
     measure_label,
+    model_info,
     models_of,
     record_pga_g,
     run_fraction,
+    scale_factor_summary,
+    short_label,
+    sliding_share,
     state_labels,
     tension_flag,
     vertical_applied,
@@ -36,6 +56,7 @@ from pipeline.report.adapters import (
 from pipeline.report.layout import pretty
 from pipeline.report.text import Item, bullet, heading, note, paragraph, table
 from pipeline.report.vertical import VerticalEffect
+from pipeline.report.words import plain, state_short_label
 
 DEFAULT_FRICTION_COEFFICIENT = 0.5
 EXTRAPOLATION_ROWS = 30
@@ -76,9 +97,72 @@ class Results:
         """The friction coefficient [-] the sliding check compares with (``[report] friction_coefficient``)."""
         return float(self.settings.get("friction_coefficient", DEFAULT_FRICTION_COEFFICIENT))
 
+    @cached_property
+    def hazard(self) -> HazardCurve | None:
+        """The study's hazard curve (``[hazard] file``, else the shipped example for PGA), or None."""
+        if self.config is None:
+            return None
+        try:
+            return study_hazard(self.config)
+        except PipelineError:  # the file changed since the run: the pages say "no hazard curve"
+            return None
+
+    @property
+    def return_periods(self) -> tuple[float, ...]:
+        """``[hazard] return_periods`` [years], else 475, 975 and 2,475."""
+        hazard = (self.config.raw.get("hazard") or {}) if self.config is not None else {}
+        return tuple(float(t) for t in hazard.get("return_periods", DEFAULT_RETURN_PERIODS))
+
+    @property
+    def decision(self) -> dict:
+        """``[decision]``: the limits of the verdict (defaults of pipeline.answer where the study is silent)."""
+        table = (self.config.raw.get("decision") or {}) if self.config is not None else {}
+        return {"max_probability_in_life": dict(table.get("max_probability_in_life", DEFAULT_LIMITS)),
+                "max_sliding_share": float(table.get("max_sliding_share", DEFAULT_SLIDING_SHARE))}
+
+    @cached_property
+    def largest_recorded(self) -> dict:
+        """Block -> the largest intensity the unscaled records reached, in the shown unit (g for accelerations)."""
+        scale, _ = display_scale(_level_units(self.cube))
+        return {str(b): largest_recorded(self.cube, b) * scale for b in self.cube.block.values}
+
+    @cached_property
+    def answers(self) -> list[BlockAnswer]:
+        """The answer of every block (pipeline.answer.block_answers) at the study's return periods."""
+        hazard, periods = self.hazard, self.return_periods
+        model = answer_model(self.fragility)
+        scale, _ = display_scale(_level_units(self.cube))
+        sliding = {}
+        if hazard is not None:
+            top = intensity_at_frequency(hazard, 1.0 / max(periods)) / scale  # in the cube's unit
+            candidates = [model, "winkler-centre", "winkler", *[str(m) for m in self.cube.model.values
+                                                                 if str(m).startswith("winkler")]]
+            sliding = {(str(b), str(s)): sliding_share(self.cube, candidates, b, s, self.friction_coefficient, top)
+                       for b in self.cube.block.values for s in self.cube.soil.values}
+        decision = self.decision
+        return block_answers(self.fragility, hazard, periods, decision["max_probability_in_life"],
+                             largest_recorded=self.largest_recorded, sliding=sliding,
+                             max_sliding_share=decision["max_sliding_share"])
+
+    def marks(self, block) -> CredibleMarks:
+        """What the figures of a block mark on their intensity axes, in the unit of the result files."""
+        scale, _ = display_scale(_level_units(self.cube))
+        answer = next((a for a in self.answers if a.block == str(block)), None)
+        periods = answer.return_periods if answer is not None else ()
+        intensities = tuple(im / scale for im in answer.intensities) if answer is not None else ()
+        return CredibleMarks(periods, intensities, self.largest_recorded[str(block)] / scale)
+
+
+def _level_units(dataset) -> str:
+    source = dataset["intensity"] if "intensity" in dataset.variables else dataset.im_level
+    return str(source.attrs.get("units", ""))
+
 
 def _g(value):
-    return f"{value:.3g}" if np.isfinite(value) else "-"
+    """Three significant figures, without an exponent below a million: 0.364, 37.1, 3,500."""
+    if not np.isfinite(value):
+        return "-"
+    return f"{float(f'{value:.3g}'):,.0f}" if 1000 <= abs(value) < 1e6 else f"{value:.3g}"
 
 
 def _percent(value):
@@ -92,6 +176,29 @@ def n_runs(cube) -> int:
     return int(sum(per_soil * (1 if m.rigid_base else cube.sizes["soil"]) for m in models_of(cube)))
 
 
+STIFF_BASE = 1e10
+"""Shear modulus [Pa] above which a "soil" of the study is a structural base (steel), not a soil."""
+
+
+def is_soil(cube, soil) -> bool:
+    """True for a soil, False for a structural base such as steel (shear modulus above ``STIFF_BASE``)."""
+    if "soil_shear_modulus" not in cube.variables:
+        return True
+    return float(cube.soil_shear_modulus.sel(soil=soil)) < STIFF_BASE
+
+
+def grounds(cube) -> str:
+    """The study's foundations in words: "4 soils (clay, sand, gravel, rock) and a steel base (steel)"."""
+    soils = [str(s) for s in cube.soil.values if is_soil(cube, s)]
+    bases = [str(s) for s in cube.soil.values if not is_soil(cube, s)]
+    parts = []
+    if soils:
+        parts.append(f"{len(soils)} soil{'s' if len(soils) != 1 else ''} ({', '.join(soils)})")
+    if bases:
+        parts.append(f"{'a' if len(bases) == 1 else len(bases)} structural base{'s' if len(bases) != 1 else ''} "
+                     f"({', '.join(bases)}; not a soil)")
+    return " and ".join(parts)
+
 
 def _result_files(results: Results) -> list[str]:
     """The result files this report read: the optional ones only when the run wrote them."""
@@ -100,24 +207,35 @@ def _result_files(results: Results) -> list[str]:
     return ["cube.nc", "ida.nc", "fragility.nc"] + [name for name, dataset in optional.items()
                                                     if dataset is not None and len(dataset.data_vars)]
 
+
 def title_items(results: Results) -> list[Item]:
     """The title page below the title: study, size of the run, what the report holds."""
     config, cube = results.config, results.cube
+    names = [block_name(config, b) for b in cube.block.values]
+    labels = [m.label for m in models_of(cube)]
     items = [
         paragraph(f"Study '{config.name}' ({config.source}); configuration hash {cube.attrs.get('config_hash', '')}; "
                   f"computed with rockfrag {cube.attrs.get('rockfrag_version', __version__)}."),
         paragraph(f"{cube.sizes['record']} record components, {cube.sizes['im_level']} intensity levels, "
-                  f"{cube.sizes['soil']} soils ({', '.join(map(str, cube.soil.values))}), {cube.sizes['block']} "
-                  f"blocks ({', '.join(map(str, cube.block.values))}) and {cube.sizes['model']} models: "
+                  f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
+                  f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{n_runs(cube)} solver runs."),
-        paragraph("This report states the fragility of each block on each soil for each model, the methods and "
-                  "assumptions behind the numbers, and where the models are outside their validity (page "
-                  "'Limitations'). Every number is read from the result files in the same folder "
-                  f"({', '.join(_result_files(results))})."),
+        paragraph("The next pages answer the question for each block: at the site's return periods, how likely it "
+                  "is to rock or overturn, how likely in its design life, and what to do. Then the fragility of "
+                  "each block on each soil for each model, the methods and assumptions behind the numbers, and "
+                  "where the models are outside their validity (page 'Limitations'). Every number is read from "
+                  f"the result files in the same folder ({', '.join(_result_files(results))})."),
     ]
     if np.isfinite(results.runtime_s):
         items.append(note(f"Run time of the pipeline run that wrote this report: {results.runtime_s:.0f} s."))
     return items
+
+
+def _ordered_models(results: Results):
+    """The answer model first, then the others as models_of orders them."""
+    first = answer_model(results.fragility)
+    models = models_of(results.fragility)
+    return [m for m in models if m.name == first] + [m for m in models if m.name != first]
 
 
 def summary_items(results: Results) -> list[Item]:
@@ -127,35 +245,67 @@ def summary_items(results: Results) -> list[Item]:
     states = [str(s) for s in fragility.damage_state.values][-2:]
     status = extrapolation(fragility, results.output).set_index(["soil", "block", "model", "damage_state"])["status"]
     unit = measure_label(fragility)
+    scale, shown_unit = display_scale(_level_units(fragility))
     life = fragility.attrs.get("design_life_years", results.config.design_life)
     header = ["block", "model", "soil"] + [f"{labels[s]}: median / β" for s in states]
-    has_risk = "probability_in_life" in fragility
+    has_risk = "probability_in_life" in fragility and np.isfinite(fragility["probability_in_life"].values).any()
     if has_risk:
-        header.append(f"P({states[-1]}) in {float(life):g} years")
-    rows = []
+        header.append(f"P({labels[states[-1]].lower()}) in {float(life):g} years")
+    rows, marks = [], set()
     for block in fragility.block.values:
-        for model in models_of(fragility):
+        largest = results.largest_recorded.get(str(block), np.inf)
+        for model in _ordered_models(results):
             soils = ["(any)"] if model.rigid_base else list(fragility.soil.values)
             for soil in soils:
                 picked = cell(fragility, model, block, None if model.rigid_base else soil)
-                row = [str(block), model.name, str(soil)]
+                row = [block_name(results.config, block), short_label(model), str(soil)]
                 for state in states:
-                    median = float(picked["median"].sel(damage_state=state))
+                    median = float(picked["median"].sel(damage_state=state)) * scale
                     beta = float(picked["beta"].sel(damage_state=state))
                     flag = status.get((str(picked.soil.values), str(block), model.name, state), "within")
-                    mark = "*" if flag not in ("within", "no fit") else ""
-                    row.append(f"{_g(median)}{mark} / {_g(beta)}")
+                    mark = ""
+                    if flag not in ("within", "no fit"):
+                        mark += "*"
+                    if np.isfinite(median) and median > largest:
+                        mark += "†"
+                    marks.update(mark)
+                    row.append(f"{_g(median)}{mark} / {_beta(beta)}")
                 if has_risk:
                     p = float(picked["probability_in_life"].sel(damage_state=states[-1]))
-                    row.append(f"{p:.1e}" if np.isfinite(p) else "-")
+                    row.append(percent(p))
                 rows.append(row)
-    items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β). Rigid-base models "
-                       "do not depend on the soil and have one row per block."), table(header, rows),
-             note("* the median lies outside the studied intensity range (an extrapolation; see Limitations). "
-                  "Confidence bounds and goodness of fit: fragility.csv.")]
+    items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β), the answering model "
+                       "first. Rigid-base models do not depend on the soil and have one row per block."),
+             table(header, rows)]
+    if "*" in marks:
+        items.append(note("* the median lies outside the studied intensity range (an extrapolation of the fit; see "
+                          "Limitations)."))
+    if "†" in marks:
+        largest = ", ".join(f"{block_name(results.config, b)} {v:.2g} {shown_unit}"
+                            for b, v in results.largest_recorded.items())
+        items.append(note(f"† the median lies above the largest intensity any record reached unscaled ({largest}): "
+                          "it comes from records scaled up beyond what they recorded (extrapolation by scaling)."))
+    items.append(note("Confidence bounds and goodness of fit: fragility.csv."))
     if has_risk:
         items.append(note(f"Hazard: {fragility.attrs.get('hazard_source', 'see Methods')}."))
     return items
+
+
+def _beta(value: float) -> str:
+    return f"{value:.2f}" if np.isfinite(value) else "-"
+
+
+STEP_WORDS = {
+    "demean": lambda o: "remove the mean",
+    "detrend": lambda o: "remove a straight-line trend",
+    "taper": lambda o: f"taper {float(o.get('max_percentage', 0.05)):.0%} of each end ({o.get('type', 'hann')} window)",
+    "pad": lambda o: "pad with zeros before filtering",
+    "unpad": lambda o: "remove the padding",
+    "bandpass": lambda o: (f"zero-phase band-pass filter {o.get('freqmin', '?')}-{o.get('freqmax', '?')} Hz "
+                           f"(order {o.get('corners', '?')}; the record's own corners where stricter)"),
+    "baseline": lambda o: f"baseline correction (polynomial of order {o.get('order', '?')} fitted to the displacement)",
+}
+"""The processing steps of pipeline/processing.toml in words."""
 
 
 def _processing_text(cube):
@@ -165,8 +315,13 @@ def _processing_text(cube):
         recipe = {}
     steps = []
     for step in recipe.get("steps", []):
-        options = ", ".join(f"{k} = {v}" for k, v in step.items() if k != "name")
-        steps.append(f"{step.get('name')}" + (f" ({options})" if options else ""))
+        options = {k: v for k, v in step.items() if k != "name"}
+        name = str(step.get("name"))
+        if name in STEP_WORDS:
+            steps.append(STEP_WORDS[name](options))
+        else:
+            shown = ", ".join(f"{k.replace('_', ' ')} {v}" for k, v in options.items())
+            steps.append(name.replace("_", " ") + (f" ({shown})" if shown else ""))
     return "; ".join(steps) or "not recorded in the cube"
 
 
@@ -196,26 +351,27 @@ def methods_items(results: Results) -> list[Item]:
         if model.rigid_base:
             role = "rigid base: the result does not depend on the soil; computed once per block"
         else:
-            rule = f"bed '{bed}'" if model.uses_bed else f"pivot switch rule '{config.switch}'"
-            role = f"on a foundation of interface stiffness k (paper eq. 19) and the soil's damping ratio; {rule}"
-        name = model.label if model.label.startswith(f"{model.name}:") else f"{model.label} [{model.name}]"
-        items.append(bullet(pretty(f"{name.split(': ')[0]}: {model.description}; {role}.")))
+            rule = f"the bed: {plain(bed)}" if model.uses_bed else plain(config.switch)
+            role = f"on a foundation of interface stiffness k (the paper's eq. 19) and the soil's damping ratio; {rule}"
+        items.append(bullet(pretty(f"{model.label}: {model.description}; {role}.")))
     items.append(paragraph(
         f"All models: planar rocking of a rigid block; the base does not slide; "
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
         f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
         f"failed integration (excluded from the fits){_vertical_outcome(cube)}."))
-    stiffness = cube.interface_stiffness
-    header = ["soil", "G_s [MPa]", "E_d [MPa]", "ξ [-]"] + [f"k, {b} [N/m]" for b in cube.block.values]
-    rows = [[str(soil), _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
+    header = ["soil or base", "G_s [MPa]", "E_d [MPa]", "ξ [-]"]
+    rows = [[str(soil) if is_soil(cube, soil) else f"{soil} (structural base, not a soil)",
+             _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
              _g(float(cube.soil_constrained_modulus.sel(soil=soil)) / 1e6),
-             _g(float(cube.soil_damping_ratio.sel(soil=soil)))]
-            + [_g(float(stiffness.sel(soil=soil, block=b))) for b in cube.block.values] for soil in cube.soil.values]
+             _g(float(cube.soil_damping_ratio.sel(soil=soil)))] for soil in cube.soil.values]
     items += [heading("Soils and blocks"), table(header, rows)]
-    header = ["block", "b [m]", "h [m]", "R [m]", "α [rad]", "mass [kg]", "uplift threshold g·tanα [g]"]
-    rows = [[str(b), _g(float(cube.block_b.sel(block=b))), _g(float(cube.block_h.sel(block=b))),
-             _g(float(cube.block_R.sel(block=b))), _g(float(cube.block_alpha.sel(block=b))),
-             _g(float(cube.block_mass.sel(block=b))), _g(math.tan(float(cube.block_alpha.sel(block=b))))]
+    stiffness = cube.interface_stiffness
+    header = ["block", "b [m]", "h [m]", "α [rad]", "mass [kg]", "uplift g·tanα [g]"] + \
+        [f"k on {soil} [N/m]" for soil in cube.soil.values]
+    rows = [[block_name(config, b), _g(float(cube.block_b.sel(block=b))), _g(float(cube.block_h.sel(block=b))),
+             _g(float(cube.block_alpha.sel(block=b))), _g(float(cube.block_mass.sel(block=b))),
+             _g(math.tan(float(cube.block_alpha.sel(block=b))))]
+            + [f"{float(stiffness.sel(soil=soil, block=b)):.2g}" for soil in cube.soil.values]
             for b in cube.block.values]
     items.append(table(header, rows))
 
@@ -224,60 +380,86 @@ def methods_items(results: Results) -> list[Item]:
     items += [heading("Record set and processing"),
               paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
                         f"from {events} earthquake{'s' if events != 1 else ''}; PGA of the processed records "
-                        f"{pga.min():.3g} to {pga.max():.3g} g. {_vertical_records(cube)}"
+                        f"{pga.min():.2g} to {pga.max():.2g} g. {_vertical_records(cube)}"
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
                         "files and each record's processing steps are stored in cube.nc.")]
 
     levels = cube.im_level.values
     spacing = "geometric" if levels.size > 2 and np.allclose(np.diff(np.log(levels)), np.log(levels[1] / levels[0]),
                                                               rtol=1e-3) else "as listed"
-    measure = str(cube.im_level.attrs.get("long_name", "")).replace("intensity level: ", "")
-    scale = cube.scale_factor.values
+    measure = measure_label(cube)
+    median_factor, largest_factor = scale_factor_summary(cube)
     relative = cube.im_level.attrs.get("units") == "1"
-    text = (f"Each processed record is scaled linearly to {levels.size} levels of {measure} "
-            f"({measure_label(cube)}), {levels.min():.3g} to {levels.max():.3g}"
-            f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}; scale factors "
-            f"{np.nanmin(scale):.3g} to {np.nanmax(scale):.3g}.")
+    scale, unit = display_scale(_level_units(cube))
+    text = (f"Each processed record is scaled linearly to {levels.size} levels of {measure}, "
+            f"{levels.min():.3g} to {levels.max():.3g}"
+            f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}. Scale factors: "
+            f"median {median_factor:.2g}, largest {largest_factor:.3g}.")
     if "intensity" in cube.variables and "block" in cube["intensity"].dims:
-        ranges = ", ".join(f"{b}: {block_levels(cube, b).min():.3g}-{block_levels(cube, b).max():.3g}"
-                           for b in cube.block.values)
+        ranges = "; ".join(f"{block_name(config, b)} {block_levels(cube, b).min() * scale:.2g} to "
+                           f"{block_levels(cube, b).max() * scale:.2g} {unit}" for b in cube.block.values)
         text += f" Each block has its own levels ({ranges})."
+    largest = ", ".join(f"{v:.2g} {unit}" for v in dict.fromkeys(results.largest_recorded.values()))
+    text += (f" The largest intensity of the unscaled records is {largest}: above it every result is an "
+             "extrapolation by scaling (shaded on the figures), kept because the analysis must reach overturning; "
+             "the site's return-period intensities are marked on every intensity axis.")
     items += [heading("Scaling (incremental dynamic analysis)"), paragraph(text)]
 
     labels = state_labels(fragility)
     methods = sorted(set(map(str, np.unique(fragility.fit_method.values))))
+    resurrected = int(fragility.n_resurrected.sum()) if "n_resurrected" in fragility else 0
     items += [heading("Fragility fits"),
-              paragraph(f"Damage states: {'; '.join(f'{n}: {t}' for n, t in labels.items())}. Each soil × block × "
-                        "model × state is fitted by maximum likelihood on the binomial counts per level (Baker 2015); "
-                        f"overturning by the {fragility.attrs.get('overturning_convention', 'outcomes as run')} "
-                        f"({int(fragility.n_resurrected.sum()) if 'n_resurrected' in fragility else 0} here); the "
-                        "refined IDA capacities are also fitted, as a check (capacity_median in fragility.csv). "
+              paragraph(f"Damage states: {'; '.join(labels.values())}. Each soil × block × model × state is fitted by "
+                        "maximum likelihood on the binomial counts per level (Baker 2015). A record counts as "
+                        "overturned, and beyond every damage state, from its first overturning level on (Vamvatsikos "
+                        f"& Cornell 2002); {resurrected} record-cells here survived a higher level after overturning "
+                        "(resurrection). The overturning capacities refined between the levels are fitted too, as a "
+                        "check (fragility.csv). "
                         f"Confidence bounds ({config.confidence:.0%}) from "
                         f"{fragility.attrs.get('bootstrap_samples', '?')} "
                         f"bootstrap samples of the records (seed {fragility.attrs.get('bootstrap_seed', '?')}). States "
                         "that would cross inside the studied range are refitted with one shared β; a state reached at "
                         "one intensity by every record is a deterministic threshold. Fit methods used: "
-                        f"{', '.join(methods)}.")]
+                        f"{'; '.join(plain(m) for m in methods)}.")]
     if "annual_frequency" in fragility:
+        periods = ", ".join(f"{t:,.0f}" for t in results.return_periods)
         items += [heading("Hazard and risk"),
                   paragraph("Hazard curve: "
                             f"{fragility.attrs.get('hazard_source', config.hazard_file or 'shipped example')}. "
                             "Mean annual frequency of each damage state λ = ∫ P(DS | im) |dλ(im)|, the hazard "
-                            "interpolated log-log; probability in the design life "
+                            "interpolated log-log (Cornell et al. 2002); probability in the design life "
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
-                            "1 − exp(−λ·years).")]
+                            f"1 − exp(−λ·years). Return periods of the answer pages: {periods} years.")]
     return items
 
 
-def _fraction_table(fraction, soils, blocks):
-    header = ["soil"] + [str(b) for b in blocks]
+def _fraction_table(fraction, soils, blocks, config=None):
+    header = ["soil"] + [block_name(config, b) for b in blocks]
     rows = [[str(s)] + [_percent(float(fraction.sel(soil=s, block=b))) for b in blocks] for s in soils]
     return table(header, rows)
 
 
+def _counts(fragility, model, block, soil, state, n_records) -> str:
+    """Records reaching a state at the lowest and the highest level: "10 of 10 at 0.18 g, 10 of 10 at 4.4 g"."""
+    if "empirical_fraction" not in fragility:
+        return "-"
+    fraction = fragility.empirical_fraction.sel(model=model, block=block, soil=soil, damage_state=state).values
+    levels = block_levels(fragility, block)
+    scale, unit = display_scale(_level_units(fragility))
+    shown = []
+    for index in (0, -1):
+        if np.isfinite(fraction[index]):
+            shown.append(f"{round(fraction[index] * n_records)} of {n_records} at {levels[index] * scale:.2g} {unit}")
+    return ", ".join(shown) or "-"
+
+
+NO_MEDIAN = {"below-range": "reached below the lowest level", "not-reached": "never reached"}
+"""Why a curve has no median, in the limitations' table."""
+
+
 def limitations_items(results: Results) -> list[Item]:
     """The limitations pages: foundation tension, sliding, extrapolated medians, solver failures (from the results)."""
-    cube, fragility = results.cube, results.fragility
+    cube, fragility, config = results.cube, results.fragility, results.config
     models = models_of(cube)
     items = [heading("Foundation tension")]
     flag = tension_flag(cube)
@@ -299,12 +481,14 @@ def limitations_items(results: Results) -> list[Item]:
         worst = fraction.where(fraction == fraction.max(), drop=True)
         items.append(paragraph(
             f"{model.label}: the foundation pulled on the block (negative support force) in {_percent(overall)} of "
-            f"the runs, most often for block {worst.block.values[0]} on {worst.soil.values[0]} "
+            f"the runs, most often for the {block_name(config, worst.block.values[0])} on {worst.soil.values[0]} "
             f"({_percent(float(fraction.max()))}). A soil cannot pull: after the first tension these runs are not "
             "physical, and the model is outside its validity there. Fraction of runs with tension:"))
-        items.append(_fraction_table(fraction, cube.soil.values, cube.block.values))
-    if not found:
+        items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
+    if not found and any(not m.rigid_base and m.can_pull for m in models):
         items.append(paragraph("No model of this study reports the support force; tension was not checked."))
+    elif not found:
+        items.append(paragraph("No foundation model of this study can pull on the block: tension does not arise."))
 
     coefficient = results.friction_coefficient
     items.append(heading("Sliding"))
@@ -321,44 +505,59 @@ def limitations_items(results: Results) -> list[Item]:
             continue
         items.append(paragraph(
             f"Every model assumes the base does not slide. {model.label}: holding the base needed a friction "
-            f"coefficient above μ = {coefficient:g} in {_percent(float(fraction.mean()))} of the runs; there the "
-            "block would slide or slide-rock, which the rocking results do not describe. Fraction of runs above μ:"))
-        items.append(_fraction_table(fraction, cube.soil.values, cube.block.values))
+            f"coefficient above μ = {coefficient:g} in {_percent(float(fraction.mean()))} of the runs (all levels); "
+            "there the block would slide or slide-rock, which the rocking results do not describe. The answer pages "
+            "count the runs up to the largest return-period intensity. Fraction of runs above μ:"))
+        items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
     if not found:
         items.append(paragraph("No model of this study reports the friction demand (|H|/N at the base); every model "
                                "assumes the base does not slide, which was not checked."))
 
     items.append(heading("Extrapolated fragility medians"))
     status = extrapolation(fragility, results.output)
-    rigid = {m.name for m in models if m.rigid_base}
+    rigid = {m.name for m in models_of(fragility) if m.rigid_base}
     first_soil = str(fragility.soil.values[0])
     status = status[~status.model.isin(rigid) | (status.soil == first_soil)]  # a rigid base once per block
     outside = status[~status.status.isin(["within", "no fit"])]
-    unfitted = int((status.status == "no fit").sum())
     order = {name: {str(v): i for i, v in enumerate(fragility[name].values)} for name in ("block", "model", "soil")}
     outside = outside.sort_values(["block", "model", "soil"], key=lambda column: column.map(order[column.name]))
+    labels = state_labels(fragility)
+    scale, unit = display_scale(_level_units(fragility))
     if outside.empty:
         items.append(paragraph("Every fitted median lies inside the studied intensity range."))
     else:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
             "lognormal fit beyond the levels that were run and are marked * in the summary."))
-        labels = state_labels(fragility)
         rows = []
         for row in outside.head(EXTRAPOLATION_ROWS).itertuples():
-            levels = block_levels(fragility, row.block)
-            rows.append([row.block, row.model, "(any)" if row.model in rigid else row.soil,
-                         labels.get(row.damage_state, row.damage_state), _g(row.median),
-                         f"{levels.min():.3g}-{levels.max():.3g}", row.status])
-        items.append(table(["block", "model", "soil", "damage state", f"median [{measure_label(fragility)}]",
-                            "studied range", "status"], rows))
+            levels = block_levels(fragility, row.block) * scale
+            rows.append([block_name(config, row.block), model_info(row.model).label,
+                         "(any)" if row.model in rigid else row.soil, labels.get(row.damage_state, row.damage_state),
+                         _g(row.median * scale), f"{levels.min():.2g} to {levels.max():.2g}", plain(row.status)])
+        items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
+                            "what it is"], rows))
         if len(outside) > EXTRAPOLATION_ROWS:
             items.append(note(f"... and {len(outside) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
-        for word in dict.fromkeys(outside.status):
-            if word in STATUS:
-                items.append(note(f"{word}: {STATUS[word]}."))
-    if unfitted:
-        items.append(note(f"{unfitted} curves could not be fitted (too few exceedances): no median is given."))
+    unfitted = status[status.status == "no fit"]
+    short_states = {name: state_short_label(name, str(text)) for name, text in
+                    zip(map(str, fragility.damage_state.values), fragility["damage_state_description"].values)} \
+        if "damage_state_description" in fragility.coords else {}
+    if not unfitted.empty:
+        n_records = int(fragility.n_records) if "n_records" in fragility else results.cube.sizes["record"]
+        fitted_status = fragility["status"] if "status" in fragility else None
+        items.append(paragraph(f"{len(unfitted)} curves have no median. The records that reached the state at the "
+                               "lowest and the highest level of the block say why:"))
+        rows = []
+        for row in unfitted.itertuples():
+            why = str(fitted_status.sel(soil=row.soil, block=row.block, model=row.model,
+                                        damage_state=row.damage_state).values) if fitted_status is not None else ""
+            rows.append([block_name(config, row.block), short_label(model_info(row.model)),
+                         "(any)" if row.model in rigid else row.soil, short_states.get(row.damage_state, ""),
+                         _counts(fragility, row.model, row.block, row.soil, row.damage_state, n_records),
+                         NO_MEDIAN.get(why, plain(why) if why else "no fit")])
+        items.append(table(["block", "model", "soil", "damage state", "records reaching it: lowest, highest level",
+                            "why no median"], rows))
 
     items += free_flight_items(cube, models)
     items.append(heading("Solver"))

@@ -24,7 +24,7 @@ LEFT = 0.02
 
 @dataclass
 class Item:
-    """kind: heading | paragraph | bullet | table | note; text, or header + rows for a table."""
+    """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table."""
 
     kind: str
     text: str = ""
@@ -40,6 +40,11 @@ def heading(text: str) -> Item:
 def paragraph(text: str) -> Item:
     """A paragraph, wrapped to the page width and followed by a blank line."""
     return Item("paragraph", text)
+
+
+def strong(text: str) -> Item:
+    """A paragraph in bold: the verdict of an answer page."""
+    return Item("strong", text)
 
 
 def bullet(text: str) -> Item:
@@ -63,7 +68,7 @@ def _lines(item) -> int:
     if item.kind == "table":
         return len(item.rows) + 2
     width = WRAP - (4 if item.kind == "bullet" else 0)
-    return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind == "paragraph" else 0)
+    return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind in ("paragraph", "strong") else 0)
 
 
 def paginate(items, capacity=None) -> list[list[Item]]:
@@ -145,9 +150,10 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
                 if item.kind == "bullet" and number == 0:
                     figure.text(LEFT + 0.006, y, "•", fontsize=9.5, va="top")
                 figure.text(LEFT + indent, y, line, fontsize=9.5 if item.kind != "note" else 8.5, va="top",
-                            style="italic" if item.kind == "note" else "normal")
+                            style="italic" if item.kind == "note" else "normal",
+                            weight="bold" if item.kind == "strong" else "normal")
                 y -= LINE
-            if item.kind == "paragraph":
+            if item.kind in ("paragraph", "strong"):
                 y -= LINE
     return figure
 
@@ -170,6 +176,8 @@ def items_html(items) -> str:
             parts.append(f"<h3>{html.escape(item.text)}</h3>")
         elif item.kind == "bullet":
             parts.append(f"<li>{html.escape(item.text)}</li>")
+        elif item.kind == "strong":
+            parts.append(f"<p class='verdict'><strong>{html.escape(item.text)}</strong></p>")
         elif item.kind == "note":
             parts.append(f"<p class='note'>{html.escape(item.text)}</p>")
         elif item.kind == "table":

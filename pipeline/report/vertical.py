@@ -29,7 +29,8 @@ from pipeline.damage_states import DamageState
 from pipeline.fragility import exceedance, first_overturn_outcomes, fragility_dataset, lognormal_cdf
 from pipeline.ida import ida_dataset
 from pipeline.report.adapters import block_levels, cell, measure_label, model_styles, models_of, panel_label
-from pipeline.report.layout import OUTCOME_COLOURS, log_axis, new_page, outside_legend, panels
+from pipeline.report.figures import axis_range, mark_intensities
+from pipeline.report.layout import OUTCOME_COLOURS, log_axis, log_y_axis, new_page, outside_legend, panels
 from pipeline.report.text import Item, heading, note, paragraph, table
 
 IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (as on the IDA pages)
@@ -124,7 +125,7 @@ def _soils_shown(cube) -> list[str]:
     return [soils[round(i * (len(soils) - 1) / (MAX_SOILS - 1))] for i in range(MAX_SOILS)]
 
 
-def vertical_page(effect: VerticalEffect, block, caption):
+def vertical_page(effect: VerticalEffect, block, caption, marks=None, name: str | None = None):
     """One column per soil: the median IDA curves (top) and the overturning fractions and fits (bottom).
 
     Every model in its colour, solid with the vertical, dashed without it; the share of runs in free
@@ -134,7 +135,7 @@ def vertical_page(effect: VerticalEffect, block, caption):
     models = models_of(cube)
     styles = model_styles(models)
     soils = _soils_shown(cube)
-    figure = new_page(f"Vertical component: block '{block}'", caption)
+    figure = new_page(f"Vertical component: {name or block}", caption)
     axes = panels(figure, 2, len(soils), sharey="row", gridspec_kw=dict(hspace=0.38))
     levels = block_levels(cube, block)
     medians = {applied: median_ida(dataset) for applied, dataset in ((True, cube), (False, effect.comparison))}
@@ -165,11 +166,15 @@ def vertical_page(effect: VerticalEffect, block, caption):
                             label=f"{panel_label(model)}: share of runs in free flight (with the vertical)")
         top.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
         top.set_xlim(0, IDA_CAP * 1.05)
+        log_y_axis(top)
+        top.set_ylim(*axis_range(levels, marks))
+        mark_intensities(top, marks, along="y")
         top.set_title(f"median IDA curve on {soil}", fontsize=9)
         top.set_xlabel("median θmax/α [-]")
         top.grid(alpha=0.3, which="both")
         log_axis(bottom)
-        bottom.set_xlim(levels[0], levels[-1])
+        bottom.set_xlim(*axis_range(levels, marks))
+        mark_intensities(bottom, marks, along="x")
         bottom.set_ylim(-0.02, 1.02)
         bottom.set_title(f"overturning on {soil}", fontsize=9)
         bottom.set_xlabel(measure_label(cube))

@@ -1,0 +1,167 @@
+"""pipeline.report.answer_page - the answer page of each block, right after the title page.
+
+Input : a ``Results`` bundle (its ``answers``: pipeline.answer.block_answers at the study's return periods,
+        with the verdict limits of ``[decision]``) and the block.
+Output: the page's items (``answer_items``): the verdict in one sentence (saying when the hazard is the
+        shipped example), which curve answers and why, the site's intensity at each return period and the
+        largest recorded one, P(each damage state) there with its band, and per soil the probability of
+        each state in the design life, its mean return period, and the verdict.
+
+Where no record reached a state below the largest recorded intensity, the page says "not reached below X
+in any record" and bounds its probability in the design life by that of exceeding X, never a fitted
+median far beyond what any record did.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
+from pipeline.report.adapters import block_description, block_name, measure_label, model_info, state_labels
+from pipeline.report.text import Item, note, paragraph, strong, table
+from pipeline.report.words import state_short_label
+
+
+def _number(value: float) -> str:
+    return f"{value:.2g}" if np.isfinite(value) else "-"
+
+
+def _years(frequency: float) -> str:
+    """A mean annual frequency as its mean return period, rounded to two figures: "1 in 2,300 years"."""
+    if not np.isfinite(frequency) or frequency <= 0:
+        return ""
+    years = float(f"{1.0 / frequency:.2g}")
+    return f"once in {years:,.0f} years"
+
+
+def curve_reason(results, model: str) -> str:
+    """Which curve answers and why, in words."""
+    fragility = results.fragility
+    if model == RECOMMENDED:
+        text = ("The answer uses the recommended curve: the tensionless Winkler bed run over the experimental range "
+                "of impact restitution (the edges and the centre of the band), its spread added to the "
+                "record-to-record dispersion (FEMA P-58).")
+        if "beta_model" in fragility and "beta_record_to_record" in fragility:
+            rows = fragility.sel(model=RECOMMENDED)
+            r2r, model_beta = rows.beta_record_to_record.values, rows.beta_model.values
+            if np.isfinite(r2r).any() and np.isfinite(model_beta).any():
+                text += (f" Here β from record to record is {np.nanmin(r2r):.2f} to {np.nanmax(r2r):.2f} and β of the "
+                         f"model {np.nanmin(model_beta):.2f} to {np.nanmax(model_beta):.2f}.")
+        return text + (" Housner's rigid base and the paper's model are references, not inputs: the first ignores "
+                       "the foundation and the second's spring pulls on the block, which a soil cannot.")
+    if model == "winkler":
+        return ("The answer uses the tensionless Winkler bed: of the models this study ran, it is the one that "
+                "stays within its own assumptions (its foundation never pulls on the block; see Limitations). "
+                "Housner's rigid base and the paper's model are shown as references. The recommended curve, which "
+                "adds the uncertainty of the impact dissipation, was not in the results.")
+    return (f"The answer uses the {model_info(model).label}: the study did not run the tensionless Winkler bed, "
+            "so read it with the Limitations page, which says where this model is outside its assumptions.")
+
+
+def answer_items(results, answer: BlockAnswer) -> list[Item]:
+    """The items of one block's answer page.
+
+    Parameters
+    ----------
+    results : Results
+        The study's results (pipeline.report.sections.Results).
+    answer : BlockAnswer
+        The block's answer (``results.answers``).
+
+    Returns
+    -------
+    list of Item
+    """
+    fragility = results.fragility
+    name = block_name(results.config, answer.block)
+    labels = state_labels(fragility)
+    descriptions = {s: str(d) for s, d in zip(map(str, fragility.damage_state.values),
+                                               fragility["damage_state_description"].values)} \
+        if "damage_state_description" in fragility.coords else {}
+    short = {s: state_short_label(s, descriptions.get(s, "")) for s in labels}
+    words = {s: text[0].lower() + text[1:] for s, text in labels.items()}
+    measure = measure_label(fragility).split(" [")[0]
+    unit = answer.unit
+    items = []
+    description = block_description(results.config, answer.block)
+    if description:
+        items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
+    items.append(strong(verdict_sentence(answer, name, words)))
+    items.append(paragraph(curve_reason(results, answer.model)))
+    largest = results.largest_recorded.get(answer.block)
+    hazard = results.hazard
+    if answer.return_periods:
+        at = ", ".join(f"{im:.2g} {unit} at {t:,.0f} years" for t, im in zip(answer.return_periods,
+                                                                              answer.intensities))
+        source = ("the shipped example curve, not site-specific" if answer.example_hazard else
+                  f"from {hazard.source}") if hazard is not None else ""
+        items.append(paragraph(f"Site hazard ({source}): {measure} {at}. The largest {measure} of the records, "
+                               f"unscaled, is {largest:.2g} {unit}; above it every result comes from records scaled "
+                               "up beyond what they recorded (extrapolation by scaling)."))
+        header = ["soil", "return period", f"{measure} [{unit}]"] + [f"P({short[s]})" for s in labels]
+        rows = []
+        for soil in answer.soils:
+            for index, (period, im) in enumerate(zip(answer.return_periods, answer.intensities)):
+                cells = [soil.soil if index == 0 else "", f"{period:,.0f} years", f"{im:.2g}"]
+                for state in soil.states:
+                    p, low, high = state.at_return_periods[index]
+                    if state.not_reached_below is not None and im <= state.not_reached_below:
+                        cells.append("not reached")
+                    elif np.isfinite(low) and np.isfinite(high) and high - low > 0.005:
+                        cells.append(f"{percent(p)} ({percent(low)}-{percent(high)})")
+                    else:
+                        cells.append(percent(p))
+                rows.append(cells)
+        items.append(table(header, rows))
+        items.append(note(f"P(damage state) at each return period's intensity, in brackets its band: the "
+                          f"{_confidence(fragility)} confidence bounds of the median, records resampled. 'not "
+                          f"reached': no record reached the state up to {largest:.2g} {unit}."))
+        limits = {s: s_limit for s, s_limit in results.decision["max_probability_in_life"].items() if s in labels}
+        life = f"{answer.design_life:g} years"
+        header = ["soil"] + [f"{short[s]}" + (f" (limit {percent(limits[s])})" if s in limits else "")
+                             for s in labels] + ["verdict"]
+        rows = []
+        for soil in answer.soils:
+            cells = [soil.soil]
+            for state in soil.states:
+                if state.not_reached_below is not None:
+                    cells.append(f"<{percent(state.probability_in_life)}, not reached below "
+                                 f"{state.not_reached_below:.2g} {unit}")
+                elif np.isfinite(state.probability_in_life):
+                    cells.append(f"{percent(state.probability_in_life)}, {_years(state.annual_frequency)}")
+                else:
+                    cells.append(_no_curve(fragility, answer, soil.soil, state.state, unit))
+            cells.append(soil.verdict)
+            rows.append(cells)
+        items.append(paragraph(f"Probability of each damage state in the design life of {life} (and how often it "
+                               "happens on average), per soil:"))
+        items.append(table(header, rows))
+        judged = ", ".join(f"{short[s]} {percent(v)}" for s, v in limits.items())
+        items.append(note(f"Verdict: 'check sliding' where more than {percent(results.decision['max_sliding_share'])} "
+                          f"of the runs up to the {answer.return_periods[-1]:,.0f}-year intensity need a base friction "
+                          f"above {results.friction_coefficient:g}; else 'anchor' where a probability in "
+                          f"{life} exceeds the study's limit ({judged or 'none set'}); else 'no action'. States "
+                          "without a limit are reported, not judged. 'not reached below X': no record reached the "
+                          "state at any level up to X, so its probability is at most that of exceeding X."))
+    else:
+        items.append(paragraph(f"The study has no hazard curve for {measure}: no return-period intensities and no "
+                               "probability in the design life. The fragility curves are on the pages that follow."))
+    return items
+
+
+def _confidence(fragility) -> str:
+    text = str(fragility["median_low"].attrs.get("long_name", "")) if "median_low" in fragility else ""
+    return text.split(" two-sided")[0] if "two-sided" in text else "bootstrap"
+
+
+def _no_curve(fragility, answer: BlockAnswer, soil, state, unit) -> str:
+    """The cell of a state without a curve: reached by most records at the lowest level, or not at all."""
+    status = str(fragility.status.sel(model=answer.model, block=answer.block, soil=soil, damage_state=state).values) \
+        if "status" in fragility else ""
+    if status == "below-range" and "studied_im_min" in fragility:
+        scale, _ = display_scale(fragility.studied_im_min.attrs.get("units", ""))
+        lowest = float(fragility.studied_im_min.sel(block=answer.block)) * scale
+        return f"most records already at {lowest:.2g} {unit}"
+    if status == "deterministic-threshold":
+        return "at the uplift threshold"
+    return "-"

@@ -1,0 +1,157 @@
+"""pipeline.report.words - the words a client reads: plain names for identifiers, glossary, references.
+
+Input : identifiers as the result files write them (fit methods, row statuses, pivot-switch rules, bed
+        laws, damage-state names, models that are not in the registry).
+Output: plain words for each (``FIT_METHODS``, ``STATUS_WORDS``, ``SWITCH_WORDS``, ``BED_WORDS``,
+        ``state_short_label``), the glossary page's entries (``glossary_items``) and the references page
+        (``REFERENCES``, ``references_items``). ``CODE_IDENTIFIERS`` lists what must never reach a page
+        (tests/test_report_words.py reads every page's text against it).
+"""
+
+from __future__ import annotations
+
+from pipeline.report.text import Item, bullet, heading, paragraph
+
+FIT_METHODS = {
+    "mle-binomial": "maximum likelihood on the counts per level",
+    "mle-binomial-shared-beta": "maximum likelihood with one dispersion shared by the states (no crossing)",
+    "exact-g-tan-alpha": "the exact uplift threshold g·tanα (a step)",
+    "step-between-levels": "a step between two levels (every record changed state there)",
+    "none": "no fit (the state was not reached, or reached by most records at the lowest level)",
+}
+"""``fit_method`` of fragility.nc in words."""
+
+STATUS_WORDS = {
+    "within": "fitted, median inside the studied range",
+    "fitted": "fitted, median inside the studied range",
+    "extrapolated": "median outside the studied range",
+    "above-range": "reached only at the highest levels: median above the studied range",
+    "below-range": "reached by most records at the lowest level: median below the studied range",
+    "not-reached": "not reached at any level",
+    "deterministic-threshold": "an exact step at the uplift threshold",
+    "separated": "a step between two levels",
+    "no fit": "no fit",
+}
+"""A fitted row's ``status`` (fragility.csv) in words."""
+
+SWITCH_WORDS = {
+    "consistent": "at each impact the pivot switches keeping the rotation rate and the velocity of the centre of "
+                  "mass (Housner's restitution follows)",
+    "continuous": "at each impact the pivot switches keeping the rotation rate and the vertical velocity",
+}
+"""The paper's model's pivot-switch rule in words."""
+
+BED_WORDS = {
+    "continuous": "springs and dashpots over the whole footprint",
+    "two-spring": "one spring and dashpot under each corner",
+    "hunt-crossley": "springs over the footprint with impact damping that vanishes with the penetration",
+}
+"""The tensionless bed's contact law in words."""
+
+CODE_IDENTIFIERS = ("exact-g-tan-alpha", "mle-binomial", "pga_ratio", "pgv_ratio", "avgsa", "switch rule '",
+                    "below-range", "above-range", "not-reached", "deterministic-threshold", "n_resurrected",
+                    "capacity_median", "rocking-0.2", "rocking-0.5", "peak_friction_demand", "theta_max")
+"""Strings no page of the report may show (tests also look for any snake_case word outside file names)."""
+
+REFERENCES = {
+    "paper": "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations (the SSI-rocking "
+             "model this project implements: a rigid block on one vertical spring-dashpot, derived from the "
+             "Lagrangian; interface stiffness k of its eq. 19).",
+    "Housner 1963": "Housner, G. W. (1963). The behavior of inverted pendulum structures during earthquakes. "
+                    "Bulletin of the Seismological Society of America 53(2), 403-417.",
+    "ElGawady et al. 2011": "ElGawady, M. A., Ma, Q., Butterworth, J. W., Ingham, J. (2011). Effects of interface "
+                            "material on the performance of free rocking blocks. Earthquake Engineering & "
+                            "Structural Dynamics 40(4), 375-392.",
+    "Baker 2015": "Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural "
+                  "analysis. Earthquake Spectra 31(1), 579-599.",
+    "Vamvatsikos & Cornell 2002": "Vamvatsikos, D., Cornell, C. A. (2002). Incremental dynamic analysis. "
+                                  "Earthquake Engineering & Structural Dynamics 31(3), 491-514.",
+    "Cornell et al. 2002": "Cornell, C. A., Jalayer, F., Hamburger, R. O., Foutch, D. A. (2002). Probabilistic basis "
+                           "for 2000 SAC Federal Emergency Management Agency steel moment frame guidelines. "
+                           "Journal of Structural Engineering 128(4), 526-533.",
+    "FEMA P695": "FEMA (2009). Quantification of Building Seismic Performance Factors, FEMA P695. Federal "
+                 "Emergency Management Agency, Washington DC (the far-field and near-field record sets).",
+    "FEMA P-58": "FEMA (2018). Seismic Performance Assessment of Buildings, FEMA P-58, 2nd ed. Federal Emergency "
+                 "Management Agency, Washington DC (fragility functions, combined dispersion of record-to-record "
+                 "and model uncertainty).",
+    "ASCE 7-22": "ASCE (2022). Minimum Design Loads and Associated Criteria for Buildings and Other Structures, "
+                 "ASCE/SEI 7-22 (risk-targeted ground motions: 1% probability of collapse in 50 years).",
+    "Psycharis & Jennings 1983": "Psycharis, I. N., Jennings, P. C. (1983). Rocking of slender rigid bodies allowed "
+                                 "to uplift. Earthquake Engineering & Structural Dynamics 11(1), 57-76.",
+    "Chopra & Yim 1985": "Chopra, A. K., Yim, S. C.-S. (1985). Simplified earthquake analysis of structures with "
+                         "foundation uplift. Journal of Structural Engineering 111(4), 906-930.",
+    "Shenton 1996": "Shenton, H. W. (1996). Criteria for initiation of slide, rock, and slide-rock rigid-body modes. "
+                    "Journal of Engineering Mechanics 122(7), 690-693.",
+    "Makris & Vassiliou 2012": "Makris, N., Vassiliou, M. F. (2012). Sizing the slenderness of free-standing rocking "
+                               "columns to withstand earthquake shaking. Archive of Applied Mechanics 82, 1497-1511.",
+}
+"""The works the report cites, by the short name the pages use."""
+
+
+def references_items() -> list[Item]:
+    """The references page: the seed paper first, then the others in the order of the dict."""
+    items = [paragraph("The pages cite these works by the short name in bold.")]
+    items += [bullet(f"{'The paper' if key == 'paper' else key}: {text}") for key, text in REFERENCES.items()]
+    return items
+
+
+GLOSSARY = (
+    ("θmax/α", "the largest rocking angle of a run over the block's slenderness angle α; 1 is the tipping point "
+               "of a block at rest, and a block that overturns is drawn at the top of the IDA axis."),
+    ("α, R", "slenderness angle (tan α = half-width over half-height) and the half-diagonal of the block."),
+    ("uplift threshold", "the ground acceleration at which the block starts to rock on a rigid base: g·tanα."),
+    ("damage state", "an outcome the fragility gives the probability of: uplift, θmax/α above a limit, "
+                     "overturning."),
+    ("fragility curve", "P(damage state | intensity), a lognormal distribution: median (the intensity at which "
+                        "half the records reach the state) and dispersion β."),
+    ("β (dispersion)", "the standard deviation of the logarithm of the intensity at which the state is reached; "
+                       "from record to record, plus the model's own uncertainty where the recommended curve "
+                       "adds it."),
+    ("band", "the confidence bounds of a median from re-fitting with the records resampled (bootstrap)."),
+    ("IDA (incremental dynamic analysis)", "each record is scaled to a ladder of intensities and run at each "
+                                           "(Vamvatsikos & Cornell 2002)."),
+    ("extrapolation by scaling", "an intensity above the largest any record of the set reached unscaled: there the "
+                                 "results come from records multiplied by large factors, not from ground motions "
+                                 "that occurred."),
+    ("return period", "the mean time between exceedances of an intensity at the site: 475, 975 and 2,475 years "
+                      "are 10%, 5% and 2% probability in 50 years."),
+    ("annual frequency, probability in the design life", "how often per year the state is reached, integrated over "
+                                                         "the site's hazard curve, and the chance that it happens at "
+                                                         "least once in the design life."),
+    ("restitution", "the share of rocking speed a block keeps at each impact; Housner's rigid base gives "
+                    "r = 1 − 1.5 sin²α."),
+    ("resurrection", "a record that overturns the block at one level but not at a higher one; counted as "
+                     "overturned from its first overturning level on."),
+    ("friction demand", "the base friction coefficient a run needs to rock without sliding; above the assumed one "
+                        "the block would slide."),
+    ("Housner model", "a rigid block rocking on a rigid base (Housner 1963): the reference; it does not depend on "
+                      "the soil."),
+    ("SSI-rocking model (the paper's)", "a rigid block on one vertical spring and dashpot under the active corner "
+                                        "(the paper); its spring can pull on the block, which a soil cannot."),
+    ("tensionless Winkler bed", "a rigid block on a bed of springs and dashpots that push but never pull: the block "
+                                "lifts off instead (Psycharis & Jennings 1983)."),
+    ("recommended curve", "the tensionless bed run over the experimental range of impact restitution, its spread "
+                          "added to β (FEMA P-58's combination)."),
+)
+"""The glossary page: term, one line."""
+
+
+def glossary_items() -> list[Item]:
+    """The glossary page's entries, one bullet each."""
+    return [heading("Terms"), *[bullet(f"{term}: {text}") for term, text in GLOSSARY]]
+
+
+def state_short_label(name: str, description: str) -> str:
+    """A damage state in a table header: its description when short ("θmax/α ≥ 0.5"), else its name in words."""
+    text = description.replace("theta_max", "θmax").replace("alpha", "α").replace(">=", "≥")
+    if text and len(text) <= 16:
+        return text
+    return name.replace("-", " ").replace("_", " ")
+
+
+def plain(text: str) -> str:
+    """A status, fit method or rule as words (the input when it has none)."""
+    for table in (STATUS_WORDS, FIT_METHODS, SWITCH_WORDS, BED_WORDS):
+        if text in table:
+            return table[text]
+    return text

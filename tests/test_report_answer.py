@@ -1,0 +1,154 @@
+"""The answer pages (issue 20, item 1): return-period intensities, P(each damage state) with its band, the
+design-life risk and the verdict, checked against closed forms on hand-made datasets (no study run)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+from scipy.stats import lognorm
+
+from pipeline.answer import (
+    ANCHOR,
+    CHECK_SLIDING,
+    NO_ACTION,
+    NO_VERDICT,
+    answer_model,
+    block_answers,
+    intensity_at_frequency,
+    percent,
+    verdict_sentence,
+)
+from pipeline.hazard import HazardCurve, load_hazard
+
+K0, K = 1e-4, 2.5  # the shipped example: lambda(s) = K0 s^-K [1/yr], s = PGA [g]
+
+
+def _power_law(source="site.csv"):
+    s = np.geomspace(0.01, 3.0, 40)
+    return HazardCurve(s, K0 * s ** -K, "pga", None, source)
+
+
+def _fragility(medians, betas=0.4, models=("housner", "winkler"), soils=("clay", "rock"), empirical=None):
+    """A fragility.nc of one block: overturning and one rocking state per soil and model, medians in g."""
+    states = ["rocking-0.5", "overturning"]
+    dims = ("soil", "block", "model", "damage_state")
+    shape = (len(soils), 1, len(models), len(states))
+    median = np.broadcast_to(np.asarray(medians, float), shape).copy()
+    beta = np.broadcast_to(np.asarray(betas, float), shape).copy()
+    levels = np.geomspace(0.1, 4.0, 8)
+    fraction = np.full((levels.size, *shape), 0.5) if empirical is None else empirical
+    g = {"units": "9.80665 m s-2"}
+    return xr.Dataset({
+        "median": (dims, median, g), "beta": (dims, beta),
+        "median_low": (dims, median * 0.8, {**g, "long_name": "90% two-sided interval: lower bound"}),
+        "median_high": (dims, median * 1.25, g),
+        "status": (dims, np.full(shape, "fitted")),
+        "empirical_fraction": (("im_level", *dims), fraction),
+        "studied_im_min": (("block",), [levels[0]], g), "studied_im_max": (("block",), [levels[-1]], g),
+    }, coords={"soil": list(soils), "block": ["cabinet"], "model": list(models), "damage_state": states,
+               "damage_state_description": ("damage_state", ["theta_max/alpha >= 0.5", "the block overturns"]),
+               "im_level": np.arange(levels.size), "intensity": (("block", "im_level"), levels[None, :], g)},
+        attrs={"design_life_years": 50.0})
+
+
+def test_return_period_intensity_is_the_closed_form_of_the_power_law():
+    hazard = _power_law()
+    for period in (475.0, 975.0, 2475.0, 1e5):  # the last beyond the tabulated curve: its power law
+        assert intensity_at_frequency(hazard, 1 / period) == pytest.approx((K0 * period) ** (1 / K), rel=1e-9)
+    shipped = load_hazard(None)
+    assert intensity_at_frequency(shipped, 1 / 2475) == pytest.approx((K0 * 2475) ** (1 / K), rel=1e-3)
+
+
+def test_probabilities_at_the_return_periods_and_in_life_against_scipy():
+    fragility = _fragility([[[[0.3, 0.6]]]])
+    answer = block_answers(fragility, _power_law(), (475.0, 2475.0), limits={"overturning": 0.01})[0]
+    assert answer.model == "winkler"  # the admissible bed, not the rigid base
+    clay = answer.soils[0]
+    overturning = clay.states[1]
+    for index, period in enumerate((475.0, 2475.0)):
+        im = (K0 * period) ** (1 / K)
+        p, low, high = overturning.at_return_periods[index]
+        assert p == pytest.approx(lognorm.cdf(im, 0.4, scale=0.6), rel=1e-9)
+        assert (low, high) == (pytest.approx(lognorm.cdf(im, 0.4, scale=0.75)),
+                               pytest.approx(lognorm.cdf(im, 0.4, scale=0.48)))  # band from the median's bounds
+    # lambda = K0 median^-K exp(K^2 beta^2 / 2) for a power-law hazard (Cornell et al. 2002)
+    closed = K0 * 0.6 ** -K * math.exp(K ** 2 * 0.4 ** 2 / 2)
+    assert overturning.annual_frequency == pytest.approx(closed, rel=0.02)
+    assert overturning.probability_in_life == pytest.approx(1 - math.exp(-50 * overturning.annual_frequency))
+
+
+def test_the_verdict_follows_the_stated_limits_and_the_sliding_share():
+    fragility = _fragility([[[[0.3, 0.6]]], [[[0.3, 3.0]]]])  # clay: overturns often; rock: rarely
+    hazard = _power_law()
+    answer = block_answers(fragility, hazard, limits={"overturning": 0.01},
+                           sliding={("cabinet", "clay"): 0.0, ("cabinet", "rock"): 0.0})[0]
+    clay, rock = answer.soils
+    assert clay.states[1].probability_in_life > 0.01 > rock.states[1].probability_in_life
+    assert (clay.verdict, rock.verdict) == (ANCHOR, NO_ACTION)
+    assert not clay.states[0].exceeds  # a state without a limit is reported, not judged
+    lenient = block_answers(fragility, hazard, limits={"overturning": 0.9})[0]
+    assert [s.verdict for s in lenient.soils] == [NO_ACTION, NO_ACTION]
+    sliding = block_answers(fragility, hazard, limits={"overturning": 0.01}, max_sliding_share=0.1,
+                            sliding={("cabinet", "clay"): 0.05, ("cabinet", "rock"): 0.4})[0]
+    assert [s.verdict for s in sliding.soils] == [ANCHOR, CHECK_SLIDING]
+    assert block_answers(fragility, None)[0].soils[0].verdict == NO_VERDICT
+    sentence = verdict_sentence(answer, "slender electrical cabinet", {"overturning": "the block overturns"})
+    assert "anchor it on clay" in sentence and "no action on rock" in sentence
+    assert f"{percent(clay.states[1].probability_in_life)}, above the 1% limit" in sentence
+    assert "example" not in sentence
+
+
+def test_the_shipped_example_hazard_is_said_in_the_verdicts_sentence():
+    answer = block_answers(_fragility([[[[0.3, 0.6]]]]), load_hazard(None))[0]
+    assert answer.example_hazard
+    assert verdict_sentence(answer, "cabinet").startswith("With the shipped example hazard curve")
+
+
+def test_a_state_no_record_reached_below_the_largest_recorded_intensity_is_said_so():
+    """Never a median of 11 g: 'not reached below X', and P(in life) bounded by P(intensity > X in life)."""
+    levels = np.geomspace(0.1, 4.0, 8)
+    shape = (levels.size, 2, 1, 2, 2)
+    empirical = np.where((levels >= 2.0)[:, None, None, None, None], 0.6, 0.0) * np.ones(shape)
+    fragility = _fragility([[[[3.0, 11.0]]]], empirical=empirical)
+    hazard = _power_law()
+    overturning = block_answers(fragility, hazard, largest_recorded={"cabinet": 0.8})[0].soils[0].states[1]
+    assert overturning.not_reached_below == 0.8
+    assert overturning.annual_frequency == pytest.approx(K0 * 0.8 ** -K, rel=1e-6)
+    reached = block_answers(fragility, hazard, largest_recorded={"cabinet": 2.5})[0].soils[0].states[1]
+    assert reached.not_reached_below is None  # some records reached it below 2.5 g
+
+
+def test_the_recommended_rows_answer_when_present():
+    fragility = _fragility([[[[0.3, 0.6]]]], models=("recommended", "housner", "winkler"))
+    assert answer_model(fragility) == "recommended"
+    assert block_answers(fragility, _power_law())[0].model == "recommended"
+
+
+@pytest.mark.parametrize("value, shown", [(0.123, "12%"), (0.0234, "2.3%"), (0.00071, "0.071%"), (0.0, "0%"),
+                                          (1e-7, "<0.01%"), (0.9996, ">99%"), (float("nan"), "-")])
+def test_probabilities_are_rounded_to_what_they_support(value, shown):
+    assert percent(value) == shown
+
+
+def test_the_study_states_the_limits_and_return_periods(tmp_path):
+    from pipeline.config import load_study
+    from pipeline.errors import ConfigError
+
+    study = tmp_path / "s.toml"
+    study.write_text('[hazard]\nreturn_periods = [100.0, 2475.0]\n[decision]\nmax_probability_in_life = '
+                     '{ overturning = 0.02 }\n')
+    raw = load_study(study).raw
+    assert raw["hazard"]["return_periods"] == [100.0, 2475.0]
+    assert raw["decision"]["max_probability_in_life"] == {"overturning": 0.02, "rocking-0.5": 0.10}  # merged
+    for text, field in (('[decision]\nmax_probability_in_life = { toppling = 0.01 }\n',
+                         "decision.max_probability_in_life.toppling"),
+                        ('[decision]\nmax_probability_in_life = { overturning = 2.0 }\n',
+                         "decision.max_probability_in_life.overturning"),
+                        ('[hazard]\nreturn_periods = [0.5]\n', "hazard.return_periods[0]")):
+        study.write_text(text)
+        with pytest.raises(ConfigError) as error:
+            load_study(study)
+        assert error.value.field == field

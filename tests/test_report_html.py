@@ -1,0 +1,84 @@
+"""The HTML report a reader can navigate (issue 20, item 4): rendered by headless Chromium, every image loads
+and every link resolves; every page leads back to the contents; the answer pages are HTML text.
+
+Chromium is a system package (README, "How to read the report": ``apt-get install chromium``). Without it the
+browser test is skipped with that command, and fails under ``make test`` (``ROCKFRAG_CONSUMERS=required``)."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+
+import pytest
+
+from tests.helpers import CONSUMERS_REQUIRED
+
+BROWSERS = ("chromium", "chromium-browser", "google-chrome", "chromium-headless-shell")
+INSTALL = "apt-get install chromium"
+
+CHECK = """<script>window.addEventListener('load', () => {
+  const images = [...document.images];
+  const bad = images.filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.alt.slice(0, 80));
+  const links = [...document.querySelectorAll('a[href]')].map(a => a.getAttribute('href'));
+  const broken = links.filter(h => !(h.startsWith('#') && document.getElementById(h.slice(1))));
+  const out = document.createElement('pre');
+  out.id = 'rockfrag-check';
+  out.textContent = JSON.stringify({images: images.length, bad, links: links.length, broken});
+  document.body.appendChild(out);
+});</script>"""
+"""Appended to a copy of report.html: the browser's own verdict on every image and link, after loading."""
+
+
+def chromium() -> str:
+    """The Chromium executable; skip (or fail under ``make test``) with the install command when missing."""
+    for name in BROWSERS:
+        found = shutil.which(name)
+        if found:
+            return found
+    reason = f"headless Chromium is not installed: {INSTALL} (as root, after apt-get update); see the README"
+    if os.environ.get(CONSUMERS_REQUIRED) == "required":
+        pytest.fail(reason)
+    pytest.skip(reason)
+
+
+def test_every_image_loads_and_every_link_resolves_in_chromium(small_pipeline, tmp_path):
+    """~3 s: one headless Chromium load of the small study's report."""
+    browser = chromium()
+    html = (small_pipeline.output / "report.html").read_text()
+    page = tmp_path / "report.html"
+    page.write_text(html.replace("</body>", CHECK + "</body>"))
+    done = subprocess.run([browser, "--headless", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=20000",
+                           "--dump-dom", page.as_uri()], capture_output=True, text=True, timeout=120)
+    found = re.search(r"<pre id=\"rockfrag-check\">(.*?)</pre>", done.stdout)
+    assert found, f"Chromium did not run the check (exit {done.returncode}): {done.stderr[-500:]}"
+    result = json.loads(found.group(1))
+    figures = html.count("<img ")
+    assert result["images"] == figures > 0 and result["bad"] == []
+    assert result["links"] > 0 and result["broken"] == []
+
+
+def test_every_page_leads_back_to_the_contents_and_sections_have_anchors(small_pipeline):
+    html = (small_pipeline.output / "report.html").read_text()
+    sections = re.findall(r"<section id='page-(\d+)'>(.*?)</section>", html, flags=re.S)
+    contents = next(number for number, body in sections if "<h2>Contents</h2>" in body)
+    back = f"<a href='#page-{contents}'>Back to the contents</a>"
+    assert all(back in body for number, body in sections if number != contents)
+    for section in ("Answer", "Summary", "Methods", "Limitations", "Glossary", "References"):
+        slug = "section-" + section.lower()
+        assert f"id='{slug}'" in html and f"href='#{slug}'" in html, section
+    answers = [body for _, body in sections if "<h2>Answer:" in body]
+    assert answers and all("<img" not in body and "<table>" in body for body in answers)  # text, not images
+    assert int(contents) == len(answers) + 2  # title, the answer pages, then the contents
+
+
+def test_a_missing_chromium_fails_under_make_test_with_the_install_command(monkeypatch):
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    monkeypatch.setenv(CONSUMERS_REQUIRED, "required")
+    with pytest.raises(pytest.fail.Exception, match=INSTALL):
+        chromium()
+    monkeypatch.delenv(CONSUMERS_REQUIRED)
+    with pytest.raises(pytest.skip.Exception, match=INSTALL):
+        chromium()

@@ -1,0 +1,266 @@
+"""Words a client reads and credible intensities (issue 20, items 2 and 3): one test per defect the issue
+lists, each able to catch it again, on the small study's results (fixture ``small_pipeline``) or on hand-made
+datasets. Independent values come from the result files, closed forms or the datasets, never from the page."""
+
+from __future__ import annotations
+
+import html as html_module
+import re
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+import xarray as xr
+
+from pipeline.report.words import CODE_IDENTIFIERS
+
+K0, K = 1e-4, 2.5  # the shipped example hazard: lambda(s) = K0 s^-K
+
+
+def _results(folder, study, **changes):
+    from pipeline.config import load_study
+    from pipeline.report import Results
+
+    opened = {}
+    for name in ("cube", "ida", "fragility", "showcase", "efficiency"):
+        with xr.open_dataset(folder / f"{name}.nc") as dataset:
+            opened[name] = dataset.load()
+    values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
+                  output=folder, showcase=opened["showcase"], efficiency=opened["efficiency"])
+    values.update(changes)
+    return Results(**values)
+
+
+def _visible_text(html: str) -> str:
+    text = re.sub(r"<img[^>]*>", " ", html)
+    text = re.sub(r"<style>.*?</style>", " ", text, flags=re.S)
+    return html_module.unescape(re.sub(r"<[^>]+>", " ", text))
+
+
+def _snake_case(text: str) -> list[str]:
+    """snake_case words that are not file names (cube.nc, fragility.csv, ...)."""
+    return [w for w in re.findall(r"\b[a-z]{2,}_[a-z0-9_]+\b(?!\.(?:nc|csv|png|pdf|html|toml))", text)]
+
+
+def _figure_text(figure) -> str:
+    texts = [t.get_text() for t in figure.findobj(plt.Text)]
+    return " ".join(texts)
+
+
+# ---------------------------------------------------------------- the whole report, as HTML text
+
+def test_no_code_identifier_reaches_the_html(small_pipeline):
+    text = _visible_text((small_pipeline.output / "report.html").read_text())
+    assert [word for word in CODE_IDENTIFIERS if word in text] == []
+    assert _snake_case(text) == []
+    assert "pivot switch rule" not in text and "[ssi]" not in text
+
+
+def test_blocks_are_named_as_the_client_knows_them(small_pipeline):
+    """The crane is not called "paper": the study's block names (defaults.toml [report] block_names)."""
+    text = _visible_text((small_pipeline.output / "report.html").read_text())
+    assert "crane portal (the paper's block)" in text and "slender electrical cabinet" in text
+    assert "block 'paper'" not in text and "block paper" not in text
+    assert "Answer: crane portal (the paper's block)" in text
+
+
+def test_references_and_glossary_pages_cite_the_sources(small_pipeline):
+    text = _visible_text((small_pipeline.output / "report.html").read_text())
+    seed = "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations"
+    for work in (seed, "Housner, G. W. (1963)", "FEMA P695", "FEMA P-58", "ElGawady", "Baker, J. W. (2015)"):
+        assert work in text, work
+    glossary = text[text.index("Glossary"):]
+    for term in ("θmax/α", "β (dispersion)", "IDA", "restitution", "resurrection", "tensionless Winkler bed"):
+        assert term in glossary, term
+
+
+def test_every_figure_has_a_caption_that_says_what_to_read(small_pipeline):
+    from pipeline.report import plan
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    figures = [page for page in plan(results) if page.html is None and page.name != "title"]
+    assert "efficiency" in [page.name for page in figures]
+    assert [page.name for page in figures if not page.caption.startswith("Read ")] == []
+
+
+# ---------------------------------------------------------------- the contradictions the issue lists
+
+def test_no_orphan_footnote_mark(small_pipeline, tmp_path):
+    """A footnote is printed only when a row carries its mark, and every mark has its footnote."""
+    from pipeline.report.sections import summary_items
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+
+    def marks_and_notes(items):
+        cells = " ".join(c for item in items if item.kind == "table" for row in item.rows for c in row)
+        notes = [item.text for item in items if item.kind == "note"]
+        return {m for m in "*†" if m in cells}, {m for m in "*†" if any(n.startswith(m) for n in notes)}
+
+    marks, notes = marks_and_notes(summary_items(results))
+    assert marks == notes
+    fragility = results.fragility.copy()
+    middle = float(np.median(results.fragility.intensity.values))
+    fragility["median"] = fragility["median"].where(False, middle)  # every median inside the studied range
+    inside = _results(small_pipeline.output, small_pipeline.study, fragility=fragility, output=tmp_path)
+    inside.largest_recorded.update({b: np.inf for b in inside.largest_recorded})
+    assert marks_and_notes(summary_items(inside)) == (set(), set())
+
+
+def test_curves_without_a_median_carry_the_counts_that_justify_it(small_pipeline):
+    from pipeline.report.sections import limitations_items
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    items = limitations_items(results)
+    text = " ".join(item.text for item in items)
+    assert "too few exceedances" not in text
+    fragility = results.fragility
+    unfitted = fragility["median"].isnull() & (fragility.status != "not-reached") | (fragility.status == "not-reached")
+    tables = [item for item in items if item.kind == "table" and "why no median" in item.header]
+    if not bool(unfitted.any()):
+        assert tables == []
+        return
+    n = int(fragility.n_records)
+    for row in tables[0].rows:
+        counts = row[4]
+        assert re.fullmatch(rf"\d+ of {n} at [\d.]+ g, \d+ of {n} at [\d.]+ g", counts), counts
+        low = int(counts.split(" of ")[0])
+        if row[5] == "reached below the lowest level":
+            assert low > n / 2  # most records reached it at the lowest level
+        if row[5] == "never reached":
+            assert counts.startswith(f"0 of {n}") and ", 0 of" in counts
+
+
+def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline):
+    from pipeline.report import figures
+
+    showcase = _results(small_pipeline.output, small_pipeline.study).showcase
+    assert "y - y_static" in showcase.settlement.attrs["long_name"]  # positive up, as the file defines it
+    figure = figures.showcase_response_page(showcase, "")
+    try:
+        settle = [a for a in figure.axes if a.get_ylabel().startswith("Δy")]
+        assert settle and "up +" in settle[0].get_title() + settle[0].get_ylabel()
+        assert "down +" not in _figure_text(figure)
+        drawn = np.concatenate([line.get_ydata() for axis in settle for line in axis.lines])
+        recorded = showcase.settlement.values[showcase.case_soil.values != ""] * 1000
+        assert np.nanmin(drawn) == pytest.approx(np.nanmin(recorded))
+    finally:
+        plt.close(figure)
+
+
+def test_contents_and_station_names_are_not_cut(small_pipeline):
+    from pipeline.report import build_plan, records_items
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    planned = build_plan(results)
+    contents = next(page for page in planned if page.name == "contents")
+    figure = contents.draw()
+    try:
+        assert "…" not in _figure_text(figure)
+        drawn = re.sub(r"\s+", " ", _figure_text(figure))
+        for page in planned:  # every title whole (wrapped lines joined)
+            assert all(word in drawn for word in page.title.split()), page.title
+    finally:
+        plt.close(figure)
+    cells = [c for item in records_items(results) for row in item.rows for c in row]
+    assert set(map(str, results.cube.record_station.values)) <= set(cells)
+    assert set(map(str, results.cube.record_event.values)) <= set(cells)
+
+
+def test_a_panel_with_points_but_no_curve_says_why():
+    """The uplift panel had dots and no curve: a state without a median is named in its panel."""
+    from pipeline.report import figures
+    from pipeline.report.adapters import model_info
+
+    levels = np.array([0.2, 0.4, 0.8])
+    dims = ("soil", "block", "model", "damage_state")
+    coords = {"soil": ["clay"], "block": ["b"], "model": ["winkler"], "damage_state": ["uplift", "overturning"],
+              "im_level": [0, 1, 2], "intensity": (("block", "im_level"), levels[None, :])}
+    fragility = xr.Dataset({
+        "median": (dims, [[[[np.nan, 0.5]]]]), "beta": (dims, [[[[np.nan, 0.3]]]]),
+        "median_low": (dims, [[[[np.nan, 0.4]]]]), "median_high": (dims, [[[[np.nan, 0.6]]]]),
+        "status": (dims, [[[["below-range", "fitted"]]]]),
+        "empirical_fraction": (("im_level", *dims), np.array([[1.0, 0.1], [1.0, 0.4], [1.0, 0.9]])[:, None, None,
+                                                                                                     None, :]),
+    }, coords=coords)
+    figure = figures.fragility_by_soil_page(fragility, "b", model_info("winkler"), "")
+    try:
+        uplift, overturning = [a for a in figure.axes if a.get_visible()][:2]
+        assert "no curve" in _figure_text(uplift) and "lowest level" in _figure_text(uplift)
+        assert "no curve" not in _figure_text(overturning)
+    finally:
+        plt.close(figure)
+
+
+def test_p_values_are_not_shown_beyond_what_they_support():
+    from pipeline.report import figures
+
+    dims = ("soil", "block", "model", "measure")
+    shape = (1, 1, 1, 3)
+    dataset = xr.Dataset({"dispersion": (dims, np.full(shape, 0.4)),
+                          "p_magnitude": (dims, np.array([1e-18, 0.3, 0.02]).reshape(shape)),
+                          "p_distance": (dims, np.full(shape, 0.5)), "p_pulse_period": (dims, np.full(shape, 0.5))},
+                         coords={"soil": ["clay"], "block": ["b"], "model": ["winkler"],
+                                 "measure": ["pga", "avgsa", "pga_ratio"]})
+    figure = figures.efficiency_page(dataset, "Read it.")
+    try:
+        text = _figure_text(figure)
+        assert "avgsa" not in text and "pga_ratio" not in text and "AvgSa" in text
+        bottom = [a for a in figure.axes if "Sufficiency" in a.get_title()][0]
+        points = np.concatenate([c.get_offsets()[:, 1] for c in bottom.collections])
+        assert points.min() >= figures.P_FLOOR and bottom.get_ylim()[0] >= 0.5 * figures.P_FLOOR
+        assert "1e-18" not in text
+    finally:
+        plt.close(figure)
+
+
+def test_a_steel_base_is_not_counted_as_a_soil():
+    from pipeline.report.sections import grounds
+
+    cube = xr.Dataset(coords={"soil": ["clay", "rock", "steel"],
+                              "soil_shear_modulus": ("soil", [3.7e7, 1e9, 8e10])})
+    assert grounds(cube) == "2 soils (clay, rock) and a structural base (steel; not a soil)"
+
+
+# ---------------------------------------------------------------- credible intensities
+
+def test_intensity_axes_are_log_and_mark_the_hazard_and_the_extrapolation(small_pipeline):
+    from pipeline.report import figures
+    from pipeline.report.adapters import models_of
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    block = str(results.cube.block.values[1])
+    marks = results.marks(block)
+    assert marks.return_periods == (475.0, 975.0, 2475.0)
+    np.testing.assert_allclose(marks.intensities, [(K0 * t) ** (1 / K) for t in marks.return_periods], rtol=1e-3)
+    assert marks.largest == pytest.approx(float(results.cube.record_pga.max()))  # a PGA study: the largest PGA
+    model = next(m for m in models_of(results.fragility) if not m.rigid_base)
+    pages = [figures.ida_page(results.ida, block, "", marks=marks),
+             figures.fragility_by_soil_page(results.fragility, block, model, "", marks=marks),
+             figures.outcomes_page(results.fragility, block, "", marks=marks)]
+    try:
+        for index, figure in enumerate(pages):
+            axes = [a for a in figure.axes if a.get_visible() and a.lines]
+            for axis in axes:
+                along = "y" if index == 0 else "x"
+                assert (axis.get_yscale() if along == "y" else axis.get_xscale()) == "log"
+                data = [line.get_ydata() if along == "y" else line.get_xdata() for line in axis.lines]
+                constant = {round(float(d[0]), 6) for d in data if len(d) == 2 and d[0] == d[1]}
+                for value in (*marks.intensities, marks.largest):
+                    low, high = axis.get_ylim() if along == "y" else axis.get_xlim()
+                    if low <= value <= high:
+                        assert round(value, 6) in constant, (figure.texts[0].get_text(), value)
+                assert "extrapolation by scaling" in " ".join(axis.get_legend_handles_labels()[1])
+            assert "2,475 yr" in _figure_text(figure)
+    finally:
+        for figure in pages:
+            plt.close(figure)
+
+
+def test_the_methods_page_states_the_scale_factors(small_pipeline):
+    from pipeline.report.sections import methods_items
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    with xr.open_dataset(small_pipeline.output / "cube.nc") as cube:
+        factors = cube.scale_factor.values
+    text = " ".join(item.text for item in methods_items(results))
+    assert f"median {np.nanmedian(factors):.2g}, largest {np.nanmax(factors):.3g}" in text
