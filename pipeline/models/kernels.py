@@ -116,6 +116,7 @@ ZENO_STEP_SHRINK = 0.25         # a whole excursion inside one step: retry with 
 MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
+SLIP_STOP_FRACTION = 1e-12      # of the slip rate's scale: a slide ending a step this slow has stopped there
 UNKNOWN_CODE = "model kernel code not handled by pipeline.models.kernels"
 
 # rows of the ground motion's samples (``GroundMotion.samples``, what the entry points take)
@@ -361,12 +362,13 @@ def error_norm(x, x_new, error, scale, rtol, atol, count):
 
 
 @njit(cache=True)
-def integrated_size(params):
-    """State components a run integrates: all with friction; without, the slip stays 0 and is not counted.
+def integrated_size(system):
+    """State components the error norm is over: all while the base slides; else the slip is constant, not counted.
 
-    (Its zero error adds exactly 0 to the error norm, so a tied run steps as before the slip was added.)
+    (Its zero error adds exactly 0 to the norm, so a tied run steps as before the slip was added, and a stuck
+    base with friction steps as the tied one.)
     """
-    return STATE_SIZE if params["mu_s"] > 0.0 else TIED_STATE_SIZE
+    return STATE_SIZE if system.slip != 0.0 else TIED_STATE_SIZE
 
 
 @njit(cache=True)
@@ -386,7 +388,7 @@ def adaptive_step(system, t, x, h, work, zeno_guard):
     """
     rtol = system.params["rtol"]
     atol = system.params["atol"]
-    count = integrated_size(system.params)
+    count = integrated_size(system)
     while True:
         dopri_step(system, t, x, h, work)
         norm = error_norm(x, work.x_new, work.error, work.scale, rtol, atol, count)
@@ -734,6 +736,15 @@ def slip_event(system, step, min_fraction, interpolated):
         if s_hit > min_fraction:
             return kind, s_hit
     return EVENT_NONE, 2.0
+
+
+@njit(cache=True)
+def stopped_at_end(system, x, scale):
+    """True when a sliding base ends a step with its slip rate at zero (or past it): the stop is there.
+
+    (A stop at a step's very end is not located inside the next one, whose start it would be.)
+    """
+    return system.slip != 0.0 and system.slip * x[SLIP_RATE] <= SLIP_STOP_FRACTION * scale[SLIP_RATE]
 
 
 @njit(cache=True)
@@ -1107,6 +1118,8 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
         f0_current = True
         if friction:
             book_slip(summary, x)
+            if kind == EVENT_NONE and stopped_at_end(system, x, work.scale):
+                kind = EVENT_SLIP_STOP
         if code == SSI and ssi_bookkeeping(system, x, y_static, t, summary):
             f0_current = False
         h = next_step(h, norm)
@@ -1305,6 +1318,8 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
         h = next_step(h, norm)
         if friction:
             book_slip(summary, x)
+            if kind == EVENT_NONE and stopped_at_end(system, x, work.scale):
+                kind = EVENT_SLIP_STOP
             if kind == EVENT_SLIP_START or kind == EVENT_SLIP_STOP:
                 if kind == EVENT_SLIP_STOP:
                     x[SLIP_RATE] = 0.0
