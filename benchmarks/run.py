@@ -22,6 +22,7 @@ warnings.simplefilter("ignore")
 
 import calibration  # noqa: E402  (benchmarks/calibration.py)
 import fragility as fragility_benchmark  # noqa: E402  (benchmarks/fragility.py)
+import sliding as sliding_benchmark  # noqa: E402  (benchmarks/sliding.py)
 from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/opensees_winkler.py)
 
 from pipeline.blocks import Block  # noqa: E402
@@ -207,6 +208,7 @@ if __name__ == "__main__":
     records = far_field()
     solver_throughput(records)
     per_run_cost(records)
+    sliding_benchmark.run(records)
     accuracy_and_chaos(records)
     study_timing()
     hunt_and_fill_savings(records)
