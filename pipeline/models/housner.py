@@ -50,8 +50,6 @@ def housner_rhs(sigma, x, accel, gravity, params, out):
     out[1] = -params["kappa"] * (gravity * math.sin(angle) + accel * math.cos(angle)) / params["R"]
     out[2] = 0.0
     out[3] = 0.0
-    out[4] = 0.0
-    out[5] = 0.0
 
 
 @njit(cache=True)

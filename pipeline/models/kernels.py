@@ -270,13 +270,17 @@ def free_flight_time(motion, g):
 
 
 @njit(cache=True)
-def rhs(code, phase, sigma, slip, x, accel, gravity, params, out):
+def rhs(code, phase, sigma, x, accel, gravity, params, out, slip=0.0):
     """dx/dt into out for state x = [theta, theta_dot, y, y_dot, u, u_dot], by the model's kernel code.
 
     ``accel`` is the horizontal ground acceleration and ``gravity`` the effective gravity g + a_v [m/s^2];
     the pivot models also read the phase and the active pivot sigma; ``slip`` is the direction in which the
-    base slides (0: stuck or tied).
+    base slides (0: stuck or tied, whose right-hand sides fill the first TIED_STATE_SIZE components: the slip's
+    rates are zero; out may then be that short).
     """
+    if slip == 0.0:
+        for i in range(TIED_STATE_SIZE, out.size):
+            out[i] = 0.0
     if code == HOUSNER:
         if phase == REST:
             if slip == 0.0:
@@ -308,8 +312,8 @@ def derivatives(system, t, x, out):
     The horizontal enters as a ground acceleration, the vertical as the effective gravity g + a_v(t).
     """
     motion = system.motion
-    rhs(system.code, system.phase, system.sigma, system.slip, x, ground(motion, t),
-        effective_gravity(system.params, motion, t), system.params, out)
+    rhs(system.code, system.phase, system.sigma, x, ground(motion, t), effective_gravity(system.params, motion, t),
+        system.params, out, system.slip)
 
 
 @njit(cache=True)

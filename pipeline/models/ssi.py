@@ -57,8 +57,6 @@ def ssi_rest_rhs(x, gravity, params, out):
     out[1] = 0.0
     out[2] = x[3]
     out[3] = gravity - omega * omega * x[2] - 2.0 * params["xi"] * omega * x[3]
-    out[4] = 0.0  # the paper's model has no sliding base
-    out[5] = 0.0
 
 
 @njit(cache=True)
@@ -81,8 +79,6 @@ def ssi_rhs(sigma, x, accel, gravity, params, out):
     out[1] = kappa / radius * (sin_a * y_acc + moment)
     out[2] = x[3]
     out[3] = y_acc
-    out[4] = 0.0
-    out[5] = 0.0
 
 
 @njit(cache=True)

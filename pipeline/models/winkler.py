@@ -102,8 +102,6 @@ def winkler_rhs(x, accel, gravity, params, out):
     out[1] = theta_acc
     out[2] = x[3]
     out[3] = y_acc
-    out[4] = 0.0  # tied or stuck: the base centre does not slide
-    out[5] = 0.0
 
 
 @njit(cache=True)
