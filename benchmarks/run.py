@@ -22,6 +22,7 @@ warnings.simplefilter("ignore")
 
 import calibration  # noqa: E402  (benchmarks/calibration.py)
 import fragility as fragility_benchmark  # noqa: E402  (benchmarks/fragility.py)
+import sliding as sliding_benchmark  # noqa: E402  (benchmarks/sliding.py)
 from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/opensees_winkler.py)
 
 from pipeline.blocks import Block  # noqa: E402
@@ -245,6 +246,7 @@ if __name__ == "__main__":
     solver_throughput(records)
     per_run_cost(records)
     per_run_cost_band(records)
+    sliding_benchmark.run(records)
     accuracy_and_chaos(records)
     accuracy_and_chaos(records, anchored=True)
     study_timing()

@@ -211,23 +211,27 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         ``g`` [m/s^2]: gravity, default 9.80665;
         ``overturn_angle`` [rad]: the |theta| of overturning (terminal), up to pi/2 (default);
         ``rtol`` and ``atol`` [-]: the error per step, relative and as a fraction of each state's scale
-        (defaults 1e-6 and 1e-7).
+        (defaults 1e-6 and 1e-7);
+        ``friction`` [-]: Coulomb friction at the base of housner and winkler, one coefficient mu (static =
+        kinetic) or a pair (mu_s, mu_k), mu_s >= mu_k > 0 (housner: mu_k <= 4/3); the block may then slide,
+        flat or while rocking, with stick-slip. None (default) ties the base horizontally, as before.
 
     Returns
     -------
     RockingResult
-        Histories at the sample times (t [s], theta [rad], theta_dot [rad/s], y [m] and y_dot [m/s],
-        NaN after overturning, free flight or failure), peaks, impacts, uplift and foundation checks in SI
-        units, the ``Outcome`` as ``status``; bed models: the damping ratio and contact law used in
-        ``extra``.
+        Histories at the sample times (t [s], theta [rad], theta_dot [rad/s], y [m] and y_dot [m/s], the
+        slip u [m] and u_dot [m/s], NaN after overturning, free flight or failure), peaks, impacts, uplift,
+        slip (``peak_slip``, ``residual_slip`` [m], ``mode_times`` [s]) and foundation checks in SI units,
+        the ``Outcome`` as ``status``; bed models: the damping ratio and contact law used in ``extra``.
 
     Raises
     ------
     SolverError
         An unknown model; ``ag`` not 1-D with 2 finite samples or more; ``dt`` <= 0 or ``t_end`` < 0;
         ``ag_vertical`` not sampled as ``ag`` or not finite; no ``k`` for a model with a foundation, or
-        ``k``, ``xi`` or an option out of range; winkler given both ``xi`` and ``restitution``, or a
-        ``restitution`` target its bed cannot reach.
+        ``k``, ``xi`` or an option out of range (``friction`` not a positive coefficient or pair with
+        mu_s >= mu_k, or given to a tied model such as ssi); winkler given both ``xi`` and ``restitution``, or
+        a ``restitution`` target its bed cannot reach.
     TypeError
         An option that is not a ``SolverOptions`` field.
 
@@ -278,6 +282,9 @@ def _result(spec, block, dt, summary, history, impacts, params):
         peak_uplift=float(summary["peak_corner_uplift"]),
         peak_friction_demand=float(summary["peak_friction_demand"]),
         time_of_free_flight=float(summary["time_of_free_flight"]),
+        u=history[:, fields.SLIP].copy(), u_dot=history[:, fields.SLIP_RATE].copy(),
+        peak_slip=float(summary["peak_slip"]), residual_slip=float(summary["residual_slip"]),
+        mode_times={name: float(summary[key]) for name, key in zip(fields.MODE_NAMES, fields.MODE_TIME_FIELDS)},
         status=status, message=message, n_steps=int(summary["n_steps"]), extra=_case_extra(spec, params))
 
 
@@ -319,7 +326,9 @@ def simulate_batch(model: str, ag: ArrayLike, dt: float, scales: ArrayLike,
     **options : float or str or None
         ``SolverOptions`` fields, as in ``simulate``: ``switch`` (ssi), ``bed`` (winkler's contact law),
         ``restitution`` [-] (pivot models: the impact coefficient; winkler: the target to which each
-        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``.
+        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``,
+        ``friction`` (housner, winkler: mu or (mu_s, mu_k); the summaries then carry ``peak_slip``,
+        ``residual_slip`` and the ``time_*`` of each contact mode).
 
     Returns
     -------
@@ -368,7 +377,9 @@ def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tup
     **options : float or str or None
         ``SolverOptions`` fields, as in ``simulate``: ``switch`` (ssi), ``bed`` (winkler's contact law),
         ``restitution`` [-] (pivot models: the impact coefficient; winkler: the target to which each
-        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``.
+        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``,
+        ``friction`` (housner, winkler: mu or (mu_s, mu_k); the summaries then carry ``peak_slip``,
+        ``residual_slip`` and the ``time_*`` of each contact mode).
 
     Returns
     -------

@@ -17,8 +17,9 @@ The contract for a model (as scipy's ``integrate/_ivp/base.py`` states its own),
    one registration in ``pipeline.models.contact``, not a new model.
 3. ``needs_foundation``: the model needs the interface stiffness k [N/m] and damping ratio xi [-];
    ``is_rigid_base``: its result does not depend on the soil (computed once per block).
-4. ``uses_restitution``, ``uses_switch``, ``uses_bed``: which solver options apply; a caller asks
-   these instead of comparing model names.
+4. ``uses_restitution``, ``uses_switch``, ``uses_bed``, ``slides``: which solver options apply
+   (``slides``: the ``friction`` option, Coulomb friction at the base); a caller asks these instead of
+   comparing model names.
 5. ``uplift_is_rigid_threshold``: uplift happens exactly when |ag| = g tan(alpha) (at rest), so under
    PGA scaling the uplift fragility is a known step.
 6. ``can_pull``: the foundation force can become negative (the paper's spring); the kernel reports
@@ -73,7 +74,8 @@ class RockingModel:
     ``kernel_code`` dispatches the model in the compiled kernels (``fields.HOUSNER`` ...);
     ``default_restitution(block)`` gives the impact coefficient [-] when no ``restitution`` option is set;
     the flags say which inputs it reads (a foundation's k and xi, restitution, switch rule, bed law) and
-    which checks apply (``can_pull``: its foundation spring can go into tension).
+    which checks apply (``can_pull``: its foundation spring can go into tension); ``slides``: it takes Coulomb
+    friction at its base (the ``friction`` option; without it the base is tied horizontally).
     """
 
     name: str
@@ -89,6 +91,7 @@ class RockingModel:
     uses_bed: bool = False
     uplift_is_rigid_threshold: bool = True
     can_pull: bool = False
+    slides: bool = False
 
 
 @dataclass
@@ -106,6 +109,10 @@ class RockingResult:
     time_of_tension [s] (first time it pulled; NaN if never), n_flights, airborne_time [s],
     peak_uplift [m] (highest corner above the ground), peak_friction_demand [-] (winkler),
     time_of_free_flight [s] (first time g + a_v < 0; NaN if never), status (Outcome) and message.
+    u, u_dot : ndarray (n,) [m], [m/s] horizontal slip of the base relative to the ground (zeros for a tied
+        base; rigid base: of the contact corner as if flat on it, bed: of the base centre), NaN as theta.
+    peak_slip, residual_slip [m]: peak and final absolute slip; mode_times [s]: the time spent in each
+    contact mode, {"rest", "slide", "rock", "slide_rock", "flight"} (fields.MODE_NAMES).
     """
 
     model: str
@@ -133,6 +140,11 @@ class RockingResult:
     peak_uplift: float = 0.0
     peak_friction_demand: float = 0.0
     time_of_free_flight: float = float("nan")
+    u: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    u_dot: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    peak_slip: float = 0.0
+    residual_slip: float = 0.0
+    mode_times: dict = field(default_factory=dict)
     extra: dict = field(default_factory=dict)
 
     @property

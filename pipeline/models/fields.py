@@ -14,10 +14,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# The state every kernel integrates: x = [theta, theta_dot, y, y_dot] (rotation [rad] and its rate
-# [rad/s], settlement of the pivot or base centre [m, positive down] and its rate [m/s]). A model
-# with more degrees of freedom (a sliding base, say) widens it here.
-STATE_SIZE = 4
+# The state every kernel integrates: x = [theta, theta_dot, y, y_dot, u, u_dot] (rotation [rad] and its
+# rate [rad/s], settlement of the pivot or base centre [m, positive down] and its rate [m/s], horizontal
+# slip of the base relative to the ground [m] and its rate [m/s]). A tied base (no friction) keeps u = 0
+# and measures its step error over the first TIED_STATE_SIZE components only, so its numbers do not
+# depend on the slip components. The slip u is that of the contact corner as if the block were flat on
+# it (rigid base: the pivot's position minus sigma b) or of the base centre (bed models).
+STATE_SIZE = 6
+TIED_STATE_SIZE = 4
+SLIP = 4       # index of u in the state
+SLIP_RATE = 5  # index of u_dot
 
 # Kernel codes: which right-hand side and which time loop a model uses (pipeline.models.kernels
 # dispatches on them; a model states its code in its ``RockingModel``).
@@ -36,6 +42,17 @@ EVENT_OVERTURN = 1      # |theta| reaches the overturning angle
 EVENT_UPLIFT = 2        # rest -> rocking (pivot models)
 EVENT_SETTLE = 3        # a start that does not lift: back to rest (pivot models)
 EVENT_CONTACT = 4       # a bed contact point opens or closes (winkler)
+EVENT_SLIP_START = 5    # a stuck base needs more friction than mu_s N (friction models)
+EVENT_SLIP_STOP = 6     # the slip rate of a sliding base reaches zero (friction models)
+
+# Contact modes of a run with friction (the summaries' time_* fields): the base stuck and flat (or in full
+# contact with a bed), sliding flat, rocking on a stuck corner, rocking on a sliding corner, all in the air.
+MODE_REST = 0
+MODE_SLIDE = 1
+MODE_ROCK = 2
+MODE_SLIDE_ROCK = 3
+MODE_FLIGHT = 4
+MODE_NAMES = ("rest", "slide", "rock", "slide_rock", "flight")
 
 PARAMS_DTYPE = np.dtype([
     ("R", "f8"),            # semi-diagonal [m]
@@ -54,6 +71,8 @@ PARAMS_DTYPE = np.dtype([
     ("atol", "f8"),         # absolute error per step as a fraction of each state's scale [-]
     ("zeno", "f8"),         # excursions below this angle end the rocking [rad] (pivot models)
     ("max_events", "f8"),   # chatter guard
+    ("mu_s", "f8"),         # static friction coefficient of the base [-]; 0: the base is tied (no sliding)
+    ("mu_k", "f8"),         # kinetic friction coefficient [-], 0 < mu_k <= mu_s (0 when tied)
 ])
 
 
@@ -91,7 +110,16 @@ SUMMARY_FIELDS = (
     SummaryField("time_of_free_flight", "s",
                  "first time g + a_v fell below zero, the ground falling faster than gravity (pivot models stop "
                  "there: outcome free_flight; NaN: never)"),
+    SummaryField("peak_slip", "m", "peak absolute horizontal slip of the base relative to the ground (0: tied base)"),
+    SummaryField("residual_slip", "m", "absolute horizontal slip of the base at the end of the run"),
+    SummaryField("time_at_rest", "s", "time with the base stuck and wholly on the ground"),
+    SummaryField("time_sliding", "s", "time with the base sliding and wholly on the ground"),
+    SummaryField("time_rocking", "s", "time rocking (part of the base lifted) on a stuck contact"),
+    SummaryField("time_slide_rocking", "s", "time rocking (part of the base lifted) on a sliding contact"),
+    SummaryField("time_in_flight", "s", "time with the whole base off the ground"),
 )
+MODE_TIME_FIELDS = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight")
+"""The summary field of each contact mode, in the order of the MODE_* codes."""
 FIELDS_BY_NAME = {field.name: field for field in SUMMARY_FIELDS}
 
 SUMMARY_DTYPE = np.dtype([(field.name, "f8") for field in SUMMARY_FIELDS])

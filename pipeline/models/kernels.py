@@ -50,17 +50,43 @@ from pipeline.models.fields import (
     EVENT_NONE,
     EVENT_OVERTURN,
     EVENT_SETTLE,
+    EVENT_SLIP_START,
+    EVENT_SLIP_STOP,
     EVENT_UPLIFT,
     HOUSNER,
+    MODE_FLIGHT,
+    MODE_REST,
+    MODE_ROCK,
+    MODE_SLIDE,
+    MODE_SLIDE_ROCK,
+    SLIP,
+    SLIP_RATE,
     SSI,
     STATE_SIZE,
     SWITCH_CONSISTENT,
+    TIED_STATE_SIZE,
     WINKLER,
 )
-from pipeline.models.housner import housner_rest_rhs, housner_rhs, housner_support
+from pipeline.models.housner import (
+    friction_impact,
+    housner_rest_rhs,
+    housner_rhs,
+    housner_slide_rhs,
+    housner_slide_rock_rhs,
+    housner_support,
+    rock_forces,
+    slide_rock_accelerations,
+)
 from pipeline.models.jit import njit
 from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
-from pipeline.models.winkler import bed_force, friction_demand, settled_beyond_reach, winkler_rhs
+from pipeline.models.winkler import (
+    bed_force,
+    friction_demand,
+    settled_beyond_reach,
+    stick_forces,
+    winkler_rhs,
+    winkler_slip_rhs,
+)
 
 # phases of the pivot loop (bed models are always ROCKING)
 REST = 0
@@ -90,6 +116,7 @@ ZENO_STEP_SHRINK = 0.25         # a whole excursion inside one step: retry with 
 MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
+SLIP_STOP_FRACTION = 1e-12      # of the slip rate's scale: a slide ending a step this slow has stopped there
 UNKNOWN_CODE = "model kernel code not handled by pipeline.models.kernels"
 
 # rows of the ground motion's samples (``GroundMotion.samples``, what the entry points take)
@@ -136,6 +163,7 @@ class System(NamedTuple):
     code: int               # the model's kernel code (fields.HOUSNER, SSI, WINKLER)
     phase: int              # REST or ROCKING (bed models: always ROCKING)
     sigma: float            # active pivot, +1 or -1 while rocking; 0 at rest and for bed models
+    slip: float             # direction of the base's slip, +1 or -1 while it slides; 0 stuck or tied
     params: np.void         # the case's ``fields.PARAMS_DTYPE`` record
     motion: GroundMotion
 
@@ -242,24 +270,37 @@ def free_flight_time(motion, g):
 
 
 @njit(cache=True)
-def rhs(code, phase, sigma, x, accel, gravity, params, out):
-    """dx/dt into out for state x = [theta, theta_dot, y, y_dot], by the model's kernel code.
+def rhs(code, phase, sigma, x, accel, gravity, params, out, slip=0.0):
+    """dx/dt into out for state x = [theta, theta_dot, y, y_dot, u, u_dot], by the model's kernel code.
 
     ``accel`` is the horizontal ground acceleration and ``gravity`` the effective gravity g + a_v [m/s^2];
-    the pivot models also read the phase and the active pivot sigma.
+    the pivot models also read the phase and the active pivot sigma; ``slip`` is the direction in which the
+    base slides (0: stuck or tied, whose right-hand sides fill the first TIED_STATE_SIZE components: the slip's
+    rates are zero; out may then be that short).
     """
+    if slip == 0.0:
+        for i in range(TIED_STATE_SIZE, out.size):
+            out[i] = 0.0
     if code == HOUSNER:
         if phase == REST:
-            housner_rest_rhs(out)
-        else:
+            if slip == 0.0:
+                housner_rest_rhs(out)
+            else:
+                housner_slide_rhs(slip, x, accel, gravity, params, out)
+        elif slip == 0.0:
             housner_rhs(sigma, x, accel, gravity, params, out)
+        else:
+            housner_slide_rock_rhs(sigma, slip, x, accel, gravity, params, out)
     elif code == SSI:
         if phase == REST:
             ssi_rest_rhs(x, gravity, params, out)
         else:
             ssi_rhs(sigma, x, accel, gravity, params, out)
     elif code == WINKLER:
-        winkler_rhs(x, accel, gravity, params, out)
+        if slip == 0.0:
+            winkler_rhs(x, accel, gravity, params, out)
+        else:
+            winkler_slip_rhs(slip, x, accel, gravity, params, out)
     else:
         raise ValueError(UNKNOWN_CODE)
 
@@ -272,7 +313,7 @@ def derivatives(system, t, x, out):
     """
     motion = system.motion
     rhs(system.code, system.phase, system.sigma, x, ground(motion, t), effective_gravity(system.params, motion, t),
-        system.params, out)
+        system.params, out, system.slip)
 
 
 @njit(cache=True)
@@ -312,13 +353,26 @@ def dopri_step(system, t, x, h, work):
 
 
 @njit(cache=True)
-def error_norm(x, x_new, error, scale, rtol, atol):
-    """RMS of the local error over the mixed absolute/relative tolerance (accept when <= 1)."""
+def error_norm(x, x_new, error, scale, rtol, atol, count):
+    """RMS of the local error over the mixed absolute/relative tolerance (accept when <= 1).
+
+    count: the number of state components the mean is over (``integrated_size``); the others are zero.
+    """
     total = 0.0
     for i in range(STATE_SIZE):
         tolerance = atol * scale[i] + rtol * max(abs(x[i]), abs(x_new[i]))
         total += (error[i] / tolerance) ** 2
-    return math.sqrt(total / STATE_SIZE)
+    return math.sqrt(total / count)
+
+
+@njit(cache=True)
+def integrated_size(system):
+    """State components the error norm is over: all while the base slides; else the slip is constant, not counted.
+
+    (Its zero error adds exactly 0 to the norm, so a tied run steps as before the slip was added, and a stuck
+    base with friction steps as the tied one.)
+    """
+    return STATE_SIZE if system.slip != 0.0 else TIED_STATE_SIZE
 
 
 @njit(cache=True)
@@ -338,9 +392,10 @@ def adaptive_step(system, t, x, h, work, zeno_guard):
     """
     rtol = system.params["rtol"]
     atol = system.params["atol"]
+    count = integrated_size(system)
     while True:
         dopri_step(system, t, x, h, work)
-        norm = error_norm(x, work.x_new, work.error, work.scale, rtol, atol)
+        norm = error_norm(x, work.x_new, work.error, work.scale, rtol, atol, count)
         if h < MIN_STEP:
             return h, norm
         if norm <= 1.0 and zeno_guard and system.sigma * work.x_new[0] <= 0.0:
@@ -403,10 +458,15 @@ def event_value(kind, index, system, step, s, interpolated):
         return system.sigma * hermite(step, s, 0)
     if kind == EVENT_OVERTURN:
         return abs(hermite(step, s, 0)) - params["overturn"]
+    if kind == EVENT_SLIP_STOP:
+        return system.slip * hermite(step, s, SLIP_RATE)
     for i in range(STATE_SIZE):
         interpolated[i] = hermite(step, s, i)
     if kind == EVENT_CONTACT:
         return contact_indicator(index, interpolated, params)
+    if kind == EVENT_SLIP_START:
+        margin, _ = stick_margin(system, interpolated, step.t + s * step.h)
+        return margin
     # uplift of a pivot model: |ag| - tan(alpha) * support force per mass
     t = step.t + s * step.h
     accel = ground(system.motion, t)
@@ -530,14 +590,16 @@ def static_settlement(code, params):
 def state_scales(params, y_static, scale):
     """Absolute-error scales of [theta, theta_dot, y, y_dot] into ``scale``; returns p^2 [1/s^2].
 
-    The scales are alpha, alpha p, the static settlement and its rate (floored for a rigid base); p^2 is
-    that of the model's own pivot equation.
+    The scales are alpha, alpha p, the static settlement and its rate (floored for a rigid base), alpha R
+    and alpha R p for the slip; p^2 is that of the model's own pivot equation.
     """
     p_squared = params["kappa"] * params["g"] / params["R"]
     scale[0] = params["alpha"]
     scale[1] = params["alpha"] * math.sqrt(p_squared)
     scale[2] = max(y_static, STATE_SCALE_FLOOR)
     scale[3] = max(y_static * params["omega"], STATE_SCALE_FLOOR)
+    scale[SLIP] = params["alpha"] * params["R"]  # the slip: the top's sway at theta = alpha, about b
+    scale[SLIP_RATE] = scale[SLIP] * math.sqrt(p_squared)
     return p_squared
 
 
@@ -623,6 +685,186 @@ def start_summary(summary, x, min_support, t_free_flight):
     summary["peak_corner_uplift"] = 0.0
     summary["peak_friction_demand"] = 0.0
     summary["time_of_free_flight"] = t_free_flight if t_free_flight < math.inf else np.nan
+    summary["peak_slip"] = abs(x[SLIP])
+    summary["residual_slip"] = abs(x[SLIP])
+    summary["time_at_rest"] = 0.0
+    summary["time_sliding"] = 0.0
+    summary["time_rocking"] = 0.0
+    summary["time_slide_rocking"] = 0.0
+    summary["time_in_flight"] = 0.0
+
+
+# ---------------------------------------------------------------------------------------------
+# friction at the base (housner, winkler): stick-slip, mode selection, bookkeeping
+# ---------------------------------------------------------------------------------------------
+
+@njit(cache=True)
+def stick_margin(system, x, t):
+    """(mu_s N - |H|, H) per unit mass [m/s^2] of the base held stuck at state x, time t.
+
+    H is the horizontal force the stuck base needs (towards +x) and N the normal force: the rigid base's
+    pivot force (``housner.rock_forces``) or g + a_v flat on it; the bed's (``winkler.stick_forces``). A
+    negative margin: the base cannot stay stuck.
+    """
+    params = system.params
+    accel = ground(system.motion, t)
+    gravity = effective_gravity(params, system.motion, t)
+    if system.code == WINKLER:
+        horizontal, normal = stick_forces(x, accel, gravity, params)
+    elif system.phase == ROCKING:
+        horizontal, normal = rock_forces(system.sigma, x[0], x[1], accel, gravity, params)
+    else:
+        horizontal, normal = accel, gravity
+    return params["mu_s"] * normal - abs(horizontal), horizontal
+
+
+@njit(cache=True)
+def slip_direction(horizontal):
+    """Direction of the slip that starts where a stuck base would need the force ``horizontal`` (opposite)."""
+    return -1.0 if horizontal > 0.0 else 1.0
+
+
+@njit(cache=True)
+def slip_event(system, step, min_fraction, interpolated):
+    """The friction event inside the step: (kind, fraction s); (EVENT_NONE, 2) if none.
+
+    A stuck base whose margin (``stick_margin``) turns negative starts to slide (EVENT_SLIP_START); a sliding
+    one whose slip rate reaches zero stops (EVENT_SLIP_STOP). Events below min_fraction are ignored.
+    """
+    kind = EVENT_SLIP_START if system.slip == 0.0 else EVENT_SLIP_STOP
+    v_start = event_value(kind, 0, system, step, 0.0, interpolated)
+    v_end = event_value(kind, 0, system, step, 1.0, interpolated)
+    crossed = v_end < 0.0 if kind == EVENT_SLIP_START else v_end <= 0.0
+    if crossed and v_start >= 0.0:
+        s_hit = locate(kind, 0, system, step, interpolated)
+        if s_hit > min_fraction:
+            return kind, s_hit
+    return EVENT_NONE, 2.0
+
+
+@njit(cache=True)
+def stopped_at_end(system, x, scale):
+    """True when a sliding base ends a step with its slip rate at zero (or past it): the stop is there.
+
+    (A stop at a step's very end is not located inside the next one, whose start it would be.)
+    """
+    return system.slip != 0.0 and system.slip * x[SLIP_RATE] <= SLIP_STOP_FRACTION * scale[SLIP_RATE]
+
+
+@njit(cache=True)
+def book_mode_time(summary, mode, duration):
+    """Add ``duration`` [s] to the time spent in contact ``mode`` (fields.MODE_*)."""
+    if mode == MODE_REST:
+        summary["time_at_rest"] += duration
+    elif mode == MODE_SLIDE:
+        summary["time_sliding"] += duration
+    elif mode == MODE_ROCK:
+        summary["time_rocking"] += duration
+    elif mode == MODE_SLIDE_ROCK:
+        summary["time_slide_rocking"] += duration
+    else:
+        summary["time_in_flight"] += duration
+
+
+@njit(cache=True)
+def pivot_mode(system):
+    """Contact mode (fields.MODE_*) of a pivot model's system: flat or rocking, stuck or sliding."""
+    if system.phase == REST:
+        return MODE_REST if system.slip == 0.0 else MODE_SLIDE
+    return MODE_ROCK if system.slip == 0.0 else MODE_SLIDE_ROCK
+
+
+@njit(cache=True)
+def bed_mode(system, indicators):
+    """Contact mode of a bed model from its corners' penetrations (indicators 0, 1) and its slip."""
+    lifted = int(indicators[0] < 0.0) + int(indicators[1] < 0.0)
+    if lifted == 2:
+        return MODE_FLIGHT
+    if lifted == 1:
+        return MODE_ROCK if system.slip == 0.0 else MODE_SLIDE_ROCK
+    return MODE_REST if system.slip == 0.0 else MODE_SLIDE
+
+
+@njit(cache=True)
+def book_slip(summary, x):
+    """Peak and current absolute slip [m] after a step (the slip's extrema are at its stops: step ends)."""
+    slip = abs(x[SLIP])
+    if slip > summary["peak_slip"]:
+        summary["peak_slip"] = slip
+    summary["residual_slip"] = slip
+
+
+@njit(cache=True)
+def flat_slide_mode(params, slip):
+    """(phase, sigma, slip) of a rigid base sliding flat in direction ``slip``.
+
+    The kinetic friction tips the block onto its leading corner when mu_k > tan(alpha) (Shenton 1996): it then
+    slide-rocks on that corner.
+    """
+    if params["mu_k"] > math.tan(params["alpha"]):
+        return ROCKING, slip, slip
+    return REST, 0.0, slip
+
+
+@njit(cache=True)
+def rest_mode(system, x, t, crossed):
+    """(phase, sigma, slip) of a rigid base with friction, flat and not sliding (u' = 0) at time t.
+
+    Shenton's (1996) initiation criteria: it rocks if |ag| > tan(alpha) (g + a_v) and the pivot's friction
+    need stays within mu_s; slide-rocks if the pivot cannot hold but a sliding pivot still tips the block
+    (mu_k > tan(alpha)); slides flat if it cannot rock but |ag| > mu_s (g + a_v); rests otherwise.
+    ``crossed``: the lower of the two thresholds was just located (it counts as exceeded).
+    """
+    params = system.params
+    accel = ground(system.motion, t)
+    gravity = effective_gravity(params, system.motion, t)
+    tan_alpha = math.tan(params["alpha"])
+    mu_s = params["mu_s"]
+    tipping = abs(accel) > tan_alpha * gravity or (crossed and tan_alpha <= mu_s)
+    sliding = abs(accel) > mu_s * gravity or (crossed and mu_s < tan_alpha)
+    if tipping:
+        sigma = -1.0 if accel > 0.0 else 1.0
+        horizontal, normal = rock_forces(sigma, 0.0, 0.0, accel, gravity, params)
+        if abs(horizontal) <= mu_s * normal:
+            return ROCKING, sigma, 0.0
+        slip = slip_direction(horizontal)
+        theta_acc, _, _ = slide_rock_accelerations(sigma, slip, 0.0, 0.0, gravity, params)
+        if sigma * theta_acc > 0.0:
+            return ROCKING, sigma, slip
+        return flat_slide_mode(params, slip_direction(accel))
+    if sliding:
+        return flat_slide_mode(params, slip_direction(accel))
+    return REST, 0.0, 0.0
+
+
+@njit(cache=True)
+def stuck_slip(system, x, t):
+    """Slip direction of a base whose slip rate is zero at time t: 0 if it can stay stuck."""
+    stuck = System(system.code, system.phase, system.sigma, 0.0, system.params, system.motion)
+    margin, horizontal = stick_margin(stuck, x, t)
+    return 0.0 if margin >= 0.0 else slip_direction(horizontal)
+
+
+@njit(cache=True)
+def friction_pivot_impact(system, x, zeno_speed, t, impact_times, summary):
+    """Impact at theta = 0 of a rigid base with friction (``housner.friction_impact``); (phase, sigma, slip) after.
+
+    The block rocks on the other corner (sliding if its slip rate is not zero, else stuck if the friction
+    holds), or, when the next excursion would be below the Zeno angle, lies flat: sliding or at rest.
+    """
+    book_impact(summary, impact_times, t)
+    x[0] = 0.0
+    friction_impact(system.sigma, x, system.params)
+    slip = 0.0 if x[SLIP_RATE] == 0.0 else (1.0 if x[SLIP_RATE] > 0.0 else -1.0)
+    if abs(x[1]) < zeno_speed:
+        x[1] = 0.0
+        if slip == 0.0:
+            return REST, 0.0, 0.0
+        return flat_slide_mode(system.params, slip)
+    sigma = -system.sigma
+    if slip == 0.0:
+        slip = stuck_slip(System(system.code, ROCKING, sigma, 0.0, system.params, system.motion), x, t)
+    return ROCKING, sigma, slip
 
 
 # ---------------------------------------------------------------------------------------------
@@ -630,11 +872,23 @@ def start_summary(summary, x, min_support, t_free_flight):
 # ---------------------------------------------------------------------------------------------
 
 @njit(cache=True)
+def start_threshold(params):
+    """The coefficient c [-] with which a pivot model at rest starts to move when |ag| > c * support.
+
+    tan(alpha), or with friction the lower of tan(alpha) (rocking) and mu_s (sliding).
+    """
+    tan_alpha = math.tan(params["alpha"])
+    if params["mu_s"] > 0.0:
+        return min(tan_alpha, params["mu_s"])
+    return tan_alpha
+
+
+@njit(cache=True)
 def rest_until_uplift(system, x, t, t_sample_end):
     """Closed-form rest phase inside one sample interval; returns (t_new, start_now).
 
-    The state x is constant; find where |ag| first beats the threshold tan(alpha) * support; t_new =
-    t_sample_end when it is not reached.
+    The state x is constant; find where |ag| first beats the threshold c * support, c = tan(alpha) or with
+    friction min(tan(alpha), mu_s) (``start_threshold``); t_new = t_sample_end when it is not reached.
 
     Both ag and the threshold are linear in time inside the interval (the rigid base's support force is
     g + a_v; a settled spring's is constant), and |ag| is below the threshold at t, so the crossing is on
@@ -642,7 +896,7 @@ def rest_until_uplift(system, x, t, t_sample_end):
     """
     motion, params, code = system.motion, system.params, system.code
     samples, dt = motion.samples, motion.dt
-    tan_alpha = math.tan(params["alpha"])
+    tan_alpha = start_threshold(params)
     a_end = ground(motion, t_sample_end)
     threshold_end = tan_alpha * support(code, params, x, effective_gravity(params, motion, t_sample_end))
     if abs(a_end) <= threshold_end:
@@ -758,13 +1012,17 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
 
     At rest the state is constant (closed form) or only the SSI vertical vibration moves; steps never
     cross a sample of the ground motion. The run stops where g + a_v first falls below zero (free flight).
+    With friction (housner, ``params["mu_s"] > 0``) the base may also slide: flat (the rest phase with a
+    slip direction) or on its pivot, with stick-slip events (``slip_event``) and Shenton's mode selection
+    (``rest_mode``) wherever the base is flat and stuck.
     """
     motion = GroundMotion(samples, dt)
     t_final = (samples.shape[1] + n_tail - 1) * dt
     t_free_flight = free_flight_time(motion, params["g"])
     t_stop = min(t_final, t_free_flight)  # the end of the run
     alpha = params["alpha"]
-    tan_alpha = math.tan(alpha)
+    threshold = start_threshold(params)
+    friction = params["mu_s"] > 0.0
     y_static = static_settlement(code, params)
     work = workspace()
     p_squared = state_scales(params, y_static, work.scale)
@@ -777,7 +1035,9 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
     if x[0] != 0.0 or x[1] != 0.0:
         phase = ROCKING
         sigma = 1.0 if (x[0] > 0.0 or (x[0] == 0.0 and x[1] > 0.0)) else -1.0
-    system = System(code, phase, sigma, params, motion)
+    system = System(code, phase, sigma, 0.0, params, motion)
+    if friction and phase == ROCKING:
+        system = System(code, phase, sigma, stuck_slip(system, x, 0.0), params, motion)
     status = NO_UPLIFT if phase == REST else ROCKING_OUTCOME
     start_summary(summary, x, support(code, params, x, effective_gravity(params, motion, 0.0)), t_free_flight)
     if phase == ROCKING:
@@ -795,31 +1055,37 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
         # Steps end on every sample: a kink of the piecewise-linear ground motion inside a step fools the
         # embedded error estimate (measured: 5% peak-angle errors on real records when steps spanned samples).
         t_sample_end = min((interval_of(t, dt) + 1) * dt, t_stop)
-        if system.phase == REST:
+        if system.phase == REST and system.slip == 0.0:
             accel = ground(motion, t)
             gravity = effective_gravity(params, motion, t)
-            if start_now or abs(accel) > tan_alpha * support(code, params, x, gravity):
-                # start rocking towards the side the inertia force pushes
+            if start_now or abs(accel) > threshold * support(code, params, x, gravity):
+                if friction:
+                    phase, sigma, slip = rest_mode(system, x, t, start_now)
+                else:  # start rocking towards the side the inertia force pushes
+                    phase, sigma, slip = ROCKING, -1.0 if accel > 0 else 1.0, 0.0
                 start_now = False
-                system = System(code, ROCKING, -1.0 if accel > 0 else 1.0, params, motion)
-                x[0] = 0.0
-                x[1] = 0.0
+                system = System(code, phase, sigma, slip, params, motion)
                 f0_current = False
-                if summary["uplifted"] == 0.0:
-                    summary["uplifted"] = 1.0
-                    summary["time_of_uplift"] = t
-                if status == NO_UPLIFT:
-                    status = ROCKING_OUTCOME
+                if phase == ROCKING:
+                    x[0] = 0.0
+                    x[1] = 0.0
+                    if summary["uplifted"] == 0.0:
+                        summary["uplifted"] = 1.0
+                        summary["time_of_uplift"] = t
+                    if status == NO_UPLIFT:
+                        status = ROCKING_OUTCOME
                 n_events += 1
                 if n_events > max_events:
                     failed = True
                     break
                 continue
             if vertical_at_rest(code, x, y_static, work.scale, vertical_quiet(motion, t)):
+                t_rest = t
                 t, start_now = rest_until_uplift(system, x, t, t_sample_end)
                 if t >= t_sample_end - SEGMENT_END_FRACTION * dt:
                     t = t_sample_end  # (a crossing at the very end starts at the next interval's top)
                     start_now = False
+                book_mode_time(summary, MODE_REST, t - t_rest)
                 next_row = hold_rows(history, next_row, dt, t, x)
                 f0_current = False
                 continue
@@ -833,18 +1099,31 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
             failed = True
             break
         step = Step(t, h, x, f0, x_new, f1)
-        kind, s_event = pivot_event(system, step, work.interpolated)
+        if friction:
+            kind, s_event = EVENT_NONE, 2.0
+            if system.phase == ROCKING:  # (sliding flat, only the slip can change: the friction ratio is fixed)
+                kind, s_event = pivot_event(system, step, work.interpolated)
+            slip_kind, s_slip = slip_event(system, step, 0.0, work.interpolated)
+            if slip_kind != EVENT_NONE and s_slip < s_event:
+                kind, s_event = slip_kind, s_slip
+        else:
+            kind, s_event = pivot_event(system, step, work.interpolated)
         if kind != EVENT_NONE and kind != EVENT_SETTLE and s_event < 1.0:
             step = Step(t, refine_event(kind, 0, system, step, s_event, work), x, f0, x_new, f1)
         if system.phase == ROCKING:
             track_peak(step, summary, params["overturn"])
         if kind != EVENT_OVERTURN:
             next_row = write_rows(history, next_row, dt, step)
+        book_mode_time(summary, pivot_mode(system), step.h)
         t = t + step.h
         for i in range(STATE_SIZE):
             x[i] = x_new[i]
             f0[i] = f1[i]
         f0_current = True
+        if friction:
+            book_slip(summary, x)
+            if kind == EVENT_NONE and stopped_at_end(system, x, work.scale):
+                kind = EVENT_SLIP_STOP
         if code == SSI and ssi_bookkeeping(system, x, y_static, t, summary):
             f0_current = False
         h = next_step(h, norm)
@@ -853,17 +1132,44 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
             book_overturn(summary, params, t)
             break
         if kind == EVENT_SETTLE:
-            system = System(code, REST, 0.0, params, motion)
             x[0] = 0.0
             x[1] = 0.0
+            system = System(code, REST, 0.0, 0.0, params, motion)
+            if friction and x[SLIP_RATE] != 0.0:
+                phase, sigma, slip = flat_slide_mode(params, 1.0 if x[SLIP_RATE] > 0.0 else -1.0)
+                system = System(code, phase, sigma, slip, params, motion)
             f0_current = False
         elif kind == EVENT_IMPACT:
-            phase, sigma = pivot_impact(system, x, zeno_speed, t, impact_times, summary)
-            system = System(code, phase, sigma, params, motion)
+            if friction:
+                phase, sigma, slip = friction_pivot_impact(system, x, zeno_speed, t, impact_times, summary)
+            else:
+                phase, sigma = pivot_impact(system, x, zeno_speed, t, impact_times, summary)
+                slip = 0.0
+            system = System(code, phase, sigma, slip, params, motion)
             f0_current = False
             n_events += 1
         elif kind == EVENT_UPLIFT:
             start_now = True  # uplift located: the top of the loop starts rocking here
+        elif kind == EVENT_SLIP_START:
+            _, horizontal = stick_margin(system, x, t)
+            system = System(code, system.phase, system.sigma, slip_direction(horizontal), params, motion)
+            f0_current = False
+            n_events += 1
+        elif kind == EVENT_SLIP_STOP:
+            x[SLIP_RATE] = 0.0
+            if system.phase == ROCKING:
+                system = System(code, ROCKING, system.sigma, stuck_slip(system, x, t), params, motion)
+            else:
+                phase, sigma, slip = rest_mode(System(code, REST, 0.0, 0.0, params, motion), x, t, False)
+                system = System(code, phase, sigma, slip, params, motion)
+                if phase == ROCKING:
+                    if summary["uplifted"] == 0.0:
+                        summary["uplifted"] = 1.0
+                        summary["time_of_uplift"] = t
+                    if status == NO_UPLIFT:
+                        status = ROCKING_OUTCOME
+            f0_current = False
+            n_events += 1
         if n_events > max_events:
             failed = True
             break
@@ -951,9 +1257,14 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
     """Integrate one response of a bed model from state x.
 
     No rest phase, no impact rule (the block flies where g + a_v < 0 as anywhere else: its bed lets go).
+    With friction (``params["mu_s"] > 0``) the base centre sticks or slides, with stick-slip events
+    (``slip_event``); a slip that stops sticks if the friction can hold it (``stuck_slip``).
     """
     motion = GroundMotion(samples, dt)
-    system = System(code, ROCKING, 0.0, params, motion)
+    friction = params["mu_s"] > 0.0
+    system = System(code, ROCKING, 0.0, 0.0, params, motion)
+    if friction:
+        system = System(code, ROCKING, 0.0, stuck_slip(system, x, 0.0), params, motion)
     t_final = (samples.shape[1] + n_tail - 1) * dt
     work = workspace()
     state_scales(params, static_settlement(code, params), work.scale)
@@ -971,6 +1282,7 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
     h = dt * 0.25
     failed = False
     overturned = False
+    n_events = 0
     derivatives(system, t, x, f0)
     while t < t_final - SEGMENT_END_FRACTION * dt:
         h = min(h, (interval_of(t, dt) + 1) * dt - t)  # steps end on every sample (see pivot_loop)
@@ -983,6 +1295,10 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
         step = Step(t, h, x, f0, x_new, f1)
         # an event at the very start of the step is the one just located: ignore it
         kind, index, s_event = bed_event(system, step, before, after, EVENT_TIME_RESOLUTION / h, work.interpolated)
+        if friction:
+            slip_kind, s_slip = slip_event(system, step, EVENT_TIME_RESOLUTION / h, work.interpolated)
+            if slip_kind != EVENT_NONE and s_slip < s_event:
+                kind, index, s_event = slip_kind, 0, s_slip
         event_at_end = False
         if kind != EVENT_NONE and s_event < 1.0:
             step = Step(t, refine_event(kind, index, system, step, s_event, work), x, f0, x_new, f1)
@@ -998,14 +1314,34 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
         for i in range(STATE_SIZE):
             x[i] = x_new[i]
             f0[i] = f1[i]  # first same as last: the bed's force law is continuous, so is f
+        book_mode_time(summary, bed_mode(system, after), step.h)
         t = t + step.h
         bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_times)
         for i in range(N_CONTACT_INDICATORS):
             before[i] = after[i]
         h = next_step(h, norm)
+        if friction:
+            book_slip(summary, x)
+            if kind == EVENT_NONE and stopped_at_end(system, x, work.scale):
+                kind = EVENT_SLIP_STOP
+            if kind == EVENT_SLIP_START or kind == EVENT_SLIP_STOP:
+                if kind == EVENT_SLIP_STOP:
+                    x[SLIP_RATE] = 0.0
+                    slip = stuck_slip(system, x, t)
+                else:
+                    _, horizontal = stick_margin(system, x, t)
+                    slip = slip_direction(horizontal)
+                system = System(code, ROCKING, 0.0, slip, params, motion)
+                derivatives(system, t, x, f0)  # the friction changed: f jumps
+                n_events += 1
+                if n_events > params["max_events"]:
+                    failed = True
+                    break
         if (history.shape[0] == 0 and t > samples.shape[1] * dt and after[0] > 0.0 and after[1] > 0.0
-                and settled_beyond_reach(x, params, summary["peak_angle"])):
-            break  # the ground is at rest and the block can no longer reach its peak or lift (no history kept)
+                and system.slip == 0.0 and settled_beyond_reach(x, params, summary["peak_angle"])):
+            # the ground is at rest and the block can no longer reach its peak, lift or slide (no history kept)
+            book_mode_time(summary, MODE_REST, t_final - t)
+            break
         if kind == EVENT_OVERTURN:
             overturned = True
             book_overturn(summary, params, t)

@@ -4,7 +4,8 @@ Input : ``SolverOptions`` fields (validated once), a model, a ``Block``, the int
         and the damping ratio xi [-].
 Output: ``SolverOptions`` and its schema ``SOLVER_OPTIONS``; ``FOUNDATION`` (k and xi);
         ``case_record``, the parameter record (``fields.PARAMS_DTYPE``) and static initial state of one
-        case with an explicit xi; ``pivot_restitution``, a ``restitution`` option as a number for a block.
+        case with an explicit xi; ``pivot_restitution``, a ``restitution`` option as a number for a block;
+        ``friction_coefficients``, a ``friction`` option as (mu_s, mu_k).
 
 ``pipeline.models.parameter_record`` is ``case_record`` plus the calibration of a restitution target for
 bed models (pipeline.models.restitution), which runs ``case_record`` itself: this module is below both.
@@ -36,6 +37,10 @@ DEFAULT_ZENO_FRACTION = 1e-6  # excursions below this fraction of alpha end the 
 MAX_EVENTS = 200_000
 
 HOUSNER = "housner"  # restitution = "housner": Housner's r = 1 - 1.5 sin^2(alpha) of the block
+RIGID_BASE_MAX_KINETIC_FRICTION = 4.0 / 3.0
+"""Largest kinetic friction coefficient of a rigid base: above it a block rocking on a sliding corner can meet
+Painleve's paradox (no solution of its equations; pipeline/models/housner.py). A bed has no such limit."""
+FRICTION_RANGE = "a number mu > 0 or a pair [mu_s, mu_k] with mu_s >= mu_k > 0 (static, kinetic)"
 MAX_XI = {HUNT_CROSSLEY: 10.0}
 """Largest damping ratio xi of a bed law whose xi may reach 1 or more (default: xi < 1). Hunt-Crossley's
 xi sets its damping at rest only (an overdamped vertical mode at rest is still a bed); its impacts need up
@@ -53,6 +58,41 @@ def _restitution_option(value, field: str, source: str | None):
     return Number(0.0, 1.0).check(value, field, source)
 
 
+def _friction_option(value, field: str, source: str | None):
+    """A ``friction`` option: one coefficient mu > 0 (static = kinetic) or a pair (mu_s, mu_k), mu_s >= mu_k > 0."""
+    pair = (value, value) if isinstance(value, (int, float)) and not isinstance(value, bool) else value
+    if not isinstance(pair, (tuple, list)) or len(pair) != 2:
+        raise ConfigError(field, f"{shown(value)}; must be {FRICTION_RANGE}", source)
+    for number in pair:
+        if isinstance(number, bool) or not isinstance(number, (int, float)) or not math.isfinite(number) \
+                or number <= 0:
+            raise ConfigError(field, f"{value!r} out of range; must be {FRICTION_RANGE}", source)
+    if pair[1] > pair[0]:
+        raise ConfigError(field, f"{value!r} out of range: the kinetic coefficient {pair[1]:g} exceeds the "
+                                 f"static one {pair[0]:g}; must be {FRICTION_RANGE}", source)
+    return value
+
+
+def friction_coefficients(friction) -> tuple[float, float]:
+    """(mu_s, mu_k) [-] of a checked ``friction`` option; (0, 0) for None (the tied base).
+
+    Parameters
+    ----------
+    friction : float or (float, float) or None
+        One coefficient (static = kinetic) or the pair (static, kinetic).
+
+    Returns
+    -------
+    tuple of float
+        The static and kinetic coefficients.
+    """
+    if friction is None:
+        return 0.0, 0.0
+    if isinstance(friction, (int, float)):
+        return float(friction), float(friction)
+    return float(friction[0]), float(friction[1])
+
+
 @dataclass(frozen=True)
 class SolverOptions:
     """Settings shared by every case of a call (validated once).
@@ -60,6 +100,8 @@ class SolverOptions:
     ``restitution``: pivot models, the impact coefficient (None: the model's default); bed models
     (winkler), the target of the calibrated bed dissipation (pipeline.models.restitution; None: xi is
     given). A number, or "housner" for Housner's value 1 - 1.5 sin^2(alpha) of each block.
+    ``friction``: Coulomb friction at the base of a model that ``slides`` (housner, winkler): one
+    coefficient (static = kinetic) or (mu_s, mu_k); None ties the base horizontally (no sliding).
     """
 
     switch: str = "consistent"               # ssi pivot-switch rule: consistent | continuous
@@ -69,6 +111,7 @@ class SolverOptions:
     overturn_angle: float = math.pi / 2
     rtol: float = DEFAULT_RTOL
     atol: float = DEFAULT_ATOL
+    friction: float | tuple[float, float] | None = None  # see the class docstring
 
     def __post_init__(self):
         check(SOLVER_OPTIONS, vars(self))
@@ -82,6 +125,7 @@ SOLVER_OPTIONS = Table({
     "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
     "rtol": Number(0.0, 1.0, low_open=True, high_open=True),
     "atol": Number(0.0, 1.0, low_open=True, high_open=True),
+    "friction": Nullable(Checked(_friction_option, FRICTION_RANGE)),
 })
 """The schema of ``SolverOptions`` (pipeline.validation)."""
 FOUNDATION = Table({"k": Number(0.0, low_open=True, unit="N/m"), "xi": Number(0.0, 1.0, high_open=True)})
@@ -109,12 +153,20 @@ def pivot_restitution(model: RockingModel, block: Block, restitution: float | st
 
 
 def case_record(model: RockingModel, block: Block, k=None, xi=None, options: SolverOptions = SolverOptions()):
-    """The kernel's parameter record and initial state [theta, theta', y, y'] (static) for one case.
+    """The kernel's parameter record and initial state [theta, theta', y, y', u, u'] (static) for one case.
 
     The damping ratio xi is explicit (None: ``DEFAULT_XI``); a bed model's ``restitution`` option is not read
     here (pipeline.models.parameter_record calibrates xi to it first).
     """
     params = fields.new_params(1)[0]
+    mu_s, mu_k = friction_coefficients(options.friction)
+    if options.friction is not None and not model.slides:
+        raise SolverError(f"friction: model {model.name!r} has a tied base (no sliding); friction applies to "
+                          "the models that slide (housner, winkler)")
+    if model.is_rigid_base and mu_k > RIGID_BASE_MAX_KINETIC_FRICTION:
+        raise SolverError(f"friction: the kinetic coefficient {mu_k:g} is out of range for the rigid base of "
+                          f"{model.name!r}; must be > 0 and <= 4/3 (above it a block rocking on a sliding corner "
+                          "can have no motion at all: Painleve's paradox)")
     omega = 0.0
     xi_value = 0.0
     y0 = 0.0
@@ -148,4 +200,8 @@ def case_record(model: RockingModel, block: Block, k=None, xi=None, options: Sol
     params["atol"] = options.atol
     params["zeno"] = DEFAULT_ZENO_FRACTION * block.alpha
     params["max_events"] = MAX_EVENTS
-    return params, np.array([0.0, 0.0, y0, 0.0])
+    params["mu_s"] = mu_s
+    params["mu_k"] = mu_k
+    state = np.zeros(fields.STATE_SIZE)
+    state[2] = y0
+    return params, state

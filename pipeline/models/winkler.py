@@ -7,7 +7,7 @@ Input : block (b, h, m), the bed's total vertical stiffness K [N/m] (eq. 19, as 
         each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model, bed_two_spring.py)
         or ``hunt-crossley`` (the continuous springs with Hunt-Crossley damping, bed_hunt_crossley.py).
 Output: registered model ``winkler`` and its compiled physics: ``bed_force``, ``accelerations``,
-        ``winkler_rhs``, ``settled_beyond_reach``, ``friction_demand``.
+        ``winkler_rhs``, ``winkler_slip_rhs``, ``stick_forces``, ``settled_beyond_reach``, ``friction_demand``.
 
 Why: the paper's model puts one linear spring-dashpot under the active pivot, and that spring pulls
 the block down whenever it rebounds, which real ground cannot do. Here every point of the base
@@ -18,9 +18,9 @@ restitution can instead be the target to which pipeline.models.restitution calib
 
 Coordinates: theta (> 0 tilts towards +x: the +b corner presses in) and y, the settlement of the
 base centre (positive down; static y = m g / K). No sliding: the base centre follows the ground
-horizontally. When the block rocks on a corner that corner therefore slips by b (1 - cos theta), a
-second-order effect; ``friction_demand`` reports |H|/N, the friction coefficient needed to hold the
-base, so a user sees where the no-sliding assumption is strained.
+horizontally (unless friction is given, below). When the block rocks on a corner that corner therefore
+slips by b (1 - cos theta), a second-order effect; ``friction_demand`` reports |H|/N, the friction
+coefficient needed to hold the base, so a user sees where the no-sliding assumption is strained.
 
 Base point s in [-b, b]: penetration delta(s) = y + s sin(theta), rate y' + s cos(theta) theta'.
 With j = J/m = (b^2 + 4 h^2)/3 (inertia about the base centre over m), F and M the bed's vertical
@@ -33,6 +33,22 @@ gives (tests/physics/test_winkler*.py checks this with sympy)
 
     j th'' + h sin(th) y'' = g h sin(th) - h cos(th) ag - cos(th) M
     h sin(th) th'' + y''   = g - F - h cos(th) th'^2.
+
+With Coulomb friction (``params["mu_s"] > 0``, static mu_s >= kinetic mu_k) the base centre may slide by u
+relative to the ground. The friction is the horizontal force H of the bed, bounded by the bed's normal
+force: |H| <= mu_s F while the base is stuck (u' = 0: the equations above, H = ag + h cos(th) th'' -
+h sin(th) th'^2, ``stick_forces``), H = eta F with eta = -mu_k sign(u') while it slides. Like the tied
+base, the friction acts at the base centre's level and the slip is the base centre's: a contact point
+s of the base moves by u - s sin(th) th' horizontally, which differs from u' by the same second-order
+term the tied model neglects. In flight F = 0, so H = 0 and the block moves freely. Sliding, the
+Newton-Euler equations per unit mass with j_c = (b^2 + h^2)/3 are explicit (``winkler_slip_rhs``):
+
+    j_c th'' = h sin(th) F - cos(th) M - h cos(th) H,
+    y''      = g - F - h sin(th) th'' - h cos(th) th'^2,
+    u''      = H - ag - h cos(th) th'' + h sin(th) th'^2.
+
+u'' grows with eta (d u''/d eta = F (1 + h cos(th) (h cos(th) + e sin(th)) / j_c) > 0 for any eccentricity
+|e| <= b), so the slip after a stop is always the one opposite to the stuck force: no Painleve paradox.
 """
 
 from __future__ import annotations
@@ -89,6 +105,38 @@ def winkler_rhs(x, accel, gravity, params, out):
 
 
 @njit(cache=True)
+def winkler_slip_rhs(slip, x, accel, gravity, params, out):
+    """dx/dt while the base slides in direction ``slip`` (+1, -1): the friction is -mu_k slip F (docstring)."""
+    h = params["h"]
+    b = params["b"]
+    sin_t = math.sin(x[0])
+    cos_t = math.cos(x[0])
+    force, moment = bed_force_at(x, params, sin_t, cos_t)
+    horizontal = -params["mu_k"] * slip * force
+    rate2 = x[1] * x[1]
+    theta_acc = (h * sin_t * force - cos_t * moment - h * cos_t * horizontal) / ((b * b + h * h) / 3.0)
+    out[0] = x[1]
+    out[1] = theta_acc
+    out[2] = x[3]
+    out[3] = gravity - force - h * sin_t * theta_acc - h * cos_t * rate2
+    out[4] = x[5]
+    out[5] = horizontal - accel - h * cos_t * theta_acc + h * sin_t * rate2
+
+
+@njit(cache=True)
+def stick_forces(x, accel, gravity, params):
+    """(H, F) per unit mass [m/s^2]: the horizontal force a stuck base needs and the bed's normal force."""
+    h = params["h"]
+    b = params["b"]
+    sin_t = math.sin(x[0])
+    cos_t = math.cos(x[0])
+    force, moment = bed_force_at(x, params, sin_t, cos_t)
+    theta_acc, _ = accelerations_at(sin_t, cos_t, x[1], accel, force, moment, h, (b * b + 4.0 * h * h) / 3.0,
+                                    gravity)
+    return accel + h * cos_t * theta_acc - h * sin_t * x[1] * x[1], force
+
+
+@njit(cache=True)
 def settled_beyond_reach(x, params, peak_angle):
     """True when the settled block can no longer reach its recorded peak angle nor lift a corner.
 
@@ -130,7 +178,7 @@ def friction_demand(x, dx, accel, force, params):
 
 MODEL = RockingModel(
     name="winkler", kernel_code=WINKLER, kappa=0.75, needs_foundation=True, uses_bed=True,
-    uplift_is_rigid_threshold=False,
+    uplift_is_rigid_threshold=False, slides=True,
     default_restitution=lambda block: 1.0,
     label="Winkler bed, tensionless",
     description="rigid block on a tensionless viscoelastic Winkler bed (continuous, two springs or "
