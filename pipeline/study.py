@@ -202,7 +202,8 @@ def cells_for_record(record, config, recipe, block_scales=None, vertical=None) -
     common = {"version": __version__, "record": record.metadata.get("sha256", record.id),
               "recipe": recipe.as_dict(), "measure": config.measure, "period": config.period,
               "damping": config.damping, "levels": list(config.levels_si),
-              "solver": {**solver_options(config), "tail": config.tail, "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL}}
+              "solver": {**solver_options(config), "tail": config.tail, "rtol": DEFAULT_RTOL, "atol": DEFAULT_ATOL},
+              "summary": list(SUMMARY_DTYPE.names)}  # a new summary field is a new cell, not a damaged checkpoint
     if vertical is not None:
         common["vertical"] = vertical
     cells = []
