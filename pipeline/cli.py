@@ -272,7 +272,9 @@ def command_fragility(args) -> int:
     config, output = _study_config(args)
     from pipeline.risk import study_hazard
 
-    study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
+    hazard = study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
+    if hazard is not None and hazard.site is not None:
+        print(f"hazard: {hazard.source}, {hazard.site.describe()}")
     executor = _executor_options(args)
     loaded = study_records(config, log=_log)
     cube, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded, **executor)
