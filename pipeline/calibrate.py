@@ -576,6 +576,7 @@ PROFILE_SPAN = 2.5  # half-span of a profile, in linearised (Wald) half-widths
 INNER_ITERATIONS = 3  # Gauss-Newton steps of the inner minimisation per profile
 MLE_ITERATIONS = 8
 FIRST_STEP = 1e-5  # first finite-difference step in the unit box, then a quarter of the conditional half-width
+RESOLUTION = 1e-6  # the solver's resolution in the unit box (its response is jagged below; ~2e-6 in k, 6e-8 in xi)
 MAX_WIDENINGS = 3
 PROFILE_BATCH = 256  # simulations per compiled call while profiling (memory: batch x samples)
 
@@ -660,7 +661,7 @@ def _maximum_likelihood(likelihood, point, axes, threshold, n_eff):
         curvature = np.sum(jacobian[0] ** 2, axis=0)  # d RSS / d offset^2 along each axis
         width = np.sqrt(threshold * rss[0] / n_eff / np.maximum(curvature, 1e-300))
         adapted = steps.copy()
-        adapted[list(axes)] = np.clip(width / 4.0, 1e-9, 1e-2)
+        adapted[list(axes)] = np.clip(width / 4.0, RESOLUTION, 1e-2)
         trials = np.repeat(point[None, :], 3, axis=0)
         trials[:, list(axes)] += np.outer([1.0, 0.5, 0.25], _gauss_newton_step(residual[0], jacobian[0]))
         _, trial_rss = likelihood.residuals(trials)
@@ -759,10 +760,14 @@ def profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: A
     # linearised covariance: sigma^2 tau (J^T J)^-1, sigma^2 = RSS/n; its diagonal sets each profile's span,
     # its regression of one coordinate on the other the ridge the inner minimisation starts from
     covariance = np.linalg.pinv(jacobian.T @ jacobian) * mle_rss / n_eff
-    profiles = {}
+    profiles, notes = {}, []
     for index, axis in enumerate(axes):
         other = 1 - axis
-        half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5) or FIRST_STEP
+        half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5)
+        if half_width < 4 * RESOLUTION:
+            notes.append(f"the {('k', 'xi')[axis]} interval is at the solver's resolution (the reference has almost "
+                         "no noise): it says how precisely the model reproduces it, not how well k and xi are known")
+            half_width = 4 * RESOLUTION
         ridge = covariance[1 - index, index] / covariance[index, index] if len(axes) == 2 else 0.0
         span = PROFILE_SPAN
         for _ in range(MAX_WIDENINGS + 1):
@@ -776,14 +781,16 @@ def profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: A
         profiles[axis] = (positions, rss)
 
     lowest = min(likelihood.best_rss, *(float(np.min(rss)) for _, rss in profiles.values()))
-    out = {"noise_rms": math.sqrt(lowest / times.size), "autocorrelation_time": tau, "notes": []}
+    out = {"noise_rms": math.sqrt(lowest / times.size), "autocorrelation_time": tau, "notes": notes}
     for axis, (positions, rss) in profiles.items():
         name, unit = ("k", " N/m") if axis == 0 else ("xi", "")
 
         def physical(x, axis=axis):
             return search.physical((x, 0.0) if axis == 0 else (0.0, x))[axis]
 
-        deviance = n_eff * np.log(rss / lowest)  # against the lowest RSS of both profiles
+        # against the profile's own minimum: the same as the lowest RSS where the response is smooth, and the
+        # only consistent reference where it is not (a noise-free reference at the solver's resolution)
+        deviance = n_eff * np.log(rss / float(np.min(rss)))
         for side, bound, edge in zip(("low", "high"), _bounds(positions, deviance, threshold),
                                      (positions[0], positions[-1])):
             if bound is None:
@@ -799,7 +806,7 @@ def profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: A
     at_fit = n_eff * math.log(float(likelihood.residuals([start])[1][0]) / lowest)
     if at_fit > threshold:
         k_best, xi_best = search.physical(likelihood.best_point)
-        out["notes"].append(f"the search's optimum lies outside its own {confidence:.0%} likelihood region (deviance "
+        out["notes"].append(f"the fit lies outside its own {confidence:.0%} likelihood region (deviance "
                             f"{at_fit:.3g} > {threshold:.3g}); the likelihood's best point is k = {k_best:.6g} N/m, "
                             f"xi = {xi_best:.5f}")
     if tau > 2.0:
@@ -1064,10 +1071,10 @@ def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, blo
     axis.set_yscale("log")
     axis.plot(result.xi * 100, result.k, "r*", ms=14, label="optimum")
     if result.k_low is not None:  # the intervals: usually far smaller than a grid cell, drawn all the same
-        xi_error = ([[(result.xi - result.xi_low) * 100], [(result.xi_high - result.xi) * 100]]
-                    if result.xi_low is not None else None)
-        axis.errorbar(result.xi * 100, result.k, yerr=[[result.k - result.k_low], [result.k_high - result.k]],
-                      xerr=xi_error, color="r", capsize=4, lw=1.2, label=f"{result.confidence:.0%} intervals")
+        axis.plot([result.xi * 100] * 2, [result.k_low, result.k_high], "r-", lw=1.5,
+                  label=f"{result.confidence:.0%} intervals")
+        if result.xi_low is not None:
+            axis.plot([result.xi_low * 100, result.xi_high * 100], [result.k] * 2, "r-", lw=1.5)
     axis.plot(result.xi_grid * 100, result.k_grid, "wo", ms=7, mfc="none", label="best grid point")
     axis.set_xlabel("damping ratio ξ [%]")
     axis.set_ylabel("interface stiffness k [N/m]")
