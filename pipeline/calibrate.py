@@ -579,6 +579,8 @@ FIRST_STEP = 1e-5  # first finite-difference step in the unit box, then a quarte
 RESOLUTION = 1e-6  # the solver's resolution in the unit box (its response is jagged below; ~2e-6 in k, 6e-8 in xi)
 MAX_WIDENINGS = 3
 PROFILE_BATCH = 256  # simulations per compiled call while profiling (memory: batch x samples)
+RESTARTS = 1  # new starts from a better point the profiles found (a nonlinear surface: model error, big noise)
+RESTART_DEVIANCE = 0.1
 
 
 def autocorrelation_time(residual: ArrayLike) -> float:
@@ -719,6 +721,40 @@ def _first_crossing(offsets, deviance, threshold):
     return float(offsets[i - 1] + fraction * (offsets[i] - offsets[i - 1]))
 
 
+def _profiles_around(likelihood, start, axes, threshold, tau, fixed_xi):
+    """Least-squares point from ``start``, then the profile of each free coordinate around it.
+
+    Returns ({axis: (positions, profile RSS)}, notes, tau, n_eff, RSS at the least-squares point).
+    """
+    samples = likelihood.times.size
+    mle, steps, jacobian, residual, mle_rss = _maximum_likelihood(likelihood, start, axes, threshold, samples / tau)
+    tau = autocorrelation_time(residual)  # at the least-squares point, where only noise and model error remain
+    n_eff = samples / tau
+    # linearised covariance: sigma^2 tau (J^T J)^-1, sigma^2 = RSS/n; its diagonal sets each profile's span,
+    # its regression of one coordinate on the other the ridge the inner minimisation starts from
+    covariance = np.linalg.pinv(jacobian.T @ jacobian) * mle_rss / n_eff
+    profiles, notes = {}, []
+    for index, axis in enumerate(axes):
+        other = 1 - axis
+        half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5)
+        if half_width < 4 * RESOLUTION:
+            notes.append(f"the {('k', 'xi')[axis]} interval is at the solver's resolution (the reference has almost "
+                         "no noise): it says how precisely the model reproduces it, not how well k and xi are known")
+            half_width = 4 * RESOLUTION
+        ridge = covariance[1 - index, index] / covariance[index, index] if len(axes) == 2 else 0.0
+        span = PROFILE_SPAN
+        for _ in range(MAX_WIDENINGS + 1):
+            positions = np.unique(np.clip(mle[axis] + span * half_width * np.linspace(-1, 1, PROFILE_POINTS), 0, 1))
+            starts = np.clip(mle[other] + ridge * (positions - mle[axis]), 0.0, 1.0)
+            rss = _profile_rss(likelihood, positions, axis, starts, steps, fixed_xi)
+            low, high = _bounds(positions, n_eff * np.log(rss / likelihood.best_rss), threshold)
+            if not ((low is None and positions[0] > 0.0) or (high is None and positions[-1] < 1.0)):
+                break
+            span *= 2.0  # the profile is flatter than its linearisation: look wider
+        profiles[axis] = (positions, rss)
+    return profiles, notes, tau, n_eff, mle_rss
+
+
 def profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: ArrayLike, fixed_xi: bool,
                       confidence: float, t_end: float) -> dict:
     """Profile-likelihood intervals of k and xi around a fit (see the block comment above).
@@ -753,32 +789,13 @@ def profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: A
     start = np.clip(np.asarray(point, float), 0.0, 1.0)
     likelihood = _Likelihood(search, times, reference, t_end, axes)
     tau = autocorrelation_time(likelihood.residuals([start])[0][0])
-    mle, steps, jacobian, residual, mle_rss = _maximum_likelihood(likelihood, start, axes, threshold,
-                                                                  times.size / tau)
-    tau = autocorrelation_time(residual)  # at the least-squares point, where only noise and model error remain
-    n_eff = times.size / tau
-    # linearised covariance: sigma^2 tau (J^T J)^-1, sigma^2 = RSS/n; its diagonal sets each profile's span,
-    # its regression of one coordinate on the other the ridge the inner minimisation starts from
-    covariance = np.linalg.pinv(jacobian.T @ jacobian) * mle_rss / n_eff
-    profiles, notes = {}, []
-    for index, axis in enumerate(axes):
-        other = 1 - axis
-        half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5)
-        if half_width < 4 * RESOLUTION:
-            notes.append(f"the {('k', 'xi')[axis]} interval is at the solver's resolution (the reference has almost "
-                         "no noise): it says how precisely the model reproduces it, not how well k and xi are known")
-            half_width = 4 * RESOLUTION
-        ridge = covariance[1 - index, index] / covariance[index, index] if len(axes) == 2 else 0.0
-        span = PROFILE_SPAN
-        for _ in range(MAX_WIDENINGS + 1):
-            positions = np.unique(np.clip(mle[axis] + span * half_width * np.linspace(-1, 1, PROFILE_POINTS), 0, 1))
-            starts = np.clip(mle[other] + ridge * (positions - mle[axis]), 0.0, 1.0)
-            rss = _profile_rss(likelihood, positions, axis, starts, steps, fixed_xi)
-            low, high = _bounds(positions, n_eff * np.log(rss / likelihood.best_rss), threshold)
-            if not ((low is None and positions[0] > 0.0) or (high is None and positions[-1] < 1.0)):
-                break
-            span *= 2.0  # the profile is flatter than its linearisation: look wider
-        profiles[axis] = (positions, rss)
+    origin = start
+    for attempt in range(RESTARTS + 1):
+        profiles, notes, tau, n_eff, mle_rss = _profiles_around(likelihood, origin, axes, threshold, tau, fixed_xi)
+        # a point better than the least-squares point found: Gauss-Newton stopped short on a nonlinear surface
+        if n_eff * math.log(mle_rss / likelihood.best_rss) <= RESTART_DEVIANCE:
+            break
+        origin = likelihood.best_point
 
     lowest = min(likelihood.best_rss, *(float(np.min(rss)) for _, rss in profiles.values()))
     out = {"noise_rms": math.sqrt(lowest / times.size), "autocorrelation_time": tau, "notes": notes}

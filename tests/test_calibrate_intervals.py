@@ -18,7 +18,7 @@ from pipeline.models import simulate
 from pipeline.processing import process_record
 from pipeline.records import load_records
 
-SEGMENT = slice(800, 1400)  # Bolu 090, 8-14 s, x 2: the paper block rocks through ~10 impacts, no overturning
+SEGMENT = slice(800, 1400)  # Bolu 090, 8-14 s, x 2: the paper block rocks through four half-cycles, no overturning
 SCALE = 2.0
 K_TRUE, XI_TRUE = 4.6e8, 0.027  # off the default grid (as in tests/test_calibrate.py)
 NOISE = 0.05  # Gaussian, of the peak |rotation|
@@ -98,7 +98,7 @@ def covering(results, confidence, shrink=1.0):
     return hits
 
 
-@pytest.mark.slow  # ~30 s on 2 cores: 40 seeds x ~460 simulations of a 6 s record (0.65 s a seed)
+@pytest.mark.slow  # 13-20 s on 2 cores: 40 seeds x ~460 simulations of a 6 s record (0.35-0.5 s a seed)
 def test_90_percent_intervals_cover_the_truth_about_90_percent_of_the_time(seeded_intervals, clean):
     low, high = binomial_band(SEEDS, 0.90)
     assert (low, high) == (30, 40)
@@ -132,7 +132,7 @@ def test_the_coverage_check_catches_a_too_narrow_interval(seeded_intervals):
     assert np.median(widths) == pytest.approx(2 * 1.645 * np.std(k_best), rel=0.3)
 
 
-@pytest.mark.slow  # ~5 s: one full search and its intervals, then the outputs
+@pytest.mark.slow  # ~4-6 s: one full search and its intervals, then the outputs
 def test_calibrate_reports_the_intervals(segment, clean, tmp_path):
     ag, dt = segment
     ref_time, rotation = noisy(clean, 1)
@@ -154,6 +154,30 @@ def test_calibrate_reports_the_intervals(segment, clean, tmp_path):
     assert tmp_path / "calibration-profile.png" in files and (tmp_path / "calibration-profile.png").stat().st_size
     wider = fit_intervals(ref_time, rotation, ag, dt, PAPER_BLOCK, result.k, result.xi, confidence=0.99)
     assert wider["k_low"] < result.k_low and wider["k_high"] > result.k_high  # a higher level, a wider interval
+
+
+def test_coloured_noise_widens_the_intervals_by_the_square_root_of_its_autocorrelation_time(segment, clean):
+    """AR(1) noise (phi = 0.8, tau = 9) of the same variance as white noise: the intervals are about 3 times as
+    wide, and the note says why."""
+    ag, dt = segment
+    ref_time, rotation = clean
+    sigma = NOISE * np.max(np.abs(rotation))
+    rng = np.random.default_rng(11)
+    white = rng.normal(0.0, sigma, rotation.size)
+    phi, shocks = 0.8, rng.normal(0.0, sigma * np.sqrt(1 - 0.8**2), rotation.size)
+    coloured = np.empty_like(shocks)
+    coloured[0] = rng.normal(0.0, sigma)
+    for i in range(1, coloured.size):
+        coloured[i] = phi * coloured[i - 1] + shocks[i]
+    results = [fit_intervals(ref_time, rotation + noise, ag, dt, PAPER_BLOCK, K_TRUE, XI_TRUE)
+               for noise in (white, coloured)]
+    assert results[0]["autocorrelation_time"] < 1.3
+    assert results[1]["autocorrelation_time"] == pytest.approx((1 + phi) / (1 - phi), rel=0.3)
+    ratio = [(results[1][f"{name}_high"] - results[1][f"{name}_low"]) / (results[0][f"{name}_high"]
+                                                                          - results[0][f"{name}_low"])
+             for name in ("k", "xi")]
+    assert ratio == pytest.approx([3.0, 3.0], rel=0.3)
+    assert any("correlated over" in note for note in results[1]["notes"])
 
 
 def test_autocorrelation_time_of_white_and_ar1_noise():
