@@ -755,7 +755,7 @@ def _profiles_around(likelihood, start, axes, threshold, tau, fixed_xi):
     return profiles, notes, tau, n_eff, mle_rss
 
 
-def profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: ArrayLike, fixed_xi: bool,
+def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: ArrayLike, fixed_xi: bool,
                       confidence: float, t_end: float) -> dict:
     """Profile-likelihood intervals of k and xi around a fit (see the block comment above).
 
@@ -955,7 +955,7 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
     k_fit, xi_fit = search.physical(best_point)
     intervals, before = {}, search.count
     if local and confidence is not None:
-        intervals = profile_intervals(search, times, objective.reference, best_point, fixed_xi, confidence, t_end)
+        intervals = _profile_intervals(search, times, objective.reference, best_point, fixed_xi, confidence, t_end)
         intervals.update(confidence=float(confidence), interval_method="profile likelihood",
                          interval_notes=intervals.pop("notes"), interval_simulations=search.count - before)
         if log:
@@ -1018,7 +1018,7 @@ def fit_intervals(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, d
     -------
     dict
         ``k_low``, ``k_high`` [N/m], ``xi_low``, ``xi_high`` [-], ``noise_rms`` [rad],
-        ``autocorrelation_time`` [samples], ``notes`` and the profiles (``profile_intervals``).
+        ``autocorrelation_time`` [samples], ``notes`` and the profiles (``_profile_intervals``).
     """
     fixed_xi = xi_range[0] == xi_range[1]
     ref_time, ref_rotation = _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, 2, 1, confidence)
@@ -1026,7 +1026,7 @@ def fit_intervals(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, d
     times, _ = _uniform_times(ref_time, dt)
     u = math.log(k / k_range[0]) / math.log(k_range[1] / k_range[0])
     v = 0.0 if fixed_xi else (xi - xi_range[0]) / (xi_range[1] - xi_range[0])
-    return profile_intervals(search, times, np.interp(times, ref_time, ref_rotation), (u, v), fixed_xi, confidence,
+    return _profile_intervals(search, times, np.interp(times, ref_time, ref_rotation), (u, v), fixed_xi, confidence,
                              float(ref_time[-1]) + dt)
 
 

@@ -199,3 +199,42 @@ def test_a_confidence_outside_zero_one_is_refused(segment, clean):
     for confidence in (0.0, 1.0, 1.5):
         with pytest.raises(ConfigError, match="confidence"):
             calibrate(*clean, ag, dt, PAPER_BLOCK, confidence=confidence)
+
+
+def test_cli_prints_the_intervals_and_passes_the_confidence(tmp_path, capsys, monkeypatch):
+    """rockfrag calibrate --confidence reaches calibrate(), and its printout and calibration.json carry the intervals
+    (the search itself replaced: its intervals are the tests above)."""
+    import pipeline.calibrate as calibration
+    from pipeline.calibrate import CalibrationResult
+    from pipeline.cli import main
+
+    asked = {}
+
+    def fake(*args, **kwargs):
+        asked.update(kwargs)
+        return CalibrationResult(
+            k_grid=4.33e8, xi_grid=0.03, correlation_grid=0.9, k=4.6e8, xi=0.027, correlation=0.99, rms_error=1e-3,
+            peak_error=0.01, peak_reference=0.03, peak_model=0.0303, area_over_depth=None, soil_shear_modulus=None,
+            block_modulus=PAPER_BLOCK.E_b, surface_k=[1e8, 9e8], surface_xi=[0.01, 0.07],
+            surface=[[0.5, 0.6], [0.7, 0.8]],
+            confidence=kwargs["confidence"], k_low=4.5e8, k_high=4.7e8, xi_low=0.026, xi_high=0.028,
+            interval_method="profile likelihood", noise_rms=1e-3, autocorrelation_time=1.0, interval_simulations=450,
+            profile_k=[4.4e8, 4.6e8, 4.8e8], profile_k_deviance=[5.0, 0.0, 5.0], profile_xi=[0.025, 0.027, 0.029],
+            profile_xi_deviance=[5.0, 0.0, 5.0])
+
+    monkeypatch.setattr(calibration, "calibrate", fake)
+    reference = tmp_path / "ref.csv"
+    seconds = np.arange(0.0, 10.0, 0.01)
+    reference.write_text("time [s],theta [rad]\n" + "\n".join(f"{t:.2f},{0.01 * np.sin(t):.6f}" for t in seconds))
+    status = main(["calibrate", str(reference), "--record", "DUZCE/BOL090", "--confidence", "0.8",
+                   "--output", str(tmp_path / "out")])
+    printed = capsys.readouterr().out
+    assert status == 0 and asked["confidence"] == 0.8
+    assert ("80% confidence (profile likelihood): k 4.5e+08 to 4.7e+08 N/m (-2.17% / +2.17%), xi 0.02600 to 0.02800"
+            in printed)
+    summary = json.loads((tmp_path / "out" / "calibration.json").read_text())
+    assert (summary["confidence"], summary["k_low"], summary["xi_high"]) == (0.8, 4.5e8, 0.028)
+    assert (tmp_path / "out" / "calibration-profile.png").stat().st_size > 0
+    with pytest.raises(SystemExit) as stop:  # a usage error, one line
+        main(["calibrate", str(reference), "--record", "DUZCE/BOL090", "--confidence", "1.5"])
+    assert stop.value.code == 2 and "--confidence: 1.5 must be > 0 and < 1" in capsys.readouterr().err
