@@ -581,6 +581,7 @@ MAX_WIDENINGS = 3
 PROFILE_BATCH = 256  # simulations per compiled call while profiling (memory: batch x samples)
 RESTARTS = 1  # new starts from a better point the profiles found (a nonlinear surface: model error, big noise)
 RESTART_DEVIANCE = 0.1
+WIDENING_NOTED = 0.05  # a widening to the region's simulated points beyond this fraction of the width is noted
 
 
 def autocorrelation_time(residual: ArrayLike) -> float:
@@ -614,9 +615,10 @@ def autocorrelation_time(residual: ArrayLike) -> float:
 class _Likelihood:
     """Residuals (model - reference on the uniform grid) of points of the unit box, and the lowest RSS seen."""
 
-    def __init__(self, search, times, reference, t_end, axes):
-        self.search, self.times, self.reference, self.t_end, self.axes = search, times, reference, t_end, axes
+    def __init__(self, search, times, reference, t_end):
+        self.search, self.times, self.reference, self.t_end = search, times, reference, t_end
         self.best_rss, self.best_point = math.inf, None
+        self.seen_points, self.seen_rss = [], []  # every evaluation: the region's points bound the intervals
 
     def residuals(self, points):
         points = np.atleast_2d(np.clip(np.asarray(points, float), 0.0, 1.0))
@@ -624,26 +626,31 @@ class _Likelihood:
         values = np.concatenate([_interpolate(self.search.histories(chunk, self.t_end), self.search.dt, self.times)
                                  for chunk in chunks]) - self.reference
         rss = np.sum(values**2, axis=1)
+        self.seen_points.append(points)
+        self.seen_rss.append(rss)
         best = int(np.argmin(rss))
         if rss[best] < self.best_rss:
             self.best_rss, self.best_point = float(rss[best]), points[best]
         return values, rss
 
     def jacobian(self, points, steps, axes):
-        """Residuals, RSS and central-difference Jacobians (n_points, n_samples, len(axes)) in one batch."""
-        points = np.atleast_2d(np.asarray(points, float))
-        stencil = [points]
+        """Residuals, RSS and central-difference Jacobians (n_points, n_samples, len(axes)) in one batch.
+
+        At an edge of the unit box the difference is one-sided (divided by the shift that remains).
+        """
+        points = np.clip(np.atleast_2d(np.asarray(points, float)), 0.0, 1.0)
+        stencil, shifts = [points], []
         for axis in axes:
-            for sign in (1.0, -1.0):
-                shifted = points.copy()
-                shifted[:, axis] += sign * steps[axis]
-                stencil.append(shifted)
+            plus, minus = points.copy(), points.copy()
+            plus[:, axis] = np.minimum(points[:, axis] + steps[axis], 1.0)
+            minus[:, axis] = np.maximum(points[:, axis] - steps[axis], 0.0)
+            stencil += [plus, minus]
+            shifts.append(plus[:, axis] - minus[:, axis])
         values, rss = self.residuals(np.concatenate(stencil))
         m = len(points)
-        centre = values[:m]
         jacobian = np.stack([(values[(1 + 2 * i) * m:(2 + 2 * i) * m] - values[(2 + 2 * i) * m:(3 + 2 * i) * m])
-                             / (2.0 * steps[axis]) for i, axis in enumerate(axes)], axis=-1)
-        return centre, rss[:m], jacobian
+                             / shift[:, None] for i, shift in enumerate(shifts)], axis=-1)
+        return values[:m], rss[:m], jacobian
 
 
 def _gauss_newton_step(residual, jacobian):
@@ -787,7 +794,7 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
     threshold = float(chi2.ppf(confidence, 1))
     axes = (0,) if fixed_xi else (0, 1)
     start = np.clip(np.asarray(point, float), 0.0, 1.0)
-    likelihood = _Likelihood(search, times, reference, t_end, axes)
+    likelihood = _Likelihood(search, times, reference, t_end)
     tau = autocorrelation_time(likelihood.residuals([start])[0][0])
     origin = start
     for attempt in range(RESTARTS + 1):
@@ -799,6 +806,10 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
 
     lowest = min(likelihood.best_rss, *(float(np.min(rss)) for _, rss in profiles.values()))
     out = {"noise_rms": math.sqrt(lowest / times.size), "autocorrelation_time": tau, "notes": notes}
+    # min over xi of D at k is at most D at any (k, xi): every evaluated point inside the joint region lies inside
+    # both intervals. Where the profiles' local minimisation falls short (a nonlinear surface), this widens them.
+    seen = np.concatenate(likelihood.seen_points)
+    inside = seen[n_eff * np.log(np.concatenate(likelihood.seen_rss) / lowest) <= threshold]
     for axis, (positions, rss) in profiles.items():
         name, unit = ("k", " N/m") if axis == 0 else ("xi", "")
 
@@ -808,14 +819,22 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
         # against the profile's own minimum: the same as the lowest RSS where the response is smooth, and the
         # only consistent reference where it is not (a noise-free reference at the solver's resolution)
         deviance = n_eff * np.log(rss / float(np.min(rss)))
-        for side, bound, edge in zip(("low", "high"), _bounds(positions, deviance, threshold),
-                                     (positions[0], positions[-1])):
-            if bound is None:
-                bound = edge
+        bounds = list(_bounds(positions, deviance, threshold))
+        for side, edge in enumerate((positions[0], positions[-1])):
+            if bounds[side] is None:
+                bounds[side] = edge
                 where = "search range's" if edge in (0.0, 1.0) else "profile's last point"
-                out["notes"].append(f"the {'lower' if side == 'low' else 'upper'} bound of {name} is the {where} "
+                out["notes"].append(f"the {('lower', 'upper')[side]} bound of {name} is the {where} "
                                     f"({physical(edge):.4g}{unit}): the reference does not bound {name} there")
-            out[f"{name}_{side}"] = float(physical(bound))
+        if inside.size:
+            widened = [min(bounds[0], inside[:, axis].min()), max(bounds[1], inside[:, axis].max())]
+            growth = (widened[1] - widened[0]) / max(bounds[1] - bounds[0], 1e-300) - 1.0
+            if growth > WIDENING_NOTED:
+                out["notes"].append(f"the {name} interval is widened by {growth:.0%} to every simulated point inside "
+                                    "the likelihood region (the surface is not quadratic at this scale): read its "
+                                    "width as a lower bound")
+            bounds = widened
+        out[f"{name}_low"], out[f"{name}_high"] = (float(physical(bound)) for bound in bounds)
         out[f"profile_{name}"] = [float(physical(x)) for x in positions]
         out[f"profile_{name}_deviance"] = [float(v) for v in deviance]
     if fixed_xi:
