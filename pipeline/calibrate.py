@@ -4,8 +4,9 @@ Input : a reference rotation history (a table of time and rotation, e.g. from LS
         test; units from the header or flags), the ground motion that produced it [m/s^2] sampled at
         dt [s], the block and a model that needs a foundation (``ssi`` by default; any registered model
         whose ``needs_foundation`` is true, solver keywords such as winkler's ``bed=`` pass through).
-Output: ``CalibrationResult``: the best grid point and the global optimum (k [N/m], xi [-]), the paper's
-        eq. 17 Pearson correlation between reference and model rotation (model interpolated onto the
+Output: ``CalibrationResult``: the best grid point and the global optimum (k [N/m], xi [-]) with their
+        profile-likelihood confidence intervals (``fit_intervals``; default 90 %), the paper's eq. 17
+        Pearson correlation between reference and model rotation (model interpolated onto the
         reference's own time steps), RMS error [rad], peak-angle error, the implied A/H of eq. 19 [m],
         the correlation surface of the grid; JSON/CSV and PNG writers.
 
