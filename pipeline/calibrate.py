@@ -4,8 +4,9 @@ Input : a reference rotation history (a table of time and rotation, e.g. from LS
         test; units from the header or flags), the ground motion that produced it [m/s^2] sampled at
         dt [s], the block and a model that needs a foundation (``ssi`` by default; any registered model
         whose ``needs_foundation`` is true, solver keywords such as winkler's ``bed=`` pass through).
-Output: ``CalibrationResult``: the best grid point and the global optimum (k [N/m], xi [-]), the paper's
-        eq. 17 Pearson correlation between reference and model rotation (model interpolated onto the
+Output: ``CalibrationResult``: the best grid point and the global optimum (k [N/m], xi [-]) with their
+        profile-likelihood confidence intervals (``fit_intervals``; default 90 %), the paper's eq. 17
+        Pearson correlation between reference and model rotation (model interpolated onto the
         reference's own time steps), RMS error [rad], peak-angle error, the implied A/H of eq. 19 [m],
         the correlation surface of the grid; JSON/CSV and PNG writers.
 
@@ -142,6 +143,24 @@ class CalibrationResult:
         Wall time of the search [s].
     surface_k, surface_xi, surface : list
         The coarse grid's k [N/m] and xi [-] values and its eq. 17 correlations, (n_k, n_xi).
+    confidence : float or None
+        Two-sided level of the intervals [-]; None: not computed (``--grid-only``, or not asked).
+    k_low, k_high, xi_low, xi_high : float or None
+        Profile-likelihood confidence interval of k [N/m] and of xi [-] (each marginal); xi's are None
+        when xi was fixed.
+    interval_method : str
+        How the intervals were computed.
+    noise_rms : float or None
+        RMS residual at the likelihood's best point [rad]: the noise the intervals assume.
+    autocorrelation_time : float or None
+        Integrated autocorrelation time of the residuals [samples of the search grid]; 1 for white noise.
+    interval_notes : list of str
+        Bounds that are the search range's (the reference does not bound the parameter there), a fit
+        outside its own likelihood region, strongly correlated residuals.
+    interval_simulations : int
+        Simulations the intervals took (included in ``n_simulations``).
+    profile_k, profile_k_deviance, profile_xi, profile_xi_deviance : list
+        The profiles: k [N/m] and xi [-] values and the profile deviance D [-] at each.
     """
 
     k_grid: float
@@ -166,16 +185,49 @@ class CalibrationResult:
     surface_k: list = field(repr=False, default_factory=list)
     surface_xi: list = field(repr=False, default_factory=list)
     surface: list = field(repr=False, default_factory=list)
+    confidence: float | None = None
+    k_low: float | None = None
+    k_high: float | None = None
+    xi_low: float | None = None
+    xi_high: float | None = None
+    interval_method: str = ""
+    noise_rms: float | None = None
+    autocorrelation_time: float | None = None
+    interval_notes: list = field(default_factory=list)
+    interval_simulations: int = 0
+    profile_k: list = field(repr=False, default_factory=list)
+    profile_k_deviance: list = field(repr=False, default_factory=list)
+    profile_xi: list = field(repr=False, default_factory=list)
+    profile_xi_deviance: list = field(repr=False, default_factory=list)
+
+    PLOTTED = ("surface_k", "surface_xi", "surface", "profile_k", "profile_k_deviance", "profile_xi",
+               "profile_xi_deviance")
+    """Fields drawn in the figures and left out of ``summary``."""
 
     def summary(self) -> dict:
-        """The fields without the surface, plus a ``units`` table (what calibration.json holds)."""
+        """The fields without the surface and profiles, plus a ``units`` table (what calibration.json holds)."""
         data = asdict(self)
-        for key in ("surface_k", "surface_xi", "surface"):
+        for key in self.PLOTTED:
             data.pop(key)
         data["units"] = {"k": "N/m", "xi": "1", "correlation": "1 (paper eq. 17)", "rms_error": "rad",
                          "peak_error": "1 (relative)", "area_over_depth": "m", "soil_shear_modulus": "Pa",
-                         "block_modulus": "Pa", "seconds": "s"}
+                         "block_modulus": "Pa", "seconds": "s", "confidence": "1 (two-sided)", "k_low": "N/m",
+                         "k_high": "N/m", "xi_low": "1", "xi_high": "1", "noise_rms": "rad",
+                         "autocorrelation_time": "samples"}
         return data
+
+    def interval_lines(self) -> list[str]:
+        """The intervals as printed by ``rockfrag calibrate`` (empty when not computed)."""
+        if self.confidence is None or self.k_low is None:
+            return []
+        k = (f"k {self.k_low:.5g} to {self.k_high:.5g} N/m ({self.k_low / self.k - 1:+.2%} / "
+             f"{self.k_high / self.k - 1:+.2%})")
+        xi = (f", xi {self.xi_low:.5f} to {self.xi_high:.5f} ({self.xi_low - self.xi:+.5f} / "
+              f"{self.xi_high - self.xi:+.5f})" if self.xi_low is not None else ", xi fixed")
+        lines = [f"{self.confidence:.0%} confidence ({self.interval_method}): {k}{xi}",
+                 f"  noise the intervals assume: RMS {self.noise_rms:.3g} rad, residual autocorrelation time "
+                 f"{self.autocorrelation_time:.2g} samples ({self.interval_simulations} simulations)"]
+        return lines + [f"  note: {note}" for note in self.interval_notes]
 
 
 # ----------------------------------------------------------------------------------------- reading
@@ -503,21 +555,320 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
     return candidates[0][1], candidates[0][0], number
 
 
+# ----------------------------------------------------------------------------------------- intervals
+# Profile likelihood. The reference is read as the model's rotation plus Gaussian noise of unknown variance:
+# with sigma profiled out, -2 ln(likelihood ratio) is D = n_eff ln(RSS / RSS_min), RSS the sum of squared
+# residuals on the uniform search grid. Wilks: {k : min over xi of D <= chi2_1(confidence)} is the interval of
+# k, and likewise for xi (each a marginal interval, not a joint region). n_eff = n / tau, tau the integrated
+# autocorrelation time of the residuals (1 for white noise): residuals that are smooth (model error, coloured
+# noise) carry fewer independent samples and widen the intervals.
+# k and xi trade off (a stiffer, more damped interface rocks alike): their estimates are correlated beyond
+# 0.99, so the profile follows a narrow diagonal ridge. Every minimisation is therefore Gauss-Newton on the
+# residuals, with finite-difference Jacobians (the response is smooth at the scale of the interval, although
+# chaotic at the scale of the search box): first from the search's optimum to the maximum-likelihood point,
+# then over xi at each profiled k (and over k at each profiled xi), all rows of a profile in one batch.
+# Why not a residual bootstrap: each resample needs the whole chaotic search again (hundreds of resamples x
+# ~2000 simulations), while the profile needs ~500 simulations in a few compiled batch calls around the fit.
+
+CONFIDENCE = 0.90
+"""Default two-sided confidence level of the intervals of k and xi."""
+PROFILE_POINTS = 21  # values of the profiled parameter per profile
+PROFILE_SPAN = 2.5  # half-span of a profile, in linearised (Wald) half-widths
+INNER_ITERATIONS = 3  # Gauss-Newton steps of the inner minimisation per profile
+MLE_ITERATIONS = 8
+FIRST_STEP = 1e-5  # first finite-difference step in the unit box, then a quarter of the conditional half-width
+RESOLUTION = 1e-6  # the solver's resolution in the unit box (its response is jagged below; ~2e-6 in k, 6e-8 in xi)
+MAX_WIDENINGS = 3
+PROFILE_BATCH = 256  # simulations per compiled call while profiling (memory: batch x samples)
+RESTARTS = 1  # new starts from a better point the profiles found (a nonlinear surface: model error, big noise)
+RESTART_DEVIANCE = 0.1
+WIDENING_NOTED = 0.05  # a widening to the region's simulated points beyond this fraction of the width is noted
+
+
+def autocorrelation_time(residual: ArrayLike) -> float:
+    """Integrated autocorrelation time [samples] of a series: 1 + 2 sum of rho_k while rho_k >= 2/sqrt(n).
+
+    Parameters
+    ----------
+    residual : array_like
+        The series (residuals of the fit on a uniform time grid).
+
+    Returns
+    -------
+    float
+        tau >= 1; about 1 for white noise, n / tau independent samples.
+    """
+    values = np.asarray(residual, float)
+    values = values - values.mean()
+    n = values.size
+    spectrum = np.fft.rfft(values, 2 * n)
+    autocovariance = np.fft.irfft(spectrum * np.conj(spectrum))[:n]
+    if n < 3 or autocovariance[0] <= 0:
+        return 1.0
+    rho = autocovariance[1:] / autocovariance[0]
+    # sum up to the first lag indistinguishable from white noise (|rho| < 2/sqrt(n)): white noise gives 1
+    # (a cut at the first negative rho would add its random positive lags, ~10 % at n = 1000)
+    small = np.flatnonzero(rho < 2.0 / math.sqrt(n))
+    lags = int(small[0]) if small.size else rho.size
+    return max(1.0, 1.0 + 2.0 * float(np.sum(rho[:lags])))
+
+
+class _Likelihood:
+    """Residuals (model - reference on the uniform grid) of points of the unit box, and the lowest RSS seen."""
+
+    def __init__(self, search, times, reference, t_end):
+        self.search, self.times, self.reference, self.t_end = search, times, reference, t_end
+        self.best_rss, self.best_point = math.inf, None
+        self.seen_points, self.seen_rss = [], []  # every evaluation: the region's points bound the intervals
+
+    def residuals(self, points):
+        points = np.atleast_2d(np.clip(np.asarray(points, float), 0.0, 1.0))
+        chunks = np.array_split(points, math.ceil(len(points) / PROFILE_BATCH))
+        values = np.concatenate([_interpolate(self.search.histories(chunk, self.t_end), self.search.dt, self.times)
+                                 for chunk in chunks]) - self.reference
+        rss = np.sum(values**2, axis=1)
+        self.seen_points.append(points)
+        self.seen_rss.append(rss)
+        best = int(np.argmin(rss))
+        if rss[best] < self.best_rss:
+            self.best_rss, self.best_point = float(rss[best]), points[best]
+        return values, rss
+
+    def jacobian(self, points, steps, axes):
+        """Residuals, RSS and central-difference Jacobians (n_points, n_samples, len(axes)) in one batch.
+
+        At an edge of the unit box the difference is one-sided (divided by the shift that remains).
+        """
+        points = np.clip(np.atleast_2d(np.asarray(points, float)), 0.0, 1.0)
+        stencil, shifts = [points], []
+        for axis in axes:
+            plus, minus = points.copy(), points.copy()
+            plus[:, axis] = np.minimum(points[:, axis] + steps[axis], 1.0)
+            minus[:, axis] = np.maximum(points[:, axis] - steps[axis], 0.0)
+            stencil += [plus, minus]
+            shifts.append(plus[:, axis] - minus[:, axis])
+        values, rss = self.residuals(np.concatenate(stencil))
+        m = len(points)
+        jacobian = np.stack([(values[(1 + 2 * i) * m:(2 + 2 * i) * m] - values[(2 + 2 * i) * m:(3 + 2 * i) * m])
+                             / shift[:, None] for i, shift in enumerate(shifts)], axis=-1)
+        return values[:m], rss[:m], jacobian
+
+
+def _gauss_newton_step(residual, jacobian):
+    """The least-squares step -(J^T J)^+ J^T r of one point."""
+    return -np.linalg.pinv(jacobian.T @ jacobian) @ (jacobian.T @ residual)
+
+
+def _maximum_likelihood(likelihood, point, axes, threshold, n_eff):
+    """Gauss-Newton from ``point`` to the least-squares point: (point, steps, J, residual, RSS) there.
+
+    The finite-difference steps become a quarter of each coordinate's conditional half-width (where D
+    reaches the threshold along that axis): inside the linear range, far above the solver's noise.
+    """
+    steps = np.full(2, FIRST_STEP)
+    residual, rss, jacobian = likelihood.jacobian([point], steps, axes)
+    for iteration in range(MLE_ITERATIONS):
+        curvature = np.sum(jacobian[0] ** 2, axis=0)  # d RSS / d offset^2 along each axis
+        width = np.sqrt(threshold * rss[0] / n_eff / np.maximum(curvature, 1e-300))
+        adapted = steps.copy()
+        adapted[list(axes)] = np.clip(width / 4.0, RESOLUTION, 1e-2)
+        trials = np.repeat(point[None, :], 3, axis=0)
+        trials[:, list(axes)] += np.outer([1.0, 0.5, 0.25], _gauss_newton_step(residual[0], jacobian[0]))
+        _, trial_rss = likelihood.residuals(trials)
+        best = int(np.argmin(trial_rss))
+        gain = n_eff * math.log(rss[0] / trial_rss[best]) if trial_rss[best] > 0 else math.inf
+        if gain > 0:
+            point = np.clip(trials[best], 0.0, 1.0)
+        if gain <= 0 and iteration > 0 and np.allclose(adapted, steps, rtol=0.5):
+            break  # no better point with a Jacobian already at the right scale
+        steps = adapted
+        residual, rss, jacobian = likelihood.jacobian([point], steps, axes)
+        if 0 < gain < 1e-4:
+            break  # converged: the deviance moves by less than 1e-4
+    return point, steps, jacobian[0], residual[0], float(rss[0])
+
+
+def _profile_rss(likelihood, positions, axis, start, steps, fixed_other):
+    """Profile RSS of ``axis`` at ``positions``: minimised over the other coordinate by batched Gauss-Newton."""
+    other = 1 - axis
+    points = np.zeros((positions.size, 2))
+    points[:, axis] = positions
+    points[:, other] = start
+    if fixed_other:
+        return likelihood.residuals(points)[1]
+    best = np.full(positions.size, np.inf)
+    for _ in range(INNER_ITERATIONS):
+        residual, rss, jacobian = likelihood.jacobian(points, steps, (other,))
+        best = np.minimum(best, rss)
+        move = -np.einsum("ij,ij->i", jacobian[:, :, 0], residual) / np.maximum(
+            np.einsum("ij,ij->i", jacobian[:, :, 0], jacobian[:, :, 0]), 1e-300)
+        points[:, other] = np.clip(points[:, other] + move, 0.0, 1.0)
+    return np.minimum(best, likelihood.residuals(points)[1])
+
+
+def _bounds(positions, deviance, threshold):
+    """(low, high) positions where the profile deviance crosses ``threshold`` on each side of its minimum.
+
+    A side without a crossing gives None.
+    """
+    centre = int(np.argmin(deviance))
+    high = _first_crossing(positions[centre:], deviance[centre:], threshold)
+    low = _first_crossing(positions[:centre + 1][::-1], deviance[:centre + 1][::-1], threshold)
+    return low, high
+
+
+def _first_crossing(offsets, deviance, threshold):
+    """The offset at which ``deviance`` (ordered by growing distance) first reaches ``threshold``; None if never."""
+    above = np.flatnonzero(deviance >= threshold)
+    if not above.size:
+        return None
+    i = int(above[0])
+    if i == 0:
+        return float(offsets[0])
+    fraction = (threshold - deviance[i - 1]) / (deviance[i] - deviance[i - 1])
+    return float(offsets[i - 1] + fraction * (offsets[i] - offsets[i - 1]))
+
+
+def _profiles_around(likelihood, start, axes, threshold, tau, fixed_xi):
+    """Least-squares point from ``start``, then the profile of each free coordinate around it.
+
+    Returns ({axis: (positions, profile RSS)}, notes, tau, n_eff, RSS at the least-squares point).
+    """
+    samples = likelihood.times.size
+    mle, steps, jacobian, residual, mle_rss = _maximum_likelihood(likelihood, start, axes, threshold, samples / tau)
+    tau = autocorrelation_time(residual)  # at the least-squares point, where only noise and model error remain
+    n_eff = samples / tau
+    # linearised covariance: sigma^2 tau (J^T J)^-1, sigma^2 = RSS/n; its diagonal sets each profile's span,
+    # its regression of one coordinate on the other the ridge the inner minimisation starts from
+    covariance = np.linalg.pinv(jacobian.T @ jacobian) * mle_rss / n_eff
+    profiles, notes = {}, []
+    for index, axis in enumerate(axes):
+        other = 1 - axis
+        half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5)
+        if half_width < 4 * RESOLUTION:
+            notes.append(f"the {('k', 'xi')[axis]} interval is at the solver's resolution (the reference has almost "
+                         "no noise): it says how precisely the model reproduces it, not how well k and xi are known")
+            half_width = 4 * RESOLUTION
+        ridge = covariance[1 - index, index] / covariance[index, index] if len(axes) == 2 else 0.0
+        span = PROFILE_SPAN
+        for _ in range(MAX_WIDENINGS + 1):
+            positions = np.unique(np.clip(mle[axis] + span * half_width * np.linspace(-1, 1, PROFILE_POINTS), 0, 1))
+            starts = np.clip(mle[other] + ridge * (positions - mle[axis]), 0.0, 1.0)
+            rss = _profile_rss(likelihood, positions, axis, starts, steps, fixed_xi)
+            low, high = _bounds(positions, n_eff * np.log(rss / likelihood.best_rss), threshold)
+            if not ((low is None and positions[0] > 0.0) or (high is None and positions[-1] < 1.0)):
+                break
+            span *= 2.0  # the profile is flatter than its linearisation: look wider
+        profiles[axis] = (positions, rss)
+    return profiles, notes, tau, n_eff, mle_rss
+
+
+def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: ArrayLike, fixed_xi: bool,
+                      confidence: float, t_end: float) -> dict:
+    """Profile-likelihood intervals of k and xi around a fit (see the block comment above).
+
+    Parameters
+    ----------
+    search : _Search
+        The simulations of the calibration (model, record, block, search box).
+    times, reference : ndarray
+        The uniform search grid [s] and the reference rotation on it [rad].
+    point : array_like
+        The fit in the unit box (u = log-k fraction, v = xi fraction).
+    fixed_xi : bool
+        xi is fixed: only k is profiled.
+    confidence : float
+        Two-sided level in (0, 1).
+    t_end : float
+        End of the simulations [s].
+
+    Returns
+    -------
+    dict
+        ``k_low``, ``k_high`` [N/m], ``xi_low``, ``xi_high`` [-] (None for a fixed xi), ``noise_rms``
+        [rad], ``autocorrelation_time`` [samples], ``notes`` (bounds that are the search box's, a fit
+        outside its own region, correlated residuals), and the profiles (``profile_k``,
+        ``profile_k_deviance``, ``profile_xi``, ``profile_xi_deviance``).
+    """
+    from scipy.stats import chi2
+
+    threshold = float(chi2.ppf(confidence, 1))
+    axes = (0,) if fixed_xi else (0, 1)
+    start = np.clip(np.asarray(point, float), 0.0, 1.0)
+    likelihood = _Likelihood(search, times, reference, t_end)
+    tau = autocorrelation_time(likelihood.residuals([start])[0][0])
+    origin = start
+    for attempt in range(RESTARTS + 1):
+        profiles, notes, tau, n_eff, mle_rss = _profiles_around(likelihood, origin, axes, threshold, tau, fixed_xi)
+        # a point better than the least-squares point found: Gauss-Newton stopped short on a nonlinear surface
+        if n_eff * math.log(mle_rss / likelihood.best_rss) <= RESTART_DEVIANCE:
+            break
+        origin = likelihood.best_point
+
+    lowest = min(likelihood.best_rss, *(float(np.min(rss)) for _, rss in profiles.values()))
+    out = {"noise_rms": math.sqrt(lowest / times.size), "autocorrelation_time": tau, "notes": notes}
+    # min over xi of D at k is at most D at any (k, xi): every evaluated point inside the joint region lies inside
+    # both intervals. Where the profiles' local minimisation falls short (a nonlinear surface), this widens them.
+    seen = np.concatenate(likelihood.seen_points)
+    inside = seen[n_eff * np.log(np.concatenate(likelihood.seen_rss) / lowest) <= threshold]
+    for axis, (positions, rss) in profiles.items():
+        name, unit = ("k", " N/m") if axis == 0 else ("xi", "")
+
+        def physical(x, axis=axis):
+            return search.physical((x, 0.0) if axis == 0 else (0.0, x))[axis]
+
+        # against the profile's own minimum: the same as the lowest RSS where the response is smooth, and the
+        # only consistent reference where it is not (a noise-free reference at the solver's resolution)
+        deviance = n_eff * np.log(rss / float(np.min(rss)))
+        bounds = list(_bounds(positions, deviance, threshold))
+        for side, edge in enumerate((positions[0], positions[-1])):
+            if bounds[side] is None:
+                bounds[side] = edge
+                where = "search range's" if edge in (0.0, 1.0) else "profile's last point"
+                out["notes"].append(f"the {('lower', 'upper')[side]} bound of {name} is the {where} "
+                                    f"({physical(edge):.4g}{unit}): the reference does not bound {name} there")
+        if inside.size:
+            widened = [min(bounds[0], inside[:, axis].min()), max(bounds[1], inside[:, axis].max())]
+            growth = (widened[1] - widened[0]) / max(bounds[1] - bounds[0], 1e-300) - 1.0
+            if growth > WIDENING_NOTED:
+                out["notes"].append(f"the {name} interval is widened by {growth:.0%} to every simulated point inside "
+                                    "the likelihood region (the surface is not quadratic at this scale): read its "
+                                    "width as a lower bound")
+            bounds = widened
+        out[f"{name}_low"], out[f"{name}_high"] = (float(physical(bound)) for bound in bounds)
+        out[f"profile_{name}"] = [float(physical(x)) for x in positions]
+        out[f"profile_{name}_deviance"] = [float(v) for v in deviance]
+    if fixed_xi:
+        out["xi_low"] = out["xi_high"] = None
+    at_fit = n_eff * math.log(float(likelihood.residuals([start])[1][0]) / lowest)
+    if at_fit > threshold:
+        k_best, xi_best = search.physical(likelihood.best_point)
+        out["notes"].append(f"the fit lies outside its own {confidence:.0%} likelihood region (deviance "
+                            f"{at_fit:.3g} > {threshold:.3g}); the likelihood's best point is k = {k_best:.6g} N/m, "
+                            f"xi = {xi_best:.5f}")
+    if tau > 2.0:
+        out["notes"].append(f"the residuals are correlated over {tau:.0f} samples (model error or coloured noise): "
+                            f"the intervals count {n_eff:.0f} of {times.size} samples as independent")
+    return out
+
+
 CALIBRATION_OPTIONS = Table({
     "n_k": Number(2, integer=True),
     "n_xi": Number(1, integer=True),
     "k_range": Interval(Number(0.0, low_open=True, unit="N/m"), names=("k_min", "k_max")),
     "xi_range": Interval(Number(0.0, 1.0, high_open=True), names=("xi_min", "xi_max"), strict=False),
+    "confidence": Number(0.0, 1.0, low_open=True, high_open=True),
 })
-"""The search settings of ``calibrate`` (pipeline.validation): grid sizes and the search box."""
+"""The search settings of ``calibrate`` (pipeline.validation): grid sizes, the search box, the confidence."""
 
 
-def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi):
+def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi, confidence=None):
     spec = get_model(model)
     if not spec.needs_foundation:
         raise ConfigError("model", f"{model!r} has no foundation parameters to calibrate; choose a model with a "
                           "foundation (e.g. ssi)")
-    CALIBRATION_OPTIONS.check({"n_k": n_k, "n_xi": n_xi, "k_range": k_range, "xi_range": xi_range}, "", None)
+    options = {"n_k": n_k, "n_xi": n_xi, "k_range": k_range, "xi_range": xi_range}
+    CALIBRATION_OPTIONS.check(options if confidence is None else {**options, "confidence": confidence}, "", None)
     ref_time = np.asarray(ref_time, float)
     ref_rotation = np.asarray(ref_rotation, float)
     if ref_time.ndim != 1 or ref_time.shape != ref_rotation.shape or ref_time.size < 10:
@@ -535,7 +886,7 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
               xi_range: tuple[float, float] = (0.01, 0.07), n_k: int = 25, n_xi: int = 7,
               soil_shear_modulus: float | None = None, switch: str = "consistent", local: bool = True,
               smoothing_hz: float | None = SMOOTHING_HZ, log: Callable[[str], object] | None = None,
-              **solver_options: object) -> CalibrationResult:
+              confidence: float | None = CONFIDENCE, **solver_options: object) -> CalibrationResult:
     """Find (k, xi) maximising eq. 17's correlation between the reference and ``model``'s rotation.
 
     Parameters
@@ -567,14 +918,17 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
         Low-pass of the search objective [Hz]; None searches on the raw signals.
     log : callable, optional
         Receives one line per search stage.
+    confidence : float or None
+        Two-sided level of the profile-likelihood intervals of k and xi (default 0.9); None skips them.
+        Not computed with ``local=False``.
     **solver_options
         Passed to ``simulate_histories`` (e.g. ``bed=`` for winkler, ``restitution=``).
 
     Returns
     -------
     CalibrationResult
-        The fitted k [N/m] and xi [-], the eq. 17 correlation, errors against the reference and the
-        coarse grid's correlation surface.
+        The fitted k [N/m] and xi [-] with their confidence intervals, the eq. 17 correlation, errors
+        against the reference and the coarse grid's correlation surface.
 
     Raises
     ------
@@ -584,16 +938,14 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
         outside the record, constant or larger than pi: usually a wrong unit).
     """
     started = clock.perf_counter()
-    ref_time, ref_rotation = _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi)
+    ref_time, ref_rotation = _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi,
+                                       confidence)
     fixed_xi = xi_range[0] == xi_range[1] or n_xi == 1
     n_xi = 1 if fixed_xi else n_xi
     search = _Search(model, np.asarray(ag, float), dt, block, k_range, xi_range, switch, solver_options)
     t_end = float(ref_time[-1]) + dt
 
-    # uniform search grid: the reference's own step, but no finer than dt/2 (finer adds nothing)
-    step = max(float(np.median(np.diff(ref_time))), dt / 2)
-    times = np.arange(ref_time[0], ref_time[-1] + 0.5 * step, step)
-    times = times[times <= ref_time[-1]]
+    times, step = _uniform_times(ref_time, dt)
     objective = _Objective(times, np.interp(times, ref_time, ref_rotation), smoothing_hz)
     windows = _window_ends(objective.smoothed_reference, step) if local else [times.size]
 
@@ -621,6 +973,13 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
             best_point, best_score = point, score
 
     k_fit, xi_fit = search.physical(best_point)
+    intervals, before = {}, search.count
+    if local and confidence is not None:
+        intervals = _profile_intervals(search, times, objective.reference, best_point, fixed_xi, confidence, t_end)
+        intervals.update(confidence=float(confidence), interval_method="profile likelihood",
+                         interval_notes=intervals.pop("notes"), interval_simulations=search.count - before)
+        if log:
+            log(f"intervals: {search.count - before} simulations (profile likelihood, {confidence:.0%})")
     theta = search.histories([best_point], t_end)
     model_on_reference = _interpolate(theta, dt, ref_time)[0]
     score = correlation(ref_rotation, model_on_reference)
@@ -641,7 +1000,54 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
         n_windows=n_windows, seconds=clock.perf_counter() - started,
         surface_k=[search.physical((u, 0))[0] for u in u_grid],
         surface_xi=[search.physical((0, v))[1] for v in v_grid],
-        surface=surface.reshape(n_k, n_xi).tolist())
+        surface=surface.reshape(n_k, n_xi).tolist(), **intervals)
+
+
+def _uniform_times(ref_time, dt):
+    """The uniform search grid [s] and its step: the reference's own, no finer than dt/2 (finer adds nothing)."""
+    step = max(float(np.median(np.diff(ref_time))), dt / 2)
+    times = np.arange(ref_time[0], ref_time[-1] + 0.5 * step, step)
+    return times[times <= ref_time[-1]], step
+
+
+def fit_intervals(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: float, block: Block, k: float,
+                  xi: float, *, model: str = "ssi", k_range: tuple[float, float] = (1e8, 9e8),
+                  xi_range: tuple[float, float] = (0.01, 0.07), confidence: float = CONFIDENCE,
+                  switch: str = "consistent", **solver_options: object) -> dict:
+    """Profile-likelihood confidence intervals of k and xi around a fit (k, xi), as ``calibrate`` computes them.
+
+    Parameters
+    ----------
+    ref_time, ref_rotation : array_like
+        Reference time [s] and rotation [rad] (as for ``calibrate``).
+    ag : array_like
+        Ground acceleration [m/s^2]; ``dt`` its step [s].
+    dt : float
+        Time step of ``ag`` [s].
+    block : Block
+        The rocking block.
+    k, xi : float
+        The fit: interface stiffness [N/m] and damping ratio [-]; the intervals start from it and move to
+        the maximum-likelihood point first, so any start in the optimum's basin gives the same intervals.
+    model, k_range, xi_range, switch, **solver_options
+        As for ``calibrate``; the intervals stay inside the search range (xi_range min == max fixes xi).
+    confidence : float
+        Two-sided level in (0, 1).
+
+    Returns
+    -------
+    dict
+        ``k_low``, ``k_high`` [N/m], ``xi_low``, ``xi_high`` [-], ``noise_rms`` [rad],
+        ``autocorrelation_time`` [samples], ``notes`` and the profiles (``_profile_intervals``).
+    """
+    fixed_xi = xi_range[0] == xi_range[1]
+    ref_time, ref_rotation = _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, 2, 1, confidence)
+    search = _Search(model, np.asarray(ag, float), dt, block, k_range, xi_range, switch, solver_options)
+    times, _ = _uniform_times(ref_time, dt)
+    u = math.log(k / k_range[0]) / math.log(k_range[1] / k_range[0])
+    v = 0.0 if fixed_xi else (xi - xi_range[0]) / (xi_range[1] - xi_range[0])
+    return _profile_intervals(search, times, np.interp(times, ref_time, ref_rotation), (u, v), fixed_xi, confidence,
+                             float(ref_time[-1]) + dt)
 
 
 def _bed_of(model, solver_options):
@@ -656,7 +1062,11 @@ def _bed_of(model, solver_options):
 
 def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, block, output, switch="consistent",
                   **solver_options):
-    """calibration.json, calibration.csv, calibration-fit.png and calibration-surface.png."""
+    """calibration.json, calibration.csv, calibration-fit.png, calibration-surface.png, calibration-profile.png.
+
+    The profile figure (the profile deviance of k and of xi, the threshold and the intervals) only when the
+    intervals were computed.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -678,8 +1088,7 @@ def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, blo
         label += f" ({result.bed} bed)"
     figure, axis = plt.subplots(figsize=(10, 4.5), constrained_layout=True)
     axis.plot(ref_time, ref_rotation, color="k", lw=1.0, label="reference")
-    axis.plot(t, th[0], color="C3", lw=0.9, ls="--",
-              label=f"{label}, k = {result.k:.4g} N/m, ξ = {result.xi:.4f}")
+    axis.plot(t, th[0], color="C3", lw=0.9, ls="--", label=f"{label}, {_fit_label(result)}")
     axis.set_xlabel("time [s]")
     axis.set_ylabel("rotation θ [rad]")
     axis.set_title(f"Calibration: correlation (eq. 17) {result.correlation:.3f}, RMS error {result.rms_error:.2e} "
@@ -698,6 +1107,11 @@ def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, blo
     mesh = axis.pcolormesh(xi_percent, np.array(result.surface_k), surface, shading="nearest", cmap="viridis")
     axis.set_yscale("log")
     axis.plot(result.xi * 100, result.k, "r*", ms=14, label="optimum")
+    if result.k_low is not None:  # the intervals: usually far smaller than a grid cell, drawn all the same
+        axis.plot([result.xi * 100] * 2, [result.k_low, result.k_high], "r-", lw=1.5,
+                  label=f"{result.confidence:.0%} intervals")
+        if result.xi_low is not None:
+            axis.plot([result.xi_low * 100, result.xi_high * 100], [result.k] * 2, "r-", lw=1.5)
     axis.plot(result.xi_grid * 100, result.k_grid, "wo", ms=7, mfc="none", label="best grid point")
     axis.set_xlabel("damping ratio ξ [%]")
     axis.set_ylabel("interface stiffness k [N/m]")
@@ -707,5 +1121,47 @@ def write_outputs(result: CalibrationResult, ref_time, ref_rotation, ag, dt, blo
     with atomic_path(output / "calibration-surface.png") as temporary:
         figure.savefig(temporary, dpi=120, format="png")
     plt.close(figure)
-    return [output / name for name in ("calibration.json", "calibration.csv", "calibration-fit.png",
-                                       "calibration-surface.png")]
+    names = ["calibration.json", "calibration.csv", "calibration-fit.png", "calibration-surface.png"]
+    if result.profile_k:
+        _plot_profiles(result, output / "calibration-profile.png")
+        names.append("calibration-profile.png")
+    return [output / name for name in names]
+
+
+def _fit_label(result: CalibrationResult) -> str:
+    """"k = 4.6e+08 N/m [4.59e+08, 4.61e+08], ξ = 0.0270 [0.0268, 0.0272] (90 %)", without brackets if none."""
+    if result.k_low is None:
+        return f"k = {result.k:.4g} N/m, ξ = {result.xi:.4f}"
+    xi = f" [{result.xi_low:.4f}, {result.xi_high:.4f}]" if result.xi_low is not None else " (fixed)"
+    return (f"k = {result.k:.4g} N/m [{result.k_low:.4g}, {result.k_high:.4g}], ξ = {result.xi:.4f}{xi} "
+            f"({result.confidence:.0%} intervals)")
+
+
+def _plot_profiles(result: CalibrationResult, path: Path) -> None:
+    """The profile deviance of k and of xi with the chi-square threshold and the intervals shaded."""
+    import matplotlib.pyplot as plt
+    from scipy.stats import chi2
+
+    threshold = chi2.ppf(result.confidence, 1)
+    panels = [("k", np.array(result.profile_k), result.profile_k_deviance, result.k, result.k_low, result.k_high,
+               "interface stiffness k [N/m]")]
+    if result.profile_xi:
+        panels.append(("xi", np.array(result.profile_xi), result.profile_xi_deviance, result.xi, result.xi_low,
+                       result.xi_high, "damping ratio ξ [-]"))
+    figure, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4.2), constrained_layout=True,
+                                squeeze=False)
+    for axis, (name, values, deviance, fit, low, high, xlabel) in zip(axes[0], panels):
+        axis.plot(values, deviance, "k.-", lw=1.0, ms=4, label="profile deviance")
+        axis.axhline(threshold, color="C3", lw=0.9, ls="--", label=f"χ²₁ {result.confidence:.0%} = {threshold:.2f}")
+        axis.axvspan(low, high, color="C0", alpha=0.15, label=f"{result.confidence:.0%} interval")
+        axis.axvline(fit, color="C3", lw=0.8, label="search's optimum")
+        axis.set_xlabel(xlabel)
+        axis.set_ylabel("profile deviance D = n_eff ln(RSS / RSS_min) [-]")
+        axis.set_ylim(0, max(3 * threshold, 1.0))
+        axis.grid(alpha=0.3)
+        axis.legend(fontsize=8)
+    figure.suptitle(f"Profile likelihood of the calibration: the {result.confidence:.0%} interval is where the "
+                    "curve stays below the line", fontsize=10)
+    with atomic_path(path) as temporary:
+        figure.savefig(temporary, dpi=120, format="png")
+    plt.close(figure)

@@ -272,7 +272,9 @@ def command_fragility(args) -> int:
     config, output = _study_config(args)
     from pipeline.risk import study_hazard
 
-    study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
+    hazard = study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
+    if hazard is not None and hazard.site is not None:
+        print(f"hazard: {hazard.source}, {hazard.site.describe()}")
     executor = _executor_options(args)
     loaded = study_records(config, log=_log)
     cube, stats = run_study(config, output=output, progress=not args.no_progress, loaded=loaded, **executor)
@@ -392,7 +394,7 @@ def command_calibrate(args) -> int:
     result = calibrate(reference.time, reference.rotation, ag, record.dt, block, model=args.model,
                        k_range=tuple(args.k_range), xi_range=tuple(args.xi_range), n_k=args.n_k, n_xi=args.n_xi,
                        soil_shear_modulus=soil_g, switch=config.switch, local=not args.grid_only,
-                       log=lambda line: print(line, file=sys.stderr), **bed_option)
+                       log=lambda line: print(line, file=sys.stderr), confidence=args.confidence, **bed_option)
     files = write_outputs(result, reference.time, reference.rotation, ag, record.dt, block, output, config.switch,
                           **bed_option)
     if result.bed:
@@ -402,6 +404,7 @@ def command_calibrate(args) -> int:
     if not args.grid_only:
         print(f"global optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation (eq. 17) "
               f"{result.correlation:.4f} ({result.n_simulations} simulations, {result.seconds:.1f} s)")
+        print("\n".join(result.interval_lines()))
     print(f"RMS error {result.rms_error:.3g} rad; peak angle {result.peak_model:.4g} rad vs reference "
           f"{result.peak_reference:.4g} rad ({result.peak_error:+.1%})")
     if result.area_over_depth is not None:
@@ -546,6 +549,8 @@ def build_parser() -> argparse.ArgumentParser:
     calibrate.add_argument("--n-k", type=GRID_SIZE, default=25, help="coarse grid points in k (log-spaced, >= 2)")
     calibrate.add_argument("--n-xi", type=GRID_SIZE, default=7, help="coarse grid points in xi (>= 2)")
     calibrate.add_argument("--grid-only", action="store_true", help="the coarse grid only (the paper's procedure)")
+    calibrate.add_argument("--confidence", type=_number_type(0, high=1, low_open=True, high_open=True), default=0.9,
+                           help="two-sided level of the profile-likelihood intervals of k and xi (default 0.9)")
     calibrate.add_argument("--time-unit", default=None, help="time unit of the reference: s, ms, us, min (default: "
                            "from its header, else s)")
     calibrate.add_argument("--angle-unit", default=None, help="angle unit of the reference: rad, mrad, deg "

@@ -32,7 +32,7 @@ import numpy as np
 from pipeline.blocks import BLOCK_RANGES, Block
 from pipeline.damage_states import EDPS, DamageState, damage_states_from_config
 from pipeline.errors import ConfigError, PipelineError
-from pipeline.hazard import hazard_for
+from pipeline.hazard import check_site, hazard_for
 from pipeline.measures import MEASURES, scaling_measures
 from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
 from pipeline.models.options import HOUSNER
@@ -120,7 +120,8 @@ SCHEMA = Table({
                                              f"{BAND!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
                       "restitution_band": Interval(Number(0.5, 1.5), strict=False)}),
     "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years"),
-                      "return_periods": Numbers(Number(1.0, 1e6, unit="years"))}),  # the report's answer pages
+                      "return_periods": Numbers(Number(1.0, 1e6, unit="years")),  # the report's answer pages
+                      "site": Checked(check_site, "[lon, lat] in degrees, lon >= -180 and < 360, lat -90 to 90")}),
     "decision": _table({"max_probability_in_life": Checked(lambda value, field, source: _named(
                             value, field, source, Number(0.0, 1.0, low_open=True)),
                             "a table of damage state = probability, each > 0 and <= 1"),
@@ -225,6 +226,8 @@ class StudyConfig:
         |theta| at which a block has overturned [rad].
     hazard_file : str
         Hazard curve CSV (intensity, annual frequency); "" for the shipped example.
+    hazard_site : (float, float) or None
+        ``[hazard] site``: the study's [lon, lat] [degrees], which picks the nearest site of a multi-site file.
     design_life : float
         Design life [years] for the probability of each damage state.
     bootstrap, seed, confidence : int, int, float
@@ -279,6 +282,7 @@ class StudyConfig:
     record_dt: float | None = None  # time step of one-column text records [s]; None: from the files
     applicability: ApplicabilitySettings = ApplicabilitySettings()
     vertical: bool = False  # apply each record's vertical component (and compare with the run without it)
+    hazard_site: tuple[float, float] | None = None  # [lon, lat] [degrees]; picks a multi-site file's nearest site
     restitution: str | float = ""  # bed models' restitution target: "band", "housner", a number, "" (none)
     restitution_band: tuple[float, float] = DEFAULT_BAND  # edges as multiples of Housner's r
 
@@ -435,7 +439,7 @@ def _check_damage_states(data, source):
                               f"the states are {', '.join(names)}", source)
 
 
-def _check_hazard(path, source, measure="pga", period=None):
+def _check_hazard(path, source, measure="pga", period=None, site=None):
     """Check that the hazard curve loads and is for the study's intensity measure (and Sa period).
 
     Loads means: the file exists, is numeric, and its frequencies decrease. No file and a measure other than
@@ -444,7 +448,7 @@ def _check_hazard(path, source, measure="pga", period=None):
     if path and Path(path).is_dir():
         raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
     try:
-        hazard_for(path, measure, period)
+        hazard_for(path, measure, period, site)
     except ConfigError as error:
         raise ConfigError(error.field, f"{error.source}: {error.reason}", source) from None
     except (ValueError, UnicodeDecodeError, OSError) as error:
@@ -484,7 +488,8 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     check_study(blocks, soils, data.get("checks", {}).get("plausibility", "error"), source)
     levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
     _check_damage_states(data, source)
-    _check_hazard(hazard.get("file", ""), source, measure, float(intensity.get("period", 1.0)))
+    site = check_site(hazard["site"], "hazard.site", source) if "site" in hazard else None
+    _check_hazard(hazard.get("file", ""), source, measure, float(intensity.get("period", 1.0)), site)
     sweep = data.get("applicability", {})
     defaults = ApplicabilitySettings()
     return StudyConfig(
@@ -498,7 +503,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
         restitution=restitution, restitution_band=tuple(solver.get("restitution_band", DEFAULT_BAND)),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
-        hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)),
+        hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)), hazard_site=site,
         bootstrap=int(fragility.get("bootstrap", 100)), seed=int(fragility.get("seed", 0)),
         confidence=float(fragility.get("confidence", 0.9)),
         record_units=study.get("units", ""), record_dt=study.get("dt"), vertical=bool(study.get("vertical", False)),

@@ -4,15 +4,22 @@ Input : a hazard curve file that states its intensity measure (and period for Sa
         formats (``load_hazard``): rockfrag's CSV (``# measure = pga`` header lines, columns intensity
         and annual frequency of exceedance [1/yr]), OpenQuake's hazard-curve CSV export as it comes
         (probabilities of exceedance in the investigation time, converted to annual frequencies), or
-        the USGS NSHMP hazard web-service JSON.
-Output: a ``HazardCurve`` (intensity in the measure's display unit, annual frequency [1/yr]) and
-        lambda(im) by log-log interpolation (``hazard_frequency``).
+        the USGS NSHMP hazard web-service JSON; optionally the study's site [lon, lat] (degrees), which
+        picks the nearest site of a multi-site OpenQuake export or USGS file (``[hazard] site``).
+Output: a ``HazardCurve`` (intensity in the measure's display unit, annual frequency [1/yr], and the
+        chosen ``HazardSite`` with its great-circle distance [km] from the study's site) and lambda(im)
+        by log-log interpolation (``hazard_frequency``).
 
 A hazard curve for another measure (or another Sa period) than the study's is a ConfigError; the study
 file's check (pipeline.config) and the risk stage (pipeline.risk) both read curves here. Measures,
 their units, labels and OpenQuake IMT names come from the registry in pipeline.measures. Beyond the
 last tabulated intensity the curve is extended with the slope of its last segment (a power law), and
 below the first point with the slope of its first.
+
+A file with several sites (an OpenQuake regional run, USGS responses saved for several sites) needs the
+study's site: without it, the file is refused with the number of sites and the fix. The distance to the
+chosen site is the haversine great-circle distance on a sphere of the mean Earth radius; a site farther
+than ``FAR_SITE_KM`` is a ``HazardSiteWarning`` when the study reads its hazard (``study_hazard``).
 """
 
 from __future__ import annotations
@@ -20,6 +27,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import warnings
 from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
@@ -30,6 +38,7 @@ from numpy.typing import ArrayLike
 
 from pipeline.errors import ConfigError
 from pipeline.measures import MEASURES, display_units, scaling_measures
+from pipeline.validation import Number, shown
 
 EXAMPLE_HAZARD = "hazard_example.csv"
 """Shipped example, PGA only: H(s) = 1e-4 s^-2.5 [1/yr], s = PGA [g] (Cornell et al. 2002 power-law form)."""
@@ -37,6 +46,71 @@ EXAMPLE_MEASURE = "pga"
 """The measure of the shipped example: a study of another measure needs its own hazard file for a risk."""
 
 PERIOD_TOLERANCE = 1e-6
+
+EARTH_RADIUS_KM = 6371.0088
+"""Mean Earth radius R1 of the IUGG [km]: the sphere of the great-circle distances."""
+FAR_SITE_KM = 50.0
+"""A hazard site farther than this from the study's site [km] is warned about: at that distance the
+curve is another site's (regional grids are typically 0.1-0.2 degrees, 10-20 km, apart)."""
+SITE_LONGITUDE = Number(-180.0, 360.0, high_open=True, unit="degrees")
+SITE_LATITUDE = Number(-90.0, 90.0, unit="degrees")
+
+
+class HazardSiteWarning(UserWarning):
+    """The hazard file's nearest site is farther than ``FAR_SITE_KM`` from the study's site."""
+
+
+def check_site(value: object, field: str = "hazard.site", source: str | None = None) -> tuple[float, float]:
+    """The study's site ``[lon, lat]`` [degrees] as two floats, or a ``ConfigError`` naming ``field``.
+
+    Parameters
+    ----------
+    value : object
+        As written in the study file: a list of two finite numbers, longitude in [-180, 360) and
+        latitude in [-90, 90].
+    field, source : str
+        The field and the file that an error names.
+
+    Returns
+    -------
+    (float, float)
+        Longitude and latitude [degrees].
+    """
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        raise ConfigError(field, f"{shown(value)}; must be [lon, lat] in degrees, e.g. [-122.27, 38.1]", source)
+    longitude = SITE_LONGITUDE.check(value[0], f"{field}[0] (longitude)", source)
+    latitude = SITE_LATITUDE.check(value[1], f"{field}[1] (latitude)", source)
+    return longitude, latitude
+
+
+def great_circle_km(lon1: ArrayLike, lat1: ArrayLike, lon2: ArrayLike, lat2: ArrayLike) -> np.ndarray | float:
+    """Great-circle distance [km] between points given in degrees (haversine, sphere of ``EARTH_RADIUS_KM``).
+
+    Longitudes may use either convention (-180..180 or 0..360): only their difference enters, through
+    its sine.
+    """
+    phi1, phi2 = np.radians(lat1), np.radians(lat2)
+    half_dphi = 0.5 * (phi2 - phi1)
+    half_dlambda = 0.5 * np.radians(np.asarray(lon2, float) - np.asarray(lon1, float))
+    a = np.sin(half_dphi) ** 2 + np.cos(phi1) * np.cos(phi2) * np.sin(half_dlambda) ** 2
+    return 2.0 * EARTH_RADIUS_KM * np.arcsin(np.sqrt(np.clip(a, 0.0, 1.0)))
+
+
+@dataclass(frozen=True)
+class HazardSite:
+    """The site of a hazard file chosen for the study's ``[hazard] site``."""
+
+    longitude: float  # of the file's site [degrees]
+    latitude: float  # [degrees]
+    distance_km: float  # great-circle distance from the study's site [km]
+    requested: tuple[float, float]  # the study's [lon, lat] [degrees]
+    index: int  # 0-based position among the file's sites
+    count: int  # sites in the file
+
+    def describe(self) -> str:
+        """"site 3 of 10 (lon -122.27, lat 38.1), 1.2 km from the study's site [-122.26, 38.1]"."""
+        return (f"site {self.index + 1} of {self.count} (lon {self.longitude:g}, lat {self.latitude:g}), "
+                f"{self.distance_km:.1f} km from the study's site [{self.requested[0]:g}, {self.requested[1]:g}]")
 
 
 @dataclass(frozen=True)
@@ -49,6 +123,7 @@ class HazardCurve:
     period: float | None  # Sa period [s]; None for pga, pgv
     source: str
     notes: dict = field(default_factory=dict)
+    site: HazardSite | None = None  # the file's site nearest the study's [hazard] site; None without one
 
     @property
     def label(self) -> str:
@@ -116,13 +191,14 @@ def _read_rockfrag_csv(text: str, source: str):
     unit = header.get("units", display)
     if unit != display:
         _fail(f"units {unit!r}; a {measure} hazard curve must be in {display}", source)
-    return values[:, 0], values[:, 1], measure, (period if uses_period else None), {}
+    return [(None, None, values[:, 0], values[:, 1])], measure, (period if uses_period else None), {}
 
 
 def _read_openquake_csv(text: str, source: str):
-    """Read an OpenQuake hazard_curve-*.csv: lambda = -ln(1 - poe) / T (Poisson).
+    """Read an OpenQuake hazard_curve-*.csv: lambda = -ln(1 - poe) / T (Poisson), one curve per site row.
 
-    The file holds a '#...investigation_time=T, imt='PGA'' line, then lon,lat,depth,poe-<level>,...
+    The file holds a '#...investigation_time=T, imt='PGA'' line, then a header naming lon, lat (and
+    depth, sometimes custom_site_id) and the poe-<level> columns, then one row per site.
     """
     lines = [line for line in text.splitlines() if line.strip()]
     first = lines[0]
@@ -132,55 +208,113 @@ def _read_openquake_csv(text: str, source: str):
         _fail("OpenQuake header line without investigation_time and imt", source)
     investigation_time = float(time_match.group(1))
     measure, period, factor = _measure_from_imt(imt_match.group(1), source)
-    columns = [c.strip() for c in lines[1].split(",")]
+    columns = [c.strip() for c in lines[1].split(",")] if len(lines) > 1 else []
     poe_columns = [i for i, c in enumerate(columns) if c.startswith("poe-")]
     if not poe_columns:
         _fail("no 'poe-<level>' columns in the OpenQuake header", source)
-    data = [line.split(",") for line in lines[2:]]
-    if len(data) != 1:
-        _fail(f"{len(data)} sites in the OpenQuake export; keep the one row of the study's site", source)
+    if "lon" not in columns or "lat" not in columns:
+        _fail("no 'lon' and 'lat' columns in the OpenQuake header", source)
+    if len(lines) < 3:
+        _fail("no site rows below the OpenQuake header", source)
     intensity = np.array([float(columns[i][4:]) for i in poe_columns]) * factor
-    poe = np.array([float(data[0][i]) for i in poe_columns])
-    if np.any((poe < 0) | (poe >= 1)):
-        _fail("probabilities of exceedance must lie in [0, 1)", source)
-    keep = poe > 0  # a zero probability has no place on a log-log curve
-    frequency = -np.log1p(-poe[keep]) / investigation_time
+    sites = []
+    for number, line in enumerate(lines[2:], start=3):
+        cells = line.split(",")
+        try:
+            lon, lat = float(cells[columns.index("lon")]), float(cells[columns.index("lat")])
+            poe = np.array([float(cells[i]) for i in poe_columns])
+        except (ValueError, IndexError):
+            _fail(f"line {number}: not a site row of numbers (lon, lat, poe-...)", source)
+        if np.any((poe < 0) | (poe >= 1)):
+            _fail(f"line {number}: probabilities of exceedance must lie in [0, 1)", source)
+        keep = poe > 0  # a zero probability has no place on a log-log curve
+        sites.append((lon, lat, intensity[keep], -np.log1p(-poe[keep]) / investigation_time))
     notes = {"investigation_time_years": investigation_time, "imt": imt_match.group(1)}
-    return intensity[keep], frequency, measure, period, notes
+    return sites, measure, period, notes
+
+
+def _usgs_imt(metadata: dict) -> str:
+    imt = metadata.get("imt", "")
+    return str(imt.get("value", imt.get("id", "")) if isinstance(imt, dict) else imt)
 
 
 def _read_usgs_json(text: str, source: str):
-    """Read a USGS NSHMP hazard web-service response: the 'Total' component of its one IMT.
+    """Read USGS NSHMP hazard web-service responses: the 'Total' curve of one IMT per site.
 
-    The JSON holds response[i].metadata.{imt, xvalues} and response[i].data[j].{component, yvalues};
-    the file must hold exactly one IMT.
+    A response holds response[i].metadata.{imt, xvalues, longitude, latitude} and
+    response[i].data[j].{component, yvalues}. The file may hold one response or a JSON list of them
+    (one per site, e.g. saved from a loop over the sites of a region); each site must hold exactly one IMT.
     """
     try:
         document = json.loads(text)
     except json.JSONDecodeError as error:
         _fail(f"not valid JSON: {error}", source)
-    responses = document.get("response")
-    if not isinstance(responses, list) or not responses:
-        _fail("USGS hazard JSON without a 'response' list", source)
-    if len(responses) != 1:
-        _fail(f"{len(responses)} intensity measures in the USGS response; request one IMT", source)
-    metadata, curves = responses[0].get("metadata", {}), responses[0].get("data", [])
-    imt = metadata.get("imt", "")
-    imt = imt.get("value", imt.get("id", "")) if isinstance(imt, dict) else imt
-    measure, period, factor = _measure_from_imt(str(imt), source)
-    total = [c for c in curves if c.get("component") == "Total"]
-    if not total or "xvalues" not in metadata:
-        _fail("USGS hazard JSON without metadata.xvalues and a 'Total' curve", source)
-    intensity = np.asarray(metadata["xvalues"], float) * factor
-    frequency = np.asarray(total[0]["yvalues"], float)
-    keep = frequency > 0
-    notes = {"imt": str(imt), "latitude": metadata.get("latitude"), "longitude": metadata.get("longitude")}
-    return intensity[keep], frequency[keep], measure, period, notes
+    documents = document if isinstance(document, list) else [document]
+    entries = []
+    for item in documents:
+        responses = item.get("response") if isinstance(item, dict) else None
+        if not isinstance(responses, list) or not responses:
+            _fail("USGS hazard JSON without a 'response' list", source)
+        entries += responses
+    by_site: dict = {}
+    for entry in entries:
+        metadata = entry.get("metadata", {}) if isinstance(entry, dict) else {}
+        by_site.setdefault((metadata.get("longitude"), metadata.get("latitude")), []).append(entry)
+    for (lon, lat), found in by_site.items():
+        if len(found) != 1:
+            where = "" if len(by_site) == 1 else f" at lon {lon}, lat {lat}"
+            _fail(f"{len(found)} intensity measures in the USGS response{where}; request one IMT", source)
+    imts = {_usgs_imt(found[0].get("metadata", {})) for found in by_site.values()}
+    if len(imts) != 1:
+        _fail(f"the USGS responses are for different intensity measures ({', '.join(sorted(imts))}); "
+              "give one IMT", source)
+    imt = imts.pop()
+    measure, period, factor = _measure_from_imt(imt, source)
+    sites = []
+    for (lon, lat), (entry,) in by_site.items():
+        metadata, curves = entry.get("metadata", {}), entry.get("data", [])
+        total = [c for c in curves if c.get("component") == "Total"]
+        if not total or "xvalues" not in metadata:
+            _fail("USGS hazard JSON without metadata.xvalues and a 'Total' curve", source)
+        intensity = np.asarray(metadata["xvalues"], float) * factor
+        frequency = np.asarray(total[0]["yvalues"], float)
+        keep = frequency > 0
+        located = isinstance(lon, (int, float)) and isinstance(lat, (int, float))
+        sites.append((float(lon) if located else None, float(lat) if located else None,
+                      intensity[keep], frequency[keep]))
+    first = next(iter(by_site))
+    notes = {"imt": imt, "latitude": first[1], "longitude": first[0]} if len(sites) == 1 else {"imt": imt}
+    return sites, measure, period, notes
+
+
+def _choose_site(sites: list, site: tuple[float, float] | None, source: str):
+    """(intensity, frequency, HazardSite or None) of the file's site nearest the study's ``site``.
+
+    Without ``site`` the file must hold one site. With it, the file must state its sites' coordinates.
+    """
+    if site is None:
+        if len(sites) != 1:
+            lons = [s[0] for s in sites if s[0] is not None]
+            lats = [s[1] for s in sites if s[1] is not None]
+            span = (f" (lon {min(lons):g} to {max(lons):g}, lat {min(lats):g} to {max(lats):g})"
+                    if lons and lats else "")
+            _fail(f"{len(sites)} sites in the file{span}; set the study's site, [hazard] site = [lon, lat] "
+                  "(degrees), to use the nearest", source)
+        return sites[0][2], sites[0][3], None
+    if any(s[0] is None or s[1] is None for s in sites):
+        _fail(f"[hazard] site = [{site[0]:g}, {site[1]:g}] is set but the file states no site coordinates (a "
+              "rockfrag CSV has none); remove [hazard] site or give an OpenQuake or USGS file", source)
+    distances = great_circle_km(site[0], site[1], np.array([s[0] for s in sites]), np.array([s[1] for s in sites]))
+    index = int(np.argmin(distances))
+    lon, lat, intensity, frequency = sites[index]
+    chosen = HazardSite(longitude=lon, latitude=lat, distance_km=float(distances[index]),
+                        requested=(float(site[0]), float(site[1])), index=index, count=len(sites))
+    return intensity, frequency, chosen
 
 
 def _read_any(text: str, source: str):
     stripped = text.lstrip()
-    if stripped.startswith("{"):
+    if stripped.startswith(("{", "[")):
         return _read_usgs_json(text, source)
     first = stripped.splitlines()[0] if stripped else ""
     if "investigation_time" in first or "generated_by" in first:
@@ -189,7 +323,7 @@ def _read_any(text: str, source: str):
 
 
 def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
-                period: float | None = None) -> HazardCurve:
+                period: float | None = None, site: tuple[float, float] | None = None) -> HazardCurve:
     """Read and check a hazard curve against the study's intensity ``measure`` (and Sa ``period`` [s]).
 
     Parameters
@@ -201,18 +335,23 @@ def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
         The study's intensity measure, a name of the registry (``pipeline.measures.MEASURES``).
     period : float, optional
         The study's Sa period [s]; checked only for a measure defined at a period.
+    site : (float, float), optional
+        The study's site, longitude and latitude [degrees] (``[hazard] site``): picks the file's nearest
+        site (great-circle distance). Required for a file of several sites.
 
     Returns
     -------
     HazardCurve
         Intensities in the measure's display unit (g for PGA and Sa, m/s for PGV), increasing, and
-        their annual frequencies of exceedance [1/yr], decreasing.
+        their annual frequencies of exceedance [1/yr], decreasing; with ``site``, the chosen site and
+        its distance [km] (``HazardCurve.site``).
 
     Raises
     ------
     ConfigError
         Field ``hazard.file``: the file is missing or malformed, has fewer than two points, is not
-        monotone, or states another measure or period than the study's.
+        monotone, or states another measure or period than the study's; holds several sites and no
+        ``site`` is given; or ``site`` is given and the file states no coordinates.
     """
     if path is None or str(path) == "":
         source_file = files("pipeline").joinpath(EXAMPLE_HAZARD)
@@ -222,7 +361,7 @@ def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
         if not source_file.is_file():
             _fail("file not found", source)
     text = source_file.read_text()
-    intensity, frequency, file_measure, file_period, notes = _read_any(text, source)
+    sites, file_measure, file_period, notes = _read_any(text, source)
     study = measure_label(measure, period)
     if file_measure != measure:
         found = measure_label(file_measure, file_period)
@@ -232,25 +371,29 @@ def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
     uses_period = measure in MEASURES and MEASURES[measure].uses_period
     if uses_period and period is not None and abs(file_period - period) > PERIOD_TOLERANCE * max(1.0, period):
         _fail(f"the curve is for {measure_label(file_measure, file_period)} but the study uses {study}", source)
+    intensity, frequency, chosen = _choose_site(sites, None if site is None else check_site(site), source)
+    where = source if chosen is None else f"{source}, site {chosen.index + 1} of {chosen.count}"
     if intensity.size < 2:
-        _fail("fewer than two points with a positive annual frequency", source)
+        _fail("fewer than two points with a positive annual frequency", where)
     if np.any(intensity <= 0) or np.any(np.diff(intensity) <= 0):
-        _fail("intensities must increase and be > 0", source)
+        _fail("intensities must increase and be > 0", where)
     if np.any(frequency <= 0) or np.any(np.diff(frequency) > 0):
-        _fail("annual frequency of exceedance must be > 0 and decrease with intensity", source)
-    return HazardCurve(intensity, frequency, file_measure, file_period, source, notes)
+        _fail("annual frequency of exceedance must be > 0 and decrease with intensity", where)
+    return HazardCurve(intensity, frequency, file_measure, file_period, source, notes, chosen)
 
 
-def hazard_for(path: str | os.PathLike | None, measure: str, period: float | None = None) -> HazardCurve | None:
+def hazard_for(path: str | os.PathLike | None, measure: str, period: float | None = None,
+               site: tuple[float, float] | None = None) -> HazardCurve | None:
     """The hazard curve of a study of ``measure`` (at ``period`` [s] for Sa), or None (no risk).
 
-    ``path`` is read and checked against the measure (``load_hazard``); without a path, the shipped
-    example for a study of its measure, else None.
+    ``path`` is read and checked against the measure, at the file's site nearest ``site`` [lon, lat in
+    degrees] if given (``load_hazard``); without a path, the shipped example for a study of its
+    measure, else None.
     """
     if not path and measure != EXAMPLE_MEASURE:
         return None
     uses_period = measure in MEASURES and MEASURES[measure].uses_period
-    return load_hazard(path or None, measure, period if uses_period else None)
+    return load_hazard(path or None, measure, period if uses_period else None, site)
 
 
 class HazardSettings(Protocol):
@@ -268,27 +411,40 @@ class HazardSettings(Protocol):
     def period(self) -> float:
         """The Sa period [s] (unused for measures not defined at a period)."""
 
+    @property
+    def hazard_site(self) -> tuple[float, float] | None:
+        """The study's site [lon, lat] in degrees (``[hazard] site``), or None; optional (read with getattr)."""
+
 
 def study_hazard(config: HazardSettings) -> HazardCurve | None:
-    """The study's hazard curve: its ``hazard.file`` checked against its measure.
+    """The study's hazard curve: its ``hazard.file`` checked against its measure, at its site.
 
     Parameters
     ----------
     config : HazardSettings
-        The study (``pipeline.config.StudyConfig``): ``hazard_file``, ``measure`` and ``period`` [s].
+        The study (``pipeline.config.StudyConfig``): ``hazard_file``, ``measure``, ``period`` [s] and,
+        if it has one, ``hazard_site`` ([lon, lat] in degrees, or None).
 
     Returns
     -------
     HazardCurve or None
         The curve (``load_hazard``); without a file, the shipped example for a PGA study and None
-        (no risk computed) for another measure.
+        (no risk computed) for another measure. A chosen site farther than ``FAR_SITE_KM`` from the
+        study's is a ``HazardSiteWarning``.
 
     Raises
     ------
     ConfigError
-        The file is missing or malformed, or is for another measure or period (``load_hazard``).
+        The file is missing or malformed, or is for another measure or period, or holds several sites
+        and the study gives none (``load_hazard``).
     """
-    return hazard_for(config.hazard_file, config.measure, config.period)
+    hazard = hazard_for(config.hazard_file, config.measure, config.period, getattr(config, "hazard_site", None))
+    if hazard is not None and hazard.site is not None and hazard.site.distance_km > FAR_SITE_KM:
+        warnings.warn(HazardSiteWarning(
+            f"the hazard file's nearest site is {hazard.site.distance_km:.0f} km from the study's site (more than "
+            f"{FAR_SITE_KM:g} km): {hazard.source}, {hazard.site.describe()}; its curve is another site's"))
+        # stacklevel 1: one location, so the CLI's read and the fragility stage's re-read warn once
+    return hazard
 
 
 def hazard_frequency(hazard: HazardCurve, intensity: ArrayLike) -> np.ndarray | float:

@@ -61,7 +61,9 @@ def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life:
     -------
     xarray.Dataset
         ``annual_frequency`` [1/yr] and ``probability_in_life`` [-] on the dimensions of ``median``,
-        with the attributes ``hazard_source``, ``design_life_years`` and ``hazard_measure``.
+        with the attributes ``hazard_source``, ``design_life_years`` and ``hazard_measure``; with a
+        ``[hazard] site``, also the chosen site (in ``hazard_source`` and ``hazard_site_longitude_deg``,
+        ``hazard_site_latitude_deg``, ``hazard_site_distance_km``, ``study_site_longitude_deg``/``_latitude_deg``).
     """
     medians = fragility["median"].values
     betas = fragility["beta"].values
@@ -79,4 +81,10 @@ def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life:
         f"none: no hazard curve for {fragility.attrs.get('intensity_measure', '?')} (risk not computed)"
     dataset.attrs = {"hazard_source": source, "design_life_years": design_life,
                      "hazard_measure": hazard.label if hazard is not None else ""}
+    site = hazard.site if hazard is not None else None
+    if site is not None:  # [hazard] site picked one site of a multi-site file: say which, and how far
+        dataset.attrs.update({
+            "hazard_source": f"{source}, {site.describe()}", "hazard_site_distance_km": site.distance_km,
+            "hazard_site_longitude_deg": site.longitude, "hazard_site_latitude_deg": site.latitude,
+            "study_site_longitude_deg": site.requested[0], "study_site_latitude_deg": site.requested[1]})
     return dataset
