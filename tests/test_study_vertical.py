@@ -46,6 +46,9 @@ vertical = true
 [intensity]
 # 0.8, 2 and 12 times the cabinet's uplift PGA: no uplift, overturning, and free flight of Housner at the top
 levels = {{ values = [0.8, 2.0, 12.0], relative_to = "uplift" }}
+[solver]
+restitution = ""  # the bed at each soil's xi, as the direct solver calls below run it
+bed = "continuous"
 """
 
 HORIZONTAL_STUDY = """
@@ -57,6 +60,9 @@ name = "far-field-small"
 record_sets = ["bolu"]
 [intensity]
 levels = { values = [0.8, 2.0, 6.0], relative_to = "uplift" }
+[solver]
+restitution = ""  # the bed at each soil's xi, as the direct solver calls below run it
+bed = "continuous"
 """
 
 QUIET = {"workers": 1, "progress": False, "log": lambda message: None}
