@@ -66,9 +66,9 @@ NRML_NAMESPACE = "http://openquake.org/xmlns/nrml/0.5"
 
 OPENQUAKE_FORMS = {
     "lognormal": "",
-    "step": f" (a step: lognormal with beta {STEP_BETA:g})",
-    "from-lowest": " (reached from the lowest level studied on: a step there)",
-    "not-reached": " (not reached in the studied range: a step at twice maxIML, never reached)",
+    "step": f" (a step: beta {STEP_BETA:g})",
+    "from-lowest": " (a step at the lowest level studied)",
+    "not-reached": " (a step at twice maxIML: never reached)",
 }
 """What the XML comment before each function says about a row written as each kind (``KINDS``)."""
 

@@ -53,8 +53,14 @@ from pipeline.cube import (
     OUTCOME_ROCKING,
 )
 from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
+from pipeline.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
+    OPENQUAKE_FILE,
+    pelicun_id,
+    pelicun_table,
+    write_csv,
+    write_exchange_files,
+)
 from pipeline.exchange import intensity_unit_label as _unit_label
-from pipeline.exchange import pelicun_id, pelicun_table, write_csv, write_exchange_files  # noqa: F401 (re-exported)
 from pipeline.hazard import study_hazard
 from pipeline.ida import resurrected
 from pipeline.lognormal_fit import (  # noqa: F401
@@ -676,5 +682,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
     table = fragility_table(dataset)
     table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])
     write_csv(table, output / "fragility.csv")
-    write_exchange_files(dataset, output, getattr(config, "period", None))
+    if output / OPENQUAKE_FILE not in write_exchange_files(dataset, output, getattr(config, "period", None)):
+        log(f"rockfrag: no {OPENQUAKE_FILE}: OpenQuake has no intensity measure type for "
+            f"{dataset.attrs.get('intensity_measure')}")
     return combined, risk

@@ -17,6 +17,7 @@ capacities give the probability to within one over the sample size: the 0.01 tol
 
 from __future__ import annotations
 
+import re
 import subprocess
 
 import numpy as np
@@ -26,7 +27,7 @@ import xarray as xr
 from scipy.stats import norm
 
 from pipeline.exchange import RECOMMENDED_MODEL, pelicun_id, pelicun_table, write_exchange_files
-from tests.helpers import CONSUMERS, consumer_python
+from tests.helpers import CONSUMERS, ROOT, consumer_python
 
 DEMAND_LEVELS = np.geomspace(0.03, 8.0, 10)
 """PGA [g] of the demand sample: below, across and above the studied ranges, on no step of the test rows."""
@@ -100,19 +101,32 @@ def pelicun_expected(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
     return np.maximum.accumulate(curves[::-1], axis=0)[::-1].T
 
 
-def run_pelicun(folder, alone: bool = False) -> dict[str, np.ndarray]:
+def readme_example(command: str) -> str:
+    """The Python of the README's example run by ``command`` (a shell block ``COMMAND - <<'EOF' ... EOF``)."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    found = re.findall(rf"^{re.escape(command)} - <<'EOF'\n(.*?)^EOF$", readme, flags=re.MULTILINE | re.DOTALL)
+    assert len(found) == 1, f"the README has {len(found)} examples run by {command}"
+    return found[0]
+
+
+def run_pelicun(folder, alone: bool = False, example: str | None = None) -> tuple[dict[str, np.ndarray], str]:
     """Write the demand sample into ``folder`` (beside fragility_pelicun.csv) and run the consumer script: every
-    component in one assessment (``together``) and, if ``alone``, each in its own (``alone``)."""
+    component in one assessment (``together``) and, if ``alone``, each in its own (``alone``); then, in the
+    same process, the Python ``example`` in ``folder``'s parent. The results and what the process printed."""
     python = consumer_python("pelicun")
     columns = [f"1-PGA-1-{d}" for d in range(1, DEMAND_LEVELS.size + 1)]  # event-type-location-direction
     with open(folder / "demand.csv", "w") as handle:  # pelicun's sample layout: a Units row under the header
         handle.write("," + ",".join(columns) + "\nUnits," + ",".join(["g"] * len(columns)) + "\n")
         pd.DataFrame(np.tile(DEMAND_LEVELS, (N_REALIZATIONS, 1))).to_csv(handle, header=False)
-    result = subprocess.run([str(python), str(CONSUMERS / "pelicun_damage.py"), str(folder)] + ["--alone"] * alone,
+    options = ["--alone"] * alone
+    if example is not None:
+        (folder.parent / "example.py").write_text(example)
+        options += ["--example", str(folder.parent / "example.py")]
+    result = subprocess.run([str(python), str(CONSUMERS / "pelicun_damage.py"), str(folder), *options],
                             capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-3000:]
     with np.load(folder / "exceedance.npz") as data:
-        return {name: data[name] for name in data.files}
+        return {name: data[name] for name in data.files}, result.stdout
 
 
 def check_against_our_curves(dataset: xr.Dataset, table: pd.DataFrame, computed: dict[str, np.ndarray]) -> None:
@@ -135,8 +149,11 @@ def written(folder) -> tuple[xr.Dataset, pd.DataFrame]:
 
 @pytest.fixture(scope="module")
 def round_trip(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("pelicun")
-    return *written(folder), run_pelicun(folder)
+    """pelicun on the test dataset's file, written where the README's example reads it; the example too."""
+    folder = tmp_path_factory.mktemp("pelicun") / "reports-example"
+    dataset, table = written(folder)
+    computed, printed = run_pelicun(folder, example=readme_example(".venv-pelicun/bin/python"))
+    return dataset, table, computed, printed
 
 
 def test_every_row_is_written_as_documented():
@@ -159,7 +176,7 @@ def test_every_row_is_written_as_documented():
 
 
 def test_every_component_loads_and_matches_our_curves_together(round_trip):
-    dataset, table, computed = round_trip
+    dataset, table, computed, _ = round_trip
     assert len(table) == dataset.soil.size * dataset.block.size * dataset.model.size
     check_against_our_curves(dataset, table, computed)
 
@@ -168,14 +185,14 @@ def test_every_component_loads_and_matches_our_curves_together(round_trip):
 def test_every_component_loads_and_matches_our_curves_alone(tmp_path):
     """One assessment per component (a file of one row must load too): about 8 s of pelicun."""
     dataset, table = written(tmp_path)
-    computed = run_pelicun(tmp_path, alone=True)
+    computed, _ = run_pelicun(tmp_path, alone=True)
     assert set(computed) == {"alone", "together"}
     check_against_our_curves(dataset, table, computed)
 
 
 def test_the_tolerance_would_catch_pelicuns_directional_factor(round_trip):
     """With Demand-Directional = 0 pelicun would multiply PGA by 1.2; the comparison above would fail."""
-    dataset, table, computed = round_trip
+    dataset, table, computed, _ = round_trip
     cell = dataset.sel(soil="sand", block="b-1", model="ssi")
     shift = np.abs(pelicun_expected(cell, 1.2 * DEMAND_LEVELS) - pelicun_expected(cell, DEMAND_LEVELS)).max()
     assert shift > 5 * TOLERANCE
@@ -183,11 +200,18 @@ def test_the_tolerance_would_catch_pelicuns_directional_factor(round_trip):
     assert np.abs(computed["together"][index] - pelicun_expected(cell, DEMAND_LEVELS)).max() < TOLERANCE
 
 
+def test_the_readme_example_runs_as_printed(round_trip):
+    """The README's pelicun example, on the file of the test dataset: a damage-state table of every component."""
+    _, table, _, printed = round_trip
+    assert printed.splitlines()[0].split() == ["ds", "0", "1", "2", "3", "4"]
+    assert all(component in printed for component in table.ID)
+
+
 @pytest.mark.slow
 def test_a_studys_file_loads_and_matches_in_pelicun(small_pipeline, tmp_path):
-    """The file ``rockfrag fragility`` wrote for the small study: every component, alone and together (the
-    session's pipeline run; about 5 s for pelicun once it has run)."""
+    """The file ``rockfrag fragility`` wrote for the small study: every component, in one assessment (the
+    session's pipeline run; about 4 s for pelicun once it has run)."""
     dataset = xr.open_dataset(small_pipeline.output / "fragility.nc")
     table = pd.read_csv(small_pipeline.output / "fragility_pelicun.csv")
     (tmp_path / "fragility_pelicun.csv").write_bytes((small_pipeline.output / "fragility_pelicun.csv").read_bytes())
-    check_against_our_curves(dataset, table, run_pelicun(tmp_path, alone=True))
+    check_against_our_curves(dataset, table, run_pelicun(tmp_path)[0])

@@ -2,17 +2,21 @@
 (Assessment -> demand.load_sample -> asset.load_cmp_model -> damage.load_model_parameters -> damage.calculate),
 every component alone and all of them together, and save P(DS >= k) at each demand level.
 
-Usage: python pelicun_damage.py FOLDER [--alone]. Reads FOLDER/fragility_pelicun.csv and FOLDER/demand.csv
-(pelicun's sample layout: one PGA column per demand level, ``1-PGA-1-<d>``, the level held over every realization,
-so that pelicun's Latin hypercube capacities give P(DS >= k) to within one over the sample size). Writes
-FOLDER/exceedance.npz: ``together`` (one assessment of every component) and, with --alone, ``alone`` (one
-assessment per component), (component, level, k) arrays of P(DS >= k) for k = 1..n (n the number of limit-state
-columns), in the file's component order. Imports pelicun, never pipeline.
+Usage: python pelicun_damage.py FOLDER [--alone] [--example FILE]. Reads FOLDER/fragility_pelicun.csv and
+FOLDER/demand.csv (pelicun's sample layout: one PGA column per demand level, ``1-PGA-1-<d>``, the level held
+over every realization, so that pelicun's Latin hypercube capacities give P(DS >= k) to within one over the
+sample size). Writes FOLDER/exceedance.npz: ``together`` (one assessment of every component) and, with
+--alone, ``alone`` (one assessment per component), (component, level, k) arrays of P(DS >= k) for k = 1..n (n
+the number of limit-state columns), in the file's component order. ``--example FILE`` then runs the Python of
+FILE (the README's pelicun example) in FOLDER's parent, in this process: one pelicun import for both. Imports
+pelicun, never pipeline.
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
+import os
+import runpy
 from pathlib import Path
 
 import numpy as np
@@ -43,12 +47,20 @@ def exceedance(folder: Path, components: list[str], n_levels: int, n_states: int
 
 
 if __name__ == "__main__":
-    target = Path(sys.argv[1])
+    parser = argparse.ArgumentParser()
+    parser.add_argument("folder", type=Path)
+    parser.add_argument("--alone", action="store_true")
+    parser.add_argument("--example", type=Path)
+    arguments = parser.parse_args()
+    target = arguments.folder.resolve()
     table = pd.read_csv(target / "fragility_pelicun.csv")
     names = list(table.ID)
     levels = len(pd.read_csv(target / "demand.csv", nrows=0).columns) - 1
     states = sum(column.endswith("-Family") for column in table.columns)
     computed = {"together": exceedance(target, names, levels, states)}
-    if "--alone" in sys.argv[2:]:
+    if arguments.alone:
         computed["alone"] = np.concatenate([exceedance(target, [name], levels, states) for name in names])
     np.savez(target / "exceedance.npz", **computed)
+    if arguments.example:
+        os.chdir(target.parent)
+        runpy.run_path(str(arguments.example.resolve()), run_name="__main__")
