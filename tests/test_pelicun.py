@@ -48,7 +48,8 @@ ROWS = {  # (block, model): (median [g], beta, status) per damage state, every w
                          (*NAN, "not-reached")],
     ("stocky", "ssi"): [(5.0, 0.0, "deterministic-threshold"), *[(*NAN, "not-reached")] * 3],
     ("stocky", RECOMMENDED_MODEL): [(*NAN, "not-reached")] * 4,
-    ("stocky", "winkler"): [(2.5, 0.3, "extrapolated"), *[(*NAN, "not-reached")] * 3],
+    ("stocky", "winkler"): [(2.5, 0.3, "extrapolated"), (*NAN, "not-reached"), (*NAN, "not-reached"),
+                            (3.5, 0.35, "extrapolated")],  # states that do not nest (a study's own states could)
 }
 STUDIED = {"b-1": (0.05, 3.0), "stocky": (0.1, 4.0)}  # studied range of each block [g]
 SOIL_FACTOR = {"sand": 1.0, "rock": 1.2}  # rock: the fitted medians 20% higher
@@ -56,8 +57,8 @@ SOIL_FACTOR = {"sand": 1.0, "rock": 1.2}  # rock: the fitted medians 20% higher
 
 def exchange_dataset() -> xr.Dataset:
     """A fragility dataset with a row of every kind: lognormal, step, below-range, above-range, not reached
-    (as the first state, after others, and in every state of a cell). The model "recommended" is not first in
-    the model coordinate; ``beta_model`` is there (the files carry it in comments only)."""
+    (as the first state, after others, between others, and in every state of a cell). The model "recommended"
+    is not first in the model coordinate; ``beta_model`` is there (the files carry it in comments only)."""
     soils, blocks, models = list(SOIL_FACTOR), list(STUDIED), ["ssi", RECOMMENDED_MODEL, "winkler"]
     shape = (len(soils), len(blocks), len(models), len(STATES))
     median, beta = np.full(shape, np.nan), np.full(shape, np.nan)
@@ -173,6 +174,8 @@ def test_every_row_is_written_as_documented():
     assert trailing["LS2-Family"] == "deterministic" and trailing["LS2-Theta_0"] == 0.45  # separated: the step
     assert pd.isna(trailing["LS3-Theta_0"]) and pd.isna(trailing["LS4-Theta_0"])  # left out
     assert "LS4 overturning: not-reached, left out" in trailing["Comment"]
+    middle = table.loc["ROCK.stocky.sand.winkler"]  # a state left out before a written one would renumber pelicun's
+    assert [middle[f"LS{k}-Theta_0"] for k in (2, 3)] == [np.inf, np.inf]  # damage states: never reached instead
 
 
 def test_every_component_loads_and_matches_our_curves_together(round_trip):
