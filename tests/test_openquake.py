@@ -195,3 +195,16 @@ def test_damage_states_that_clash_as_openquake_limit_states_are_refused(tmp_path
     dataset = exchange_dataset().assign_coords(damage_state=["uplift", "rocking-0.2", "rocking-0_2", "overturning"])
     with pytest.raises(ConfigError, match="rocking-0_2"):
         write_exchange_files(dataset, tmp_path)
+
+
+def test_ids_that_clash_are_refused_and_the_comments_carry_the_dispersion_parts(tmp_path):
+    """'b-1' and 'b_1' give the same component ID: a ConfigError names both. beta_model is in the comments only."""
+    with pytest.raises(ConfigError, match="same component ID ROCK.b_1.sand.recommended"):
+        write_exchange_files(exchange_dataset().assign_coords(block=["b-1", "b_1"]), tmp_path)
+    write_exchange_files(exchange_dataset(), tmp_path)
+    text = (tmp_path / OPENQUAKE_FILE).read_text()
+    start = text.index("<!-- ROCK.b_1.sand.recommended")
+    comment = text[start:text.index("-->", start)]
+    assert "studied range 0.05-3 g" in comment and "beta is the total; beta_model 0.2" in comment
+    params = ElementTree.parse(tmp_path / OPENQUAKE_FILE).getroot().iter("{http://openquake.org/xmlns/nrml/0.5}params")
+    assert {tuple(sorted(element.attrib)) for element in params} == {("ls", "mean", "stddev")}
