@@ -137,12 +137,35 @@ def pelicun_id(block: str, soil: str, model: str) -> str:
 
 
 def intensity_unit_label(dataset: xr.Dataset) -> str:
-    """The intensity unit as tables show it ("g"), from a fragility dataset's attributes."""
+    """The intensity unit as tables show it, from a fragility dataset's attributes.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A fragility dataset (``intensity_unit_label``, else ``intensity_unit`` in its attributes).
+
+    Returns
+    -------
+    str
+        "g", "m/s", ...
+    """
     return dataset.attrs.get("intensity_unit_label") or unit_label(dataset.attrs.get("intensity_unit", ""))
 
 
 def write_csv(table: pd.DataFrame, path: str | Path) -> None:
-    """Write ``table`` to the CSV file ``path`` atomically (6 significant digits, no index)."""
+    """Write ``table`` to the CSV file ``path`` atomically (6 significant digits, no index).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table.
+    path : str or pathlib.Path
+        The file to write.
+
+    Returns
+    -------
+    None
+    """
     with atomic_path(path) as temporary:
         table.to_csv(temporary, index=False, float_format="%.6g")
 
@@ -150,8 +173,20 @@ def write_csv(table: pd.DataFrame, path: str | Path) -> None:
 def exchange_cells(dataset: xr.Dataset) -> list[tuple[str, str, str]]:
     """(soil, block, model) of every component, in the order both files list them.
 
-    Rows of the model "recommended" first; then the dataset's order (soil, then block, then model).
-    Two cells that give the same ``pelicun_id`` raise a ``ConfigError``.
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The fragility dataset.
+
+    Returns
+    -------
+    list of tuple of str
+        Rows of the model "recommended" first; then the dataset's order (soil, then block, then model).
+
+    Raises
+    ------
+    ConfigError
+        Two cells that give the same ``pelicun_id``.
     """
     cells = [(str(soil), str(block), str(model)) for soil in dataset.soil.values for block in dataset.block.values
              for model in dataset.model.values]
@@ -285,7 +320,19 @@ def openquake_imt(measure: str, period: float | None = None) -> str | None:
 
 
 def openquake_limit_state(name: str) -> str:
-    """A damage state's name as an OpenQuake limit state (letters, digits, '_', '-', ':'): "rocking-0_2"."""
+    """A damage state's name as an OpenQuake limit state.
+
+    Parameters
+    ----------
+    name : str
+        The damage state ("rocking-0.2").
+
+    Returns
+    -------
+    str
+        The name with every character OpenQuake does not accept in a limit state (anything but letters,
+        digits, '_', '-' and ':') replaced by '_': "rocking-0_2".
+    """
     return re.sub(r"[^\w\-:]", "_", name)
 
 
