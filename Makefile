@@ -48,7 +48,7 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 	      && $(UV) pip install --python .venv-$*/bin/python -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
 	then touch $@; else echo "the $* consumer environment failed to build: see .venv-$*.log" >&2; exit 1; fi
 
-consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun) of the round-trip tests
+consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun, .venv-openquake) of the round-trip tests
 
 # Compiles the numba kernels into their on-disk cache once, so that the test workers load them instead of
 # each compiling them (about 25 s of CPU in a fresh clone, a second when cached).

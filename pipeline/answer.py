@@ -30,9 +30,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.fragility import RECOMMENDED
 from pipeline.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
 from pipeline.lognormal_fit import lognormal_cdf
+from pipeline.models.variants import RECOMMENDED
 from pipeline.risk import annual_frequency as risk_annual_frequency
 from pipeline.risk import probability_in_life as risk_probability_in_life
 from pipeline.units import STANDARD_GRAVITY

@@ -288,8 +288,9 @@ def command_fragility(args) -> int:
         efficiency_stage(cube, loaded.records, config, output)
         print(f"wrote {output / 'efficiency.nc'} and {output / 'efficiency.csv'}")
     fragility, risk = fragility_stage(cube, ida, config, output, progress=not args.no_progress)
-    for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv"):
-        print(f"wrote {output / name}")
+    for name in ("fragility.nc", "fragility.csv", "fragility_pelicun.csv", "fragility_openquake.xml"):
+        if (output / name).is_file():  # no OpenQuake file for a measure OpenQuake does not have
+            print(f"wrote {output / name}")
     if run_applicability(args, config):
         from pipeline.applicability import applicability_stage
 

@@ -6,7 +6,7 @@ Input : the study cube (outcome, peak_angle_ratio over record x im_level x soil 
 Output: ``reports/fragility.nc`` (median, beta, bootstrap bounds, fit method, ``status``, the
         ``extrapolated`` flag, goodness of fit, the non-crossing rule's deviance cost and the studied
         range per soil x block x model x damage state; empirical fractions per level; the three-outcome
-        probabilities), ``fragility.csv`` and a pelicun damage-model CSV (``pelicun_table``).
+        probabilities), ``fragility.csv``, and through ``pipeline.exchange`` the files for pelicun and OpenQuake.
 
 Fits (Baker 2015, Earthquake Spectra 31(1); the numerics on arrays are in ``pipeline.lognormal_fit``):
 binomial maximum likelihood on the counts per level, a probit regression solved by vectorised Fisher
@@ -53,7 +53,14 @@ from pipeline.cube import (
     OUTCOME_ROCKING,
 )
 from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
-from pipeline.errors import ConfigError
+from pipeline.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
+    OPENQUAKE_FILE,
+    pelicun_id,
+    pelicun_table,
+    write_csv,
+    write_exchange_files,
+)
+from pipeline.exchange import intensity_unit_label as _unit_label
 from pipeline.hazard import study_hazard
 from pipeline.ida import resurrected
 from pipeline.lognormal_fit import (  # noqa: F401
@@ -70,8 +77,8 @@ from pipeline.lognormal_fit import (  # noqa: F401
 )
 from pipeline.measures import MEASURES, convert_units, parse_units, udunits, unit_label
 from pipeline.models import MODELS
-from pipeline.models.variants import BAND_ROLES, split_variant
-from pipeline.outputs import atomic_path, write_dataset
+from pipeline.models.variants import BAND_ROLES, RECOMMENDED, split_variant
+from pipeline.outputs import write_dataset
 from pipeline.risk import risk_dataset
 from pipeline.units import STANDARD_GRAVITY
 
@@ -556,8 +563,6 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
 
 # ---------------------------------------------------------------- the recommended curve
 
-RECOMMENDED = "recommended"
-"""The model coordinate of the recommended curves: the admissible bed model over its restitution band."""
 BAND_COMBINATION = (
     "recommended = the admissible tensionless-bed model over the restitution band (pipeline.models.variants): "
     "median and beta_record_to_record are the band centre's fit; beta_model is the spread of the median over "
@@ -719,92 +724,10 @@ def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:
     return table[keep]
 
 
-def _unit_label(dataset: xr.Dataset) -> str:
-    """The intensity unit as tables show it ("g"), from a fragility dataset's attributes."""
-    return dataset.attrs.get("intensity_unit_label") or unit_label(dataset.attrs.get("intensity_unit", ""))
-
-
-# ---------------------------------------------------------------- pelicun damage-model export
-
-def pelicun_id(block: str, soil: str, model: str) -> str:
-    """A component ID pelicun can parse: it splits IDs on '-', so names keep '_' instead."""
-    return ".".join(["ROCK", *(str(part).replace("-", "_").replace(" ", "_") for part in (block, soil, model))])
-
-
-def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFrame:
-    """The pelicun damage-model table: one component per soil/block/model, LS1..LSn the damage states.
-
-    ``Demand-Directional = 1``: the demand is the scaled component itself, so pelicun must not apply its
-    non-directional factor (1.2 x the larger of two directions) to it. A state no record reached leaves its
-    LS empty and marks the component ``Incomplete`` (pelicun then skips it); the ``Comment`` column says what
-    each LS is, the studied range and which medians are extrapolated.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        The fragility dataset (``fragility_dataset``).
-    period : float, optional
-        The Sa period [s], for measures that have one (it becomes part of pelicun's demand type).
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per component, in pelicun's damage-model column layout (medians in g for accelerations).
-
-    Raises
-    ------
-    ConfigError
-        Two (block, soil, model) cells that map to the same pelicun component ID.
-    """
-    measure = dataset.attrs.get("intensity_measure", "pga")
-    registered = MEASURES.get(measure)
-    demand_type, demand_unit = (registered and registered.pelicun_demand) or ("", "")
-    if registered is not None and registered.uses_period and period:
-        demand_type = f"{demand_type}|{period:g}"
-    unit = _unit_label(dataset)
-    rows, seen = [], {}
-    for soil in dataset.soil.values:
-        for block in dataset.block.values:
-            for model in dataset.model.values:
-                component = pelicun_id(block, soil, model)
-                if component in seen:
-                    raise ConfigError("blocks/soils/models", f"names {seen[component]} and {(block, soil, model)} "
-                                      f"give the same pelicun ID {component}; rename one")
-                seen[component] = (block, soil, model)
-                cell = dataset.sel(soil=soil, block=block, model=model)
-                low, high = float(cell.studied_im_min), float(cell.studied_im_max)
-                row = {"ID": component, "Incomplete": 0, "Demand-Type": demand_type, "Demand-Unit": demand_unit,
-                       "Demand-Offset": 0, "Demand-Directional": 1}
-                notes = [f"rockfrag {measure} fragility, studied range {low:.4g}-{high:.4g} {unit}"]
-                for level, state in enumerate(dataset.damage_state.values, start=1):
-                    median = float(cell["median"].sel(damage_state=state))
-                    beta = float(cell["beta"].sel(damage_state=state))
-                    status = str(cell["status"].sel(damage_state=state).values)
-                    notes.append(f"LS{level} {state}: {status}")
-                    if not np.isfinite(median):
-                        row["Incomplete"] = 1
-                        row.update({f"LS{level}-Family": "", f"LS{level}-Theta_0": np.nan,
-                                    f"LS{level}-Theta_1": np.nan, f"LS{level}-DamageStateWeights": ""})
-                        continue
-                    row[f"LS{level}-Family"] = "deterministic" if beta == 0 else "lognormal"
-                    row[f"LS{level}-Theta_0"] = median
-                    row[f"LS{level}-Theta_1"] = np.nan if beta == 0 else beta
-                    row[f"LS{level}-DamageStateWeights"] = ""
-                row["Comment"] = "; ".join(notes)
-                rows.append(row)
-    return pd.DataFrame(rows)
-
-
-def write_csv(table: pd.DataFrame, path: str | Path) -> None:
-    """Write ``table`` to the CSV file ``path`` atomically (6 significant digits, no index)."""
-    with atomic_path(path) as temporary:
-        table.to_csv(temporary, index=False, float_format="%.6g")
-
-
 def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, output: str | Path,
                     progress: bool | None = None,
                     log: Callable[[str], object] | None = None) -> tuple[xr.Dataset, xr.Dataset]:
-    """Fit, add the risk, and write fragility.nc, fragility.csv and fragility_pelicun.csv.
+    """Fit, add the risk, and write fragility.nc, fragility.csv and the exchange files (``pipeline.exchange``).
 
     The hazard curve is read (and checked against the study's intensity measure) before any fit.
     Fit warnings are printed to ``log`` (stderr by default) and kept in the dataset.
@@ -853,5 +776,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
     table = fragility_table(dataset)
     table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])
     write_csv(table, output / "fragility.csv")
-    write_csv(pelicun_table(dataset, getattr(config, "period", None)), output / "fragility_pelicun.csv")
+    if output / OPENQUAKE_FILE not in write_exchange_files(dataset, output, getattr(config, "period", None)):
+        log(f"rockfrag: no {OPENQUAKE_FILE}: OpenQuake has no intensity measure type for "
+            f"{dataset.attrs.get('intensity_measure')}")
     return combined, risk

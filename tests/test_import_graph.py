@@ -29,8 +29,9 @@ LAYERS: list[tuple[str, ...]] = [
     ("pipeline.models", "pipeline.models.*"),
     # 5 the study definition
     ("pipeline.config",),
-    # 6 results of one kind: the cube, IDA, risk, calibration, the records table
-    ("pipeline.cube", "pipeline.ida", "pipeline.risk", "pipeline.calibrate", "pipeline.records_report"),
+    # 6 results of one kind: the cube, IDA, risk, calibration, the records table, the exchange files (8b)
+    ("pipeline.cube", "pipeline.ida", "pipeline.risk", "pipeline.calibrate", "pipeline.records_report",
+     "pipeline.exchange"),
     # 7 stages that combine them: the sweep, the fits (which add the risk), the measure ranking
     ("pipeline.study", "pipeline.fragility", "pipeline.efficiency"),
     # 8 stages built on the sweep

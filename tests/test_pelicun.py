@@ -1,64 +1,220 @@
-"""Round trip through pelicun: our fragility_pelicun.csv loads with pelicun's own API (Assessment ->
-demand.load_sample -> asset.load_cmp_model -> damage.load_model_parameters -> damage.calculate), and
-P(DS >= k) over a demand sample agrees with our lognormals within Monte-Carlo noise.
+"""Round trip through pelicun: every component of our fragility_pelicun.csv loads and computes with pelicun's own
+API (Assessment -> demand.load_sample -> asset.load_cmp_model -> damage.load_model_parameters -> damage.calculate),
+one at a time and all together, and its P(DS >= k) matches our curves within 0.01 at every demand level.
 
 pelicun 3.10 pins scipy<1.16 and pandas<3, so it runs in its own environment (.venv-pelicun, from
 tests/consumers/pelicun.txt, built by `make consumers`): the CSV and the demand sample are written here, in the
 main environment, and tests/consumers/pelicun_damage.py computes the damage states with that environment's
-Python. `make test` requires the environment; elsewhere the test is skipped when it is not built."""
+Python. `make test` requires the environment; elsewhere those tests are skipped when it is not built.
+
+The expected P(DS >= k) is the documented way each row is written (pipeline/exchange.py): a lognormal, a step at
+the median (beta = 0), a step at the lowest level studied (below-range), or never (not reached), evaluated with
+scipy here. pelicun samples the capacities of a component's limit states perfectly correlated and reports the
+most severe state exceeded, so P(DS >= k) is the largest of our curves k..n (the curves may cross in a tail
+outside the data). The demand is held at each level over all realizations, so pelicun's Latin hypercube
+capacities give the probability to within one over the sample size: the 0.01 tolerance is not Monte-Carlo noise.
+"""
 
 from __future__ import annotations
 
+import re
 import subprocess
 
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 from scipy.stats import norm
 
-from pipeline.fragility import fragility_dataset, lognormal_cdf, pelicun_table
-from tests.helpers import CONSUMERS, consumer_python
-from tests.test_fragility import synthetic_cube
+from pipeline.exchange import RECOMMENDED_MODEL, pelicun_id, pelicun_table, write_exchange_files
+from tests.helpers import CONSUMERS, ROOT, consumer_python
 
-N_DEMANDS = 20000
+DEMAND_LEVELS = np.geomspace(0.03, 8.0, 10)
+"""PGA [g] of the demand sample: below, across and above the studied ranges, on no step of the test rows."""
+
+N_REALIZATIONS = 200
+"""Realizations per demand level: pelicun's Latin hypercube capacities resolve P to 1/200."""
+
+TOLERANCE = 0.01
+
+STATES = ["uplift", "rocking-0.2", "rocking-0.5", "overturning"]
+NAN = (np.nan, np.nan)
+ROWS = {  # (block, model): (median [g], beta, status) per damage state, every way a row can be written
+    ("b-1", "ssi"): [(0.2, 0.0, "deterministic-threshold"), (0.4, 0.35, "fitted"), (0.6, 0.4, "fitted"),
+                     (0.9, 0.45, "fitted")],
+    ("b-1", RECOMMENDED_MODEL): [(*NAN, "below-range"), (0.3, 0.5, "fitted"), (0.5, 0.45, "fitted"),
+                                 (0.8, 0.5, "fitted")],
+    ("b-1", "winkler"): [(0.1, 0.3, "fitted"), (0.45, 0.0, "separated"), (*NAN, "above-range"),
+                         (*NAN, "not-reached")],
+    ("stocky", "ssi"): [(5.0, 0.0, "deterministic-threshold"), *[(*NAN, "not-reached")] * 3],
+    ("stocky", RECOMMENDED_MODEL): [(*NAN, "not-reached")] * 4,
+    ("stocky", "winkler"): [(2.5, 0.3, "extrapolated"), (*NAN, "not-reached"), (*NAN, "not-reached"),
+                            (3.5, 0.35, "extrapolated")],  # states that do not nest (a study's own states could)
+}
+STUDIED = {"b-1": (0.05, 3.0), "stocky": (0.1, 4.0)}  # studied range of each block [g]
+SOIL_FACTOR = {"sand": 1.0, "rock": 1.2}  # rock: the fitted medians 20% higher
+
+
+def exchange_dataset() -> xr.Dataset:
+    """A fragility dataset with a row of every kind: lognormal, step, below-range, above-range, not reached
+    (as the first state, after others, between others, and in every state of a cell). The model "recommended"
+    is not first in the model coordinate; ``beta_model`` is there (the files carry it in comments only)."""
+    soils, blocks, models = list(SOIL_FACTOR), list(STUDIED), ["ssi", RECOMMENDED_MODEL, "winkler"]
+    shape = (len(soils), len(blocks), len(models), len(STATES))
+    median, beta = np.full(shape, np.nan), np.full(shape, np.nan)
+    status = np.full(shape, "", dtype=object)
+    for (s, soil), (b, block), (m, model) in ((a, c, d) for a in enumerate(soils) for c in enumerate(blocks)
+                                              for d in enumerate(models)):
+        for k, (row_median, row_beta, row_status) in enumerate(ROWS[block, model]):
+            factor = SOIL_FACTOR[soil] if row_beta > 0 else 1.0  # steps (g tan alpha) do not depend on the soil
+            median[s, b, m, k], beta[s, b, m, k], status[s, b, m, k] = row_median * factor, row_beta, row_status
+    dims = ("soil", "block", "model", "damage_state")
+    g = {"units": "9.80665 m s-2"}
+    return xr.Dataset(
+        {"median": (dims, median, g), "beta": (dims, beta), "status": (dims, status.astype(str)),
+         "beta_model": (dims, np.where(beta > 0, 0.2, np.nan)),
+         "studied_im_min": ("block", [STUDIED[b][0] for b in blocks], g),
+         "studied_im_max": ("block", [STUDIED[b][1] for b in blocks], g)},
+        coords={"soil": soils, "block": blocks, "model": models, "damage_state": STATES},
+        attrs={"intensity_measure": "pga", "intensity_unit": "9.80665 m s-2", "intensity_unit_label": "g"})
+
+
+def our_curves(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
+    """P(state k | demand) of one cell as the exchange files write it (pipeline/exchange.py): (k, demand)."""
+    curves = []
+    for state in cell.damage_state.values:
+        median, beta = float(cell["median"].sel(damage_state=state)), float(cell.beta.sel(damage_state=state))
+        status = str(cell.status.sel(damage_state=state).values)
+        if np.isfinite(median) and beta > 0:
+            curves.append(norm.cdf(np.log(demand / median) / beta))
+        elif np.isfinite(median):
+            curves.append((demand >= median).astype(float))
+        elif status == "below-range":
+            curves.append((demand >= float(cell.studied_im_min)).astype(float))
+        else:
+            curves.append(np.zeros_like(demand))
+    return np.array(curves)
+
+
+def pelicun_expected(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
+    """P(DS >= k | demand) in pelicun: the most severe state exceeded, capacities perfectly correlated: (demand, k)."""
+    curves = our_curves(cell, demand)
+    return np.maximum.accumulate(curves[::-1], axis=0)[::-1].T
+
+
+def readme_example(command: str) -> str:
+    """The Python of the README's example run by ``command`` (a shell block ``COMMAND - <<'EOF' ... EOF``)."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    found = re.findall(rf"^{re.escape(command)} - <<'EOF'\n(.*?)^EOF$", readme, flags=re.MULTILINE | re.DOTALL)
+    assert len(found) == 1, f"the README has {len(found)} examples run by {command}"
+    return found[0]
+
+
+def run_pelicun(folder, alone: bool = False, example: str | None = None) -> tuple[dict[str, np.ndarray], str]:
+    """Write the demand sample into ``folder`` (beside fragility_pelicun.csv) and run the consumer script: every
+    component in one assessment (``together``) and, if ``alone``, each in its own (``alone``); then, in the
+    same process, the Python ``example`` in ``folder``'s parent. The results and what the process printed."""
+    python = consumer_python("pelicun")
+    columns = [f"1-PGA-1-{d}" for d in range(1, DEMAND_LEVELS.size + 1)]  # event-type-location-direction
+    with open(folder / "demand.csv", "w") as handle:  # pelicun's sample layout: a Units row under the header
+        handle.write("," + ",".join(columns) + "\nUnits," + ",".join(["g"] * len(columns)) + "\n")
+        pd.DataFrame(np.tile(DEMAND_LEVELS, (N_REALIZATIONS, 1))).to_csv(handle, header=False)
+    options = ["--alone"] * alone
+    if example is not None:
+        (folder.parent / "example.py").write_text(example)
+        options += ["--example", str(folder.parent / "example.py")]
+    result = subprocess.run([str(python), str(CONSUMERS / "pelicun_damage.py"), str(folder), *options],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    with np.load(folder / "exceedance.npz") as data:
+        return {name: data[name] for name in data.files}, result.stdout
+
+
+def check_against_our_curves(dataset: xr.Dataset, table: pd.DataFrame, computed: dict[str, np.ndarray]) -> None:
+    cells = {pelicun_id(b, s, m): (s, b, m) for s in dataset.soil.values for b in dataset.block.values
+             for m in dataset.model.values}
+    for way in computed:
+        assert computed[way].shape == (len(table), DEMAND_LEVELS.size, len(dataset.damage_state))
+        for index, component in enumerate(table.ID):
+            soil, block, model = cells[component]
+            expected = pelicun_expected(dataset.sel(soil=soil, block=block, model=model), DEMAND_LEVELS)
+            error = np.abs(computed[way][index] - expected)
+            assert error.max() <= TOLERANCE, (way, component, error.max(), computed[way][index], expected)
+
+
+def written(folder) -> tuple[xr.Dataset, pd.DataFrame]:
+    dataset = exchange_dataset()
+    write_exchange_files(dataset, folder)
+    return dataset, pd.read_csv(folder / "fragility_pelicun.csv")
 
 
 @pytest.fixture(scope="module")
 def round_trip(tmp_path_factory):
-    python = consumer_python("pelicun")
-    folder = tmp_path_factory.mktemp("pelicun")
-    fragility = fragility_dataset(synthetic_cube(n_records=200), n_bootstrap=0)
-    pelicun_table(fragility).to_csv(folder / "fragility_pelicun.csv", index=False)
-    rng = np.random.default_rng(0)
-    pga = np.exp(rng.uniform(np.log(0.05), np.log(3.0), N_DEMANDS))
-    demand = pd.DataFrame({"1-PGA-1-1": pga})
-    with open(folder / "demand.csv", "w") as handle:  # pelicun's sample layout: a Units row under the header
-        handle.write(",1-PGA-1-1\nUnits,g\n")
-        demand.to_csv(handle, header=False)
-    result = subprocess.run([str(python), str(CONSUMERS / "pelicun_damage.py"), str(folder)], capture_output=True,
-                            text=True, timeout=300)
-    assert result.returncode == 0, result.stderr[-3000:]
-    damage_state = np.load(folder / "damage_state.npy")
-    assert damage_state.shape == (N_DEMANDS,)
-    return fragility.isel(soil=0, block=0, model=0), pga, damage_state
+    """pelicun on the test dataset's file, written where the README's example reads it; the example too."""
+    folder = tmp_path_factory.mktemp("pelicun") / "reports-example"
+    dataset, table = written(folder)
+    computed, printed = run_pelicun(folder, example=readme_example(".venv-pelicun/bin/python"))
+    return dataset, table, computed, printed
 
 
-def test_pelicun_damage_states_match_our_lognormals(round_trip):
-    cell, pga, damage_state = round_trip
-    for k, state in enumerate(cell.damage_state.values, start=1):
-        median, beta = float(cell["median"].sel(damage_state=state)), float(cell.beta.sel(damage_state=state))
-        expected = lognormal_cdf(pga, median, beta).mean()
-        observed = np.mean(damage_state >= k)
-        noise = np.sqrt(expected * (1 - expected) / pga.size)
-        assert observed == pytest.approx(expected, abs=4 * noise + 1e-3), state
+def test_every_row_is_written_as_documented():
+    """The table itself (no pelicun needed): each kind of row in pelicun's terms."""
+    table = pelicun_table(exchange_dataset()).set_index("ID")
+    assert (table.Incomplete == 0).all()  # every component computes: none is skipped by pelicun
+    models = [component.rsplit(".", 1)[1] for component in table.index]
+    assert models[:4] == [RECOMMENDED_MODEL] * 4 and RECOMMENDED_MODEL not in models[4:]  # recommended first
+    below = table.loc["ROCK.b_1.sand.recommended"]
+    assert (below["LS1-Family"], below["LS1-Theta_0"]) == ("deterministic", 0.05)  # reached from the lowest level
+    assert below["LS2-Family"] == "lognormal" and below["LS2-Theta_1"] == 0.5  # beta is the total, not beta_model
+    assert "beta_model 0.2" in below["Comment"] and "below-range" in below["Comment"]
+    nothing = table.loc["ROCK.stocky.sand.recommended"]
+    assert (nothing["LS1-Family"], nothing["LS1-Theta_0"]) == ("deterministic", np.inf)  # pelicun needs LS1
+    assert all(pd.isna(nothing[f"LS{k}-Theta_0"]) and not nothing[f"LS{k}-Family"] for k in (2, 3, 4))
+    trailing = table.loc["ROCK.b_1.rock.winkler"]
+    assert trailing["LS2-Family"] == "deterministic" and trailing["LS2-Theta_0"] == 0.45  # separated: the step
+    assert pd.isna(trailing["LS3-Theta_0"]) and pd.isna(trailing["LS4-Theta_0"])  # left out
+    assert "LS4 overturning: not-reached, left out" in trailing["Comment"]
+    middle = table.loc["ROCK.stocky.sand.winkler"]  # a state left out before a written one would renumber pelicun's
+    assert [middle[f"LS{k}-Theta_0"] for k in (2, 3)] == [np.inf, np.inf]  # damage states: never reached instead
 
 
-def test_directional_demand_is_not_scaled_by_pelicun(round_trip):
-    """With Demand-Directional = 0 pelicun would multiply PGA by 1.2: P(DS) some points too high."""
-    cell, pga, damage_state = round_trip
-    median = float(cell["median"].sel(damage_state="overturning"))
-    beta = float(cell.beta.sel(damage_state="overturning"))
-    scaled = norm.cdf(np.log(1.2 * pga / median) / beta).mean()
-    unscaled = norm.cdf(np.log(pga / median) / beta).mean()
-    observed = np.mean(damage_state >= 4)
-    assert abs(observed - unscaled) < abs(observed - scaled) / 4
+def test_every_component_loads_and_matches_our_curves_together(round_trip):
+    dataset, table, computed, _ = round_trip
+    assert len(table) == dataset.soil.size * dataset.block.size * dataset.model.size
+    check_against_our_curves(dataset, table, computed)
+
+
+@pytest.mark.slow
+def test_every_component_loads_and_matches_our_curves_alone(tmp_path):
+    """One assessment per component (a file of one row must load too): about 8 s of pelicun."""
+    dataset, table = written(tmp_path)
+    computed, _ = run_pelicun(tmp_path, alone=True)
+    assert set(computed) == {"alone", "together"}
+    check_against_our_curves(dataset, table, computed)
+
+
+def test_the_tolerance_would_catch_pelicuns_directional_factor(round_trip):
+    """With Demand-Directional = 0 pelicun would multiply PGA by 1.2; the comparison above would fail."""
+    dataset, table, computed, _ = round_trip
+    cell = dataset.sel(soil="sand", block="b-1", model="ssi")
+    shift = np.abs(pelicun_expected(cell, 1.2 * DEMAND_LEVELS) - pelicun_expected(cell, DEMAND_LEVELS)).max()
+    assert shift > 5 * TOLERANCE
+    index = list(table.ID).index("ROCK.b_1.sand.ssi")
+    assert np.abs(computed["together"][index] - pelicun_expected(cell, DEMAND_LEVELS)).max() < TOLERANCE
+
+
+def test_the_readme_example_runs_as_printed(round_trip):
+    """The README's pelicun example, on the file of the test dataset: a damage-state table of every component."""
+    _, table, _, printed = round_trip
+    assert printed.splitlines()[0].split() == ["ds", "0", "1", "2", "3", "4"]
+    assert all(component in printed for component in table.ID)
+
+
+@pytest.mark.slow
+def test_a_studys_file_loads_and_matches_in_pelicun(small_pipeline, tmp_path):
+    """The file ``rockfrag fragility`` wrote for the small study: every component, in one assessment (the
+    session's pipeline run; about 4 s for pelicun once it has run)."""
+    dataset = xr.open_dataset(small_pipeline.output / "fragility.nc")
+    table = pd.read_csv(small_pipeline.output / "fragility_pelicun.csv")
+    (tmp_path / "fragility_pelicun.csv").write_bytes((small_pipeline.output / "fragility_pelicun.csv").read_bytes())
+    check_against_our_curves(dataset, table, run_pelicun(tmp_path)[0])

@@ -31,6 +31,9 @@ from pipeline.errors import SolverError
 from pipeline.models.restitution import calibrate_dissipation, calibrated_law, reachable_range, restitution_target
 from pipeline.units import STANDARD_GRAVITY
 
+RECOMMENDED = "recommended"
+"""The model name of the recommended curves the fragility stage combines from a band's variants
+(pipeline.fragility.with_recommended); every output that carries them uses this name."""
 BAND_ROLES = {"low": 0.0, "centre": 0.5, "high": 1.0}
 """A variant's position in the band, from the low edge (Housner's value) to the high edge."""
 BAND_LABELS = {"low": "band low edge", "centre": "band centre", "high": "band high edge"}

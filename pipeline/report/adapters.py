@@ -17,11 +17,11 @@ import pandas as pd
 
 from pipeline.damage_states import DAMAGE_STATES
 from pipeline.errors import SolverError
-from pipeline.fragility import RECOMMENDED
 from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
 from pipeline.measures import short_label as measure_short_label
 from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
+from pipeline.models.variants import RECOMMENDED
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
 
 OUTCOME_ROCKING, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = int(Outcome.ROCKING), int(Outcome.FAILED), \

@@ -1,0 +1,210 @@
+"""Round trip through OpenQuake: our fragility_openquake.xml reads with OpenQuake's own NRML reader (the engine's
+``nrml.to_python`` with risklib's fragility-model reader), every function with our medians and betas, the
+study's IMT and our curves wherever OpenQuake evaluates them; and risklib's classical damage on a hazard curve
+gives our probability of each damage state in the design life (pipeline/risk.py).
+
+OpenQuake's engine declares a server and GIS stack (Django, GDAL) that its NRML reader does not import, so it
+runs in its own environment (.venv-openquake, from tests/consumers/openquake.no-deps.txt and openquake.txt,
+built by `make consumers`): the file is written here, in the main environment, and
+tests/consumers/openquake_fragility.py reads it with that environment's Python. `make test` requires the
+environment; elsewhere these tests are skipped when it is not built. Importing OpenQuake's reader takes about
+8 s of CPU (it imports every ground-motion model), so the tests are `slow` and share one consumer run, which also
+reads the file of the session's small pipeline run.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import xml.etree.ElementTree as ElementTree
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from pipeline.errors import ConfigError
+from pipeline.exchange import (
+    OPENQUAKE_FILE,
+    RECOMMENDED_MODEL,
+    openquake_imt,
+    openquake_limit_state,
+    pelicun_id,
+    write_exchange_files,
+)
+from pipeline.hazard import HazardCurve
+from pipeline.risk import annual_frequency, probability_in_life
+from tests.helpers import CONSUMERS, consumer_python
+from tests.test_pelicun import exchange_dataset, our_curves, readme_example
+
+LEVELS = np.geomspace(0.001, 100.0, 61)
+"""PGA [g] at which OpenQuake evaluates every function: far below and above every studied range."""
+
+DESIGN_LIFE = 50.0
+HAZARD_IMLS = np.geomspace(0.001, 200.0, 600)
+HAZARD_RATES = 1e-4 * HAZARD_IMLS ** -2.5
+"""The example site's power-law hazard (pipeline/hazard_example.csv: 1e-4 /yr at 1 g, slope 2.5) on a dense grid
+that reaches far beyond every curve: risklib sums occurrences between the hazard's levels only (it drops the rate
+above the highest), our integral continues the power law."""
+
+
+def run_openquake(*folders, example: str | None = None) -> tuple[list[dict], str]:
+    """Run the consumer script on each folder's fragility_openquake.xml (one OpenQuake import, about 8 s of CPU)
+    and then the Python ``example`` in the first folder's parent: what OpenQuake read and computed, per folder,
+    and what the process printed."""
+    python = consumer_python("openquake")
+    poes = -np.expm1(-HAZARD_RATES * DESIGN_LIFE)  # an OpenQuake hazard curve: P(exceedance in the time)
+    query = {"levels": LEVELS.tolist(), "hazard": {"imls": HAZARD_IMLS.tolist(), "poes": poes.tolist(),
+                                                   "investigation_time": DESIGN_LIFE,
+                                                   "risk_investigation_time": DESIGN_LIFE}}
+    for folder in folders:
+        (folder / "query.json").write_text(json.dumps(query))
+    options = []
+    if example is not None:
+        (folders[0].parent / "example.py").write_text(example)
+        options = ["--example", str(folders[0].parent / "example.py")]
+    result = subprocess.run([str(python), str(CONSUMERS / "openquake_fragility.py"), *map(str, folders), *options],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    return [json.loads((folder / "openquake.json").read_text()) for folder in folders], result.stdout
+
+
+def near_a_step(cell: xr.Dataset, levels: np.ndarray) -> np.ndarray:
+    """Levels within 2% of a step of the cell (written as a lognormal with beta 0.001 in OpenQuake's file)."""
+    steps = [float(m) for m, b in zip(cell["median"].values, cell.beta.values) if np.isfinite(m) and b == 0]
+    steps += [float(cell.studied_im_min)] if "below-range" in cell.status.values else []
+    return np.array([any(abs(np.log(level / step)) < 0.02 for step in steps) for level in levels], bool)
+
+
+def check_functions(dataset: xr.Dataset, read: dict) -> None:
+    """Every cell has its function, with our limit states, IMT, medians, betas and curves."""
+    assert read["limitStates"] == [openquake_limit_state(s) for s in dataset.damage_state.values]
+    cells = {pelicun_id(b, s, m): (s, b, m) for s in dataset.soil.values for b in dataset.block.values
+             for m in dataset.model.values}
+    ids = [function["id"] for function in read["functions"]]
+    assert sorted(ids) == sorted(cells)  # one function per block x soil x model
+    models = [cells[i][2] for i in ids]
+    first = models.count(RECOMMENDED_MODEL)
+    assert models[:first] == [RECOMMENDED_MODEL] * first  # the recommended rows come first
+    for function in read["functions"]:
+        soil, block, model = cells[function["id"]]
+        cell = dataset.sel(soil=soil, block=block, model=model)
+        assert function["imt"] == "PGA" and function["format"] == "continuous"
+        assert function["minIML"] <= float(cell.studied_im_min) and function["maxIML"] >= float(cell.studied_im_max)
+        mean, stddev = np.array(function["mean"]), np.array(function["stddev"])
+        beta = np.sqrt(np.log1p((stddev / mean) ** 2))  # OpenQuake's mean and stddev of the intensity -> lognormal
+        median = mean / np.sqrt(1 + (stddev / mean) ** 2)
+        fitted = np.isfinite(cell["median"].values) & (cell.beta.values > 0)
+        np.testing.assert_allclose(median[fitted], cell["median"].values[fitted], rtol=1e-8)
+        np.testing.assert_allclose(beta[fitted], cell.beta.values[fitted], rtol=1e-8)
+        away = ~near_a_step(cell, LEVELS)
+        np.testing.assert_allclose(np.array(function["poes"])[:, away], our_curves(cell, LEVELS)[:, away], atol=1e-6,
+                                   err_msg=function["id"])
+
+
+@pytest.fixture(scope="module")
+def round_trip(tmp_path_factory, small_pipeline):
+    """What OpenQuake reads from our file for the test dataset (every kind of row) and from the file
+    ``rockfrag fragility`` wrote for the session's small study: one consumer run for both."""
+    synthetic = tmp_path_factory.mktemp("openquake") / "reports-example"  # where the README's example reads
+    study = tmp_path_factory.mktemp("openquake-study")
+    dataset = exchange_dataset()
+    assert synthetic / OPENQUAKE_FILE in write_exchange_files(dataset, synthetic)
+    (study / OPENQUAKE_FILE).write_bytes((small_pipeline.output / OPENQUAKE_FILE).read_bytes())
+    example = readme_example("NUMBA_DISABLE_JIT=1 .venv-openquake/bin/python")
+    (read, read_study), printed = run_openquake(synthetic, study, example=example)
+    return dataset, read, xr.open_dataset(small_pipeline.output / "fragility.nc"), read_study, printed
+
+
+@pytest.mark.slow
+def test_every_function_reads_with_our_medians_betas_and_curves(round_trip):
+    dataset, read, _, _, _ = round_trip
+    assert (read["id"], read["lossCategory"]) == ("rockfrag", "structural")
+    check_functions(dataset, read)
+
+
+@pytest.mark.slow
+def test_risklib_classical_damage_gives_our_probability_in_the_design_life(round_trip):
+    """On the same hazard curve, every lognormal row within 0.1% of pipeline/risk.py (measured: 0.04%), and every
+    step within the hazard's resolution: risklib sums the occurrences at the hazard's levels, so it places a step
+    at one of the two levels around it, whose rates differ by 5% on this grid (measured: 1.6%)."""
+    dataset, read, _, _, _ = round_trip
+    hazard = HazardCurve(HAZARD_IMLS, HAZARD_RATES, "pga", None, "test power law")
+    compared = 0
+    for function in read["functions"]:
+        soil, block, model = (part for part in function["id"].split(".")[1:])
+        cell = next(dataset.sel(soil=s, block=b, model=m) for s in dataset.soil.values for b in dataset.block.values
+                    for m in dataset.model.values if pelicun_id(b, s, m) == function["id"])
+        for k, state in enumerate(cell.damage_state.values):
+            median, beta = float(cell["median"].sel(damage_state=state)), float(cell.beta.sel(damage_state=state))
+            if not np.isfinite(median):
+                continue
+            ours = float(probability_in_life(annual_frequency(median, beta, hazard), DESIGN_LIFE))
+            tolerance = 0.001 if beta > 0 else HAZARD_RATES[0] / HAZARD_RATES[1] - 1
+            assert function["in_life"][k] == pytest.approx(ours, rel=tolerance), (function["id"], state)
+            compared += 1
+    assert compared >= 20
+
+
+@pytest.mark.slow
+def test_a_studys_file_reads_in_openquake(round_trip):
+    """Every function of the file ``rockfrag fragility`` wrote for the small study."""
+    _, _, dataset, read, _ = round_trip
+    check_functions(dataset, read)
+
+
+@pytest.mark.slow
+def test_the_readme_example_runs_as_printed(round_trip):
+    """The README's OpenQuake example, on the file of the test dataset: the limit states, then every function."""
+    _, read, _, _, printed = round_trip
+    lines = printed.splitlines()
+    assert lines[0] == "structural ['uplift', 'rocking-0_2', 'rocking-0_5', 'overturning']"
+    assert [line.split()[0] for line in lines[1:]] == [function["id"] for function in read["functions"]]
+
+
+# ---------------------------------------------------------------- the writer alone (no OpenQuake needed)
+
+@pytest.mark.parametrize("measure, period, imt", [
+    ("pga", None, "PGA"), ("pga", 1.0, "PGA"), ("sa", 1.0, "SA(1.0)"), ("sa", 0.3, "SA(0.3)"), ("sa", 2, "SA(2.0)"),
+    ("sa", None, None), ("pgv", None, "PGV"), ("avgsa", 1.0, None), ("pga_ratio", None, None),
+])
+def test_the_imt_comes_from_the_measure_registry(measure, period, imt):
+    assert openquake_imt(measure, period) == imt
+
+
+def test_pgv_is_written_in_centimetres_per_second(tmp_path):
+    """OpenQuake's PGV is in cm/s: a median of 0.3 m/s is written as 30 (the mean and stddev of a lognormal)."""
+    dataset = exchange_dataset().assign_attrs(intensity_measure="pgv", intensity_unit="m s-1",
+                                              intensity_unit_label="m/s")
+    write_exchange_files(dataset, tmp_path)
+    namespace = {"nrml": "http://openquake.org/xmlns/nrml/0.5"}
+    root = ElementTree.parse(tmp_path / OPENQUAKE_FILE).getroot()
+    function = root.find(".//nrml:fragilityFunction[@id='ROCK.b_1.sand.recommended']", namespace)
+    assert function.find("nrml:imls", namespace).get("imt") == "PGV"
+    params = function.findall("nrml:params", namespace)[1]  # rocking-0.2: median 0.3 m/s, beta 0.5
+    mean, stddev = float(params.get("mean")), float(params.get("stddev"))
+    assert mean / np.sqrt(1 + (stddev / mean) ** 2) == pytest.approx(30.0, rel=1e-9)
+
+
+def test_no_openquake_file_for_a_measure_openquake_does_not_have(tmp_path):
+    (tmp_path / OPENQUAKE_FILE).write_text("an older run's file")
+    written = write_exchange_files(exchange_dataset().assign_attrs(intensity_measure="avgsa"), tmp_path, 1.0)
+    assert written == [tmp_path / "fragility_pelicun.csv"] and not (tmp_path / OPENQUAKE_FILE).exists()
+
+
+def test_damage_states_that_clash_as_openquake_limit_states_are_refused(tmp_path):
+    dataset = exchange_dataset().assign_coords(damage_state=["uplift", "rocking-0.2", "rocking-0_2", "overturning"])
+    with pytest.raises(ConfigError, match="rocking-0_2"):
+        write_exchange_files(dataset, tmp_path)
+
+
+def test_ids_that_clash_are_refused_and_the_comments_carry_the_dispersion_parts(tmp_path):
+    """'b-1' and 'b_1' give the same component ID: a ConfigError names both. beta_model is in the comments only."""
+    with pytest.raises(ConfigError, match="same component ID ROCK.b_1.sand.recommended"):
+        write_exchange_files(exchange_dataset().assign_coords(block=["b-1", "b_1"]), tmp_path)
+    write_exchange_files(exchange_dataset(), tmp_path)
+    text = (tmp_path / OPENQUAKE_FILE).read_text()
+    start = text.index("<!-- ROCK.b_1.sand.recommended")
+    comment = text[start:text.index("-->", start)]
+    assert "studied range 0.05-3 g" in comment and "beta is the total; beta_model 0.2" in comment
+    params = ElementTree.parse(tmp_path / OPENQUAKE_FILE).getroot().iter("{http://openquake.org/xmlns/nrml/0.5}params")
+    assert {tuple(sorted(element.attrib)) for element in params} == {("ls", "mean", "stddev")}
