@@ -25,13 +25,13 @@ import xarray as xr
 from pipeline.errors import ConfigError
 from pipeline.exchange import (
     OPENQUAKE_FILE,
-    RECOMMENDED_MODEL,
     openquake_imt,
     openquake_limit_state,
     pelicun_id,
     write_exchange_files,
 )
 from pipeline.hazard import HazardCurve
+from pipeline.models.variants import RECOMMENDED
 from pipeline.risk import annual_frequency, probability_in_life
 from tests.helpers import CONSUMERS, consumer_python
 from tests.test_pelicun import exchange_dataset, our_curves, readme_example
@@ -83,8 +83,8 @@ def check_functions(dataset: xr.Dataset, read: dict) -> None:
     ids = [function["id"] for function in read["functions"]]
     assert sorted(ids) == sorted(cells)  # one function per block x soil x model
     models = [cells[i][2] for i in ids]
-    first = models.count(RECOMMENDED_MODEL)
-    assert models[:first] == [RECOMMENDED_MODEL] * first  # the recommended rows come first
+    first = models.count(RECOMMENDED)
+    assert models[:first] == [RECOMMENDED] * first  # the recommended rows come first
     for function in read["functions"]:
         soil, block, model = cells[function["id"]]
         cell = dataset.sel(soil=soil, block=block, model=model)

@@ -26,7 +26,8 @@ import pytest
 import xarray as xr
 from scipy.stats import norm
 
-from pipeline.exchange import RECOMMENDED_MODEL, pelicun_id, pelicun_table, write_exchange_files
+from pipeline.exchange import pelicun_id, pelicun_table, write_exchange_files
+from pipeline.models.variants import RECOMMENDED
 from tests.helpers import CONSUMERS, ROOT, consumer_python
 
 DEMAND_LEVELS = np.geomspace(0.03, 8.0, 10)
@@ -42,12 +43,12 @@ NAN = (np.nan, np.nan)
 ROWS = {  # (block, model): (median [g], beta, status) per damage state, every way a row can be written
     ("b-1", "ssi"): [(0.2, 0.0, "deterministic-threshold"), (0.4, 0.35, "fitted"), (0.6, 0.4, "fitted"),
                      (0.9, 0.45, "fitted")],
-    ("b-1", RECOMMENDED_MODEL): [(*NAN, "below-range"), (0.3, 0.5, "fitted"), (0.5, 0.45, "fitted"),
+    ("b-1", RECOMMENDED): [(*NAN, "below-range"), (0.3, 0.5, "fitted"), (0.5, 0.45, "fitted"),
                                  (0.8, 0.5, "fitted")],
     ("b-1", "winkler"): [(0.1, 0.3, "fitted"), (0.45, 0.0, "separated"), (*NAN, "above-range"),
                          (*NAN, "not-reached")],
     ("stocky", "ssi"): [(5.0, 0.0, "deterministic-threshold"), *[(*NAN, "not-reached")] * 3],
-    ("stocky", RECOMMENDED_MODEL): [(*NAN, "not-reached")] * 4,
+    ("stocky", RECOMMENDED): [(*NAN, "not-reached")] * 4,
     ("stocky", "winkler"): [(2.5, 0.3, "extrapolated"), (*NAN, "not-reached"), (*NAN, "not-reached"),
                             (3.5, 0.35, "extrapolated")],  # states that do not nest (a study's own states could)
 }
@@ -59,7 +60,7 @@ def exchange_dataset() -> xr.Dataset:
     """A fragility dataset with a row of every kind: lognormal, step, below-range, above-range, not reached
     (as the first state, after others, between others, and in every state of a cell). The model "recommended"
     is not first in the model coordinate; ``beta_model`` is there (the files carry it in comments only)."""
-    soils, blocks, models = list(SOIL_FACTOR), list(STUDIED), ["ssi", RECOMMENDED_MODEL, "winkler"]
+    soils, blocks, models = list(SOIL_FACTOR), list(STUDIED), ["ssi", RECOMMENDED, "winkler"]
     shape = (len(soils), len(blocks), len(models), len(STATES))
     median, beta = np.full(shape, np.nan), np.full(shape, np.nan)
     status = np.full(shape, "", dtype=object)
@@ -162,7 +163,7 @@ def test_every_row_is_written_as_documented():
     table = pelicun_table(exchange_dataset()).set_index("ID")
     assert (table.Incomplete == 0).all()  # every component computes: none is skipped by pelicun
     models = [component.rsplit(".", 1)[1] for component in table.index]
-    assert models[:4] == [RECOMMENDED_MODEL] * 4 and RECOMMENDED_MODEL not in models[4:]  # recommended first
+    assert models[:4] == [RECOMMENDED] * 4 and RECOMMENDED not in models[4:]  # recommended first
     below = table.loc["ROCK.b_1.sand.recommended"]
     assert (below["LS1-Family"], below["LS1-Theta_0"]) == ("deterministic", 0.05)  # reached from the lowest level
     assert below["LS2-Family"] == "lognormal" and below["LS2-Theta_1"] == 0.5  # beta is the total, not beta_model
