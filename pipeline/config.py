@@ -38,7 +38,7 @@ from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
 from pipeline.models.options import HOUSNER
 from pipeline.models.variants import DEFAULT_BAND, band_variants
 from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
-from pipeline.soils import SOIL_RANGES, SOILS, SoilClass
+from pipeline.soils import DEFAULT_FRICTION, SOIL_RANGES, SOILS, SoilClass
 from pipeline.validation import (
     Checked,
     Either,
@@ -58,6 +58,9 @@ from pipeline.validation import shown as _shown
 BAND = "band"
 """``[solver] restitution = "band"``: each bed model runs at the edges and centre of ``restitution_band``
 (pipeline.models.variants)."""
+
+FRICTION_MODES = ("where-it-matters", "all", "none")
+"""``[solver] friction``: which housner and winkler cells slide (pipeline.study.cell_friction)."""
 
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
@@ -118,7 +121,8 @@ SCHEMA = Table({
                       "bed": Text(tuple(BED_TYPES)),
                       "restitution": Checked(lambda value, field, source: _restitution(value, field, source),
                                              f"{BAND!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
-                      "restitution_band": Interval(Number(0.5, 1.5), strict=False)}),
+                      "restitution_band": Interval(Number(0.5, 1.5), strict=False),
+                      "friction": Text(FRICTION_MODES)}),
     "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years"),
                       "return_periods": Numbers(Number(1.0, 1e6, unit="years")),  # the report's answer pages
                       "site": Checked(check_site, "[lon, lat] in degrees, lon >= -180 and < 360, lat -90 to 90")}),
@@ -130,7 +134,7 @@ SCHEMA = Table({
                          "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
     "checks": _table({"plausibility": Text(ON_IMPLAUSIBLE)}),
     "report": _table({"title": TEXT, "project": TEXT, "author": TEXT, "showcase_record": TEXT,
-                      "showcase_block": TEXT, "friction_coefficient": Number(0, 10, low_open=True),
+                      "showcase_block": TEXT,
                       "block_names": Checked(lambda value, field, source: _named(value, field, source, TEXT),
                                              "a table of block = the name the report gives it")}),
     "applicability": _table({
@@ -159,8 +163,19 @@ def _named(value, field, source, item):
     return {name: item.check(entry, f"{field}.{name}", source) for name, entry in value.items()}
 
 
+REMOVED_KEYS = {
+    ("report", "friction_coefficient"): "removed: the base friction is per soil now, friction_static and "
+    "friction_kinetic of each soil class (pipeline/soils.py; a [soils_custom.NAME] table may set them), and "
+    "[solver] friction says which runs slide",
+}
+"""Keys a study file may no longer hold, with what replaces them."""
+
+
 def validate(data: dict, source: str) -> None:
     """Check keys, TOML types and ranges of a (possibly partial) study dict, as the user wrote it."""
+    for (table, key), reason in REMOVED_KEYS.items():
+        if isinstance(data.get(table), dict) and key in data[table]:
+            raise ConfigError(f"{table}.{key}", reason, source)
     SCHEMA.check(data, "", source)
     blocks = data.get("blocks")
     for table, tables in (("blocks", blocks if isinstance(blocks, dict) else {}),
@@ -220,6 +235,10 @@ class StudyConfig:
         the bed's damping ratio is the soil's ``damping_ratio``).
     restitution_band : (float, float)
         The band's edges as multiples of Housner's restitution (each capped at 0.99).
+    friction : str
+        ``[solver] friction``, which housner and winkler cells run with Coulomb friction at the base (each
+        soil's ``friction_static``/``friction_kinetic``): "where-it-matters" (where the soil's mu_s is below the
+        block's b/h), "all" or "none" (every base tied). ssi is always tied (pipeline.study.cell_friction).
     tail : float
         Free vibration simulated after the record [s].
     overturn_angle : float
@@ -285,6 +304,7 @@ class StudyConfig:
     hazard_site: tuple[float, float] | None = None  # [lon, lat] [degrees]; picks a multi-site file's nearest site
     restitution: str | float = ""  # bed models' restitution target: "band", "housner", a number, "" (none)
     restitution_band: tuple[float, float] = DEFAULT_BAND  # edges as multiples of Housner's r
+    friction: str = "where-it-matters"  # which cells slide: where-it-matters | all | none
 
     @property
     def calibrates_bed(self) -> bool:
@@ -406,7 +426,8 @@ def _soil(name, data, source) -> SoilClass:
     try:
         return SoilClass(name, float(data["shear_modulus"]), float(data.get("poisson_ratio", 0.3)),
                          float(data.get("density", 2000.0)), float(data.get("damping_ratio", 0.05)),
-                         data.get("why", "user soil"))
+                         data.get("why", "user soil"), float(data.get("friction_static", DEFAULT_FRICTION[0])),
+                         float(data.get("friction_kinetic", DEFAULT_FRICTION[1])))
     except KeyError:
         raise ConfigError(f"soils_custom.{name}.shear_modulus", "missing; must be a number > 0 [Pa]",
                           source) from None
@@ -502,6 +523,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         soils=soils, blocks=blocks, models=models,
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
         restitution=restitution, restitution_band=tuple(solver.get("restitution_band", DEFAULT_BAND)),
+        friction=solver.get("friction", "where-it-matters"),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
         hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)), hazard_site=site,
         bootstrap=int(fragility.get("bootstrap", 100)), seed=int(fragility.get("seed", 0)),

@@ -28,7 +28,7 @@ from pipeline import __version__
 from pipeline.measures import MEASURES, file_units, parse_units
 from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
-from pipeline.models.fields import FIELDS_BY_NAME
+from pipeline.models.fields import FIELDS_BY_NAME, MODE_TIME_FIELDS
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
 OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = (
@@ -79,9 +79,22 @@ VARIABLES = {
     "time_of_free_flight": ("time_of_free_flight", _always),
 }
 
+SLIP_VARIABLES = ("peak_slip", "residual_slip", *MODE_TIME_FIELDS)
+"""Cube variables of the base's slip and the time in each contact mode [m, s]: finite only in the cells that
+run with friction (``friction_static`` finite), NaN where the base is tied (pipeline.study.cell_friction)."""
+FRICTION_VARIABLES = {
+    "friction_static": "static friction coefficient mu_s of the base in the cell's runs (NaN: the base is tied, "
+                       "no sliding)",
+    "friction_kinetic": "kinetic friction coefficient mu_k of the base in the cell's runs (NaN: the base is tied)",
+}
 
-def summaries_to_variables(summaries, blocks, model_names):
-    """Turn summary records (record, level, soil, block, model) into named arrays (NaN where not applicable)."""
+
+def summaries_to_variables(summaries, blocks, model_names, friction=None):
+    """Turn summary records (record, level, soil, block, model) into named arrays (NaN where not applicable).
+
+    ``friction`` (2, soil, block, model): each cell's (mu_s, mu_k), NaN where tied (None: every base tied); the
+    ``SLIP_VARIABLES`` are NaN in the tied cells.
+    """
     models = [get_model(name) for name in model_names]
     mass = np.array([b.mass for b in blocks])[None, None, None, :, None]
     alpha = np.array([b.alpha for b in blocks])[None, None, None, :, None]
@@ -90,6 +103,9 @@ def summaries_to_variables(summaries, blocks, model_names):
         mask = np.array([applies(model) for model in models])[None, None, None, None, :]
         values = summaries[field] * mass if FIELDS_BY_NAME[field].per_mass else summaries[field]
         out[name] = np.where(mask, values, np.nan)
+    sliding = np.zeros(summaries.shape[2:], bool) if friction is None else np.isfinite(friction[0])
+    for name in SLIP_VARIABLES:
+        out[name] = np.where(sliding[None, None], summaries[name], np.nan)
     out["outcome"] = np.nan_to_num(summaries["status"], nan=int(Outcome.FAILED)).astype(np.int8)
     out["peak_angle_ratio"] = out["peak_angle"] / alpha
     pulls = np.array([model.can_pull for model in models])[None, None, None, None, :]
@@ -111,7 +127,7 @@ DERIVED_ATTRIBUTES = {
 
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
                intensity=None, capacities=None, capacity_stats=None, verticals=None,
-               vertical_applied=False, calibration=None) -> xr.Dataset:
+               vertical_applied=False, calibration=None, friction=None) -> xr.Dataset:
     """Assemble the labelled cube.
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
@@ -123,7 +139,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     (pipeline.study.gather_capacities) or None; capacity_stats : its run accounting; verticals : the
     processed vertical component of each record (a Record, or None where it has none), or None when the
     study takes no verticals; vertical_applied : whether the runs applied those verticals (the cube's
-    ``vertical_applied`` flag per record, and its ``vertical`` attribute).
+    ``vertical_applied`` flag per record, and its ``vertical`` attribute); friction : (2, n_soil, n_block,
+    n_model) each cell's base friction (mu_s, mu_k) [-], NaN where tied (pipeline.study.friction_grid; None:
+    every base tied): the cube's ``friction_static``/``friction_kinetic`` and where ``SLIP_VARIABLES`` apply.
 
     Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
     with ``levels.relative_to = "uplift"``, else the levels in the measure's display unit. The physical
@@ -133,7 +151,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     """
     model_names = list(config.models)
     n_block = len(config.blocks)
-    values = summaries_to_variables(summaries, config.blocks, model_names)
+    if friction is None:
+        friction = np.full((2, len(config.soils), n_block, len(model_names)), np.nan)
+    values = summaries_to_variables(summaries, config.blocks, model_names, friction)
     measure = MEASURES[config.measure]
     acceleration_units = file_units("m/s^2")
     g_factor = parse_units(acceleration_units)[0]  # SI value of one unit of acceleration_units
@@ -152,7 +172,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         if name in DERIVED_ATTRIBUTES:
             data_vars[name] = (DIMS, array, dict(DERIVED_ATTRIBUTES[name]))
         else:
-            field = FIELDS_BY_NAME[VARIABLES[name][0]]
+            field = FIELDS_BY_NAME[VARIABLES[name][0] if name in VARIABLES else name]
             data_vars[name] = (DIMS, array, {"long_name": field.long_name, "units": field.units})
     data_vars["scale_factor"] = (("record", "im_level", "block"), scale_factors,
                                  {"long_name": "factor applied to the processed record", "units": "1"})
@@ -171,6 +191,8 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
                                         {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
     data_vars.update(_calibration_variables(calibration, model_names, stiffness.shape))
+    for index, (name, long_name) in enumerate(FRICTION_VARIABLES.items()):
+        data_vars[name] = (("soil", "block", "model"), friction[index], {"long_name": long_name, "units": "1"})
     coords = {
         "record": ("record", [r.id for r in records], {"long_name": "record id (records/MANIFEST.csv)"}),
         **_level_coordinates(config, measure_name, intensity),
@@ -194,6 +216,11 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                                       "units": "Pa"}),
         "soil_damping_ratio": ("soil", [s.damping_ratio for s in config.soils],
                                {"long_name": "damping ratio xi of the vertical dashpot", "units": "1"}),
+        "soil_friction_static": ("soil", [s.friction_static for s in config.soils],
+                                 {"long_name": "static friction coefficient mu_s of a base on the soil", "units": "1"}),
+        "soil_friction_kinetic": ("soil", [s.friction_kinetic for s in config.soils],
+                                  {"long_name": "kinetic friction coefficient mu_k of a base on the soil",
+                                   "units": "1"}),
         "block_R": ("block", [b.R for b in config.blocks], {"long_name": "semi-diagonal R", "units": "m"}),
         "block_alpha": ("block", [b.alpha for b in config.blocks], {"long_name": "slenderness angle alpha",
                                                                     "units": "rad"}),
@@ -227,6 +254,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "restitution": str(config.restitution),
         "restitution_band": json.dumps(list(config.restitution_band)),
         "vertical": VERTICAL_APPLIED if vertical_applied else VERTICAL_NOT_APPLIED,
+        "friction": config.friction,
     }
     return dataset
 

@@ -7,6 +7,11 @@ Output: ``DamageState`` objects in order of increasing severity, read by the stu
 
 A state is reached when its engineering demand parameter ``edp`` (a cube variable, or the outcome
 ``uplifted`` / ``overturned``) is at least ``threshold``; overturning exceeds every rocking threshold.
+
+Slip states (``edp = "peak_slip"``, threshold in metres) are a family of their own beside the rocking ones:
+they apply only to the cells that run with friction at the base (pipeline.study.cell_friction; elsewhere the
+fits mark them ``not-applicable``), do not nest with the rocking states, and sort after uplift and before the
+rocking states (so the two most severe states stay the rocking ones and overturning).
 A new shipped state is one ``register_damage_state`` call.
 """
 
@@ -16,7 +21,9 @@ from dataclasses import dataclass
 
 from pipeline.errors import ConfigError
 
-EDPS = ("uplifted", "overturned", "peak_angle_ratio", "peak_angle", "peak_uplift", "n_impacts")
+SLIP_EDPS = ("peak_slip",)
+"""EDPs of the slip family: the peak horizontal slip of the base [m]."""
+EDPS = ("uplifted", "overturned", "peak_angle_ratio", "peak_angle", "peak_uplift", "n_impacts", *SLIP_EDPS)
 """Engineering demand parameters a damage state may use: the two outcomes, then cube variables."""
 
 
@@ -30,19 +37,43 @@ class DamageState:
     description: str
 
 
+def severity_order(state: DamageState) -> tuple[float, float]:
+    """Sort key of the damage states: uplift, slip states, rocking states (each by threshold), overturning."""
+    order = {"uplifted": 0.0, "overturned": 2.0, **{edp: 0.5 for edp in SLIP_EDPS}}
+    return order.get(state.edp, 1.0), state.threshold
+
+
 DAMAGE_STATES: dict[str, DamageState] = {}
 """The shipped damage states by name, in order of increasing severity."""
 
 
 def register_damage_state(state: DamageState) -> None:
-    """Add a damage state; the registry order is the order of increasing severity."""
+    """Add a damage state; the registry is kept in the order of increasing severity (``severity_order``)."""
     DAMAGE_STATES[state.name] = state
+    ordered = sorted(DAMAGE_STATES.values(), key=severity_order)
+    DAMAGE_STATES.clear()
+    DAMAGE_STATES.update((s.name, s) for s in ordered)
 
 
 register_damage_state(DamageState("uplift", "uplifted", 1.0, "rocking starts (the heel lifts off)"))
 register_damage_state(DamageState("rocking-0.2", "peak_angle_ratio", 0.2, "theta_max/alpha >= 0.2"))
 register_damage_state(DamageState("rocking-0.5", "peak_angle_ratio", 0.5, "theta_max/alpha >= 0.5"))
 register_damage_state(DamageState("overturning", "overturned", 1.0, "the block overturns"))
+register_damage_state(DamageState("slip-0.05", "peak_slip", 0.05,
+                                  "the base slid 0.05 m or more (cables, pipes and anchors strained)"))
+register_damage_state(DamageState("slip-0.30", "peak_slip", 0.30,
+                                  "the base slid 0.30 m or more: off a plinth whose edge is 0.30 m beyond the base "
+                                  "(a typical edge distance; set your plinth's in [damage_states.slip-0.30])"))
+
+
+def is_slip_state(state: DamageState) -> bool:
+    """Whether ``state`` is of the slip family (its EDP is a slip of the base)."""
+    return state.edp in SLIP_EDPS
+
+
+def state_family(state: DamageState) -> str:
+    """"slip" or "rocking": states of one family nest (more severe: reached later); the two families do not."""
+    return "slip" if is_slip_state(state) else "rocking"
 
 
 def damage_states_from_config(raw: dict) -> list[DamageState]:
@@ -56,7 +87,7 @@ def damage_states_from_config(raw: dict) -> list[DamageState]:
     Returns
     -------
     list of DamageState
-        Uplift first, then the rocking states by threshold, overturning last.
+        Uplift first, then the slip states, then the rocking states, each by threshold, overturning last.
 
     Raises
     ------
@@ -72,5 +103,5 @@ def damage_states_from_config(raw: dict) -> list[DamageState]:
         if not isinstance(threshold, (int, float)) or threshold <= 0:
             raise ConfigError(f"damage_states.{name}.threshold", f"{threshold!r}; allowed > 0")
         states[name] = DamageState(name, edp, float(threshold), spec.get("description", ""))
-    order = {"uplifted": 0, "overturned": 2}
-    return sorted(states.values(), key=lambda s: (order.get(s.edp, 1), s.threshold))
+    return sorted(states.values(), key=severity_order)
+

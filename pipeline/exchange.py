@@ -9,7 +9,10 @@ Output: ``fragility_pelicun.csv``, pelicun 3.x damage-model parameters (``pelicu
 
 One pelicun component and one OpenQuake fragility function per block x soil x model, with the same ID
 (``pelicun_id``), rows of the model "recommended" first; one limit state per damage state, in order of
-severity. The dispersion written is always ``beta`` (the total). A row is written by what it is
+severity. Slip states (``edp = "peak_slip"``) do not nest with the rocking states, so a cell that slides has
+a second component, ``ID.SLIP``, and its functions go to ``fragility_openquake_slip.xml``
+(``state_families``); a tied cell (slip rows ``not-applicable``) has none. The dispersion written is always
+``beta`` (the total). A row is written by what it is
 (``written_state``), the same way in both files where the consumers allow it:
 
 - a lognormal (finite median, beta > 0): as it is; OpenQuake wants the mean and standard deviation of the
@@ -41,6 +44,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from pipeline.damage_states import SLIP_EDPS
 from pipeline.errors import ConfigError
 from pipeline.measures import MEASURES, Measure, convert_units, unit_label
 from pipeline.models.variants import RECOMMENDED
@@ -48,6 +52,8 @@ from pipeline.outputs import atomic_path
 
 PELICUN_FILE = "fragility_pelicun.csv"
 OPENQUAKE_FILE = "fragility_openquake.xml"
+OPENQUAKE_SLIP_FILE = "fragility_openquake_slip.xml"
+NOT_APPLICABLE = "not-applicable"  # pipeline.fragility's status of a tied cell's slip rows
 
 STEP_BETA = 0.001
 """The lognormal dispersion that stands for a step (beta = 0) in OpenQuake's continuous format: the
@@ -168,6 +174,30 @@ def write_csv(table: pd.DataFrame, path: str | Path) -> None:
         table.to_csv(temporary, index=False, float_format="%.6g")
 
 
+SLIP_SUFFIX = ".SLIP"
+"""The component ID of a cell's slip states: ``pelicun_id(...) + SLIP_SUFFIX`` (a family of its own)."""
+
+
+def state_families(dataset: xr.Dataset) -> dict[str, list[str]]:
+    """The damage states by family, each in order of severity: {"": rocking states, SLIP_SUFFIX: slip states}.
+
+    A component's limit states must nest (each more severe one reached later), which the rocking and the slip
+    states do not; so each family is a component (pelicun) or a file (OpenQuake) of its own. The family of a
+    state is that of its EDP (``damage_state_edp``; pipeline.damage_states.SLIP_EDPS).
+    """
+    states = [str(s) for s in dataset.damage_state.values]
+    edps = [str(e) for e in dataset["damage_state_edp"].values] if "damage_state_edp" in dataset.coords \
+        else [""] * len(states)
+    families = {"": [s for s, e in zip(states, edps) if e not in SLIP_EDPS],
+                SLIP_SUFFIX: [s for s, e in zip(states, edps) if e in SLIP_EDPS]}
+    return {suffix: members for suffix, members in families.items() if members}
+
+
+def _applies(cell: xr.Dataset, states: list[str]) -> bool:
+    """Whether a cell has rows of ``states`` (a tied cell's slip rows are ``not-applicable``)."""
+    return any(str(cell["status"].sel(damage_state=s).values) != NOT_APPLICABLE for s in states)
+
+
 def exchange_cells(dataset: xr.Dataset) -> list[tuple[str, str, str]]:
     """(soil, block, model) of every component, in the order both files list them.
 
@@ -255,15 +285,17 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
     if measure is not None and measure.uses_period and period:
         demand_type = f"{demand_type}|{period:g}"
     unit = intensity_unit_label(dataset)
-    states = [str(s) for s in dataset.damage_state.values]
     rows = []
-    for soil, block, model in exchange_cells(dataset):
+    for (soil, block, model), (suffix, states) in ((c, f) for f in state_families(dataset).items()
+                                                   for c in exchange_cells(dataset)):
         cell = dataset.sel(soil=soil, block=block, model=model)
+        if not _applies(cell, states):
+            continue
         low, high = float(cell.studied_im_min), float(cell.studied_im_max)
         written = [written_state(float(cell["median"].sel(damage_state=s)), float(cell["beta"].sel(damage_state=s)),
                                  str(cell["status"].sel(damage_state=s).values), low) for s in states]
         last = max((k for k, w in enumerate(written) if w.kind != "not-reached"), default=0)
-        row = {"ID": pelicun_id(block, soil, model), "Incomplete": 0, "Demand-Type": demand_type,
+        row = {"ID": pelicun_id(block, soil, model) + suffix, "Incomplete": 0, "Demand-Type": demand_type,
                "Demand-Unit": demand_unit, "Demand-Offset": 0, "Demand-Directional": 1}
         notes = [f"rockfrag {name} fragility of {block} on {soil}, model {model}, studied range "
                  f"{low:.4g}-{high:.4g} {unit}"]
@@ -353,7 +385,8 @@ def openquake_mean_stddev(median: float, beta: float) -> tuple[float, float]:
     return float(mean), float(mean * np.sqrt(np.expm1(beta ** 2)))
 
 
-def openquake_model(dataset: xr.Dataset, period: float | None = None) -> ElementTree.ElementTree | None:
+def openquake_model(dataset: xr.Dataset, period: float | None = None,
+                    family: str = "") -> ElementTree.ElementTree | None:
     """The NRML 0.5 ``fragilityModel``: one continuous lognormal function per block x soil x model.
 
     Its limit states are the damage states (``openquake_limit_state``); each function's ``imls`` carry the
@@ -367,11 +400,16 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None) -> Element
         The fragility dataset (``fragility_dataset``).
     period : float, optional
         The Sa period [s], for measures that have one.
+    family : str
+        The family of damage states (``state_families``): "" the rocking states, ``SLIP_SUFFIX`` the slip
+        states (their own file: one model's functions share its limit states), written for the cells that
+        slide.
 
     Returns
     -------
     xml.etree.ElementTree.ElementTree or None
-        The document; None when OpenQuake has no intensity measure type for the study's measure.
+        The document; None when OpenQuake has no intensity measure type for the study's measure, or no cell
+        has states of the family.
 
     Raises
     ------
@@ -384,7 +422,11 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None) -> Element
     if imt is None:
         return None
     measure = MEASURES[name]
-    states = [str(s) for s in dataset.damage_state.values]
+    states = state_families(dataset).get(family, [])
+    cells = [c for c in exchange_cells(dataset) if states and _applies(dataset.sel(soil=c[0], block=c[1],
+                                                                                   model=c[2]), states)]
+    if not cells:
+        return None
     limit_states = [openquake_limit_state(s) for s in states]
     if len(set(limit_states)) < len(states):
         raise ConfigError("damage_states", f"{states} give clashing OpenQuake limit states {limit_states}; "
@@ -405,7 +447,7 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None) -> Element
         f"{TAIL_SIGMAS:g} beta beyond every curve and the studied range; the comment before each function gives "
         f"the studied range." + (f" Limit states renamed: {renamed}." if renamed else ""))
     ElementTree.SubElement(model, "limitStates").text = " ".join(limit_states)
-    for soil, block, model_name in exchange_cells(dataset):
+    for soil, block, model_name in cells:
         cell = dataset.sel(soil=soil, block=block, model=model_name)
         low, high = (float(_consumer_values(dataset, measure, cell[v])) / measure.openquake_factor
                      for v in ("studied_im_min", "studied_im_max"))
@@ -420,10 +462,10 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None) -> Element
         curves = [(m, b) if np.isfinite(m) else (2 * max_iml, STEP_BETA) for m, b in curves]
         notes = [f"{s}: {_cell_notes(cell, s)}{OPENQUAKE_FORMS[form.kind]}" for s, form in zip(states, forms)]
         model.append(ElementTree.Comment(
-            f" {pelicun_id(block, soil, model_name)}: {block} on {soil}, model {model_name}; studied range "
+            f" {pelicun_id(block, soil, model_name) + family}: {block} on {soil}, model {model_name}; studied range "
             f"{low:.4g}-{high:.4g} {unit}; " + "; ".join(notes) + " "))
         function = ElementTree.SubElement(model, "fragilityFunction", {
-            "id": pelicun_id(block, soil, model_name), "format": "continuous", "shape": "logncdf"})
+            "id": pelicun_id(block, soil, model_name) + family, "format": "continuous", "shape": "logncdf"})
         ElementTree.SubElement(function, "imls", {"imt": imt, "minIML": f"{min_iml:.10g}",
                                                   "maxIML": f"{max_iml:.10g}"})
         for limit_state, (median, beta) in zip(limit_states, curves):
@@ -435,7 +477,7 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None) -> Element
     return tree
 
 
-def write_openquake(dataset: xr.Dataset, path: str | Path, period: float | None = None) -> bool:
+def write_openquake(dataset: xr.Dataset, path: str | Path, period: float | None = None, family: str = "") -> bool:
     """Write ``openquake_model`` to ``path`` atomically (UTF-8 XML).
 
     Parameters
@@ -453,7 +495,7 @@ def write_openquake(dataset: xr.Dataset, path: str | Path, period: float | None 
         False (and nothing written, an older file at ``path`` removed) when OpenQuake has no intensity
         measure type for the study's measure.
     """
-    tree = openquake_model(dataset, period)
+    tree = openquake_model(dataset, period, family)
     if tree is None:
         Path(path).unlink(missing_ok=True)
         return False
@@ -489,4 +531,6 @@ def write_exchange_files(dataset: xr.Dataset, output: str | Path, period: float 
     write_csv(pelicun_table(dataset, period), written[0])
     if write_openquake(dataset, output / OPENQUAKE_FILE, period):
         written.append(output / OPENQUAKE_FILE)
+    if write_openquake(dataset, output / OPENQUAKE_SLIP_FILE, period, SLIP_SUFFIX):
+        written.append(output / OPENQUAKE_SLIP_FILE)
     return written

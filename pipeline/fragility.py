@@ -52,7 +52,13 @@ from pipeline.cube import (
     OUTCOME_OVERTURNED,
     OUTCOME_ROCKING,
 )
-from pipeline.damage_states import DAMAGE_STATES, DamageState, damage_states_from_config
+from pipeline.damage_states import (
+    DAMAGE_STATES,
+    DamageState,
+    damage_states_from_config,
+    is_slip_state,
+    state_family,
+)
 from pipeline.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
     OPENQUAKE_FILE,
     pelicun_id,
@@ -90,6 +96,8 @@ STATUS = {
     "above-range": "a few records reached the state, only at the highest level: the median is above the range",
     "deterministic-threshold": "an exact step at g tan(alpha) (uplift under PGA scaling), beta = 0",
     "separated": "perfectly separated counts: a step between two levels, beta = 0 (not identifiable)",
+    "not-applicable": "a slip state of a cell whose base is tied (no friction, no sliding: [solver] friction); "
+                      "no curve",
 }
 """The ``status`` of a fragility row and what it means (the report prints these)."""
 
@@ -131,8 +139,19 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
     counts as uplifted; it reached a rocking state when its response before the stop already did (peak
     values only grow), else it is unknown; whether it would have overturned is unknown. The fits count
     the known runs only (censored), level by level.
+
+    Slip states (``edp = "peak_slip"``): reached where the peak slip is at least the threshold [m] or the block
+    overturned; known only in the cells that run with friction (the cube's ``friction_static`` finite): a
+    tied cell's runs are all unknown, and its row is ``not-applicable``.
     """
     outcome = first_overturn_outcomes(cube)
+    if is_slip_state(state):
+        if state.edp not in cube or "friction_static" not in cube:  # a cube from before sliding: every base tied
+            return xr.full_like(outcome, np.nan, dtype=float)
+        reached = (cube[state.edp] >= state.threshold) | (outcome == OUTCOME_OVERTURNED)
+        known = (outcome != OUTCOME_FAILED) & (~(outcome == OUTCOME_FREE_FLIGHT) | reached) \
+            & np.isfinite(cube.friction_static)
+        return reached.astype(float).where(known)
     flight = outcome == OUTCOME_FREE_FLIGHT
     if state.edp == "uplifted":
         reached = outcome >= OUTCOME_ROCKING  # rocking, overturned or free flight (failed: masked below)
@@ -272,7 +291,10 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
     for s, state in enumerate(states):
         row = RowFit()
         has_data = total[s] > 0
-        if state.edp == "uplifted" and threshold is not None:
+        if is_slip_state(state) and not has_data.any():
+            row.status = "not-applicable"
+            row.warn("the base is tied in this cell (no friction): it does not slide")
+        elif state.edp == "uplifted" and threshold is not None:
             row.median, row.beta, row.method, row.status = float(threshold), 0.0, "exact-g-tan-alpha", \
                 "deterministic-threshold"
             step = (levels > threshold).astype(float)
@@ -297,9 +319,13 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
         else:
             row.median, row.beta, row.method, row.status = medians[s], betas[s], "mle-binomial", "fitted"
         rows.append(row)
-    usable = [s for s, row in enumerate(rows) if row.method == "mle-binomial"]
-    groups, fits = noncrossing_groups(levels, exceed, total, {s: (rows[s].median, rows[s].beta) for s in usable},
-                                      usable)
+    groups, fits = [], {}
+    for family in dict.fromkeys(map(state_family, states)):  # slip and rocking states do not nest: each on its own
+        usable = [s for s, row in enumerate(rows) if row.method == "mle-binomial" and state_family(states[s]) == family]
+        family_groups, family_fits = noncrossing_groups(levels, exceed, total,
+                                                        {s: (rows[s].median, rows[s].beta) for s in usable}, usable)
+        groups += family_groups
+        fits.update(family_fits)
     for group in groups:
         if len(group) < 2:
             continue
@@ -542,6 +568,8 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     coords = {d: cube[d] for d in group_dims}
     coords.update({"im_level": im_level, "damage_state": [s.name for s in states],
                    "damage_state_description": ("damage_state", [s.description for s in states]),
+                   "damage_state_edp": ("damage_state", [s.edp for s in states], {
+                       "long_name": "engineering demand parameter of the damage state (peak_slip: the slip family)"}),
                    "outcome_class": ["no_uplift", "rocking", "overturned"],
                    "intensity": (("block", "im_level"), intensity, {
                        "long_name": f"intensity of each level ({measure})", "units": unit})})

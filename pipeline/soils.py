@@ -6,6 +6,10 @@ Output: the interface stiffness k [N/m] of paper eq. 19, k = (A/H) / (1/G_s + 1/
         circular frequency w = sqrt(k/m) [rad/s] and dashpot c = 2 xi w m [N s/m] (eq. 10); with
         ``foundation`` also the static settlement m g / k [m] and w / p, which pipeline.plausibility checks.
 
+Base friction: each soil class also carries the Coulomb friction coefficients of a block's base on it,
+static ``friction_static`` and kinetic ``friction_kinetic`` [-] (``FRICTION_SOURCES``), which the study uses
+for the runs that slide (pipeline.study.cell_friction).
+
 The paper's "dynamic elastic modulus" E_d of eq. 7 / Table 1, E_d = 2G(1-nu)/(1-2nu), is the
 constrained (oedometric, P-wave) modulus, not Young's modulus; it is labelled so here.
 """
@@ -19,13 +23,39 @@ from pipeline.errors import ConfigError
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number
 
+MAX_KINETIC_FRICTION = 4.0 / 3.0
+"""Largest kinetic coefficient a soil may state: a rigid base's limit (Painleve's paradox), which is
+pipeline.models.options.RIGID_BASE_MAX_KINETIC_FRICTION (importing it here would be circular: the models import
+this module; tests/test_soils.py checks that the two agree)."""
+
 SOIL_RANGES = {
     "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),
     "poisson_ratio": Number(0, 0.5, high_open=True),
     "density": Number(0, 1e5, low_open=True, unit="kg/m^3"),
     "damping_ratio": Number(0, 1, high_open=True),
+    "friction_static": Number(0, 1.5, low_open=True),
+    "friction_kinetic": Number(0, MAX_KINETIC_FRICTION, low_open=True),
 }
 """Allowed values of a soil's numbers (also the study file's ``[soils_custom.NAME]`` ranges)."""
+
+
+KINETIC_OVER_STATIC = 0.85
+"""mu_k / mu_s of the shipped soils: a modelling choice inside the 0.8-0.9 that the study's design takes for
+concrete and steel sliding on soil and rock (no table of NAVFAC DM-7.02 gives kinetic values)."""
+DEFAULT_FRICTION = (0.5, 0.4)
+"""(mu_s, mu_k) of a soil that does not state its own (a ``[soils_custom.NAME]`` table without them): the
+steel-on-steel pair below, and the coefficient the report's sliding check used before friction was per soil."""
+FRICTION_SOURCES = (
+    "Soils and rock: the ultimate friction factor tan(delta) of mass concrete on the material, NAVFAC DM-7.02 "
+    "(1986) Foundations and Earth Structures, Table 1 'Ultimate friction factors and adhesion for dissimilar "
+    "materials': clean sound rock 0.70; clean gravel, gravel-sand mixtures, coarse sand 0.55-0.60 (0.55 taken); "
+    "clean fine to medium sand 0.45-0.55 (0.45 taken); medium stiff and stiff clay 0.30-0.35 (0.35 taken). "
+    f"The lower end of each range is taken (less friction, more sliding). Kinetic = {KINETIC_OVER_STATIC} x "
+    "static (rounded to 0.01). Steel base on a steel deck: 0.50 static, the slip coefficient of blast-cleaned "
+    "steel faying surfaces (AISC 360-16 Specification for Structural Steel Buildings, J3.8, class B surfaces), "
+    "below the 0.74 of clean dry mild steel in the laboratory (Marks' Standard Handbook for Mechanical "
+    "Engineers, Table 3.2.1); 0.40 kinetic (0.8 x static).")
+"""Where the shipped soils' friction coefficients come from (README, "The models")."""
 
 
 @dataclass(frozen=True)
@@ -38,10 +68,21 @@ class SoilClass:
     density: float  # rho [kg/m^3]
     damping_ratio: float = 0.05  # xi of the vertical dashpot [-]
     description: str = ""
+    friction_static: float = DEFAULT_FRICTION[0]  # mu_s of a block's base on this soil [-]
+    friction_kinetic: float = DEFAULT_FRICTION[1]  # mu_k [-], at most mu_s
 
     def __post_init__(self):
         for key, allowed in SOIL_RANGES.items():
             allowed.check(getattr(self, key), f"soil {self.name}.{key}", None)
+        if self.friction_kinetic > self.friction_static:
+            raise ConfigError(f"soil {self.name}.friction_kinetic",
+                              f"{self.friction_kinetic:g} exceeds friction_static {self.friction_static:g}; "
+                              "must be > 0 and <= friction_static")
+
+    @property
+    def friction(self) -> tuple[float, float]:
+        """(mu_s, mu_k) [-] of a block's base on this soil (the solver's ``friction`` option)."""
+        return self.friction_static, self.friction_kinetic
 
     @property
     def constrained_modulus(self) -> float:
@@ -112,16 +153,22 @@ def foundation(soil: SoilClass, block, g: float = STANDARD_GRAVITY) -> Foundatio
                       frequency_ratio=omega / block.p(g))
 
 
-def _from_constrained(name, constrained_mpa, nu, density, description):
+def _from_constrained(name, constrained_mpa, nu, density, description, friction):
     shear = constrained_mpa * 1e6 * (1 - 2 * nu) / (2 * (1 - nu))
-    return SoilClass(name, shear, nu, density, 0.05, description)
+    return SoilClass(name, shear, nu, density, 0.05, description, *friction)
 
 
-# Paper Table 1 (G_max, nu, rho); clay from the text (E_d = 130 MPa, nu = 0.3 assumed).
+def _navfac(static: float) -> tuple[float, float]:
+    """(mu_s, mu_k) of concrete on a soil from its NAVFAC DM-7.02 friction factor (``FRICTION_SOURCES``)."""
+    return static, round(KINETIC_OVER_STATIC * static, 2)
+
+
+# Paper Table 1 (G_max, nu, rho); clay from the text (E_d = 130 MPa, nu = 0.3 assumed). Friction: FRICTION_SOURCES.
 SOILS = {
-    "clay": _from_constrained("clay", 130.0, 0.3, 1800.0, "soft clay, E_d = 130 MPa (paper Figs. 9-11)"),
-    "sand": SoilClass("sand", 80e6, 0.3, 1900.0, 0.05, "sand, G = 80 MPa (paper Table 1)"),
-    "gravel": SoilClass("gravel", 300e6, 0.3, 2000.0, 0.05, "gravel, G = 300 MPa (paper Table 1)"),
-    "rock": SoilClass("rock", 1000e6, 0.3, 2500.0, 0.05, "rock, G = 1000 MPa (paper Table 1)"),
-    "steel": SoilClass("steel", 80e9, 0.3, 7800.0, 0.05, "steel base, G = 80 GPa (paper Table 1)"),
+    "clay": _from_constrained("clay", 130.0, 0.3, 1800.0, "soft clay, E_d = 130 MPa (paper Figs. 9-11)",
+                              _navfac(0.35)),
+    "sand": SoilClass("sand", 80e6, 0.3, 1900.0, 0.05, "sand, G = 80 MPa (paper Table 1)", *_navfac(0.45)),
+    "gravel": SoilClass("gravel", 300e6, 0.3, 2000.0, 0.05, "gravel, G = 300 MPa (paper Table 1)", *_navfac(0.55)),
+    "rock": SoilClass("rock", 1000e6, 0.3, 2500.0, 0.05, "rock, G = 1000 MPa (paper Table 1)", *_navfac(0.70)),
+    "steel": SoilClass("steel", 80e9, 0.3, 7800.0, 0.05, "steel base, G = 80 GPa (paper Table 1)", 0.50, 0.40),
 }

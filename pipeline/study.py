@@ -14,8 +14,12 @@ as a second checkpoint entry, so capacities come from runs, not from the grid. A
 checkpointed as one small file named by a hash of everything it depends on (record checksum,
 processing recipe, intensity settings, levels, block, soil, model, solver settings, package version),
 so an interrupted study resumes where it stopped and a changed input recomputes only the cells it
-touches. Housner results do not depend on the soil: they are computed once per block and shared by
-every soil.
+touches. A tied (no-sliding) housner result does not depend on the soil: it is computed once per block and
+shared by every soil on which it does not slide.
+
+Sliding (``[solver] friction``, ``cell_friction``): a housner or winkler cell runs with Coulomb friction at
+the base, the soil's (mu_s, mu_k), where the study says it slides; its friction is part of its job and of its
+checkpoint key (a tied cell's key is the same as before friction existed). A sliding housner cell is per soil.
 
 Executors (pipeline.executors): in-process (workers=1), all local cores (default, process pool), or
 dask.distributed (``scheduler`` address of a running cluster, or ``dask_workers`` to start a
@@ -63,12 +67,44 @@ from pipeline.soils import soil_block_stiffness
 
 @dataclass(frozen=True)
 class Cell:
-    """One (block, soil, model) combination for one record; soil is None for rigid-base models."""
+    """One (block, soil, model) combination for one record.
+
+    soil is None for a tied rigid-base model under ``[solver] friction = "none"`` (one cell for every soil);
+    friction is the base's (mu_s, mu_k) [-], or None for a tied base. Cells of one key run once.
+    """
 
     key: str
     block_index: int
     soil_index: int | None
     model: str
+    friction: tuple[float, float] | None = None
+
+
+def cell_friction(block, soil, model: str, mode: str) -> tuple[float, float] | None:
+    """Whether, and with which (mu_s, mu_k) [-], a (block, soil, model) cell slides; None: the base is tied.
+
+    Parameters
+    ----------
+    block : pipeline.blocks.Block
+        The block (half-width b and half-height h [m]).
+    soil : pipeline.soils.SoilClass or None
+        The soil (``friction_static``, ``friction_kinetic``); None: no soil, a tied base.
+    model : str
+        The model's name; only models that slide (housner, winkler) take friction: ssi is always tied.
+    mode : str
+        ``[solver] friction``: "where-it-matters" slides where the soil's mu_s < b/h (below it a block at rest
+        slides before it can rock: Shenton 1996), "all" slides every cell of a model that slides, "none" none.
+
+    Returns
+    -------
+    (float, float) or None
+        The soil's (mu_s, mu_k), or None.
+    """
+    if soil is None or mode == "none" or not get_model(model).slides:
+        return None
+    if mode == "all" or soil.friction_static < block.b / block.h:
+        return soil.friction
+    return None
 
 
 def record_intensity(acceleration, dt, config, block=None) -> float:
@@ -143,12 +179,12 @@ def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolu
     free-flight stripe has no capacity (NaN), censored at the highest stripe it survived below it
     (``lower``; NaN if none). Without free flight this is exactly ``capacity_from_stripes``.
     """
-    _, model, block, k, xi = job
+    _, model, block, k, xi, friction = job
     seen = []  # (scale, overturned) of each refining run
 
     def overturns(scale):
         result = simulate_batch(model, acceleration, dt, [scale], [(block, k, xi)], ag_vertical=ag_vertical,
-                                t_end=t_end, **options)
+                                t_end=t_end, **options, friction=friction)
         status = int(result[0, 0]["status"])
         if status == int(Outcome.FREE_FLIGHT):
             raise _FreeFlight
@@ -212,16 +248,53 @@ def cells_for_record(record, config, recipe, block_scales=None, vertical=None) -
         if block_scales is not None:
             block_spec["scales"] = [float(f"{v:.12g}") for v in block_scales[:, block_index]]
         for model in config.models:
-            if get_model(model).is_rigid_base:
+            rigid = get_model(model).is_rigid_base
+            if rigid and config.friction == "none":
                 cells.append(Cell(_hash({**common, "block": block_spec, "model": model}), block_index, None, model))
                 continue
             dissipation = restitution_key(config, model)
             for soil_index, soil in enumerate(config.soils):
-                soil_spec = {k: v for k, v in asdict(soil).items() if k not in ("name", "description")}
-                cells.append(Cell(_hash({**common, "block": block_spec, "soil": soil_spec, "model": model,
-                                         **dissipation}),
-                                  block_index, soil_index, model))
+                friction = cell_friction(block, soil, model, config.friction)
+                # the friction enters the key only where the cell slides: a tied cell keeps its old key, and a
+                # tied rigid-base cell the key it shares with every soil
+                slip = {} if friction is None else {"friction": list(friction)}
+                if rigid and friction is None:
+                    key = _hash({**common, "block": block_spec, "model": model})
+                elif rigid:
+                    key = _hash({**common, "block": block_spec, "model": model, **slip})
+                else:
+                    soil_spec = {k: v for k, v in asdict(soil).items() if k not in SOIL_KEY_EXCLUDED}
+                    key = _hash({**common, "block": block_spec, "soil": soil_spec, "model": model, **dissipation,
+                                 **slip})
+                cells.append(Cell(key, block_index, soil_index, model, friction))
     return cells
+
+
+SOIL_KEY_EXCLUDED = ("name", "description", "friction_static", "friction_kinetic")
+"""Soil fields left out of a cell's checkpoint key: labels, and the friction (in the key only where a cell slides)."""
+
+
+def friction_grid(config) -> np.ndarray:
+    """Every cell's base friction, (2, soil, block, model): mu_s and mu_k [-], NaN where the base is tied.
+
+    Parameters
+    ----------
+    config : pipeline.config.StudyConfig
+        The study (soils, blocks, models and ``[solver] friction``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``cell_friction`` of each (soil, block, model).
+    """
+    grid = np.full((2, len(config.soils), len(config.blocks), len(config.models)), np.nan)
+    for s, soil in enumerate(config.soils):
+        for b, block in enumerate(config.blocks):
+            for m, model in enumerate(config.models):
+                friction = cell_friction(block, soil, model, config.friction)
+                if friction is not None:
+                    grid[:, s, b, m] = friction
+    return grid
 
 
 def vertical_key(record, vertical, applied) -> dict:
@@ -293,29 +366,30 @@ def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
 def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0, ag_vertical=None):
     """Pure task function (runs in a worker): summaries for each job.
 
-    jobs : list of (key, model, block, k, xi); options : ``solver_options``; ag_vertical : the record's
+    jobs : list of (key, model, block, k, xi, friction), friction the base's (mu_s, mu_k) or None (tied);
+    options : ``solver_options``; ag_vertical : the record's
     vertical component [m/s^2, up positive], sampled as ``acceleration`` and scaled by the same factors, or None.
     Returns {key: summary records (n_scale,)} and, when ``capacity_resolution`` > 0,
     {capacity_key(key): [capacity, lower, upper, runs]} (scale factors).
     """
     results = {}
     t_end = (acceleration.size - 1) * dt + tail
-    by_model = {}
-    for key, model, block, k, xi in jobs:
-        by_model.setdefault(get_model(model).name, []).append((key, block, k, xi))
-    for model, group in by_model.items():
+    by_model = {}  # friction is a solver option: one batch per (model, friction)
+    for key, model, block, k, xi, friction in jobs:
+        by_model.setdefault((get_model(model).name, friction), []).append((key, block, k, xi))
+    for (model, friction), group in by_model.items():
         # band variants whose targets the bed reaches at the same xi (moved to one end of its range) run once
         cases = list(dict.fromkeys((b, k, xi) for _, b, k, xi in group))
         summaries = dict(zip(cases, simulate_batch(model, acceleration, dt, scales, cases, ag_vertical=ag_vertical,
-                                                   t_end=t_end, **options)))
+                                                   t_end=t_end, **options, friction=friction)))
         for key, b, k, xi in group:
             results[key] = summaries[(b, k, xi)]
     if capacity_resolution > 0:
         refined = {}
-        for key, model, block, k, xi in jobs:
+        for key, model, block, k, xi, friction in jobs:
             if not refines_capacity(model):
                 continue
-            case = (get_model(model).name, block, k, xi)
+            case = (get_model(model).name, block, k, xi, friction)
             if case not in refined:
                 refined[case] = cell_capacity(acceleration, dt, scales, results[key], (key, *case), options, t_end,
                                               capacity_resolution, ag_vertical)
@@ -544,11 +618,11 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                                             vertical_key(record, verticals[index], variant) if config.vertical
                                             else None)
                            for index, record in enumerate(records)] for variant in variants}
-    keys = [c.key for variant in variants for cells in all_cells[variant] for c in cells]
+    keys = list(dict.fromkeys(c.key for variant in variants for cells in all_cells[variant] for c in cells))
     results = store.load_verified(keys, (n_levels,), SUMMARY_DTYPE)
     if resolution > 0:
-        refining = [c.key for variant in variants for cells in all_cells[variant] for c in cells
-                    if refines_capacity(c.model)]
+        refining = list(dict.fromkeys(c.key for variant in variants for cells in all_cells[variant] for c in cells
+                                      if refines_capacity(c.model)))
         results.update(store.load_verified([capacity_key(k, resolution) for k in refining], (4,), np.float64))
     tasks = [(*task, variant) for variant in variants
              for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration)]
@@ -610,7 +684,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                 f"({stats['runs_saved_fraction']:.0%} saved)")
         cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
-                                     calibration=calibration,
+                                     calibration=calibration, friction=friction_grid(config),
                                      verticals=verticals, vertical_applied=variant), stats)
     dataset, capacity_stats = cubes[variants[0]]
     if config.vertical:  # the comparison first: a cube.nc on disk always has its comparison beside it
@@ -629,7 +703,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
 
 
 def _gather_summaries(all_cells, results, config, n_records, n_levels) -> np.ndarray:
-    """The summary records of every cell, (record, level, soil, block, model); rigid-base cells on every soil."""
+    """The summary records of every cell, (record, level, soil, block, model); a cell without soil on every soil."""
     summaries = new_summaries((n_records, n_levels, len(config.soils), len(config.blocks), len(config.models)))
     for r, cells in enumerate(all_cells):
         for cell in cells:
@@ -646,27 +720,31 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
     """(record index, block index, jobs) for every record and block with cells still to run.
 
     Cells still to run are those not in ``available``, the verified checkpoints; a job is
-    (key, model, block, k, xi), xi the soil's damping ratio or, for a bed model with a restitution target,
-    its calibrated one (``calibration``, a ``BandCalibration``). Grouped by block because scale factors are
-    per block.
+    (key, model, block, k, xi, friction), xi the soil's damping ratio or, for a bed model with a restitution
+    target, its calibrated one (``calibration``, a ``BandCalibration``), friction the cell's (mu_s, mu_k) or None
+    (``cell_friction``). Grouped by block because scale factors are per block; cells of one key (a tied housner
+    cell on several soils) are one job. A rigid-base model's k and xi are None.
     """
     def damping(cell):
         if calibration is not None and cell.model in calibration.variants:
             return float(calibration.xi[cell.soil_index, cell.block_index, calibration.variants.index(cell.model)])
         return config.soils[cell.soil_index].damping_ratio
 
+    def rigid(cell):
+        return cell.soil_index is None or get_model(cell.model).is_rigid_base
+
     tasks = []
     for index, cells in enumerate(all_cells):
         by_block = {}
-        for cell in cells:
+        for cell in {c.key: c for c in cells}.values():
             done = cell.key in available and (resolution <= 0 or not refines_capacity(cell.model)
                                               or capacity_key(cell.key, resolution) in available)
             if not done:
                 by_block.setdefault(cell.block_index, []).append(cell)
         for block_index, missing in by_block.items():
             jobs = [(c.key, c.model, config.blocks[c.block_index],
-                     None if c.soil_index is None else stiffness[c.soil_index, c.block_index],
-                     None if c.soil_index is None else damping(c))
+                     None if rigid(c) else stiffness[c.soil_index, c.block_index],
+                     None if rigid(c) else damping(c), c.friction)
                     for c in missing]
             tasks.append((index, block_index, jobs))
     return tasks
@@ -683,7 +761,6 @@ def gather_capacities(all_cells, available, config, intensity, resolution):
     capacities = np.full(shape, np.nan)
     if resolution <= 0:
         return None, {}
-    extra = 0
     for r, cells in enumerate(all_cells):
         for cell in cells:
             if not refines_capacity(cell.model):
@@ -692,11 +769,13 @@ def gather_capacities(all_cells, available, config, intensity, resolution):
             soils = slice(None) if cell.soil_index is None else cell.soil_index
             capacities[:, r, soils, cell.block_index, config.models.index(cell.model)] = result[:, None] \
                 if cell.soil_index is None else result
-            extra += int(result[3])
-    n_cells = sum(refines_capacity(c.model) for cells in all_cells for c in cells)
+    # the run accounting counts each computed cell once (a tied housner cell shared by soils is one)
+    unique = [c for cells in all_cells for c in {c.key: c for c in cells}.values() if refines_capacity(c.model)]
+    extra = sum(int(available[capacity_key(c.key, resolution)][3]) for c in unique)
+    n_cells = len(unique)
     n_levels = intensity.shape[1]
     uniform = sum(uniform_stripe_runs(intensity[c.block_index, 0], intensity[c.block_index, -1], resolution)
-                  for cells in all_cells for c in cells if refines_capacity(c.model))
+                  for c in unique)
     grid = n_cells * n_levels
     return capacities, {"capacity_runs": extra, "grid_runs": grid, "uniform_runs": uniform,
                         "capacity_resolution": resolution,

@@ -20,7 +20,7 @@ from pipeline.measures import spectral_acceleration
 from pipeline.models import simulate
 from pipeline.processing import process_record
 from pipeline.records import load_records
-from pipeline.soils import soil_block_stiffness
+from pipeline.soils import SOILS, soil_block_stiffness
 from pipeline.study import run_study
 from tests.helpers import SMALL_STUDY
 
@@ -143,7 +143,9 @@ def test_resume_reuses_checkpoints_and_changed_soil_touches_only_its_cells(small
                                    log=lambda m: None)
     assert stats_again["runs_computed"] == 0 and stats_again["cells_reused"] == stats["cells"]
     xr.testing.assert_identical(cube, again)
-    changed = load_study(small_study, {"soils_custom": {"rock": {"shear_modulus": 2e9}}})
+    rock = SOILS["rock"]  # the same friction: the skid's sliding Housner cell on rock depends on nothing else
+    friction = {"friction_static": rock.friction_static, "friction_kinetic": rock.friction_kinetic}
+    changed = load_study(small_study, {"soils_custom": {"rock": {"shear_modulus": 2e9, **friction}}})
     _, stats_changed = run_study(changed, output=output, workers=1, progress=False, log=lambda m: None)
     # one soil x 3 blocks x 2 records of SSI cells; Housner cells and the other soil are reused
     assert stats_changed["runs_computed"] == 3 * 2 * 4

@@ -23,6 +23,7 @@ from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
 from pipeline.models.variants import RECOMMENDED
 from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
+from pipeline.soils import DEFAULT_FRICTION
 
 OUTCOME_ROCKING, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = int(Outcome.ROCKING), int(Outcome.FAILED), \
     int(Outcome.FREE_FLIGHT)
@@ -213,12 +214,30 @@ def tension_flag(cube):
     return None
 
 
-def friction_flag(cube, coefficient):
-    """1 where holding the base without sliding needed more than ``coefficient``, NaN where unknown."""
+def soil_friction(cube):
+    """Each soil's static friction coefficient mu_s [-] (the cube's ``soil_friction_static``; an older cube: 0.5)."""
+    if "soil_friction_static" in cube.variables:
+        return cube.soil_friction_static
+    return DEFAULT_FRICTION[0]
+
+
+def tied(cube):
+    """True in the (soil, block, model) cells whose base is tied (no friction), False where the runs slide."""
+    if "friction_static" not in cube:
+        return True
+    return ~np.isfinite(cube.friction_static)
+
+
+def friction_flag(cube, coefficient=None):
+    """1 where holding a tied base needed more than ``coefficient`` (default: each soil's mu_s), NaN where unknown.
+
+    Runs with friction at the base (they slide where they need more) are NaN: their slip is in the cube.
+    """
     if "peak_friction_demand" not in cube:
         return None
-    demand = cube.peak_friction_demand
-    return (demand > coefficient).where(demand.notnull())
+    demand = cube.peak_friction_demand.where(tied(cube))
+    limit = soil_friction(cube) if coefficient is None else coefficient
+    return (demand > limit).where(demand.notnull())
 
 
 def uplift_intensity(cube, block) -> float:
@@ -270,20 +289,27 @@ def scale_factor_summary(cube) -> tuple[float, float]:
     return float(np.nanmedian(values)), float(np.nanmax(values))
 
 
-def sliding_share(cube, models, block, soil, coefficient: float, up_to: float) -> float:
+def sliding_share(cube, models, block, soil, coefficient: float | None, up_to: float) -> float:
     """Share of the runs at levels up to ``up_to`` (unit of the levels) that need more friction than ``coefficient``.
 
-    From the first of ``models`` that the cube holds and that reports the friction demand; NaN when none
-    does. At least the lowest level counts, so a block whose levels all lie above
+    ``coefficient`` None: the soil's mu_s. From the first of ``models`` that the cube holds and that reports the
+    friction demand on a tied base; NaN when none does (a cell that runs with friction slides where it must: its
+    slip damage states answer instead). At least the lowest level counts, so a block whose levels all lie above
     ``up_to`` still gets an answer from its mildest runs.
     """
     if "peak_friction_demand" not in cube:
         return float("nan")
+    if coefficient is None:
+        friction = soil_friction(cube)
+        coefficient = float(friction.sel(soil=soil)) if hasattr(friction, "sel") else float(friction)
+    ties = tied(cube)
     names = [m for m in models if m in set(map(str, cube.model.values))]
     levels = block_levels(cube, block)
     keep = np.flatnonzero(levels <= up_to * (1 + 1e-9))
     keep = keep if keep.size else np.array([0])
     for name in names:
+        if ties is not True and not bool(ties.sel(model=name, block=block, soil=soil)):
+            continue
         demand = cube.peak_friction_demand.sel(model=name, block=block, soil=soil).isel(im_level=keep)
         valid = demand.notnull() & (cube.outcome.sel(model=name, block=block, soil=soil).isel(im_level=keep)
                                     != OUTCOME_FAILED)

@@ -139,7 +139,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         judged = ", ".join(f"{short[s]} {percent(v)}" for s, v in limits.items())
         items.append(note(f"Verdict: 'check sliding' where more than {percent(results.decision['max_sliding_share'])} "
                           f"of the runs up to the {answer.return_periods[-1]:,.0f}-year intensity need a base friction "
-                          f"above {results.friction_coefficient:g}; else 'anchor' where a probability in "
+                          f"above the soil's μ_s ({results.friction_text}) on a tied base (the runs with friction "
+                          "answer with their slip damage states); else 'anchor' where a probability in "
                           f"{life} exceeds the study's limit ({judged or 'none set'}); else 'no action'. States "
                           "without a limit are reported, not judged. 'not reached below X': no record reached the "
                           "state at any level up to X, so its probability is at most that of exceeding X."))

@@ -58,7 +58,6 @@ from pipeline.report.text import Item, bullet, heading, note, paragraph, table
 from pipeline.report.vertical import VerticalEffect
 from pipeline.report.words import plain, state_short_label
 
-DEFAULT_FRICTION_COEFFICIENT = 0.5
 EXTRAPOLATION_ROWS = 30
 
 
@@ -93,9 +92,9 @@ class Results:
         return str(self.settings.get("title") or "Seismic fragility of unanchored rocking blocks")
 
     @property
-    def friction_coefficient(self) -> float:
-        """The friction coefficient [-] the sliding check compares with (``[report] friction_coefficient``)."""
-        return float(self.settings.get("friction_coefficient", DEFAULT_FRICTION_COEFFICIENT))
+    def friction_text(self) -> str:
+        """Each soil's static friction coefficient, as the sliding check compares with: "clay 0.35, sand 0.45"."""
+        return ", ".join(f"{soil.name} {soil.friction_static:g}" for soil in self.config.soils)
 
     @cached_property
     def hazard(self) -> HazardCurve | None:
@@ -137,7 +136,7 @@ class Results:
             top = intensity_at_frequency(hazard, 1.0 / max(periods)) / scale  # in the cube's unit
             candidates = [model, "winkler-centre", "winkler", *[str(m) for m in self.cube.model.values
                                                                  if str(m).startswith("winkler")]]
-            sliding = {(str(b), str(s)): sliding_share(self.cube, candidates, b, s, self.friction_coefficient, top)
+            sliding = {(str(b), str(s)): sliding_share(self.cube, candidates, b, s, None, top)
                        for b in self.cube.block.values for s in self.cube.soil.values}
         decision = self.decision
         return block_answers(self.fragility, hazard, periods, decision["max_probability_in_life"],
@@ -490,9 +489,9 @@ def limitations_items(results: Results) -> list[Item]:
     elif not found:
         items.append(paragraph("No foundation model of this study can pull on the block: tension does not arise."))
 
-    coefficient = results.friction_coefficient
+    coefficient = f"the soil's μ_s ({results.friction_text})"
     items.append(heading("Sliding"))
-    flag = friction_flag(cube, coefficient)
+    flag = friction_flag(cube)
     found = False
     for model in models:
         fraction = None if flag is None else run_fraction(cube, flag, model)
@@ -500,14 +499,15 @@ def limitations_items(results: Results) -> list[Item]:
             continue
         found = True
         if float(fraction.max()) == 0:
-            items.append(paragraph(f"{model.label}: the friction needed to hold the base never exceeded "
-                                   f"μ = {coefficient:g}."))
+            items.append(paragraph(f"{model.label}, runs with a tied base: the friction needed to hold the base "
+                                   f"never exceeded {coefficient}."))
             continue
         items.append(paragraph(
-            f"Every model assumes the base does not slide. {model.label}: holding the base needed a friction "
-            f"coefficient above μ = {coefficient:g} in {_percent(float(fraction.mean()))} of the runs (all levels); "
-            "there the block would slide or slide-rock, which the rocking results do not describe. The answer pages "
-            "count the runs up to the largest return-period intensity. Fraction of runs above μ:"))
+            f"{model.label}, runs with a tied base (no friction: [solver] friction; the runs with friction slide "
+            f"where they must, and their slip is in the cube and the slip damage states): holding the base needed "
+            f"a friction coefficient above {coefficient} in {_percent(float(fraction.mean()))} of those runs (all "
+            "levels); there the block would slide or slide-rock, which the rocking results do not describe. The "
+            "answer pages count the runs up to the largest return-period intensity. Fraction of runs above μ_s:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
     if not found:
         items.append(paragraph("No model of this study reports the friction demand (|H|/N at the base); every model "
