@@ -63,7 +63,7 @@ register_damage_state(DamageState("slip-0.05", "peak_slip", 0.05,
                                   "the base slid 0.05 m or more (cables, pipes and anchors strained)"))
 register_damage_state(DamageState("slip-0.30", "peak_slip", 0.30,
                                   "the base slid 0.30 m or more: off a plinth whose edge is 0.30 m beyond the base "
-                                  "(a typical edge distance; set your plinth's in [damage_states.slip-0.30])"))
+                                  "(a typical edge distance; set your plinth's in the study file)"))
 
 
 def is_slip_state(state: DamageState) -> bool:

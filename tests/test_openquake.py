@@ -28,6 +28,7 @@ from pipeline.exchange import (
     openquake_imt,
     openquake_limit_state,
     pelicun_id,
+    state_families,
     write_exchange_files,
 )
 from pipeline.hazard import HazardCurve
@@ -76,7 +77,9 @@ def near_a_step(cell: xr.Dataset, levels: np.ndarray) -> np.ndarray:
 
 
 def check_functions(dataset: xr.Dataset, read: dict) -> None:
-    """Every cell has its function, with our limit states, IMT, medians, betas and curves."""
+    """Every cell has its function, with our limit states, IMT, medians, betas and curves (the rocking states:
+    a sliding cell's slip states are a file of their own)."""
+    dataset = dataset.sel(damage_state=state_families(dataset)[""])
     assert read["limitStates"] == [openquake_limit_state(s) for s in dataset.damage_state.values]
     cells = {pelicun_id(b, s, m): (s, b, m) for s in dataset.soil.values for b in dataset.block.values
              for m in dataset.model.values}

@@ -345,7 +345,7 @@ def _capacity(monkeypatch, stripes, statuses, rule, resolution=0.02):
     monkeypatch.setattr("pipeline.study.simulate_batch", fake)
     summary = np.zeros(len(stripes), dtype=[("status", "f8")])
     summary["status"] = [float(s) for s in statuses]
-    job = ("key", "housner", None, None, None)
+    job = ("key", "housner", None, None, None, None)  # (key, model, block, k, xi, friction): tied
     return cell_capacity(np.zeros(3), 0.01, np.asarray(stripes, float), summary, job, {}, 1.0, resolution), calls
 
 

@@ -540,6 +540,11 @@ def limitations_items(results: Results) -> list[Item]:
         if len(outside) > EXTRAPOLATION_ROWS:
             items.append(note(f"... and {len(outside) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
     unfitted = status[status.status == "no fit"]
+    if "status" in fragility and not unfitted.empty:  # a tied cell's slip states have no curve by design
+        applicable = [str(fragility["status"].sel(soil=r.soil, block=r.block, model=r.model,
+                                                  damage_state=r.damage_state).values) != "not-applicable"
+                      for r in unfitted.itertuples()]
+        unfitted = unfitted[applicable]
     short_states = {name: state_short_label(name, str(text)) for name, text in
                     zip(map(str, fragility.damage_state.values), fragility["damage_state_description"].values)} \
         if "damage_state_description" in fragility.coords else {}
