@@ -407,10 +407,10 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:
                 verdict = NO_VERDICT
+            elif any(r.exceeds for r in rows):  # anchoring also stops the sliding: it never hides behind it
+                verdict = ANCHOR
             elif np.isfinite(share) and share > max_sliding_share:
                 verdict = CHECK_SLIDING
-            elif any(r.exceeds for r in rows):
-                verdict = ANCHOR
             else:
                 verdict = NO_ACTION
             soils.append(SoilAnswer(soil, tuple(rows), share, verdict))
@@ -468,7 +468,9 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
         for state in dict.fromkeys(r.state for s in soils for r in s.states if r.exceeds):
             values = [r.probability_in_life for s in soils for r in s.states if r.state == state and r.exceeds]
             limit = next(r.limit for s in soils for r in s.states if r.state == state)
-            shown = percent(min(values)) if len(values) == 1 else f"{percent(min(values))} to {percent(max(values))}"
+            def near(value, limit=limit):  # a value that rounds to the limit is shown to three digits
+                return f"{100 * value:.3g}%" if percent(value) == percent(limit) else percent(value)
+            shown = near(min(values)) if len(values) == 1 else f"{near(min(values))} to {near(max(values))}"
             reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
                            f"{percent(limit)} limit")
         return "; ".join(reasons)
@@ -480,7 +482,7 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
             continue
         where = "on " + _and([s.soil for s in soils])
         if verdict == ANCHOR:
-            parts.append(f"anchor it {where} ({exceeded(soils)})")
+            parts.append(f"anchor it {where} ({exceeded(soils)}; the anchorage holds it against sliding too)")
         elif verdict == CHECK_SLIDING:
             shares = [s.sliding_share for s in soils]
             shown = percent(min(shares)) if len(shares) == 1 else f"{percent(min(shares))} to {percent(max(shares))}"

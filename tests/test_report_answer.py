@@ -94,6 +94,10 @@ def test_the_verdict_follows_the_stated_limits_and_the_sliding_share():
     sliding = block_answers(fragility, hazard, limits={"overturning": 0.01}, max_sliding_share=0.1,
                             sliding={("cabinet", "clay"): 0.05, ("cabinet", "rock"): 0.4})[0]
     assert [s.verdict for s in sliding.soils] == [ANCHOR, CHECK_SLIDING]
+    # a block that must be anchored is told so even where it also slides (the client read "check sliding" only)
+    both = block_answers(fragility, hazard, limits={"overturning": 0.01}, max_sliding_share=0.1,
+                         sliding={("cabinet", "clay"): 0.4, ("cabinet", "rock"): 0.4})[0]
+    assert [s.verdict for s in both.soils] == [ANCHOR, CHECK_SLIDING]
     assert block_answers(fragility, None)[0].soils[0].verdict == NO_VERDICT
     sentence = verdict_sentence(answer, "slender electrical cabinet", {"overturning": "the block overturns"})
     assert "anchor it on clay" in sentence and "no action on rock" in sentence

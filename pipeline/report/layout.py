@@ -33,7 +33,8 @@ SOIL_COLOURS = {"clay": "#8c510a", "sand": "#d8a03a", "gravel": "#35978f", "rock
                 "steel": "#5e3c99"}
 RIGID_STYLE = dict(color="black", ls="--", lw=1.5, zorder=4)  # on top: its dashes stay visible
 MODEL_STYLES = [dict(color="#d62728", ls="-", lw=1.4), dict(color="#1f77b4", ls="-.", lw=1.4),
-                dict(color="#2ca02c", ls=":", lw=1.6), dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4)]
+                dict(color="#2ca02c", ls=":", lw=1.6), dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4),
+                dict(color="#ff7f0e", ls="--", lw=1.4), dict(color="#8c564b", ls=(0, (3, 1, 1, 1, 1, 1)), lw=1.4)]
 FRACTILE_STYLES = {0.16: dict(color="#1f77b4", ls="--", lw=1.5), 0.5: dict(color="black", ls="-", lw=2.2),
                    0.84: dict(color="#d62728", ls=":", lw=1.8)}
 OUTCOME_COLOURS = {"no_uplift": "#c7e9c0", "rocking": "#fdae6b", "overturned": "#d7301f",

@@ -18,6 +18,7 @@ FIT_METHODS = {
     "exact-g-tan-alpha": "the exact uplift threshold g·tanα (a step)",
     "step-between-levels": "a step between two levels (every record changed state there)",
     "none": "no fit (the state was not reached, or reached by most records at the lowest level)",
+    "band-centre-p58": "the restitution band's centre, its dispersion widened by the band's spread (FEMA P-58)",
 }
 """``fit_method`` of fragility.nc in words."""
 
