@@ -151,13 +151,18 @@ def study_scale_factors(intensity, record_im) -> np.ndarray:
     return intensity.T[None, :, :] / record_im[:, None, :]
 
 
-def refines_capacity(model: str) -> bool:
-    """Whether a model's cells refine their overturning capacities: all but a restitution band's edges.
+def refines_capacity(model: str, friction: tuple[float, float] | None = None) -> bool:
+    """Whether a cell refines its overturning capacities: not a restitution band's edges, not a sliding base.
 
-    The recommended curve is the band centre's fit; the edges give only its model dispersion (from their
-    stripe fits), so their capacity runs would check a curve no output publishes.
+    The refined capacities check the stripe fit of the overturning curve (``capacity_median``). The recommended
+    curve is the band centre's fit; the edges give only its model dispersion (from their stripe fits), so their
+    capacity runs would check a curve no output publishes. A block that slides (mu_s < b/h) overturns, if at
+    all, only far beyond the credible intensities, and its sliding runs there cost 3-4 times a tied run (the
+    squat skid's refining runs were half the default study's time): its stripe fit stands alone. Nor do the
+    paper's spring models (``can_pull``): references whose runs after the spring pulls are not physical, so
+    a 2% capacity would refine a number nobody should read.
     """
-    return split_variant(model)[1] not in ("low", "high")
+    return split_variant(model)[1] not in ("low", "high") and friction is None and not get_model(model).can_pull
 
 
 def capacity_key(key, resolution) -> str:
@@ -387,7 +392,7 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
     if capacity_resolution > 0:
         refined = {}
         for key, model, block, k, xi, friction in jobs:
-            if not refines_capacity(model):
+            if not refines_capacity(model, friction):
                 continue
             case = (get_model(model).name, block, k, xi, friction)
             if case not in refined:
@@ -622,7 +627,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     results = store.load_verified(keys, (n_levels,), SUMMARY_DTYPE)
     if resolution > 0:
         refining = list(dict.fromkeys(c.key for variant in variants for cells in all_cells[variant] for c in cells
-                                      if refines_capacity(c.model)))
+                                      if refines_capacity(c.model, c.friction)))
         results.update(store.load_verified([capacity_key(k, resolution) for k in refining], (4,), np.float64))
     tasks = [(*task, variant) for variant in variants
              for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration)]
@@ -737,7 +742,7 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
     for index, cells in enumerate(all_cells):
         by_block = {}
         for cell in {c.key: c for c in cells}.values():
-            done = cell.key in available and (resolution <= 0 or not refines_capacity(cell.model)
+            done = cell.key in available and (resolution <= 0 or not refines_capacity(cell.model, cell.friction)
                                               or capacity_key(cell.key, resolution) in available)
             if not done:
                 by_block.setdefault(cell.block_index, []).append(cell)
@@ -763,14 +768,15 @@ def gather_capacities(all_cells, available, config, intensity, resolution):
         return None, {}
     for r, cells in enumerate(all_cells):
         for cell in cells:
-            if not refines_capacity(cell.model):
+            if not refines_capacity(cell.model, cell.friction):
                 continue
             result = available[capacity_key(cell.key, resolution)]
             soils = slice(None) if cell.soil_index is None else cell.soil_index
             capacities[:, r, soils, cell.block_index, config.models.index(cell.model)] = result[:, None] \
                 if cell.soil_index is None else result
     # the run accounting counts each computed cell once (a tied housner cell shared by soils is one)
-    unique = [c for cells in all_cells for c in {c.key: c for c in cells}.values() if refines_capacity(c.model)]
+    unique = [c for cells in all_cells for c in {c.key: c for c in cells}.values()
+              if refines_capacity(c.model, c.friction)]
     extra = sum(int(available[capacity_key(c.key, resolution)][3]) for c in unique)
     n_cells = len(unique)
     n_levels = intensity.shape[1]

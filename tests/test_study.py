@@ -66,7 +66,7 @@ def test_invalid_study_names_field_and_file(tmp_path, text, field):
 
 def test_default_study_matches_the_issue():
     config = load_study()
-    assert len(config.levels) == 28 and config.measure == "pga"
+    assert len(config.levels) == 20 and config.measure == "pga"
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
     assert config.models == ("housner", "ssi", "winkler-low", "winkler-centre", "winkler-high")
     assert config.restitution == "band" and len(config.blocks) == 3
