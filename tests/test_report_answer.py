@@ -156,3 +156,34 @@ def test_the_study_states_the_limits_and_return_periods(tmp_path):
         with pytest.raises(ConfigError) as error:
             load_study(study)
         assert error.value.field == field
+
+
+def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nearest_level():
+    """Issue 19: which mode governs at each return-period intensity. Mode times where the base slides; the
+    outcome where it is tied (no mode times); the recommended curve reads the band centre's runs."""
+    import xarray as xr
+
+    from pipeline.models.fields import MODE_TIME_FIELDS
+    from pipeline.models.variants import RECOMMENDED
+    from pipeline.report.answer_page import governing_modes
+
+    levels = np.array([0.1, 0.3, 1.0])  # g
+    times = np.zeros((4, 3, 1, 1, 2, len(MODE_TIME_FIELDS)))  # record, level, soil, block, model, mode
+    times[:, 0, ..., 0] = 10.0   # at rest at 0.1 g
+    times[:, 1, ..., 1] = 10.0   # slides at 0.3 g
+    times[:, 1, ..., 2] = 2.0
+    times[:, 2, ..., 3] = 10.0   # slides and rocks at 1 g
+    times[..., 1, :] = np.nan    # the second model is tied: no mode times
+    outcome = np.zeros((4, 3, 1, 1, 2), np.int8)
+    outcome[:, 1:, ..., 1] = 1   # tied: rocks from 0.3 g
+    outcome[:3, 2, ..., 1] = 2   # ... and 3 of 4 records overturn at 1 g
+    dims = ("record", "im_level", "soil", "block", "model")
+    cube = xr.Dataset({field: (dims, times[..., k]) for k, field in enumerate(MODE_TIME_FIELDS)} |
+                      {"outcome": (dims, outcome)},
+                      coords={"soil": ["clay"], "block": ["skid"], "model": ["winkler-centre", "housner"],
+                              "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
+    assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.28, 0.9], 1.0) == \
+        ["at rest", "slides", "slides and rocks"]
+    assert governing_modes(cube, "skid", "housner", "clay", [0.1, 0.3, 1.0], 1.0) == \
+        ["at rest (100% of the records)", "rocks (100% of the records)", "overturns (75% of the records)"]
+    assert governing_modes(None, "skid", "housner", "clay", [0.1], 1.0) == ["-"]

@@ -17,6 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
+from pipeline.models.base import Outcome
+from pipeline.models.fields import MODE_TIME_FIELDS
+from pipeline.models.variants import variant_name
 from pipeline.report.adapters import block_description, block_name, measure_label, model_info, state_labels
 from pipeline.report.text import Item, note, paragraph, strong, table
 from pipeline.report.words import state_short_label
@@ -56,6 +59,45 @@ def curve_reason(results, model: str) -> str:
                 "adds the uncertainty of the impact dissipation, was not in the results.")
     return (f"The answer uses the {model_info(model).label}: the study did not run the tensionless Winkler bed, "
             "so read it with the Limitations page, which says where this model is outside its assumptions.")
+
+
+MODE_WORDS = {"time_at_rest": "at rest", "time_sliding": "slides", "time_rocking": "rocks",
+              "time_slide_rocking": "slides and rocks", "time_in_flight": "flies"}
+"""The contact modes of a run (pipeline.models.fields.MODE_TIME_FIELDS) in words."""
+
+
+def governing_modes(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
+    """What the block mostly does at each intensity: the mode with the longest median time over the records.
+
+    At the cube's level nearest each intensity (in the answer's unit, ``scale`` times the cube's), from the runs
+    of ``model`` (the recommended curve's: the band centre). A tied base has no mode times: there the outcome
+    says it ("at rest" without uplift, "rocks", "overturns" for most records).
+    """
+    if cube is None or "intensity" not in cube:
+        return ["-"] * len(intensities)
+    name = variant_name("winkler", "centre") if model == RECOMMENDED else model
+    if name not in cube.model.values:
+        return ["-"] * len(intensities)
+    levels = np.asarray(cube.intensity.sel(block=block).values, float) * scale
+    cell = cube.sel(block=block, soil=soil, model=name)
+    out = []
+    for im in intensities:
+        level = int(np.argmin(np.abs(np.log(levels / im))))
+        runs = cell.isel(im_level=level)
+        times = {field: runs[field].values for field in MODE_TIME_FIELDS if field in runs}
+        if times and all(np.isfinite(v).any() for v in times.values()):
+            times = {field: float(np.nanmedian(v)) for field, v in times.items()}
+            overturned = float(np.mean(runs.outcome.values == int(Outcome.OVERTURNED)))
+            mode = MODE_WORDS[max(times, key=times.get)]
+            out.append(f"{mode} (overturns: {percent(overturned)})" if overturned > 0 else mode)
+            continue
+        outcome = runs.outcome.values
+        shares = {"at rest": np.mean(outcome == int(Outcome.NO_UPLIFT)),
+                  "rocks": np.mean(outcome == int(Outcome.ROCKING)),
+                  "overturns": np.mean(outcome == int(Outcome.OVERTURNED))}
+        mode = max(shares, key=shares.get)
+        out.append(f"{mode} ({percent(shares[mode])} of the records)")
+    return out
 
 
 def answer_items(results, answer: BlockAnswer) -> list[Item]:
@@ -113,6 +155,15 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                         cells.append(percent(p))
                 rows.append(cells)
         items.append(table(header, rows))
+        cube = getattr(results, "cube", None)
+        scale = display_scale(cube.intensity.attrs.get("units", ""))[0] if cube is not None and "intensity" in cube \
+            else 1.0
+        modes = [[soil.soil, *governing_modes(cube, answer.block, answer.model, soil.soil, answer.intensities, scale)]
+                 for soil in answer.soils]
+        if any(cell != "-" for row in modes for cell in row[1:]):
+            items.append(paragraph("What the block does at each return period's intensity (the mode that lasts "
+                                   "longest in the median record, at the nearest level run):"))
+            items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], modes))
         items.append(note(f"P(damage state) at each return period's intensity, in brackets its band: the "
                           f"{_confidence(fragility)} confidence bounds of the median, records resampled. 'not "
                           f"reached': no record reached the state up to {largest:.2g} {unit}."))
@@ -137,11 +188,12 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                "happens on average), per soil:"))
         items.append(table(header, rows))
         judged = ", ".join(f"{short[s]} {percent(v)}" for s, v in limits.items())
-        items.append(note(f"Verdict: 'check sliding' where more than {percent(results.decision['max_sliding_share'])} "
-                          f"of the runs up to the {answer.return_periods[-1]:,.0f}-year intensity need a base friction "
-                          f"above the soil's μ_s ({results.friction_text}) on a tied base (the runs with friction "
-                          "answer with their slip damage states); else 'anchor' where a probability in "
-                          f"{life} exceeds the study's limit ({judged or 'none set'}); else 'no action'. States "
+        items.append(note(f"Verdict: 'anchor' where a probability in {life} exceeds the study's limit "
+                          f"({judged or 'none set'}; an anchorage holds the block against sliding too); else 'check "
+                          f"sliding' where more than {percent(results.decision['max_sliding_share'])} of the runs up "
+                          f"to the {answer.return_periods[-1]:,.0f}-year intensity need a base friction above the "
+                          f"soil's μ_s ({results.friction_text}) on a tied base (the runs with friction answer with "
+                          "their slip damage states); else 'no action'. States "
                           "without a limit are reported, not judged. 'not reached below X': no record reached the "
                           "state at any level up to X, so its probability is at most that of exceeding X."))
     else:
