@@ -43,7 +43,7 @@ ANSWER_MODELS = (RECOMMENDED, "winkler-centre", "winkler", "ssi", "ssi-paper", "
 DEFAULT_RETURN_PERIODS = (475.0, 975.0, 2475.0)
 """Return periods [years] of the answer pages when the study gives none (10%, 5%, 2% in 50 years)."""
 
-DEFAULT_LIMITS = {"overturning": 0.01, "rocking-0.5": 0.10}
+DEFAULT_LIMITS = {"overturning": 0.01, "rocking-0.5": 0.10, "slip-0.30": 0.10}
 """``[decision] max_probability_in_life`` when the study gives none (pipeline/defaults.toml says why)."""
 
 DEFAULT_SLIDING_SHARE = 0.10

@@ -146,7 +146,8 @@ def test_the_study_states_the_limits_and_return_periods(tmp_path):
                      '{ overturning = 0.02 }\n')
     raw = load_study(study).raw
     assert raw["hazard"]["return_periods"] == [100.0, 2475.0]
-    assert raw["decision"]["max_probability_in_life"] == {"overturning": 0.02, "rocking-0.5": 0.10}  # merged
+    assert raw["decision"]["max_probability_in_life"] == {"overturning": 0.02, "rocking-0.5": 0.10,
+                                                          "slip-0.30": 0.10}  # merged
     for text, field in (('[decision]\nmax_probability_in_life = { toppling = 0.01 }\n',
                          "decision.max_probability_in_life.toppling"),
                         ('[decision]\nmax_probability_in_life = { overturning = 2.0 }\n',
