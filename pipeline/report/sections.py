@@ -528,7 +528,7 @@ def limitations_items(results: Results) -> list[Item]:
     else:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
-            "lognormal fit beyond the levels that were run and are marked * in the summary."))
+            "lognormal fit beyond the levels that were run (the summary marks them * for the states it shows)."))
         rows = []
         for row in outside.head(EXTRAPOLATION_ROWS).itertuples():
             levels = block_levels(fragility, row.block) * scale

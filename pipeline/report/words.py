@@ -36,15 +36,16 @@ STATUS_WORDS = {
 """A fitted row's ``status`` (fragility.csv) in words."""
 
 SWITCH_WORDS = {
-    "consistent": "at each impact the pivot switches keeping the rotation rate and the velocity of the centre of "
-                  "mass (Housner's restitution follows)",
+    "consistent": "at each impact the pivot switches with the rotation rate and the velocity of the centre of mass "
+                  "unchanged, so the switch itself loses no energy; the spring's dashpot then takes out what the "
+                  "corner impact would (a stiff spring gives Housner's restitution)",
     "continuous": "at each impact the pivot switches keeping the rotation rate and the vertical velocity",
 }
 """The paper's model's pivot-switch rule in words."""
 
 BED_WORDS = {
     "continuous": "springs and dashpots over the whole footprint",
-    "two-spring": "one spring and dashpot under each corner",
+    "two-spring": "the bed's stiffness as one spring and dashpot under each corner (the default)",
     "hunt-crossley": "springs over the footprint with impact damping that vanishes with the penetration",
 }
 """The tensionless bed's contact law in words."""
