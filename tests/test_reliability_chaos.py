@@ -79,7 +79,9 @@ def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
         during_work = target == "worker" or rng.random() < 0.6  # else: at a random point of start-up
         seen_children: set[int] = set()
         if during_work:
-            wait_until(lambda: bool(children(process.pid)) or process.poll() is not None, timeout=90)
+            # the workers seen when they appear count too: a short run's pool may be gone after the random pause
+            wait_until(lambda: bool(seen_children.update(children(process.pid)) or seen_children)
+                       or process.poll() is not None, timeout=90)
             time.sleep(rng.uniform(0.0, 0.2))
         else:
             deadline = time.monotonic() + rng.uniform(0.2, 3.0)
@@ -87,8 +89,9 @@ def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
                 time.sleep(0.02)
         seen_children |= children(process.pid)
         if target == "worker":
-            if seen_children and process.poll() is None:
-                os.kill(rng.choice(sorted(seen_children)), signal.SIGKILL)
+            running = children(process.pid)  # a worker seen earlier may have finished
+            if running and process.poll() is None:
+                os.kill(rng.choice(sorted(running)), signal.SIGKILL)
                 outcomes.append("worker killed")
             try:
                 _, stderr = process.communicate(timeout=120)
