@@ -22,6 +22,8 @@ from dataclasses import dataclass
 from pipeline.errors import ConfigError
 
 SLIP_EDPS = ("peak_slip",)
+NOT_APPLICABLE = "not-applicable"
+"""The fragility ``status`` of a slip state in a cell whose base is tied (no friction: no slip to fit)."""
 """EDPs of the slip family: the peak horizontal slip of the base [m]."""
 EDPS = ("uplifted", "overturned", "peak_angle_ratio", "peak_angle", "peak_uplift", "n_impacts", *SLIP_EDPS)
 """Engineering demand parameters a damage state may use: the two outcomes, then cube variables."""

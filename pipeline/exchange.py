@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pipeline.damage_states import SLIP_EDPS
+from pipeline.damage_states import NOT_APPLICABLE, SLIP_EDPS
 from pipeline.errors import ConfigError
 from pipeline.measures import MEASURES, Measure, convert_units, unit_label
 from pipeline.models.variants import RECOMMENDED
@@ -53,7 +53,6 @@ from pipeline.outputs import atomic_path
 PELICUN_FILE = "fragility_pelicun.csv"
 OPENQUAKE_FILE = "fragility_openquake.xml"
 OPENQUAKE_SLIP_FILE = "fragility_openquake_slip.xml"
-NOT_APPLICABLE = "not-applicable"  # pipeline.fragility's status of a tied cell's slip rows
 
 STEP_BETA = 0.001
 """The lognormal dispersion that stands for a step (beta = 0) in OpenQuake's continuous format: the

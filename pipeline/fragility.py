@@ -54,6 +54,7 @@ from pipeline.cube import (
 )
 from pipeline.damage_states import (
     DAMAGE_STATES,
+    NOT_APPLICABLE,
     DamageState,
     damage_states_from_config,
     is_slip_state,
@@ -96,7 +97,7 @@ STATUS = {
     "above-range": "a few records reached the state, only at the highest level: the median is above the range",
     "deterministic-threshold": "an exact step at g tan(alpha) (uplift under PGA scaling), beta = 0",
     "separated": "perfectly separated counts: a step between two levels, beta = 0 (not identifiable)",
-    "not-applicable": "a slip state of a cell whose base is tied (no friction, no sliding: [solver] friction); "
+    NOT_APPLICABLE: "a slip state of a cell whose base is tied (no friction, no sliding: [solver] friction); "
                       "no curve",
 }
 """The ``status`` of a fragility row and what it means (the report prints these)."""
@@ -292,7 +293,7 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
         row = RowFit()
         has_data = total[s] > 0
         if is_slip_state(state) and not has_data.any():
-            row.status = "not-applicable"
+            row.status = NOT_APPLICABLE
             row.warn("the base is tied in this cell (no friction): it does not slide")
         elif state.edp == "uplifted" and threshold is not None:
             row.median, row.beta, row.method, row.status = float(threshold), 0.0, "exact-g-tan-alpha", \

@@ -324,11 +324,8 @@ def simulate_batch(model: str, ag: ArrayLike, dt: float, scales: ArrayLike,
     t_end : float, optional
         End time [s], >= 0 (see ``simulate``). Default: the record + 10 s.
     **options : float or str or None
-        ``SolverOptions`` fields, as in ``simulate``: ``switch`` (ssi), ``bed`` (winkler's contact law),
-        ``restitution`` [-] (pivot models: the impact coefficient; winkler: the target to which each
-        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``,
-        ``friction`` (housner, winkler: mu or (mu_s, mu_k); the summaries then carry ``peak_slip``,
-        ``residual_slip`` and the ``time_*`` of each contact mode).
+        ``SolverOptions`` fields, as in ``simulate`` (``switch``, ``bed``, ``restitution``, ``g``,
+        ``overturn_angle``, ``rtol``, ``atol``, ``friction``).
 
     Returns
     -------
@@ -375,11 +372,8 @@ def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tup
     t_end : float, optional
         End time [s], >= 0 (see ``simulate``). Default: the record + 10 s.
     **options : float or str or None
-        ``SolverOptions`` fields, as in ``simulate``: ``switch`` (ssi), ``bed`` (winkler's contact law),
-        ``restitution`` [-] (pivot models: the impact coefficient; winkler: the target to which each
-        case's bed damping is calibrated), ``g`` [m/s^2], ``overturn_angle`` [rad], ``rtol``, ``atol``,
-        ``friction`` (housner, winkler: mu or (mu_s, mu_k); the summaries then carry ``peak_slip``,
-        ``residual_slip`` and the ``time_*`` of each contact mode).
+        ``SolverOptions`` fields, as in ``simulate`` (``switch``, ``bed``, ``restitution``, ``g``,
+        ``overturn_angle``, ``rtol``, ``atol``, ``friction``).
 
     Returns
     -------

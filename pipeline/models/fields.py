@@ -86,6 +86,15 @@ class SummaryField:
     per_mass: bool = False  # stored per unit mass in the kernel; the cube multiplies by the mass
 
 
+MODE_TIMES = {
+    "time_at_rest": "time with the base stuck and wholly on the ground",
+    "time_sliding": "time with the base sliding and wholly on the ground",
+    "time_rocking": "time rocking (part of the base lifted) on a stuck contact",
+    "time_slide_rocking": "time rocking (part of the base lifted) on a sliding contact",
+    "time_in_flight": "time with the whole base off the ground",
+}
+"""Summary field and long name of the time in each contact mode [s], in the order of the MODE_* codes."""
+
 SUMMARY_FIELDS = (
     SummaryField("status", "1", "outcome of the run (pipeline.models.base.Outcome)"),
     SummaryField("peak_angle", "rad", "peak absolute rocking angle"),
@@ -112,13 +121,9 @@ SUMMARY_FIELDS = (
                  "there: outcome free_flight; NaN: never)"),
     SummaryField("peak_slip", "m", "peak absolute horizontal slip of the base relative to the ground (0: tied base)"),
     SummaryField("residual_slip", "m", "absolute horizontal slip of the base at the end of the run"),
-    SummaryField("time_at_rest", "s", "time with the base stuck and wholly on the ground"),
-    SummaryField("time_sliding", "s", "time with the base sliding and wholly on the ground"),
-    SummaryField("time_rocking", "s", "time rocking (part of the base lifted) on a stuck contact"),
-    SummaryField("time_slide_rocking", "s", "time rocking (part of the base lifted) on a sliding contact"),
-    SummaryField("time_in_flight", "s", "time with the whole base off the ground"),
+    *(SummaryField(name, "s", long_name) for name, long_name in MODE_TIMES.items()),
 )
-MODE_TIME_FIELDS = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight")
+MODE_TIME_FIELDS = tuple(MODE_TIMES)
 """The summary field of each contact mode, in the order of the MODE_* codes."""
 FIELDS_BY_NAME = {field.name: field for field in SUMMARY_FIELDS}
 

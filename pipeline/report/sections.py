@@ -29,6 +29,7 @@ from pipeline.answer import (
     percent,
 )
 from pipeline.config import StudyConfig
+from pipeline.damage_states import NOT_APPLICABLE
 from pipeline.errors import PipelineError
 from pipeline.hazard import HazardCurve, study_hazard
 from pipeline.report.adapters import (
@@ -542,7 +543,7 @@ def limitations_items(results: Results) -> list[Item]:
     unfitted = status[status.status == "no fit"]
     if "status" in fragility and not unfitted.empty:  # a tied cell's slip states have no curve by design
         applicable = [str(fragility["status"].sel(soil=r.soil, block=r.block, model=r.model,
-                                                  damage_state=r.damage_state).values) != "not-applicable"
+                                                  damage_state=r.damage_state).values) != NOT_APPLICABLE
                       for r in unfitted.itertuples()]
         unfitted = unfitted[applicable]
     short_states = {name: state_short_label(name, str(text)) for name, text in

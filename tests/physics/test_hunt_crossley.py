@@ -25,8 +25,8 @@ from pipeline.models import bed_hunt_crossley as law
 from pipeline.models.restitution import launch_rate
 
 from . import winkler_reference as reference
-from .test_winkler_vs_reference import BLOCK as RECORD_BLOCK
-from .test_winkler_vs_reference import SAMPLES, TAIL, case_motion
+from .motions import BLOCK as RECORD_BLOCK
+from .motions import SAMPLES, TAIL, case_motion
 
 G = 9.80665
 BED = "hunt-crossley"
