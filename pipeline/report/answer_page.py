@@ -17,9 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
-from pipeline.fragility import band_models
 from pipeline.models.base import Outcome
 from pipeline.models.fields import MODE_TIME_FIELDS
+from pipeline.models.variants import split_variant
 from pipeline.report.adapters import block_description, block_name, measure_label, model_info, state_labels
 from pipeline.report.text import Item, note, paragraph, strong, table
 from pipeline.report.words import state_short_label
@@ -75,7 +75,8 @@ def governing_modes(cube, block: str, model: str, soil: str, intensities, scale:
     """
     if cube is None or "intensity" not in cube:
         return ["-"] * len(intensities)
-    name = (band_models([str(m) for m in cube.model.values]) or {}).get("centre") if model == RECOMMENDED else model
+    centres = [str(m) for m in cube.model.values if split_variant(str(m))[1] == "centre"]  # the band's centre
+    name = (centres[0] if centres else None) if model == RECOMMENDED else model
     if name is None or name not in cube.model.values:
         return ["-"] * len(intensities)
     levels = np.asarray(cube.intensity.sel(block=block).values, float) * scale
