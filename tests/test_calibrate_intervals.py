@@ -18,6 +18,8 @@ from pipeline.models import simulate
 from pipeline.processing import process_record
 from pipeline.records import load_records
 
+pytestmark = pytest.mark.xdist_group("calibration-intervals")  # one worker computes the 40 seeds' intervals once
+
 SEGMENT = slice(800, 1400)  # Bolu 090, 8-14 s, x 2: the paper block rocks through four half-cycles, no overturning
 SCALE = 2.0
 K_TRUE, XI_TRUE = 4.6e8, 0.027  # off the default grid (as in tests/test_calibrate.py)

@@ -14,6 +14,7 @@ below zero (``free_flight_time``): the pivot models have no flight phase.
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -37,6 +38,43 @@ def free_flight_time(ag_vertical, dt, g=G):
                   (i - 1) * dt, i * dt, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
 
+def solve_by_interval(fun, t_start, t_stop, state, dt, events, args=(), first_step=None, **tolerances):
+    """solve_ivp(DOP853) from ``t_start`` to ``t_stop``, one sample interval of the ground motion at a time.
+
+    The ground motion is linear inside each interval [i dt, (i + 1) dt] and has a kink at each sample, so
+    the integrator restarts there instead of stepping across the kinks (where most of its steps were
+    rejected). Stops at the first terminal event like solve_ivp; returns an object with solve_ivp's ``t``,
+    ``y`` (every interval's points, concatenated), ``t_events`` and ``y_events``. ``first_step`` [s] bounds the
+    first step: an excursion starts on its event surface (theta = 0), so a first step that crossed the whole
+    excursion would find its end at the start.
+    """
+    events = tuple(events)
+    ts, ys = [np.array([t_start])], [np.asarray(state, dtype=float).reshape(-1, 1)]
+    t_events = [[] for _ in events]
+    y_events = [[] for _ in events]
+    t, y = t_start, np.asarray(state, dtype=float)
+    while t < t_stop:
+        knot = (math.floor(t / dt + 1e-9) + 1) * dt
+        t_next = min(knot, t_stop)
+        if t_next - t <= 1e-12 * max(1.0, t):
+            t = t_next
+            continue
+        first = None if first_step is None or t > t_start else min(first_step, t_next - t)
+        piece = solve_ivp(fun, (t, t_next), y, method="DOP853", events=events, args=args, first_step=first,
+                          **tolerances)
+        ts.append(piece.t[1:])
+        ys.append(piece.y[:, 1:])
+        for k in range(len(events)):
+            t_events[k].extend(piece.t_events[k])
+            y_events[k].extend(piece.y_events[k])
+        t, y = float(piece.t[-1]), piece.y[:, -1]
+        if piece.status == 1:  # a terminal event
+            break
+    return SimpleNamespace(t=np.concatenate(ts), y=np.concatenate(ys, axis=1),
+                           t_events=[np.array(v) for v in t_events],
+                           y_events=[np.array(v).reshape(-1, y.size) for v in y_events])
+
+
 def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, switch="consistent",
                        t_end=None, rtol=1e-10, atol=1e-12, ag_vertical=None):
     """Peak |theta| [rad], impact times [s] and whether the block overturned, up to t_end or to the free
@@ -53,12 +91,17 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
     vertical_samples = np.zeros(ag.size) if ag_vertical is None else np.asarray(ag_vertical, dtype=float)
     vertical_end = (np.flatnonzero(vertical_samples)[-1] + 1) * dt if np.any(vertical_samples) else -1.0
 
+    # the ground motion is piecewise linear through the samples and returns to zero one step after the last;
+    # the padded arrays are built once (building them in every call made the reference O(samples) per call)
+    knots = np.append(times, times[-1] + dt)
+    ground_knots, vertical_knots = np.append(ag, 0.0), np.append(vertical_samples, 0.0)
+
     def ground(t):
-        return float(np.interp(t, np.append(times, times[-1] + dt), np.append(ag, 0.0), right=0.0))
+        return float(np.interp(t, knots, ground_knots, right=0.0))
 
     def gravity(t):
         """G + a_v(t) [m/s^2]."""
-        return G + float(np.interp(t, np.append(times, times[-1] + dt), np.append(vertical_samples, 0.0), right=0.0))
+        return G + float(np.interp(t, knots, vertical_knots, right=0.0))
 
     def rocking(t, x, sigma):
         a = ground(t)
@@ -97,8 +140,7 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
             if uplift(t, state) > 0:
                 start = (t, -math.copysign(1.0, ground(t)))
             else:
-                solution = solve_ivp(vertical, (t, t_end), state, method="DOP853", rtol=rtol, atol=atol * y_static,
-                                     max_step=dt, events=uplift)
+                solution = solve_by_interval(vertical, t, t_end, state, dt, (uplift,), rtol=rtol, atol=atol * y_static)
                 state = solution.y[:, -1].copy()
                 t = solution.t[-1]
                 if not solution.t_events[0].size:
@@ -133,8 +175,8 @@ def reference_response(model, ag, dt, block, k=None, xi=0.05, restitution=None, 
             def extremum(time, x, s):
                 return x[1]
 
-            solution = solve_ivp(rocking, (t, t_end), state, method="DOP853", rtol=rtol, atol=atol,
-                                 max_step=dt, events=(impact, overturn, extremum), args=(sigma,))
+            solution = solve_by_interval(rocking, t, t_end, state, dt, (impact, overturn, extremum), args=(sigma,),
+                                         first_step=1e-6 * dt, rtol=rtol, atol=atol)
             for x_ext in solution.y_events[2]:
                 peak = max(peak, abs(x_ext[0]))
             peak = max(peak, float(np.max(np.abs(solution.y[0]))))
