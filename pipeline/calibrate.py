@@ -572,7 +572,7 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
 
 CONFIDENCE = 0.90
 """Default two-sided confidence level of the intervals of k and xi."""
-PROFILE_POINTS = 21  # values of the profiled parameter per profile
+PROFILE_POINTS = 11  # values of the profiled parameter per profile (0.5 Wald half-widths apart)
 PROFILE_SPAN = 2.5  # half-span of a profile, in linearised (Wald) half-widths
 INNER_ITERATIONS = 3  # Gauss-Newton steps of the inner minimisation per profile
 MLE_ITERATIONS = 8
@@ -718,14 +718,19 @@ def _bounds(positions, deviance, threshold):
 
 
 def _first_crossing(offsets, deviance, threshold):
-    """The offset at which ``deviance`` (ordered by growing distance) first reaches ``threshold``; None if never."""
+    """The offset at which ``deviance`` (ordered by growing distance) first reaches ``threshold``; None if never.
+
+    Interpolated linearly in the root deviance sqrt(D), which is linear in the parameter where the profile is
+    quadratic (the signed root of Venzon & Moolgavkar 1988), so that a coarse profile still finds its crossing.
+    """
     above = np.flatnonzero(deviance >= threshold)
     if not above.size:
         return None
     i = int(above[0])
     if i == 0:
         return float(offsets[0])
-    fraction = (threshold - deviance[i - 1]) / (deviance[i] - deviance[i - 1])
+    root_low, root_high = math.sqrt(max(deviance[i - 1], 0.0)), math.sqrt(deviance[i])
+    fraction = (math.sqrt(threshold) - root_low) / (root_high - root_low)
     return float(offsets[i - 1] + fraction * (offsets[i] - offsets[i - 1]))
 
 
