@@ -155,7 +155,9 @@ def test_resume_reuses_checkpoints_and_changed_soil_touches_only_its_cells(small
 def test_killed_run_resumes_without_recomputing(small_study, tmp_path):
     """kill -9 during a run, run again: finished cells are not recomputed, the cube is identical."""
     study = tmp_path / "study.toml"
-    study.write_text(SMALL.replace('record_sets = ["bolu"]', 'record_sets = ["far-field"]')
+    ten = ["NORTHR/MUL009", "NORTHR/MUL279", "DUZCE/BOL000", "DUZCE/BOL090", "KOBE/NIS000", "KOBE/NIS090",
+           "LANDERS/YER270", "LANDERS/YER360", "CAPEMEND/RIO270", "CAPEMEND/RIO360"]  # 90 cells: killed at 20
+    study.write_text(SMALL.replace('record_sets = ["bolu"]', f"record_sets = {ten}".replace("'", '"'))
                      .replace("levels = [0.1, 0.3, 0.6, 1.0]",  # one checkpoint file per cell
                               "levels = [0.6]\ncapacity_resolution = 0.0"))
     output = tmp_path / "out"
