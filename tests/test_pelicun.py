@@ -151,12 +151,17 @@ def written(folder) -> tuple[xr.Dataset, pd.DataFrame]:
     return dataset, pd.read_csv(folder / "fragility_pelicun.csv")
 
 
+ROUND_TRIP = pytest.mark.xdist_group("pelicun-round-trip")
+"""The tests of ``round_trip`` share one xdist worker, so that pelicun runs once (not once per worker)."""
+
+
 @pytest.fixture(scope="module")
 def round_trip(tmp_path_factory):
-    """pelicun on the test dataset's file, written where the README's example reads it; the example too."""
+    """pelicun on the test dataset's file, written where the README's example reads it: every component in one
+    assessment and each in its own (one pelicun process: its start-up is most of the cost), then the example."""
     folder = tmp_path_factory.mktemp("pelicun") / "reports-example"
     dataset, table = written(folder)
-    computed, printed = run_pelicun(folder, example=readme_example(".venv-pelicun/bin/python"))
+    computed, printed = run_pelicun(folder, alone=True, example=readme_example(".venv-pelicun/bin/python"))
     return dataset, table, computed, printed
 
 
@@ -181,21 +186,23 @@ def test_every_row_is_written_as_documented():
     assert [middle[f"LS{k}-Theta_0"] for k in (2, 3)] == [np.inf, np.inf]  # damage states: never reached instead
 
 
+@ROUND_TRIP
 def test_every_component_loads_and_matches_our_curves_together(round_trip):
     dataset, table, computed, _ = round_trip
     assert len(table) == dataset.soil.size * dataset.block.size * dataset.model.size
-    check_against_our_curves(dataset, table, computed)
+    check_against_our_curves(dataset, table, {"together": computed["together"]})
 
 
+@ROUND_TRIP
 @pytest.mark.slow
-def test_every_component_loads_and_matches_our_curves_alone(tmp_path):
-    """One assessment per component (a file of one row must load too): about 8 s of pelicun."""
-    dataset, table = written(tmp_path)
-    computed, _ = run_pelicun(tmp_path, alone=True)
+def test_every_component_loads_and_matches_our_curves_alone(round_trip):
+    """One assessment per component (a file of one row must load too)."""
+    dataset, table, computed, _ = round_trip
     assert set(computed) == {"alone", "together"}
-    check_against_our_curves(dataset, table, computed)
+    check_against_our_curves(dataset, table, {"alone": computed["alone"]})
 
 
+@ROUND_TRIP
 def test_the_tolerance_would_catch_pelicuns_directional_factor(round_trip):
     """With Demand-Directional = 0 pelicun would multiply PGA by 1.2; the comparison above would fail."""
     dataset, table, computed, _ = round_trip
@@ -206,6 +213,7 @@ def test_the_tolerance_would_catch_pelicuns_directional_factor(round_trip):
     assert np.abs(computed["together"][index] - pelicun_expected(cell, DEMAND_LEVELS)).max() < TOLERANCE
 
 
+@ROUND_TRIP
 def test_the_readme_example_runs_as_printed(round_trip):
     """The README's pelicun example, on the file of the test dataset: a damage-state table of every component."""
     _, table, _, printed = round_trip
