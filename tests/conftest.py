@@ -20,14 +20,28 @@ RECORDS = ROOT / "records"
 @pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the xdist_group marks
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Put every test that uses ``small_pipeline`` in one xdist group, so that one worker runs the pipeline
-    (``--dist loadgroup``; a test that forgets the mark cannot make the other worker run it again). Under xdist,
+    (``--dist loadgroup``; a test that forgets the mark cannot make the other worker run it again), and the tests
+    of a module that share a module-scoped fixture in a group of their own (one worker computes it). Under xdist,
     move the ``slow`` tests to the front (stable), so that the longest ones do not start last and leave one
     worker idle at the end; without xdist the order stays as collected (module fixtures are set up once)."""
     for item in items:
-        if "small_pipeline" in getattr(item, "fixturenames", ()) and not item.get_closest_marker("xdist_group"):
+        if item.get_closest_marker("xdist_group"):
+            continue
+        if "small_pipeline" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.xdist_group(PIPELINE_GROUP))
+        elif _uses_a_module_fixture(item):  # else each worker that runs one of them computes the fixture again
+            item.add_marker(pytest.mark.xdist_group(f"module-fixture:{item.module.__name__}"))
     if hasattr(config, "workerinput"):  # an xdist worker (each collects the same list, sorted the same way)
         items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
+def _uses_a_module_fixture(item: pytest.Item) -> bool:
+    """Whether the test uses a module- or class-scoped fixture (computed once per worker that runs its tests)."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return False
+    return any(definition.scope in ("module", "class") for definitions in info.name2fixturedefs.values()
+               for definition in definitions)
 
 
 @pytest.fixture(scope="session")
