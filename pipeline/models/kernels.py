@@ -1314,7 +1314,9 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
         for i in range(STATE_SIZE):
             x[i] = x_new[i]
             f0[i] = f1[i]  # first same as last: the bed's force law is continuous, so is f
-        book_mode_time(summary, bed_mode(system, after), step.h)
+        # the step's mode is the one it started in: a step that ends on a contact change still belongs to the
+        # mode before it (booking it after made a lift-off's mode gain the step, a landing's lose it)
+        book_mode_time(summary, bed_mode(system, before), step.h)
         t = t + step.h
         bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_times)
         for i in range(N_CONTACT_INDICATORS):

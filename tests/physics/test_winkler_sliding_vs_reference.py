@@ -11,7 +11,8 @@ Requirement (issue 19): peak slip and peak angle within 2% where the response is
 a 1e-6 change of the amplitude moves none of peak slip, peak angle, residual slip by more than 1e-4). Measured (kernel
 at its default rtol 1e-6): all three within 1.7e-5 (6.2e-5 where the block flies), the same impacts and flights,
 the time the base is not stuck to 1.2e-6 s (5e-4 s with 40 flights), the slip history to 3e-5 of its peak.
-The time in each contact mode is off by up to 14 ms: a kernel bookkeeping error (strict xfail at the end).
+The time in each contact mode within 2e-6 s (7.5e-4 s with flights): the kernel booked a step that ends on a contact
+change to the mode after it (up to 14 ms off) until this reference showed it.
 """
 
 from __future__ import annotations
@@ -201,13 +202,6 @@ MODES = {"rest": "time_at_rest", "slide": "time_sliding", "rock": "time_rocking"
          "flight": "time_in_flight"}
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "kernel bookkeeping (pipeline/models/kernels.py, the bed's step loop): a step that ends on a corner's "
-    "contact change is booked wholly to the mode after the change (book_mode_time(summary, bed_mode(system, "
-    "after), step.h)), so the modes with a corner up gain the step before each lift-off and lose the step "
-    "before each landing: off by up to 14 ms here (slide-rock -14 ms, flight +14 ms with 40 flights; rest "
-    "-12 ms, rock +12 ms for the skid on the continuous bed). Booking with the indicators at the step's start "
-    "(bed_mode(system, before)) brings every mode within 2e-6 s (7.5e-4 s with flights): checked on a copy."))
 def test_time_in_each_mode_matches_reference():
     for case in CASES:
         reference, product, _ = both(case)
