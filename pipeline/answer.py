@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from pipeline.damage_states import SLIP_EDPS
 from pipeline.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
 from pipeline.lognormal_fit import lognormal_cdf
 from pipeline.models.variants import RECOMMENDED
@@ -337,6 +338,38 @@ def _at(row: xr.Dataset, im: float, scale: float, levels: np.ndarray, empirical:
     return np.nan, np.nan, np.nan
 
 
+def nested_families(fragility: xr.Dataset) -> list[list[int]]:
+    """Indices of the damage states by family (rocking, slip), each in the dataset's order of severity."""
+    edps = [str(e) for e in fragility["damage_state_edp"].values] if "damage_state_edp" in fragility.coords \
+        else [""] * fragility.damage_state.size
+    families = [[i for i, e in enumerate(edps) if e not in SLIP_EDPS],
+                [i for i, e in enumerate(edps) if e in SLIP_EDPS]]
+    return [family for family in families if family]
+
+
+def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnswer]:
+    """The states' probabilities made to nest: P(a state) is at least that of every more severe one of its family.
+
+    A block that overturns has also rocked past every angle and uplifted, and one that slid 30 cm has slid 5 cm,
+    so exceeding a state implies exceeding the milder ones. Curves fitted one by one may cross in a tail below
+    the data (where the fit keeps them apart only from the first level a severe state is reached,
+    ``pipeline.fragility``); the answer reads each state as "this state or worse", the largest of its own and
+    the more severe states' values, as pelicun reads the limit states of one component.
+    """
+    rows = list(rows)
+    for family in families:
+        for position in range(len(family) - 2, -1, -1):
+            milder, severe = rows[family[position]], rows[family[position + 1]]
+            if severe.not_reached_below is not None:
+                continue  # its value is an upper bound P(intensity > the limit), not a probability of the state
+            periods = tuple(tuple(np.fmax(np.asarray(a, float), np.asarray(b, float)))
+                            for a, b in zip(milder.at_return_periods, severe.at_return_periods))
+            frequency = float(np.fmax(milder.annual_frequency, severe.annual_frequency))
+            probability = float(np.fmax(milder.probability_in_life, severe.probability_in_life))
+            rows[family[position]] = StateAnswer(milder.state, periods, frequency, probability, milder.limit, None)
+    return rows
+
+
 def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                   return_periods: Sequence[float] = DEFAULT_RETURN_PERIODS,
                   limits: Mapping[str, float] | None = None, design_life: float | None = None,
@@ -379,6 +412,7 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     periods = tuple(float(t) for t in return_periods) if hazard is not None else ()
     intensities = tuple(intensity_at_frequency(hazard, 1.0 / t) for t in periods)
     states = [str(s) for s in fragility.damage_state.values]
+    families = nested_families(fragility)
     answers = []
     for block in map(str, fragility.block.values):
         levels = _levels(fragility, block, scale)
@@ -404,6 +438,7 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                     else np.nan
                 rows.append(StateAnswer(state, tuple(_at(row, im, scale, levels, empirical) for im in intensities),
                                         frequency, probability, limits.get(state), not_reached))
+            rows = nested(rows, families)
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:
                 verdict = NO_VERDICT
@@ -505,4 +540,5 @@ def _and(words: Sequence[str]) -> str:
 
 __all__ = ["ANCHOR", "ANSWER_MODELS", "ANSWER_STATE", "CHECK_SLIDING", "NO_ACTION", "NO_VERDICT", "RECOMMENDED",
            "BlockAnswer", "SoilAnswer", "StateAnswer", "answer_model", "answer_rows", "answer_table", "block_answers",
+           "nested",
            "display_scale", "intensity_at_frequency", "percent", "verdict_sentence"]

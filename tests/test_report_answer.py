@@ -171,9 +171,10 @@ def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nea
     levels = np.array([0.1, 0.3, 1.0])  # g
     times = np.zeros((4, 3, 1, 1, 2, len(MODE_TIME_FIELDS)))  # record, level, soil, block, model, mode
     times[:, 0, ..., 0] = 10.0   # at rest at 0.1 g
-    times[:, 1, ..., 1] = 10.0   # slides at 0.3 g
-    times[:, 1, ..., 2] = 2.0
-    times[:, 2, ..., 3] = 10.0   # slides and rocks at 1 g
+    times[:, 1, ..., 1] = 10.0   # slides at 0.3 g (one record also rocks for 2 s: not half of them)
+    times[0, 1, ..., 2] = 2.0
+    times[:, 2, ..., 0] = 30.0   # at 1 g mostly at rest, but every record slides and rocks for a while: that
+    times[:, 2, ..., 3] = 1.0    # is what it does (the longest mode would say "at rest")
     times[..., 1, :] = np.nan    # the second model is tied: no mode times
     outcome = np.zeros((4, 3, 1, 1, 2), np.int8)
     outcome[:, 1:, ..., 1] = 1   # tied: rocks from 0.3 g
@@ -184,7 +185,28 @@ def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nea
                       coords={"soil": ["clay"], "block": ["skid"], "model": ["winkler-centre", "housner"],
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
     assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.28, 0.9], 1.0) == \
-        ["at rest", "slides", "slides and rocks"]
+        ["at rest (100% of the records)", "slides (100% of the records)", "slides and rocks (100% of the records)"]
     assert governing_modes(cube, "skid", "housner", "clay", [0.1, 0.3, 1.0], 1.0) == \
         ["at rest (100% of the records)", "rocks (100% of the records)", "overturns (75% of the records)"]
     assert governing_modes(None, "skid", "housner", "clay", [0.1], 1.0) == ["-"]
+
+
+def test_curves_that_cross_below_the_data_are_read_as_this_state_or_worse():
+    """The example study's rock row: theta/alpha >= 0.5 at 0.97 g (beta 0.55) and overturning at 1.13 g (beta 0.67)
+    cross at 0.48 g, so at the 475-year 0.30 g overturning alone would be likelier than the milder state. The
+    answer reads each state as "this state or worse": the milder state takes the severe one's larger value."""
+    fragility = _fragility([[[[0.974, 1.133]]]], betas=[[[[0.549, 0.667]]]])
+    answer = block_answers(fragility, _power_law(), (475.0, 2475.0))[0]
+    milder, severe = answer.soils[0].states
+    im = (K0 * 475.0) ** (1 / K)
+    own = lognorm.cdf(im, 0.549, scale=0.974)
+    assert lognorm.cdf(im, 0.667, scale=1.133) > own  # the fitted curves do cross there
+    assert severe.at_return_periods[0][0] == pytest.approx(lognorm.cdf(im, 0.667, scale=1.133), rel=1e-9)
+    for milder_values, severe_values in zip(milder.at_return_periods, severe.at_return_periods):
+        assert np.all(np.asarray(milder_values) >= np.asarray(severe_values))
+    assert milder.at_return_periods[0][0] == pytest.approx(severe.at_return_periods[0][0])
+    assert milder.probability_in_life >= severe.probability_in_life
+    # where the milder curve is above (2,475 years: 0.72 g), it keeps its own value
+    im = (K0 * 2475.0) ** (1 / K)
+    if lognorm.cdf(im, 0.549, scale=0.974) > lognorm.cdf(im, 0.667, scale=1.133):
+        assert milder.at_return_periods[1][0] == pytest.approx(lognorm.cdf(im, 0.549, scale=0.974), rel=1e-9)

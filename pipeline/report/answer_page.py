@@ -18,7 +18,6 @@ import numpy as np
 
 from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
 from pipeline.models.base import Outcome
-from pipeline.models.fields import MODE_TIME_FIELDS
 from pipeline.models.variants import split_variant
 from pipeline.report.adapters import block_description, block_name, measure_label, model_info, state_labels
 from pipeline.report.text import Item, note, paragraph, strong, table
@@ -63,11 +62,19 @@ def curve_reason(results, model: str) -> str:
 
 MODE_WORDS = {"time_at_rest": "at rest", "time_sliding": "slides", "time_rocking": "rocks",
               "time_slide_rocking": "slides and rocks", "time_in_flight": "flies"}
-"""The contact modes of a run (pipeline.models.fields.MODE_TIME_FIELDS) in words."""
+"""The contact modes of a run (the time fields pipeline.models.fields.MODE_TIME_FIELDS) in words."""
+
+
+MODE_SEVERITY = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight")
+"""The contact modes from the mildest to the most severe (a record's motion is the most severe it enters)."""
 
 
 def governing_modes(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
-    """What the block mostly does at each intensity: the mode with the longest median time over the records.
+    """What the block does at each intensity: the most severe mode that at least half the records enter.
+
+    Each record's motion is the most severe mode it spends any time in (a block that rocks for 2 s of a 40 s
+    record rocks; the longest mode would say "at rest"), ``MODE_SEVERITY``; the page shows the mode that half
+    the records reach or pass, with the share of records that reach it.
 
     At the cube's level nearest each intensity (in the answer's unit, ``scale`` times the cube's), from the runs
     of ``model`` (the recommended curve's: the band centre). A tied base has no mode times: there the outcome
@@ -85,12 +92,16 @@ def governing_modes(cube, block: str, model: str, soil: str, intensities, scale:
     for im in intensities:
         level = int(np.argmin(np.abs(np.log(levels / im))))
         runs = cell.isel(im_level=level)
-        times = {field: runs[field].values for field in MODE_TIME_FIELDS if field in runs}
-        if times and all(np.isfinite(v).any() for v in times.values()):
-            times = {field: float(np.nanmedian(v)) for field, v in times.items()}
+        times = {field: np.asarray(runs[field].values, float) for field in MODE_SEVERITY if field in runs}
+        if len(times) == len(MODE_SEVERITY) and all(np.isfinite(v).any() for v in times.values()):
+            entered = np.stack([np.nan_to_num(times[field]) > 0.0 for field in MODE_SEVERITY])  # (mode, record)
+            worst = np.max(np.where(entered, np.arange(len(MODE_SEVERITY))[:, None], 0), axis=0)
+            reach = [float(np.mean(worst >= m)) for m in range(len(MODE_SEVERITY))]
+            mode = max(m for m in range(len(MODE_SEVERITY)) if reach[m] >= 0.5)
             overturned = float(np.mean(runs.outcome.values == int(Outcome.OVERTURNED)))
-            mode = MODE_WORDS[max(times, key=times.get)]
-            out.append(f"{mode} (overturns: {percent(overturned)})" if overturned > 0 else mode)
+            text = MODE_WORDS[MODE_SEVERITY[mode]]
+            text += f" ({percent(reach[mode])} of the records"
+            out.append(text + (f"; overturns: {percent(overturned)})" if overturned > 0 else ")"))
             continue
         outcome = runs.outcome.values
         shares = {"at rest": np.mean(outcome == int(Outcome.NO_UPLIFT)),
@@ -162,8 +173,12 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         modes = [[soil.soil, *governing_modes(cube, answer.block, answer.model, soil.soil, answer.intensities, scale)]
                  for soil in answer.soils]
         if any(cell != "-" for row in modes for cell in row[1:]):
-            items.append(paragraph("What the block does at each return period's intensity (the mode that lasts "
-                                   "longest in the median record, at the nearest level run):"))
+            items.append(paragraph("What the block does at each return period's intensity, at the nearest level "
+                                   "run: the most severe motion that at least half the records reach (at rest, "
+                                   "slides, rocks, slides and rocks, flies), with the share of records that reach "
+                                   "it or a more severe one. The probabilities above read each state as 'this "
+                                   "state or worse', so a milder state is never less likely than a more severe "
+                                   "one:"))
             items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], modes))
         items.append(note(f"P(damage state) at each return period's intensity, in brackets its band: the "
                           f"{_confidence(fragility)} confidence bounds of the median, records resampled. 'not "
