@@ -210,3 +210,19 @@ def test_curves_that_cross_below_the_data_are_read_as_this_state_or_worse():
     im = (K0 * 2475.0) ** (1 / K)
     if lognorm.cdf(im, 0.549, scale=0.974) > lognorm.cdf(im, 0.667, scale=1.133):
         assert milder.at_return_periods[1][0] == pytest.approx(lognorm.cdf(im, 0.549, scale=0.974), rel=1e-9)
+
+
+def test_the_answer_says_where_the_bed_could_not_reach_the_band():
+    """The example study's log warned that the bed runs the band's centre and upper edge at a lower r than asked;
+    the answer page must say it too (beta_model there leaves out the less dissipative side)."""
+    from pipeline.report.answer_page import _band_reach
+
+    dims = ("soil", "block", "model")
+    requested = np.array([[[np.nan, 0.825, 0.845, 0.866]], [[np.nan, 0.825, 0.845, 0.866]]])
+    reached = np.array([[[np.nan, 0.825, 0.836, 0.836]], [[np.nan, 0.825, 0.845, 0.866]]])
+    cube = xr.Dataset({"restitution_requested": (dims, requested), "restitution_target": (dims, reached)},
+                      coords={"soil": ["clay", "rock"], "block": ["cabinet"],
+                              "model": ["housner", "winkler-low", "winkler-centre", "winkler-high"]})
+    text = _band_reach(cube)
+    assert "On clay the bed" in text and "rock" not in text and "0.866" in text and "0.836" in text
+    assert _band_reach(cube.assign(restitution_target=cube.restitution_requested)) == ""

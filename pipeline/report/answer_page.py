@@ -36,6 +36,22 @@ def _years(frequency: float) -> str:
     return f"once in {years:,.0f} years"
 
 
+def _band_reach(cube) -> str:
+    """A sentence on the cells where the bed could not reach the band's restitution (empty when it did)."""
+    if cube is None or "restitution_requested" not in cube or "restitution_target" not in cube:
+        return ""
+    requested, target = cube.restitution_requested, cube.restitution_target
+    short = (requested - target) > 5e-4  # the bed ran at a lower r than the band asked for
+    if not bool(short.any()):
+        return ""
+    soils = [str(s) for s in cube.soil.values if bool(short.sel(soil=s).any())]
+    asked, reached = float(requested.where(short).max()), float(target.where(short).max())
+    return (f" On {', '.join(soils)} the bed cannot dissipate as little as the band's upper edge asks (r up to "
+            f"{asked:.3f}; it reaches {reached:.3f} at most): those variants run at the nearest r it reaches, so "
+            "β of the model there leaves out the less dissipative side of the band, the side on which a block "
+            "rocks more.")
+
+
 def curve_reason(results, model: str) -> str:
     """Which curve answers and why, in words."""
     fragility = results.fragility
@@ -49,8 +65,14 @@ def curve_reason(results, model: str) -> str:
             if np.isfinite(r2r).any() and np.isfinite(model_beta).any():
                 text += (f" Here β from record to record is {np.nanmin(r2r):.2f} to {np.nanmax(r2r):.2f} and β of the "
                          f"model {np.nanmin(model_beta):.2f} to {np.nanmax(model_beta):.2f}.")
-        return text + (" Housner's rigid base and the paper's model are references, not inputs: the first ignores "
-                       "the foundation and the second's spring pulls on the block, which a soil cannot.")
+        text += _band_reach(getattr(results, "cube", None))
+        models = {str(m) for m in fragility.model.values}
+        if "housner" in models and any(m.startswith("ssi") for m in models):
+            text += (" Housner's rigid base and the paper's model are references, not inputs: the first ignores "
+                     "the foundation and the second's spring pulls on the block, which a soil cannot.")
+        elif "housner" in models:
+            text += " Housner's rigid base is a reference, not an input: it ignores the foundation."
+        return text
     if model == "winkler":
         return ("The answer uses the tensionless Winkler bed: of the models this study ran, it is the one that "
                 "stays within its own assumptions (its foundation never pulls on the block; see Limitations). "
