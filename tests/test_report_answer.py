@@ -224,5 +224,5 @@ def test_the_answer_says_where_the_bed_could_not_reach_the_band():
                       coords={"soil": ["clay", "rock"], "block": ["cabinet"],
                               "model": ["housner", "winkler-low", "winkler-centre", "winkler-high"]})
     text = _band_reach(cube)
-    assert "On clay the bed" in text and "rock" not in text and "0.866" in text and "0.836" in text
+    assert "On clay the bed" in text and "clay, rock" not in text and "0.866" in text and "0.836" in text
     assert _band_reach(cube.assign(restitution_target=cube.restitution_requested)) == ""
