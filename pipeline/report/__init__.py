@@ -171,7 +171,7 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure("spectra", "Records", "Response spectra of the record set", pages.spectra_page,
                                showcase, caption=CAPTIONS["spectra"]))
     if showcase is not None and "theta" in showcase:
-        record = showcase.attrs["showcase_record"]
+        record = pages.record_words(showcase)
         showcase_name = names.get(str(showcase.attrs.get("showcase_block", "")))
         planned.append(_figure("showcase-processing", "Showcase record", f"{record}: raw and processed",
                                pages.showcase_ground_page, showcase, caption=CAPTIONS["showcase-processing"]))

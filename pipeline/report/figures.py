@@ -8,6 +8,7 @@ Input : the opened result datasets (cube, ida, fragility, showcase, applicabilit
 from __future__ import annotations
 
 import math
+import re
 import textwrap
 
 import numpy as np
@@ -52,34 +53,63 @@ EXTRAPOLATION = dict(color="0.55", alpha=0.13, lw=0, zorder=0)  # beyond the lar
 NO_CURVE = "no curve: "
 
 
+MARK_SIZE = 6.5  # pt, the return-period labels
+
+
+def mark_groups(axis, marks: CredibleMarks, along: str = "x") -> list[tuple[list[float], str]]:
+    """The return-period marks inside the axis, grouped where their labels would overlap.
+
+    Marks closer on the page than 1.4 label heights share one label ("475 / 975 / 2,475 yr", in the order
+    of the lines along the axis), so labels never overprint. Needs the axis limits and scale set.
+
+    Returns
+    -------
+    list of (intensities, label)
+        One entry per label: the intensities it names (increasing) and its text.
+    """
+    low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
+    inside = sorted((im, t) for t, im in zip(marks.return_periods, marks.intensities) if low <= im <= high)
+    if not inside:
+        return []
+    to_pixels = axis.transData.transform
+    where = [to_pixels((im, 1.0) if along == "x" else (1.0, im))[0 if along == "x" else 1] for im, _ in inside]
+    room = 1.4 * MARK_SIZE * axis.figure.dpi / 72.0
+    groups = [[0]]
+    for index in range(1, len(inside)):
+        if abs(where[index] - where[groups[-1][-1]]) < room:
+            groups[-1].append(index)
+        else:
+            groups.append([index])
+    return [([inside[i][0] for i in group], " / ".join(f"{inside[i][1]:,.0f}" for i in group) + " yr")
+            for group in groups]
+
+
 def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> None:
     """Mark the site's return-period intensities and the extrapolation by scaling on an intensity axis.
 
-    Dotted labelled lines at the return-period intensities; beyond the largest recorded intensity, a
-    shade; ``along`` is the intensity axis ("x" or "y"). Call it after the axis limits are set: the
-    shading runs to the axis end.
+    Dotted lines at the return-period intensities, labelled in groups that never overlap (``mark_groups``);
+    beyond the largest recorded intensity, a shade; ``along`` is the intensity axis ("x" or "y"). Call it
+    after the axis limits and scale are set: the shading runs to the axis end.
     """
     if marks is None:
         return
     low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
+    line = axis.axvline if along == "x" else axis.axhline
     if marks.largest is not None and np.isfinite(marks.largest) and marks.largest < high:
         span = axis.axvspan if along == "x" else axis.axhspan
         span(max(marks.largest, low), high, **EXTRAPOLATION, label="beyond the largest recorded intensity: "
                                                                    "extrapolation by scaling")
-        line = axis.axvline if along == "x" else axis.axhline
         line(marks.largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
-    for period, intensity in zip(marks.return_periods, marks.intensities):
-        if not low <= intensity <= high:
-            continue
-        line = axis.axvline if along == "x" else axis.axhline
-        line(intensity, color=MARK_COLOUR, lw=0.9, ls=":", label="site hazard at the return periods")
-        text = f"{period:,.0f} yr"
+    for intensities, text in mark_groups(axis, marks, along):
+        for intensity in intensities:
+            line(intensity, color=MARK_COLOUR, lw=0.9, ls=":", label="site hazard at the return periods")
+        box = dict(facecolor="white", edgecolor="none", alpha=0.7, pad=0.5)
         if along == "x":
-            axis.text(intensity, 0.98, text, transform=axis.get_xaxis_transform(), rotation=90, fontsize=6.5,
-                      color=MARK_COLOUR, ha="right", va="top")
+            axis.text(intensities[-1], 0.98, text, transform=axis.get_xaxis_transform(), rotation=90,
+                      fontsize=MARK_SIZE, color=MARK_COLOUR, ha="right", va="top", bbox=box)
         else:
-            axis.text(0.98, intensity, text, transform=axis.get_yaxis_transform(), fontsize=6.5, color=MARK_COLOUR,
-                      ha="right", va="bottom")
+            axis.text(0.98, intensities[-1], text, transform=axis.get_yaxis_transform(), fontsize=MARK_SIZE,
+                      color=MARK_COLOUR, ha="right", va="bottom", bbox=box)
 
 
 def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
@@ -125,8 +155,7 @@ def showcase_ground_page(showcase, caption):
     ``showcase`` is the opened ``showcase.nc``: acceleration (drawn in g), velocity [m/s] and
     displacement [m] against time [s], under the page title and ``caption``.
     """
-    title = (f"{showcase.attrs.get('showcase_event', '')}, {showcase.attrs.get('showcase_station', '')} "
-             f"{showcase.attrs.get('showcase_component', '')} ({showcase.attrs['showcase_record']}): raw and processed")
+    title = f"{record_words(showcase)}: raw and processed"
     figure = new_page(title, caption)
     axes = panels(figure, 3, 1, sharex=True, gridspec_kw=dict(hspace=0.12))[:, 0]
     time = showcase.time_ground.values
@@ -144,6 +173,18 @@ def showcase_ground_page(showcase, caption):
     return figure
 
 
+def record_words(showcase) -> str:
+    """The showcase record as a reader names it: "Duzce 1999, Bolu, component 090" (its id when unnamed)."""
+    attrs = showcase.attrs
+    event, station = str(attrs.get("showcase_event", "")).strip(), str(attrs.get("showcase_station", "")).strip()
+    component = str(attrs.get("showcase_component", "")).strip()
+    component = re.sub(r"^[A-Za-z_-]+(?=\d)", "", component)  # BOL090 -> 090: the station is named already
+    if not (event or station):
+        return f"record {attrs.get('showcase_record', '')}"
+    words = ", ".join(part for part in (event, f"{station} station" if station else "") if part)
+    return words + (f", component {component}" if component else "")
+
+
 def _time_window(showcase):
     start = float(showcase.attrs.get("strong_motion_start_s", 0.0)) - WINDOW_BEFORE
     end = float(showcase.attrs.get("strong_motion_end_s", showcase.time.values[-1])) + WINDOW_AFTER
@@ -156,7 +197,7 @@ def showcase_response_page(showcase, caption, name: str | None = None):
     One y-scale per column, time cropped to the strong motion.
     """
     block = showcase.attrs["showcase_block"]
-    figure = new_page(f"{showcase.attrs['showcase_record']}, {name or block} (R = "
+    figure = new_page(f"{record_words(showcase)}, {name or block} (R = "
                       f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
                       "rad): rocking on each soil", caption)
     soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
@@ -164,15 +205,22 @@ def showcase_response_page(showcase, caption, name: str | None = None):
     styles = model_styles(models)
     start, end = _time_window(showcase)
     margins = dict(left=0.075, right=GRID["right"], wspace=0.22)
-    ground = figure.add_gridspec(1, 1, top=GRID["top"], bottom=0.79, **margins).subplots()
-    ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35", lw=0.7)
-    ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
-                   color="0.9", zorder=0, label="5-95% Arias window")
-    ground.set_ylabel("ground [g]")
-    ground.set_xlim(start, end)
-    ground.grid(alpha=0.3)
-    ground.tick_params(labelbottom=False)
-    grid = figure.add_gridspec(len(soils), 2, top=0.74, bottom=GRID["bottom"], hspace=0.12, **margins)
+    # the ground motion above each column, on the same time axis as the panels below it
+    grounds = figure.add_gridspec(1, 2, top=GRID["top"], bottom=0.785, **margins).subplots(sharex=True, sharey=True)
+    for column, ground in enumerate(grounds):
+        ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35",
+                    lw=0.7)
+        ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
+                       color="0.9", zorder=0, label="strong-motion window (5-95% Arias intensity)" if column == 0
+                       else None)
+        ground.set_xlim(start, end)
+        ground.grid(alpha=0.3)
+        ground.tick_params(labelsize=8)
+        ground.set_xlabel("time [s]", fontsize=8, labelpad=1)
+        ground.set_title("ground acceleration (processed record, unscaled)", fontsize=9)
+    grounds[0].set_ylabel("ground [g]", fontsize=9)
+    ground = grounds[0]
+    grid = figure.add_gridspec(len(soils), 2, top=0.69, bottom=GRID["bottom"], hspace=0.12, **margins)
     peak = np.nanmax(np.abs(showcase.theta.values)) if np.isfinite(showcase.theta.values).any() else 0.0
     scale, unit = (1000.0, "mrad") if peak < 0.1 else (1.0, "rad")
     theta_axes, settle_axes = [], []
@@ -192,16 +240,17 @@ def showcase_response_page(showcase, caption, name: str | None = None):
             if not model.rigid_base:
                 settle_axis.plot(showcase.time.values, showcase.settlement.values[index] * 1000,
                                  **styles[model.name])
-        theta_axis.set_ylabel(f"θ [{unit}]")
-        settle_axis.set_ylabel("Δy [mm], up +")
+        theta_axis.set_ylabel(f"θ [{unit}]", fontsize=9)
+        settle_axis.set_ylabel("Δy [mm]", fontsize=9)
         theta_axis.text(0.01, 0.92, soil, transform=theta_axis.transAxes, fontsize=9, weight="bold", va="top",
                         bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
         for axis in (theta_axis, settle_axis):
+            axis.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
+                         color="0.95", zorder=0)
             axis.grid(alpha=0.3)
             axis.tick_params(labelbottom=row == len(soils) - 1)
-    theta_axes[0].set_title("rocking angle θ (the rigid base is the same on every soil)", fontsize=9)
-    settle_axes[0].set_title("vertical displacement from the static position (up +, settlement −; each model's "
-                             "reference point)", fontsize=9)
+    theta_axes[0].set_title("rocking angle θ (the rigid base: the same on every soil)", fontsize=9)
+    settle_axes[0].set_title("vertical displacement Δy from rest (up +, settlement −)", fontsize=9)
     theta_axes[-1].set_xlabel("time [s]")
     settle_axes[-1].set_xlabel("time [s]")
     outside_legend(figure, [ground, *theta_axes])
@@ -212,49 +261,76 @@ def _finite_capped(values):
     return np.where(np.isfinite(values), np.minimum(values, IDA_CAP), IDA_CAP)
 
 
-def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
-    """One panel per rigid-base model and per foundation model x soil, filling the page in reading order.
+ROW_GAP = 0.5  # in between two rows of IDA panels: the row's heading and the panels' titles
 
-    Intensity on a log axis, the site's return-period intensities and the extrapolation by scaling marked.
+
+def _ida_rows(models, soils, most_columns=5):
+    """The IDA page's rows: (heading, [(model, soil or None), ...]); the rigid-base models share the first row."""
+    rigid = [m for m in models if m.rigid_base]
+    founded = [m for m in models if not m.rigid_base]
+    columns = min(max(len(soils) if founded else 1, len(rigid), 1), most_columns)
+    rows = []
+    for start in range(0, len(rigid), columns):
+        rows.append(("rigid base: the same on every soil", [(m, None) for m in rigid[start:start + columns]]))
+    for model in founded:
+        for start in range(0, len(soils), columns):
+            rows.append((panel_label(model), [(model, soil) for soil in soils[start:start + columns]]))
+    return rows, columns
+
+
+def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
+    """One row of panels per foundation model (a panel per soil), the rigid-base models in the first row.
+
+    Each row is headed by its model, each panel titled by its soil. Intensity on a log axis, the site's
+    return-period intensities and the extrapolation by scaling marked.
     """
     models = models_of(ida)
     soils = list(map(str, ida.soil.values))
-    drawn = [(m, None) for m in models if m.rigid_base]
-    drawn += [(m, soil) for m in models if not m.rigid_base for soil in soils]
-    columns = min(len(drawn), 3 if len(drawn) <= 6 else 4)
-    rows = math.ceil(len(drawn) / columns)
+    rows, columns = _ida_rows(models, soils)
     figure = new_page(f"IDA curves: {name or block}", caption)
-    axes = panels(figure, rows, columns, sharex=True, sharey=True, gridspec_kw=dict(hspace=0.3))
+    top, bottom = 0.86, GRID["bottom"]
+    height = (top - bottom) * figure.get_figheight()
+    panel_height = (height - (len(rows) - 1) * ROW_GAP) / len(rows)
+    axes = panels(figure, len(rows), columns, sharex=True, sharey=True,
+                  gridspec_kw=dict(top=top, hspace=ROW_GAP / panel_height))
     levels = block_levels(ida, block)
-    low, high = axis_range(levels, marks)
-    for axis, (model, soil) in zip(axes.flat, drawn):
-        picked = cell(ida, model, block, soil)
-        for curve in picked.edp.transpose("record", "im_level").values:
-            axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
-        for q in ida.fractile.values:
-            style = FRACTILE_STYLES.get(round(float(q), 2), dict(color="C4", lw=1.2))
-            axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
-                      label=f"{float(q):.0%} fractile", **style)
-        axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
-        axis.set_title(short_label(model) if soil is None else f"{panel_label(model)}\non {soil}", fontsize=9)
-        axis.grid(alpha=0.3, which="both")
-        axis.set_xlim(0, IDA_CAP * 1.05)
-        log_y_axis(axis)
-        axis.set_ylim(low, high)
+    span = axis_range(levels, marks)
+    drawn = []
+    for row, (heading, cells) in enumerate(rows):
+        for column in range(columns):
+            axis = axes[row, column]
+            if column >= len(cells):
+                axis.set_visible(False)
+                continue
+            model, soil = cells[column]
+            drawn.append(axis)
+            picked = cell(ida, model, block, soil)
+            for curve in picked.edp.transpose("record", "im_level").values:
+                axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
+            for q in ida.fractile.values:
+                style = FRACTILE_STYLES.get(round(float(q), 2), dict(color="C4", lw=1.2))
+                axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
+                          label=f"{float(q):.0%} fractile", **style)
+            axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
+            axis.set_title(short_label(model) if soil is None else f"on {soil}", fontsize=8, pad=3)
+            axis.grid(alpha=0.3, which="both")
+            axis.set_xlim(0, IDA_CAP * 1.05)
+            axis.set_xticks([0, 0.5, 1.0, 1.5])
+            axis.tick_params(labelsize=8)
+            if column == 0:
+                axis.set_ylabel(measure_label(ida), fontsize=8)
+            if row == len(rows) - 1 or (row + 1 < len(rows) and column >= len(rows[row + 1][1])):
+                axis.set_xlabel("θmax/α [-]")
+                axis.tick_params(labelbottom=True)
+        first = axes[row, 0].get_position()
+        figure.text(first.x0, first.y1 + 0.027, heading, fontsize=9, weight="bold", va="bottom", ha="left")
+    for axis in drawn:
+        log_y_axis(axis, span)
+    for axis in drawn:
         mark_intensities(axis, marks, along="y")
-    axes.flat[0].plot([], [], color="0.65", lw=0.5, label="one record")
-    axes.flat[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
-    for index, axis in enumerate(axes.flat):
-        if index >= len(drawn):
-            axis.set_visible(False)
-            continue
-        row, column = divmod(index, columns)
-        if column == 0:
-            axis.set_ylabel(measure_label(ida))
-        if index + columns >= len(drawn):  # nothing drawn below: label the x axis here
-            axis.set_xlabel("θmax/α [-]")
-            axis.tick_params(labelbottom=True)
-    outside_legend(figure, [axes.flat[0]])
+    drawn[0].plot([], [], color="0.65", lw=0.5, label="one record")
+    drawn[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at θmax/α = {IDA_CAP})")
+    outside_legend(figure, [drawn[0]])
     return figure
 
 
@@ -318,8 +394,7 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
     for axis in axes.flat:
         if not axis.get_visible():
             continue
-        log_axis(axis)
-        axis.set_xlim(*span)
+        log_axis(axis, span)
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
         mark_intensities(axis, marks, along="x")
