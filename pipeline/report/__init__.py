@@ -137,17 +137,30 @@ CAPTIONS = {
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
-    "applicability": "Read where the rigid-base model is good enough: inside the grey band each foundation model's "
-                     "median peak angle is within 10% of the rigid base's; runs between 1.2 and 3 times each "
-                     "block's uplift threshold; top axis: the study's soils.",
+    "applicability": "Read where the rigid-base model is good enough: each line is one foundation model (its colour "
+                     "and dashes) for one block (its marker): the median peak angle of the runs between 1.2 and 3 "
+                     "times the block's uplift threshold over the rigid base's. Grey band: within 10% of the rigid "
+                     "base. Green band: 300-1000 MPa, the soil stiffness above which the paper finds the rigid base "
+                     "good enough. Top axis: the study's soils. Lines that coincide hide each other.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
-                           "green: the paper's 300-1000 MPa; solid concrete block, dashed steel block.",
+                           "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
+                           "enough; colours: the intensity level; solid concrete block, dashed steel block.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does, and the measure alone is not enough).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
+
+
+def _twins_words(efficiency) -> str:
+    """The efficiency caption's sentence on the measures left out because they repeat another ("" if none)."""
+    twins = pages.efficiency_twins(efficiency)
+    if not twins:
+        return ""
+    pairs = "; ".join(f"{pages.measure_words(m)} repeats {pages.measure_words(o)}" for m, o in twins.items())
+    return (f" Not drawn ({pairs}): dividing an intensity by a constant of the block (its uplift acceleration "
+            "g·tanα) changes nothing within one block, so their bars and p-values are identical by construction.")
 
 
 def plan(results: Results) -> list[Page]:
@@ -215,7 +228,8 @@ def plan(results: Results) -> list[Page]:
                                        "in both models.", names=names))
     if results.efficiency is not None and "dispersion" in results.efficiency:
         planned.append(_figure("efficiency", "Measure efficiency", "Efficiency of intensity measures",
-                               pages.efficiency_page, results.efficiency, caption=CAPTIONS["efficiency"],
+                               pages.efficiency_page, results.efficiency,
+                               caption=CAPTIONS["efficiency"] + _twins_words(results.efficiency),
                                names=names))
     planned += _text_pages("glossary", "Glossary", "Glossary", glossary_items())
     planned += _text_pages("references", "References", "References", references_items())

@@ -14,6 +14,7 @@ import textwrap
 import numpy as np
 import xarray as xr
 
+from pipeline.damage_states import NOT_APPLICABLE
 from pipeline.fragility import lognormal_cdf
 from pipeline.measures import MEASURES
 from pipeline.report.adapters import (
@@ -27,11 +28,13 @@ from pipeline.report.adapters import (
     panel_label,
     short_label,
     state_labels,
+    state_title,
     uplift_intensity,
 )
 from pipeline.report.layout import (
     FRACTILE_STYLES,
     GRID,
+    chars_across,
     log_axis,
     log_y_axis,
     new_page,
@@ -357,17 +360,23 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
         return ""
     axis.plot([], [], label=label, **style)  # listed once in the legend; the panel says why there is no curve
     status = str(values["status"].values) if "status" in values else ""
+    if status == NOT_APPLICABLE:  # e.g. a slip state of a model run with a tied base: nothing to explain
+        return ""
     reason = {"below-range": "reached by most records at the lowest level",
               "not-reached": "not reached at any level"}.get(status, plain(status) if status else "no fit")
-    return f"{label}: {reason}"
+    return f"{label.split(' (')[0]}: {reason}"
+
+
+NOTE_SIZE = 6.0  # pt, the no-curve note inside a panel
 
 
 def _no_curve_note(axis, reasons) -> None:
-    """Say in the panel which series have points but no curve, and why."""
+    """Say in the panel which series have points but no curve, and why (wrapped to the panel's width)."""
     reasons = [r for r in reasons if r]
     if reasons:
-        text = "\n".join(textwrap.fill(line, 55) for line in [NO_CURVE.rstrip(": ") + ":", *reasons])
-        axis.text(0.97, 0.5, text, transform=axis.transAxes, fontsize=6.5, va="center", ha="right",
+        width = chars_across(axis, NOTE_SIZE) - 3
+        text = "\n".join(textwrap.fill(line, width) for line in [NO_CURVE.rstrip(": ") + ":", *reasons])
+        axis.text(0.97, 0.5, text, transform=axis.transAxes, fontsize=NOTE_SIZE, va="center", ha="right",
                   bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.9, pad=2), zorder=10)
 
 
@@ -378,7 +387,7 @@ def _state_axes(figure, fragility, n_rows=1):
     else:
         rows, columns = n_rows, len(states)
     axes = panels(figure, rows, columns, sharex=True, sharey=True,
-                  gridspec_kw=dict(hspace=0.45 if n_rows > 1 else 0.32))
+                  gridspec_kw=dict(hspace=0.6 if n_rows > 1 else 0.55))
     for axis in axes.flat[len(states) * (1 if n_rows == 1 else n_rows):]:
         axis.set_visible(False)
     return states, axes
@@ -398,10 +407,12 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
         mark_intensities(axis, marks, along="x")
+        axis.tick_params(labelbottom=True, labelsize=8)  # every row: a panel is read on its own
     for axis in axes[:, 0]:
         axis.set_ylabel(y_label)
-    for axis in axes[-1]:
-        axis.set_xlabel(x_label)
+    for axis in axes.flat:
+        if axis.get_visible():
+            axis.set_xlabel(x_label, fontsize=8, labelpad=1)
 
 
 def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMarks | None = None,
@@ -424,8 +435,8 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
             reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
                                              styles[reference.name], short_label(reference), span))
         _no_curve_note(axis, reasons)
-        axis.set_title(labels[state], fontsize=10)
-    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]", marks)
+        axis.set_title(textwrap.fill(state_title(labels[state]), chars_across(axis, 9)), fontsize=9)
+    _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
     outside_legend(figure, list(axes.flat))
     return figure
 
@@ -447,8 +458,9 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
             reasons = [_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                          styles[model.name], short_label(model), span) for model in models]
             _no_curve_note(axis, reasons)
-            axis.set_title(f"{labels[state]}\non {soil}", fontsize=9)
-    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]", marks)
+            axis.set_title(textwrap.fill(f"{state_title(labels[state])} on {soil}", chars_across(axis, 8.5)),
+                           fontsize=8.5)
+    _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
     outside_legend(figure, list(axes.flat))
     return figure
 
@@ -491,7 +503,9 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
 def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     """Median peak angle of each foundation model over the rigid-base reference against G_s, per block.
 
-    The soils are named on the top axis.
+    A model keeps its colour and dashes, a block its marker; the legend lists the models and the blocks
+    apart (blocks without a run in the band are left out and named in the legend). The soils are named on
+    the top axis.
     """
     models = models_of(cube)
     reference = next(m for m in models if m.rigid_base)
@@ -504,23 +518,36 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     shear = cube.soil_shear_modulus.values / 1e6
     order = np.argsort(shear)
     markers = "os^Dv"
+    drawn_blocks, missing = [], []
     for b_index, block in enumerate(cube.block.values):
         uplift = uplift_intensity(cube, block)
         levels = block_levels(cube, block)
         band = (levels >= 1.2 * uplift) & (levels <= 3.0 * uplift)
-        if not band.any():
-            continue
-        sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band))
-        rigid_angle = sub.peak_angle.sel(model=reference.name)
-        for model in founded:
+        sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band)) if band.any() else None
+        drew = False
+        for model in founded if sub is not None else []:
+            rigid_angle = sub.peak_angle.sel(model=reference.name)
             survived = (sub.outcome.sel(model=[reference.name, model.name]) == OUTCOME_ROCKING).all("model")
             ratio = (sub.peak_angle.sel(model=model.name).where(survived).median(["record", "im_level"]) /
                      rigid_angle.where(survived).median(["record", "im_level"])).values
-            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], color=f"C{b_index % 10}",
-                      ls=styles[model.name]["ls"], lw=1.4,
-                      label=f"{names.get(str(block), block)}, {panel_label(model)}")
+            if not np.isfinite(ratio).any():
+                continue
+            drew = True
+            style = styles[model.name]
+            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], ms=5, mfc="white",
+                      color=style["color"], ls=style["ls"], lw=1.3)
+        name = names.get(str(block), str(block))
+        (drawn_blocks if drew else missing).append((name, markers[b_index % len(markers)]))
+    for model in founded:
+        style = styles[model.name]
+        axis.plot([], [], color=style["color"], ls=style["ls"], lw=1.3, label=short_label(model))
+    for name, marker in drawn_blocks:
+        axis.plot([], [], ls="none", marker=marker, ms=5, mfc="white", color="0.2", label=f"block: {name}")
+    for name, _ in missing:
+        axis.plot([], [], ls="none", label=f"block: {name}: no run rocked without overturning in both models")
     axis.axhspan(1 - limit, 1 + limit, color="0.88", label=f"within ±{limit:.0%} of the rigid base", zorder=0)
-    axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, label="paper's limit: G_s = 300-1000 MPa", zorder=0)
+    axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0,
+                 label="300-1000 MPa: above it the paper finds the rigid base good enough")
     axis.axhline(1.0, color="k", lw=0.8)
     log_axis(axis)
     axis.set_xlabel("soil shear modulus G_s [MPa]")
@@ -566,47 +593,81 @@ def sweep_page(dataset, caption, names: dict | None = None):
 P_FLOOR = 1e-3  # p-values below this are drawn at it: "below 0.001" is all such a number supports
 
 
+MEASURE_WORDS = {"pulse_amplitude": "pulse acceleration", "pulse_period": "pulse period",
+                 "pga_ratio": "PGA/(g·tanα)", "pgv_ratio": "PGV·p/(g·tanα)"}
+"""Intensity measures whose registry label is a symbol (a_p) or a formula, as the efficiency page names them."""
+P_MARKERS = (("p_magnitude", "o", "black", "against magnitude"), ("p_distance", "s", "0.55", "against distance"),
+             ("p_pulse_period", "^", "#6a3d9a", "against pulse period"))
+"""Sufficiency p-values: marker, colour (none of the blocks' bar colours) and what each tests."""
+
+
+def measure_words(measure: str) -> str:
+    """An intensity measure as the efficiency page names it."""
+    if measure in MEASURE_WORDS:
+        return MEASURE_WORDS[measure]
+    return pretty(MEASURES[measure].short_label()) if measure in MEASURES else measure.replace("_", " ")
+
+
+def efficiency_twins(dataset) -> dict[str, str]:
+    """Measures whose dispersion equals an earlier measure's in every cell: measure -> the one it repeats.
+
+    Dividing an intensity by a constant of the block (g·tanα, the uplift acceleration) changes no
+    dispersion within a block, so PGA/(g·tanα) repeats PGA; the page draws one of each pair.
+    """
+    twins = {}
+    measures = [str(m) for m in dataset.measure.values]
+    values = {m: np.asarray(dataset.dispersion.sel(measure=m).values, float) for m in measures}
+    for index, measure in enumerate(measures):
+        for earlier in measures[:index]:
+            if earlier not in twins and np.allclose(values[measure], values[earlier], rtol=1e-6, atol=1e-9,
+                                                    equal_nan=True) and np.isfinite(values[measure]).any():
+                twins[measure] = earlier
+                break
+    return twins
+
+
 def efficiency_page(dataset, caption, names: dict | None = None):
     """Which intensity measure predicts overturning best, from ``efficiency.nc``.
 
     Top: the dispersion of the overturning capacity per measure and block (median over soils and
     models, whiskers their range; smaller is better). Bottom: the sufficiency p-values against magnitude,
-    distance and pulse period (median over cells), on a log axis floored at ``P_FLOOR``.
+    distance and pulse period (median over cells), on a log axis floored at ``P_FLOOR``. A measure that
+    repeats another within every block (``efficiency_twins``) is left out; the caption says why.
     """
     names = names or {}
     figure = new_page("Efficiency of intensity measures: which one predicts overturning best", caption)
-    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45))[:, 0]
-    measures = [str(m) for m in dataset.measure.values]
-    labels = [pretty(MEASURES[m].short_label()) if m in MEASURES else m.replace("_", " ") for m in measures]
-    blocks = list(map(str, dataset.block.values))
+    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45, left=0.085))[:, 0]
+    twins = efficiency_twins(dataset)
+    measures = [str(m) for m in dataset.measure.values if str(m) not in twins]
+    labels = [measure_words(m) for m in measures]
+    blocks = [b for b in map(str, dataset.block.values)
+              if np.isfinite(dataset.dispersion.sel(block=b, measure=measures).values).any()]
     x = np.arange(len(measures))
     width = 0.8 / max(len(blocks), 1)
     for index, block in enumerate(blocks):
-        dispersion = dataset.dispersion.sel(block=block)
+        dispersion = dataset.dispersion.sel(block=block, measure=measures)
         middle = dispersion.median(["soil", "model"]).values
         low, high = dispersion.min(["soil", "model"]).values, dispersion.max(["soil", "model"]).values
         top.bar(x + (index - (len(blocks) - 1) / 2) * width, middle, width, label=names.get(block, block),
                 yerr=[middle - low, high - middle], capsize=2, color=f"C{index % 10}")
     top.set_xticks(x, labels, fontsize=8)
-    top.set_ylabel("dispersion of ln capacity [-]")
-    top.set_title("Efficiency: dispersion of the overturning capacity (smaller is better)", fontsize=10)
+    top.set_ylabel("dispersion of ln capacity [-]", fontsize=9)
+    top.set_title("Efficiency: dispersion of the overturning capacity per block (smaller is better)", fontsize=10)
     top.grid(alpha=0.3, axis="y")
-    for name, marker, what in (("p_magnitude", "o", "p-value against magnitude"),
-                               ("p_distance", "s", "p-value against distance"),
-                               ("p_pulse_period", "^", "p-value against pulse period")):
+    for name, marker, colour, what in P_MARKERS:
         if name not in dataset:
             continue
-        p = dataset[name].median(["soil", "model", "block"]).values
-        bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, label=what)
+        p = dataset[name].sel(measure=measures).median(["soil", "model", "block"]).values
+        bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, color=colour, label=f"p-value {what}")
     bottom.axhline(0.05, color="k", lw=0.8, ls="--", label="0.05: below it the measure is not sufficient")
     bottom.set_yscale("log")
     bottom.set_ylim(P_FLOOR * 0.7, 1.5)
     bottom.set_yticks([P_FLOOR, 0.01, 0.05, 0.1, 1.0], ["≤ 0.001", "0.01", "0.05", "0.1", "1"])
     bottom.minorticks_off()
     bottom.set_xticks(x, labels, fontsize=8)
-    bottom.set_ylabel("p-value, median over cells [-]")
-    bottom.set_title("Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake?",
-                     fontsize=10)
+    bottom.set_ylabel("p-value [-]", fontsize=9)
+    bottom.set_title("Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake? "
+                     "(median p-value over soils, models and blocks)", fontsize=10)
     bottom.grid(alpha=0.3, axis="y")
     outside_legend(figure, [top, bottom])
     return figure

@@ -35,9 +35,12 @@ TITLE_SIZE = 13
 SOIL_COLOURS = {"clay": "#8c510a", "sand": "#d8a03a", "gravel": "#35978f", "rock": "#01665e",
                 "steel": "#5e3c99"}
 RIGID_STYLE = dict(color="black", ls="--", lw=1.5, zorder=4)  # on top: its dashes stay visible
-MODEL_STYLES = [dict(color="#d62728", ls="-", lw=1.4), dict(color="#1f77b4", ls="-.", lw=1.4),
-                dict(color="#2ca02c", ls=":", lw=1.6), dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4),
-                dict(color="#ff7f0e", ls="--", lw=1.4), dict(color="#8c564b", ls=(0, (3, 1, 1, 1, 1, 1)), lw=1.4)]
+RECOMMENDED_STYLE = dict(color="#d62728", ls="-", lw=2.8, zorder=5)  # the only solid coloured line: the answer
+MODEL_STYLES = [dict(color="#1f77b4", ls="-.", lw=1.4), dict(color="#2ca02c", ls=":", lw=1.6),
+                dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4), dict(color="#ff7f0e", ls="--", lw=1.4),
+                dict(color="#8c564b", ls=(0, (3, 1, 1, 1, 1, 1)), lw=1.4),
+                dict(color="#e377c2", ls=(0, (1, 1)), lw=1.6)]
+"""Models other than the rigid base and the recommended curve: none solid, none red."""
 FRACTILE_STYLES = {0.16: dict(color="#1f77b4", ls="--", lw=1.5), 0.5: dict(color="black", ls="-", lw=2.2),
                    0.84: dict(color="#d62728", ls=":", lw=1.8)}
 OUTCOME_COLOURS = {"no_uplift": "#c7e9c0", "rocking": "#fdae6b", "overturned": "#d7301f",
@@ -184,6 +187,12 @@ def outside_legend(figure, axes, **options):
     if handles:
         figure.legend(handles, labels, loc="upper left", bbox_to_anchor=LEGEND_ANCHOR, fontsize=7.5, frameon=False,
                       **options)
+
+
+def chars_across(axis, size: float) -> int:
+    """How many characters of ``size`` pt fit across an axes (for wrapping panel titles and notes)."""
+    width_pt = axis.get_position().width * axis.figure.get_figwidth() * 72.0
+    return max(12, int(width_pt / (0.6 * size)))
 
 
 def pretty(text: str) -> str:
