@@ -488,7 +488,7 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
             axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
             if soil is None or len(soils) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
-        axis.set_title(short_label(model), fontsize=10)
+        axis.set_title(textwrap.fill(short_label(model), chars_across(axis, 9.5)), fontsize=9.5)
     _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")

@@ -67,6 +67,8 @@ class Page:
         The page's body as HTML for text pages; figure pages are embedded as their PNG.
     png : bytes
         The rendered page (empty until ``pipeline.report.render`` has drawn it).
+    also : tuple of str
+        Further sections that start on this page (text sections packed onto one page when they fit).
     """
 
     name: str
@@ -76,6 +78,7 @@ class Page:
     caption: str = ""
     html: str | None = None
     png: bytes = field(default=b"", repr=False)
+    also: tuple[str, ...] = ()
 
 
 def new_page(title: str, caption: str = "") -> Figure:

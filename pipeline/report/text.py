@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import html
 import textwrap
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import matplotlib.lines
 
@@ -24,12 +24,16 @@ LEFT = 0.02
 
 @dataclass
 class Item:
-    """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table."""
+    """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table.
+
+    ``part`` is the index of the section the item belongs to when several sections share pages (``pack``).
+    """
 
     kind: str
     text: str = ""
     header: list = field(default_factory=list)
     rows: list = field(default_factory=list)
+    part: int = 0
 
 
 def heading(text: str) -> Item:
@@ -66,7 +70,7 @@ def _lines(item) -> int:
     if item.kind == "heading":
         return 2
     if item.kind == "table":
-        return len(item.rows) + 2
+        return len(item.rows) + 1 + len(table_layout(item)[0][0]) if item.header else len(item.rows) + 2
     width = WRAP - (4 if item.kind == "bullet" else 0)
     return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind in ("paragraph", "strong") else 0)
 
@@ -85,13 +89,17 @@ def paginate(items, capacity=None) -> list[list[Item]]:
         if item.kind == "table" and need > capacity - used:
             room = capacity - used - 2
             if room < 3 and current:
-                pages.append(current)
-                current, used = [], 0
+                carried = []
+                while current and current[-1].kind == "heading":  # a heading goes with its table
+                    carried.insert(0, current.pop())
+                if current:
+                    pages.append(current)
+                current, used = carried, sum(_lines(c) for c in carried)
                 queue.insert(0, item)
                 continue
             room = max(room, 3)
-            head = Item("table", header=item.header, rows=item.rows[:room])
-            tail = Item("table", header=item.header, rows=item.rows[room:])
+            head = replace(item, rows=item.rows[:room])
+            tail = replace(item, rows=item.rows[room:])
             current.append(head)
             pages.append(current)
             current, used = [], 0
@@ -112,14 +120,37 @@ def paginate(items, capacity=None) -> list[list[Item]]:
     return pages
 
 
-def _column_positions(item) -> list[float]:
-    widths = [max(len(item.header[c]), *(len(row[c]) for row in item.rows)) if item.rows else len(item.header[c])
-              for c in range(len(item.header))]
+TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type across the page
+
+
+def table_layout(item) -> tuple[list[list[str]], list[float]]:
+    """Where a table goes: its header wrapped so the table fits the page width, and each column's x.
+
+    A header is wrapped (never cut) only as far as the page needs: the longest header line shrinks until
+    the columns fit ``TABLE_CHARS`` or reach the cells' own width.
+
+    Returns
+    -------
+    header : list of list of str
+        Per column, the lines of its header (every column the same number of lines, blank-padded).
+    positions : list of float
+        The figure x of each column.
+    """
+    cells = [max((len(row[c]) for row in item.rows), default=0) for c in range(len(item.header))]
+    limit = max((len(h) for h in item.header), default=1)
+    while True:
+        wrapped = [textwrap.wrap(h, max(limit, 1), break_long_words=False) or [""] for h in item.header]
+        widths = [max(cell, *(len(line) for line in lines)) for cell, lines in zip(cells, wrapped)]
+        if sum(w + 2 for w in widths) <= TABLE_CHARS or limit <= 6:
+            break
+        limit -= 1
+    height = max((len(lines) for lines in wrapped), default=1)
+    wrapped = [lines + [""] * (height - len(lines)) for lines in wrapped]
     positions, x = [], LEFT + 0.01
     for width in widths:
         positions.append(x)
         x += (width + 2) * CHAR
-    return positions
+    return wrapped, positions
 
 
 def draw_text_page(title, items, caption="", top=TOP, figure=None):
@@ -132,11 +163,13 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
             figure.text(LEFT, y, item.text, fontsize=11, weight="bold", va="top")
             y -= 1.6 * LINE
         elif item.kind == "table":
-            positions = _column_positions(item)
-            for x, text in zip(positions, item.header):
-                figure.text(x, y, text, fontsize=8.5, weight="bold", va="top")
-            y -= LINE
-            figure.add_artist(_rule(y + 0.25 * LINE, positions[-1] + (len(item.header[-1]) + 12) * CHAR))
+            header, positions = table_layout(item)
+            for line in range(len(header[0])):
+                for x, lines in zip(positions, header):
+                    figure.text(x, y, lines[line], fontsize=8.5, weight="bold", va="top")
+                y -= LINE
+            right = positions[-1] + (max(len(line) for line in header[-1]) + 12) * CHAR
+            figure.add_artist(_rule(y + 0.25 * LINE, right))
             for row in item.rows:
                 for x, text in zip(positions, row):
                     figure.text(x, y, text, fontsize=8.5, va="top")
