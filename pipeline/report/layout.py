@@ -29,6 +29,7 @@ LEGEND_ANCHOR = (0.85, 0.885)  # upper left corner of the page legend, right of 
 CAPTION_Y = 0.082
 CAPTION_SIZE = 7.5
 CAPTION_WRAP = 205  # characters of 7.5 pt italic across the page width (tests check the drawn extent)
+CAPTION_LINES = 3  # lines between the axes' labels and the footer
 FOOTER_Y = 0.008
 TITLE_SIZE = 13
 
@@ -90,8 +91,12 @@ def new_page(title: str, caption: str = "") -> Figure:
     figure = plt.figure(figsize=PAGE_SIZE)
     figure.text(0.015, 0.975, title, fontsize=TITLE_SIZE, weight="bold", va="top", ha="left")
     if caption:
-        figure.text(0.015, CAPTION_Y, "\n".join(textwrap.wrap(caption, CAPTION_WRAP)), fontsize=CAPTION_SIZE,
-                    style="italic", va="top", ha="left", linespacing=1.25)
+        for size in (CAPTION_SIZE, 7.0, 6.5, 6.0):  # a long caption in smaller type: three lines above the footer
+            lines = textwrap.wrap(caption, int(CAPTION_WRAP * CAPTION_SIZE / size))
+            if len(lines) <= CAPTION_LINES:
+                break
+        figure.text(0.015, CAPTION_Y, "\n".join(lines), fontsize=size, style="italic", va="top", ha="left",
+                    linespacing=1.25)
     return figure
 
 

@@ -475,6 +475,8 @@ def sources_items(results: Results) -> list[Item]:
     labels = state_labels(fragility)
     items = [heading("Where the numbers come from")]
     for state, limit in results.decision["max_probability_in_life"].items():
+        if state not in labels:  # a limit on a state this study did not compute judges nothing
+            continue
         shipped = SHIPPED_LIMITS.get(state) == limit and state in LIMIT_SOURCES
         items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', {limit:.0%} in the "
                             f"design life: {LIMIT_SOURCES[state] if shipped else 'the study file (its own limit)'}."))

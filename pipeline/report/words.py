@@ -135,7 +135,10 @@ GLOSSARY = (
                                                          "the site's hazard curve, and the chance that it happens at "
                                                          "least once in the design life."),
     ("restitution", "the share of rocking speed a block keeps at each impact; Housner's rigid base gives "
-                    "r = 1 − 1.5 sin²α."),
+                    "r = 1 − 1.5 sin²α, and experiments on rigid bases find about that value or a few percent more "
+                    "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
+    ("record sets", "the earthquake records the study runs; the far-field and near-field sets (with and without a "
+                    "velocity pulse) are those of FEMA P695."),
     ("resurrection", "a record that overturns the block at one level but not at a higher one; counted as "
                      "overturned from its first overturning level on."),
     ("friction demand", "the base friction coefficient a run needs to rock without sliding; above the assumed one "
