@@ -296,6 +296,9 @@ def test_efficiency_leaves_out_a_measure_identical_by_construction_and_says_why(
     dataset = _efficiency()
     assert figures.efficiency_twins(dataset) == {"pga_ratio": "pga"}
     assert figures.efficiency_twins(_efficiency(("pga", "pgv"))) == {}
+    equal = _efficiency(("pga", "pgv"))
+    equal["dispersion"][:] = 0.4
+    assert figures.efficiency_twins(equal) == {}  # equal by chance, not by construction: both drawn
     figure = figures.efficiency_page(dataset, "caption")
     try:
         top = figure.axes[0]

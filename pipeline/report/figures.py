@@ -608,21 +608,24 @@ def measure_words(measure: str) -> str:
     return pretty(MEASURES[measure].short_label()) if measure in MEASURES else measure.replace("_", " ")
 
 
+NORMALISED = {"pga_ratio": "pga", "pgv_ratio": "pgv"}
+"""Measures that divide another by a constant of the block (g·tanα; p/(g·tanα)): measure -> the one it divides."""
+
+
 def efficiency_twins(dataset) -> dict[str, str]:
-    """Measures whose dispersion equals an earlier measure's in every cell: measure -> the one it repeats.
+    """Normalised measures (``NORMALISED``) whose results repeat their measure's in every cell: measure -> it.
 
     Dividing an intensity by a constant of the block (g·tanα, the uplift acceleration) changes no
-    dispersion within a block, so PGA/(g·tanα) repeats PGA; the page draws one of each pair.
+    dispersion or p-value within a block, so PGA/(g·tanα) repeats PGA; the page draws one of each pair.
+    A pair that differs (a file written otherwise) is kept.
     """
-    twins = {}
     measures = [str(m) for m in dataset.measure.values]
-    values = {m: np.asarray(dataset.dispersion.sel(measure=m).values, float) for m in measures}
-    for index, measure in enumerate(measures):
-        for earlier in measures[:index]:
-            if earlier not in twins and np.allclose(values[measure], values[earlier], rtol=1e-6, atol=1e-9,
-                                                    equal_nan=True) and np.isfinite(values[measure]).any():
-                twins[measure] = earlier
-                break
+    twins = {}
+    for measure, base in NORMALISED.items():
+        if measure in measures and base in measures:
+            values = [np.asarray(dataset.dispersion.sel(measure=m).values, float) for m in (measure, base)]
+            if np.allclose(*values, rtol=1e-6, atol=1e-9, equal_nan=True):
+                twins[measure] = base
     return twins
 
 
