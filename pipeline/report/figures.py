@@ -581,7 +581,8 @@ def sweep_page(dataset, caption, names: dict | None = None):
             axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
             axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
             axis.axhline(1.0, color="k", lw=0.7)
-            axis.set_title(f"{(names or {}).get(str(block), block)}: {label}", fontsize=9)
+            axis.set_title(textwrap.fill(f"{(names or {}).get(str(block), block)}: {label}", chars_across(axis, 9)),
+                           fontsize=9)
             log_axis(axis)
             axis.set_xlabel("soil shear modulus G_s [MPa]")
             axis.grid(alpha=0.3, which="both")

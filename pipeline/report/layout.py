@@ -32,6 +32,7 @@ CAPTION_WRAP = 205  # characters of 7.5 pt italic across the page width (tests c
 CAPTION_LINES = 3  # lines between the axes' labels and the footer
 FOOTER_Y = 0.008
 TITLE_SIZE = 13
+TITLE_CHARS = 95  # characters of a bold 13 pt title across the page; a longer title is set smaller
 
 SOIL_COLOURS = {"clay": "#8c510a", "sand": "#d8a03a", "gravel": "#35978f", "rock": "#01665e",
                 "steel": "#5e3c99"}
@@ -89,7 +90,8 @@ def new_page(title: str, caption: str = "") -> Figure:
     and keeps pages alike.
     """
     figure = plt.figure(figsize=PAGE_SIZE)
-    figure.text(0.015, 0.975, title, fontsize=TITLE_SIZE, weight="bold", va="top", ha="left")
+    size = TITLE_SIZE if len(title) <= TITLE_CHARS else max(9.0, TITLE_SIZE * TITLE_CHARS / len(title))
+    figure.text(0.015, 0.975, title, fontsize=size, weight="bold", va="top", ha="left")
     if caption:
         for size in (CAPTION_SIZE, 7.0, 6.5, 6.0):  # a long caption in smaller type: three lines above the footer
             lines = textwrap.wrap(caption, int(CAPTION_WRAP * CAPTION_SIZE / size))

@@ -66,11 +66,15 @@ def table(header, rows) -> Item:
     return Item("table", header=[str(h) for h in header], rows=[[str(c) for c in row] for row in rows])
 
 
+def _header_lines(item) -> int:
+    return len(table_layout(item)[0][0]) if item.header else 1
+
+
 def _lines(item) -> int:
     if item.kind == "heading":
         return 2
     if item.kind == "table":
-        return len(item.rows) + 1 + len(table_layout(item)[0][0]) if item.header else len(item.rows) + 2
+        return len(item.rows) + 1 + _header_lines(item)
     width = WRAP - (4 if item.kind == "bullet" else 0)
     return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind in ("paragraph", "strong") else 0)
 
@@ -87,7 +91,7 @@ def paginate(items, capacity=None) -> list[list[Item]]:
         item = queue.pop(0)
         need = _lines(item)
         if item.kind == "table" and need > capacity - used:
-            room = capacity - used - 2
+            room = capacity - used - 1 - _header_lines(item)
             if room < 3 and current:
                 carried = []
                 while current and current[-1].kind == "heading":  # a heading goes with its table
@@ -123,11 +127,16 @@ def paginate(items, capacity=None) -> list[list[Item]]:
 TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type across the page
 
 
-def table_layout(item) -> tuple[list[list[str]], list[float]]:
-    """Where a table goes: its header wrapped so the table fits the page width, and each column's x.
+TABLE_SIZE = 8.5  # pt, table type; smaller (down to MIN_TABLE_SIZE) only for a table too wide for the page
+MIN_TABLE_SIZE = 6.0
+
+
+def table_layout(item) -> tuple[list[list[str]], list[float], float]:
+    """Where a table goes: its header wrapped so the table fits the page width, each column's x, the type size.
 
     A header is wrapped (never cut) only as far as the page needs: the longest header line shrinks until
-    the columns fit ``TABLE_CHARS`` or reach the cells' own width.
+    the columns fit ``TABLE_CHARS`` or reach the cells' own width. A table still too wide is set in
+    smaller type, never cut.
 
     Returns
     -------
@@ -135,6 +144,8 @@ def table_layout(item) -> tuple[list[list[str]], list[float]]:
         Per column, the lines of its header (every column the same number of lines, blank-padded).
     positions : list of float
         The figure x of each column.
+    size : float
+        The type size [pt].
     """
     cells = [max((len(row[c]) for row in item.rows), default=0) for c in range(len(item.header))]
     limit = max((len(h) for h in item.header), default=1)
@@ -146,11 +157,14 @@ def table_layout(item) -> tuple[list[list[str]], list[float]]:
         limit -= 1
     height = max((len(lines) for lines in wrapped), default=1)
     wrapped = [lines + [""] * (height - len(lines)) for lines in wrapped]
+    total = sum(w + 2 for w in widths)
+    size = max(MIN_TABLE_SIZE, min(TABLE_SIZE, TABLE_SIZE * TABLE_CHARS / total)) if total else TABLE_SIZE
+    char = CHAR * size / TABLE_SIZE
     positions, x = [], LEFT + 0.01
     for width in widths:
         positions.append(x)
-        x += (width + 2) * CHAR
-    return wrapped, positions
+        x += (width + 2) * char
+    return wrapped, positions, size
 
 
 def draw_text_page(title, items, caption="", top=TOP, figure=None):
@@ -163,16 +177,16 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
             figure.text(LEFT, y, item.text, fontsize=11, weight="bold", va="top")
             y -= 1.6 * LINE
         elif item.kind == "table":
-            header, positions = table_layout(item)
+            header, positions, size = table_layout(item)
             for line in range(len(header[0])):
                 for x, lines in zip(positions, header):
-                    figure.text(x, y, lines[line], fontsize=8.5, weight="bold", va="top")
+                    figure.text(x, y, lines[line], fontsize=size, weight="bold", va="top")
                 y -= LINE
-            right = positions[-1] + (max(len(line) for line in header[-1]) + 12) * CHAR
+            right = positions[-1] + (max(len(line) for line in header[-1]) + 12) * CHAR * size / TABLE_SIZE
             figure.add_artist(_rule(y + 0.25 * LINE, right))
             for row in item.rows:
                 for x, text in zip(positions, row):
-                    figure.text(x, y, text, fontsize=8.5, va="top")
+                    figure.text(x, y, text, fontsize=size, va="top")
                 y -= LINE
             y -= LINE
         else:
