@@ -20,6 +20,8 @@ LINE = 0.021  # one line of 9.5 pt text on the A4-landscape page [figure fractio
 WRAP = 150  # characters per line of 9.5 pt text across the page
 CHAR = 0.0062  # width of one 8.5 pt table character [figure fraction], for column positions
 LEFT = 0.02
+STRETCH = 7  # lines the last page of a run may hold beyond its capacity, set closer together
+MIN_HEADER = 12  # characters: a header is not wrapped narrower than this to make a table fit
 
 
 @dataclass
@@ -82,12 +84,17 @@ def _lines(item) -> int:
 def paginate(items, capacity=None) -> list[list[Item]]:
     """Split items into pages of ``capacity`` lines (default: a full page).
 
-    A table longer than a page is split with its header repeated; a heading never ends a page.
+    A table longer than a page is split with its header repeated; a heading never ends a page. When what
+    is left overflows the last page by at most ``STRETCH`` lines, it goes on that page with its lines set
+    closer (``draw_text_page``) rather than alone on a near-empty page.
     """
     capacity = capacity or int((TOP - BOTTOM) / LINE)
     pages, current, used = [], [], 0
     queue = list(items)
     while queue:
+        if sum(_lines(rest) for rest in queue) <= capacity - used + STRETCH:  # the rest fits, a little closer
+            current += queue
+            break
         item = queue.pop(0)
         need = _lines(item)
         if item.kind == "table" and need > capacity - used:
@@ -152,7 +159,7 @@ def table_layout(item) -> tuple[list[list[str]], list[float], float]:
     while True:
         wrapped = [textwrap.wrap(h, max(limit, 1), break_long_words=False) or [""] for h in item.header]
         widths = [max(cell, *(len(line) for line in lines)) for cell, lines in zip(cells, wrapped)]
-        if sum(w + 2 for w in widths) <= TABLE_CHARS or limit <= 6:
+        if sum(w + 2 for w in widths) <= TABLE_CHARS or limit <= MIN_HEADER:
             break
         limit -= 1
     height = max((len(lines) for lines in wrapped), default=1)
@@ -171,37 +178,39 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
     """One page figure with the items drawn top-down from ``top``."""
     figure = figure or new_page(title, caption)
     y = top
+    lines = sum(_lines(item) for item in items)
+    line = min(LINE, (top - BOTTOM) / lines) if lines else LINE  # a stretched last page: lines set closer
     for item in items:
         if item.kind == "heading":
-            y -= 0.4 * LINE
+            y -= 0.4 * line
             figure.text(LEFT, y, item.text, fontsize=11, weight="bold", va="top")
-            y -= 1.6 * LINE
+            y -= 1.6 * line
         elif item.kind == "table":
             header, positions, size = table_layout(item)
-            for line in range(len(header[0])):
-                for x, lines in zip(positions, header):
-                    figure.text(x, y, lines[line], fontsize=size, weight="bold", va="top")
-                y -= LINE
-            right = positions[-1] + (max(len(line) for line in header[-1]) + 12) * CHAR * size / TABLE_SIZE
-            figure.add_artist(_rule(y + 0.25 * LINE, right))
+            for level in range(len(header[0])):
+                for x, column in zip(positions, header):
+                    figure.text(x, y, column[level], fontsize=size, weight="bold", va="top")
+                y -= line
+            right = positions[-1] + (max(len(text) for text in header[-1]) + 12) * CHAR * size / TABLE_SIZE
+            figure.add_artist(_rule(y + 0.25 * line, right))
             for row in item.rows:
                 for x, text in zip(positions, row):
                     figure.text(x, y, text, fontsize=size, va="top")
-                y -= LINE
-            y -= LINE
+                y -= line
+            y -= line
         else:
             indent = 0.02 if item.kind == "bullet" else 0.0
             width = WRAP - (4 if item.kind == "bullet" else 0)
-            lines = textwrap.wrap(item.text, width) or [""]
-            for number, line in enumerate(lines):
+            wrapped = textwrap.wrap(item.text, width) or [""]
+            for number, text_line in enumerate(wrapped):
                 if item.kind == "bullet" and number == 0:
                     figure.text(LEFT + 0.006, y, "•", fontsize=9.5, va="top")
-                figure.text(LEFT + indent, y, line, fontsize=9.5 if item.kind != "note" else 8.5, va="top",
+                figure.text(LEFT + indent, y, text_line, fontsize=9.5 if item.kind != "note" else 8.5, va="top",
                             style="italic" if item.kind == "note" else "normal",
                             weight="bold" if item.kind == "strong" else "normal")
-                y -= LINE
+                y -= line
             if item.kind in ("paragraph", "strong"):
-                y -= LINE
+                y -= line
     return figure
 
 
