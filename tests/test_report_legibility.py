@@ -28,7 +28,7 @@ def _shown_texts(figure):
     figure.canvas.draw()
     renderer = figure.canvas.get_renderer()
     all_ticks, drawn_ticks = set(), set()
-    for axis in figure.axes:
+    for axis in [a for parent in figure.axes for a in (parent, *parent.child_axes)]:
         for side in (axis.xaxis, axis.yaxis):
             for tick in side.get_major_ticks() + side.get_minor_ticks():
                 all_ticks.update((id(tick.label1), id(tick.label2)))

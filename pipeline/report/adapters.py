@@ -111,8 +111,11 @@ def panel_label(model: ModelInfo) -> str:
 
 
 def cell(dataset, model: ModelInfo, block, soil=None):
-    """The results of one model and block; a rigid-base model on the first soil (all soils are equal)."""
-    if "soil" in dataset.dims and (model.rigid_base or soil is None):
+    """The results of one model and block on ``soil``; without a soil, on the first.
+
+    A rigid base's soils are equal unless base friction lets it slide on some: then the caller names the soil.
+    """
+    if "soil" in dataset.dims and soil is None:
         soil = dataset.soil.values[0]
     selection = {"model": model.name, "block": block}
     if "soil" in dataset.dims:

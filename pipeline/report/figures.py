@@ -267,18 +267,33 @@ def _finite_capped(values):
 ROW_GAP = 0.5  # in between two rows of IDA panels: the row's heading and the panels' titles
 
 
-def _ida_rows(models, soils, most_columns=5):
-    """The IDA page's rows: (heading, [(model, soil or None), ...]); the rigid-base models share the first row."""
-    rigid = [m for m in models if m.rigid_base]
-    founded = [m for m in models if not m.rigid_base]
+def _ida_rows(models, soils, per_soil=(), most_columns=5):
+    """The IDA page's rows: (heading, [(model, soil or None), ...]).
+
+    The rigid-base models share the first row, except those in ``per_soil`` (their runs differ by soil:
+    base friction lets the block slide on some soils), which get a row of their own like the foundation
+    models.
+    """
+    rigid = [m for m in models if m.rigid_base and m.name not in per_soil]
+    founded = [m for m in models if not m.rigid_base or m.name in per_soil]
     columns = min(max(len(soils) if founded else 1, len(rigid), 1), most_columns)
     rows = []
     for start in range(0, len(rigid), columns):
         rows.append(("rigid base: the same on every soil", [(m, None) for m in rigid[start:start + columns]]))
     for model in founded:
+        heading = panel_label(model)
+        if model.rigid_base:
+            heading += " (rigid base; base friction: it slides on some soils)"
         for start in range(0, len(soils), columns):
-            rows.append((panel_label(model), [(model, soil) for soil in soils[start:start + columns]]))
+            rows.append((heading, [(model, soil) for soil in soils[start:start + columns]]))
     return rows, columns
+
+
+def _differs_by_soil(dataset, model, block) -> bool:
+    """The runs of a rigid-base model differ between soils (base friction, which depends on the soil)."""
+    edp = dataset.edp.sel(model=model.name, block=block).transpose("soil", ...).values
+    first = edp[0]
+    return any(not np.array_equal(first, other, equal_nan=True) for other in edp[1:])
 
 
 def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
@@ -289,7 +304,8 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     """
     models = models_of(ida)
     soils = list(map(str, ida.soil.values))
-    rows, columns = _ida_rows(models, soils)
+    per_soil = [m.name for m in models if m.rigid_base and _differs_by_soil(ida, m, block)]
+    rows, columns = _ida_rows(models, soils, per_soil)
     figure = new_page(f"IDA curves: {name or block}", caption)
     top, bottom = 0.86, GRID["bottom"]
     height = (top - bottom) * figure.get_figheight()
@@ -549,7 +565,7 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0,
                  label="300-1000 MPa: above it the paper finds the rigid base good enough")
     axis.axhline(1.0, color="k", lw=0.8)
-    log_axis(axis)
+    log_axis(axis, (0.7 * min(shear.min(), 300.0), 1.4 * max(shear.max(), 1000.0)))  # every soil on the top axis
     axis.set_xlabel("soil shear modulus G_s [MPa]")
     axis.set_ylabel(f"median θmax (model) / median θmax ({panel_label(reference)}) [-]")
     axis.grid(alpha=0.3, which="both")
