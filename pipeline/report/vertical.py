@@ -178,7 +178,7 @@ def vertical_page(effect: VerticalEffect, block, caption, marks=None, name: str 
         bottom.set_xlabel(measure_label(cube))
         bottom.grid(alpha=0.3, which="both")
     axes[0, 0].set_ylabel(measure_label(cube))
-    axes[1, 0].set_ylabel("P(overturning | IM) [-]")
+    axes[1, 0].set_ylabel("probability of overturning [-]")
     axes[0, 0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
     outside_legend(figure, list(axes.flat))
     return figure

@@ -112,7 +112,8 @@ def references_items() -> list[Item]:
 
 GLOSSARY = (
     ("θmax/α", "the largest rocking angle of a run over the block's slenderness angle α; 1 is the tipping point "
-               "of a block at rest, and a block that overturns is drawn at the top of the IDA axis."),
+               "of a block at rest; on the IDA pages a run that overturns is drawn at θmax/α = 1.6, the right "
+               "edge of each panel."),
     ("α, R", "slenderness angle (tan α = half-width over half-height) and the half-diagonal of the block; of two "
              "blocks with the same α the larger (larger R) is the more stable (Makris & Vassiliou 2012)."),
     ("uplift threshold", "the ground acceleration at which the block starts to rock on a rigid base: g·tanα."),
@@ -123,7 +124,17 @@ GLOSSARY = (
     ("β (dispersion)", "the standard deviation of the logarithm of the intensity at which the state is reached; "
                        "from record to record, plus the model's own uncertainty where the recommended curve "
                        "adds it."),
-    ("band", "the confidence bounds of a median from re-fitting with the records resampled (bootstrap)."),
+    ("band", "two meanings, named apart on the pages: the confidence band of a fitted curve (the bounds of its "
+             "median from re-fitting with the records resampled, bootstrap), and the restitution band (the "
+             "range of impact restitution the recommended curve runs: its low edge, centre and high edge)."),
+    ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
+                               "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, the "
+                               "integral of the squared acceleration), D5-95 (the time between 5% and 95% of Ia)."),
+    ("G_s, E_d, ξ, k", "the soil's shear modulus, its constrained (oedometric) modulus, the damping ratio of the "
+                       "foundation's dashpot, and the foundation's vertical stiffness under the block (the "
+                       "paper's eq. 19)."),
+    ("μ_s (base friction)", "the static friction coefficient between the block's base and the ground: below the "
+                            "block's width over height the block slides before it can rock (Shenton 1996)."),
     ("IDA (incremental dynamic analysis)", "each record is scaled to a ladder of intensities and run at each "
                                            "(Vamvatsikos & Cornell 2002)."),
     ("extrapolation by scaling", "an intensity above the largest any record of the set reached unscaled: there the "
