@@ -163,7 +163,8 @@ CAPTIONS = {
     "ida": "Read at which intensity the block starts to rock and where it overturns: thin lines, one record each; "
            "bold, the 16/50/84% fractiles of θmax/α. Overturning is drawn at the right edge. Dotted: the site's "
            "return-period intensities; shaded: beyond the largest recorded intensity (extrapolation by scaling). "
-           "Curves are not smoothed: a record may overturn at one level and survive a higher one (resurrection).",
+           "A block that slides instead of rocking stays at θmax/α = 0. Curves are not smoothed: a record may "
+           "overturn at one level and survive a higher one (resurrection).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
                        "the fitted lognormal; band, the confidence bounds of the median; black dashed, the rigid "
