@@ -273,9 +273,10 @@ def summary_items(results: Results) -> list[Item]:
     for block in fragility.block.values:
         largest = results.largest_recorded.get(str(block), np.inf)
         for model in _ordered_models(results):
-            soils = ["(any)"] if model.rigid_base else list(fragility.soil.values)
+            once = model.rigid_base and not _differs_by_soil(fragility["median"].sel(model=model.name, block=block))
+            soils = ["(any)"] if once else list(fragility.soil.values)
             for soil in soils:
-                picked = cell(fragility, model, block, None if model.rigid_base else soil)
+                picked = cell(fragility, model, block, None if once else soil)
                 row = [block_name(results.config, block), short_label(model), str(soil)]
                 for state in states:
                     median = float(picked["median"].sel(damage_state=state)) * scale
@@ -293,7 +294,8 @@ def summary_items(results: Results) -> list[Item]:
                     row.append(percent(p))
                 rows.append(row)
     items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β), the answering model "
-                       "first. Rigid-base models do not depend on the soil and have one row per block."),
+                       "first. A rigid-base model has one row per block (soil '(any)') unless base friction lets "
+                       "the block slide on some soils: then one row per soil."),
              table(header, rows)]
     if "*" in marks:
         items.append(note("* the median lies outside the studied intensity range (an extrapolation of the fit; see "
@@ -307,6 +309,12 @@ def summary_items(results: Results) -> list[Item]:
     if has_risk:
         items.append(note(f"Hazard: {fragility.attrs.get('hazard_source', 'see Methods')}."))
     return items
+
+
+def _differs_by_soil(values: xr.DataArray) -> bool:
+    """A rigid base's results differ between soils (base friction lets it slide on some): one row per soil."""
+    rows = values.transpose("soil", ...).values
+    return any(not np.array_equal(rows[0], other, equal_nan=True) for other in rows[1:])
 
 
 def _beta(value: float) -> str:
