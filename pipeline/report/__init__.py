@@ -47,8 +47,15 @@ from pipeline.report import figures as pages  # noqa: E402
 from pipeline.report.adapters import block_name, models_of, record_pga_g, short_label  # noqa: E402
 from pipeline.report.answer_page import answer_items  # noqa: E402
 from pipeline.report.layout import Page, add_footer, new_page  # noqa: E402
-from pipeline.report.sections import Results, limitations_items, methods_items, summary_items, title_items  # noqa: E402
-from pipeline.report.text import Item, draw_text_page, items_html, paginate, table  # noqa: E402
+from pipeline.report.sections import (  # noqa: E402
+    Results,
+    limitations_items,
+    methods_items,
+    provenance_items,
+    summary_items,
+    title_items,
+)
+from pipeline.report.text import Item, draw_text_page, items_html, note, paginate, table  # noqa: E402
 from pipeline.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
 from pipeline.report.words import glossary_items, references_items  # noqa: E402
 from pipeline.units import STANDARD_GRAVITY  # noqa: E402
@@ -65,6 +72,39 @@ def _text_pages(name, section, title, items, caption=""):
         planned.append(Page(f"{name}-{number}" if len(chunks) > 1 else name, section, title + suffix,
                             lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk, caption),
                             caption, items_html(chunk)))
+    return planned
+
+
+def _packed_pages(parts) -> list[Page]:
+    """Consecutive text sections on shared pages, so no page holds a few table rows or a single line alone.
+
+    A section starts on the page where the previous one ends when it fits there, headed by its title.
+
+    ``parts`` lists (name, section, title, items); a page is named and titled by the section it starts with,
+    and lists the other sections that start on it in ``Page.also`` (the contents and the HTML anchors).
+    """
+    flow = []
+    for index, (_, _, title, items) in enumerate(parts):
+        if index:
+            flow.append(Item("heading", title, part=index))
+        flow += [replace(item, part=index) for item in items]
+    chunks = paginate(flow)
+    first_part = [chunk[0].part if chunk else 0 for chunk in chunks]
+    planned, counters = [], {}
+    for number, chunk in enumerate(chunks):
+        part = first_part[number]
+        if chunk and chunk[0].kind == "heading" and chunk[0].part and chunk[0].text == parts[part][2] \
+                and (number == 0 or first_part[number - 1] != part):
+            chunk = chunk[1:]  # the page title says it
+        name, section, title, _ = parts[part]
+        holding = [n for n, other in enumerate(chunks) if any(item.part == part for item in other)]
+        counters[part] = counters.get(part, 0) + 1
+        suffix = f" ({holding.index(number) + 1}/{len(holding)})" if len(holding) > 1 else ""
+        pages_of_part = sum(1 for p in first_part if p == part)
+        also = tuple(dict.fromkeys(parts[item.part][1] for item in chunk if item.part != part))
+        planned.append(Page(f"{name}-{counters[part]}" if pages_of_part > 1 else name, section, title + suffix,
+                            lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk), "", items_html(chunk),
+                            also=also))
     return planned
 
 
@@ -123,7 +163,8 @@ CAPTIONS = {
     "ida": "Read at which intensity the block starts to rock and where it overturns: thin lines, one record each; "
            "bold, the 16/50/84% fractiles of θmax/α. Overturning is drawn at the right edge. Dotted: the site's "
            "return-period intensities; shaded: beyond the largest recorded intensity (extrapolation by scaling). "
-           "Curves are not smoothed: a record may overturn at one level and survive a higher one (resurrection).",
+           "A block that slides instead of rocking stays at θmax/α = 0. Curves are not smoothed: a record may "
+           "overturn at one level and survive a higher one (resurrection).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
                        "the fitted lognormal; band, the confidence bounds of the median; black dashed, the rigid "
@@ -137,17 +178,31 @@ CAPTIONS = {
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
-    "applicability": "Read where the rigid-base model is good enough: inside the grey band each foundation model's "
-                     "median peak angle is within 10% of the rigid base's; runs between 1.2 and 3 times each "
-                     "block's uplift threshold; top axis: the study's soils.",
+    "applicability": "Read where the rigid-base model is good enough: each line is one foundation model (its colour "
+                     "and dashes) for one block (its marker): the median peak angle of the runs between 1.2 and 3 "
+                     "times the block's uplift threshold over the rigid base's. Grey band: within 10% of the rigid "
+                     "base. Green band: 300-1000 MPa, the soil stiffness above which the paper finds the rigid base "
+                     "good enough. Top axis: the study's soils. Lines that coincide hide each other.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
-                           "green: the paper's 300-1000 MPa; solid concrete block, dashed steel block.",
+                           "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
+                           "enough; colours: the intensity level; solid concrete block, dashed steel block.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
-                  "below the dashed line it does, and the measure alone is not enough).",
+                  "below the dashed line it does, and the measure alone is not enough; the test of Luco & Cornell "
+                  "2007).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
+
+
+def _twins_words(efficiency) -> str:
+    """The efficiency caption's sentence on the measures left out because they repeat another ("" if none)."""
+    twins = pages.efficiency_twins(efficiency)
+    if not twins:
+        return ""
+    pairs = "; ".join(f"{pages.measure_words(m)} repeats {pages.measure_words(o)}" for m, o in twins.items())
+    return (f" Not drawn ({pairs}): dividing an intensity by a constant of the block (its uplift acceleration "
+            "g·tanα) changes nothing within one block, so their bars and p-values are identical by construction.")
 
 
 def plan(results: Results) -> list[Page]:
@@ -160,18 +215,19 @@ def plan(results: Results) -> list[Page]:
     for answer in results.answers:
         name = names.get(answer.block, answer.block)
         planned += _text_pages(f"answer-{answer.block}", "Answer", f"Answer: {name}", answer_items(results, answer))
-    planned += _text_pages("summary", "Summary", "Summary of the fitted fragility functions", summary_items(results))
-    planned += _text_pages("methods", "Methods", "Methods and assumptions", methods_items(results))
-    planned += _text_pages("limitations", "Limitations", "Limitations: where the models are outside their validity",
-                           limitations_items(results))
-    planned += _text_pages("records-table", "Records", "Intensity measures of the processed records",
-                           records_items(results),
-                           "PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) after processing.")
+    planned += _packed_pages([
+        ("summary", "Summary", "Summary of the fitted fragility functions", summary_items(results)),
+        ("methods", "Methods", "Methods and assumptions", methods_items(results)),
+        ("limitations", "Limitations", "Limitations: where the models are outside their validity",
+         limitations_items(results)),
+        ("records-table", "Records", "Intensity measures of the processed records",
+         [*records_items(results), note("PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) "
+                                        "after processing.")])])
     if showcase is not None and "record_spectrum" in showcase:
         planned.append(_figure("spectra", "Records", "Response spectra of the record set", pages.spectra_page,
                                showcase, caption=CAPTIONS["spectra"]))
     if showcase is not None and "theta" in showcase:
-        record = showcase.attrs["showcase_record"]
+        record = pages.record_words(showcase)
         showcase_name = names.get(str(showcase.attrs.get("showcase_block", "")))
         planned.append(_figure("showcase-processing", "Showcase record", f"{record}: raw and processed",
                                pages.showcase_ground_page, showcase, caption=CAPTIONS["showcase-processing"]))
@@ -215,10 +271,13 @@ def plan(results: Results) -> list[Page]:
                                        "in both models.", names=names))
     if results.efficiency is not None and "dispersion" in results.efficiency:
         planned.append(_figure("efficiency", "Measure efficiency", "Efficiency of intensity measures",
-                               pages.efficiency_page, results.efficiency, caption=CAPTIONS["efficiency"],
+                               pages.efficiency_page, results.efficiency,
+                               caption=CAPTIONS["efficiency"] + _twins_words(results.efficiency),
                                names=names))
-    planned += _text_pages("glossary", "Glossary", "Glossary", glossary_items())
-    planned += _text_pages("references", "References", "References", references_items())
+    planned += _packed_pages([("glossary", "Glossary", "Glossary", glossary_items()),
+                              ("references", "References", "References", references_items()),
+                              ("provenance", "Provenance", "Provenance: how this report was computed",
+                               provenance_items(results))])
     return planned
 
 
@@ -242,6 +301,10 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
             rows.append(("section", page.section, shown))
             last = page.section
         rows.append(("page", page.title, shown))
+        for section in page.also:  # a section that starts part-way down this page
+            rows.append(("section", section, shown))
+            rows.append(("page", f"{section} (from part-way down the page)", shown))
+            last = section
     lines = []
     for kind, text, number in rows:
         wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" else 0)) or [""]
@@ -298,9 +361,10 @@ def html_document(title: str, rendered: list[Page]) -> str:
              f"<style>{HTML_STYLE}</style></head><body>"]
     last = None
     for number, page in enumerate(rendered, start=1):
-        if page.section != last:
-            parts.append(f"<div id='{_slug(page.section)}'></div>")
-            last = page.section
+        for section in (page.section, *page.also):
+            if section != last:
+                parts.append(f"<div id='{_slug(section)}'></div>")
+                last = section
         parts.append(f"<section id='page-{number}'><span class='pageno'>page {number} of {len(rendered)}</span>"
                      f"<h2>{html.escape(page.title)}</h2>")
         if contents is not None and number != contents:
@@ -314,7 +378,7 @@ def html_document(title: str, rendered: list[Page]) -> str:
         if page.caption:
             parts.append(f"<p class='caption'>{html.escape(page.caption)}</p>")
         parts.append("</section>")
-    parts.append(f"<footer><p class='note'>rockfrag {__version__}</p></footer></body></html>")
+    parts.append("</body></html>")
     return "\n".join(parts)
 
 

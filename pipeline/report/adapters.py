@@ -9,6 +9,7 @@ Output: small answers the pages draw: model labels and roles (rigid base or on a
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,7 +23,7 @@ from pipeline.measures import short_label as measure_short_label
 from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
 from pipeline.models.variants import RECOMMENDED
-from pipeline.report.layout import MODEL_STYLES, RIGID_STYLE, pretty
+from pipeline.report.layout import MODEL_STYLES, RECOMMENDED_STYLE, RIGID_STYLE, pretty
 from pipeline.soils import DEFAULT_FRICTION
 
 OUTCOME_ROCKING, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = int(Outcome.ROCKING), int(Outcome.FAILED), \
@@ -83,11 +84,16 @@ def models_of(dataset) -> list[ModelInfo]:
 
 
 def model_styles(models) -> dict:
-    """Line style per model: rigid base black dashed, the others distinct colours and dash patterns."""
+    """Line style per model: rigid base black dashed, the recommended curve thick solid red.
+
+    The others get distinct colours and dash patterns, none solid.
+    """
     styles, index = {}, 0
     for model in models:
         if model.rigid_base:
             styles[model.name] = dict(RIGID_STYLE)
+        elif model.name == RECOMMENDED:
+            styles[model.name] = dict(RECOMMENDED_STYLE)
         else:
             styles[model.name] = dict(MODEL_STYLES[index % len(MODEL_STYLES)])
             index += 1
@@ -96,7 +102,7 @@ def model_styles(models) -> dict:
 
 def short_label(model: ModelInfo) -> str:
     """A label short enough for a legend: the registry label, or the name for long descriptions."""
-    return model.label if len(model.label) <= 45 else model.name
+    return model.label if len(model.label) <= 50 else model.name
 
 
 def panel_label(model: ModelInfo) -> str:
@@ -105,8 +111,11 @@ def panel_label(model: ModelInfo) -> str:
 
 
 def cell(dataset, model: ModelInfo, block, soil=None):
-    """The results of one model and block; a rigid-base model on the first soil (all soils are equal)."""
-    if "soil" in dataset.dims and (model.rigid_base or soil is None):
+    """The results of one model and block on ``soil``; without a soil, on the first.
+
+    A rigid base's soils are equal unless base friction lets it slide on some: then the caller names the soil.
+    """
+    if "soil" in dataset.dims and soil is None:
         soil = dataset.soil.values[0]
     selection = {"model": model.name, "block": block}
     if "soil" in dataset.dims:
@@ -128,6 +137,11 @@ def measure_label(dataset) -> str:
     measure = str(dataset.attrs.get("intensity_measure", "")).lower()
     long_name = str(dataset.im_level.attrs.get("long_name", ""))
     return f"{measure_short_label(measure, long_name)} [{unit}]"  # the registry's label (pipeline.measures)
+
+
+def state_title(label: str) -> str:
+    """A damage state's label shortened for a panel title: up to its first colon or parenthesis."""
+    return re.split(r":| \(", label, maxsplit=1)[0].strip()
 
 
 def state_labels(fragility) -> dict:

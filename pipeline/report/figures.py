@@ -8,11 +8,13 @@ Input : the opened result datasets (cube, ida, fragility, showcase, applicabilit
 from __future__ import annotations
 
 import math
+import re
 import textwrap
 
 import numpy as np
 import xarray as xr
 
+from pipeline.damage_states import NOT_APPLICABLE
 from pipeline.fragility import lognormal_cdf
 from pipeline.measures import MEASURES
 from pipeline.report.adapters import (
@@ -26,11 +28,13 @@ from pipeline.report.adapters import (
     panel_label,
     short_label,
     state_labels,
+    state_title,
     uplift_intensity,
 )
 from pipeline.report.layout import (
     FRACTILE_STYLES,
     GRID,
+    chars_across,
     log_axis,
     log_y_axis,
     new_page,
@@ -52,34 +56,63 @@ EXTRAPOLATION = dict(color="0.55", alpha=0.13, lw=0, zorder=0)  # beyond the lar
 NO_CURVE = "no curve: "
 
 
+MARK_SIZE = 6.5  # pt, the return-period labels
+
+
+def mark_groups(axis, marks: CredibleMarks, along: str = "x") -> list[tuple[list[float], str]]:
+    """The return-period marks inside the axis, grouped where their labels would overlap.
+
+    Marks closer on the page than 1.4 label heights share one label ("475 / 975 / 2,475 yr", in the order
+    of the lines along the axis), so labels never overprint. Needs the axis limits and scale set.
+
+    Returns
+    -------
+    list of (intensities, label)
+        One entry per label: the intensities it names (increasing) and its text.
+    """
+    low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
+    inside = sorted((im, t) for t, im in zip(marks.return_periods, marks.intensities) if low <= im <= high)
+    if not inside:
+        return []
+    to_pixels = axis.transData.transform
+    where = [to_pixels((im, 1.0) if along == "x" else (1.0, im))[0 if along == "x" else 1] for im, _ in inside]
+    room = 1.4 * MARK_SIZE * axis.figure.dpi / 72.0
+    groups = [[0]]
+    for index in range(1, len(inside)):
+        if abs(where[index] - where[groups[-1][-1]]) < room:
+            groups[-1].append(index)
+        else:
+            groups.append([index])
+    return [([inside[i][0] for i in group], " / ".join(f"{inside[i][1]:,.0f}" for i in group) + " yr")
+            for group in groups]
+
+
 def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> None:
     """Mark the site's return-period intensities and the extrapolation by scaling on an intensity axis.
 
-    Dotted labelled lines at the return-period intensities; beyond the largest recorded intensity, a
-    shade; ``along`` is the intensity axis ("x" or "y"). Call it after the axis limits are set: the
-    shading runs to the axis end.
+    Dotted lines at the return-period intensities, labelled in groups that never overlap (``mark_groups``);
+    beyond the largest recorded intensity, a shade; ``along`` is the intensity axis ("x" or "y"). Call it
+    after the axis limits and scale are set: the shading runs to the axis end.
     """
     if marks is None:
         return
     low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
+    line = axis.axvline if along == "x" else axis.axhline
     if marks.largest is not None and np.isfinite(marks.largest) and marks.largest < high:
         span = axis.axvspan if along == "x" else axis.axhspan
         span(max(marks.largest, low), high, **EXTRAPOLATION, label="beyond the largest recorded intensity: "
                                                                    "extrapolation by scaling")
-        line = axis.axvline if along == "x" else axis.axhline
         line(marks.largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
-    for period, intensity in zip(marks.return_periods, marks.intensities):
-        if not low <= intensity <= high:
-            continue
-        line = axis.axvline if along == "x" else axis.axhline
-        line(intensity, color=MARK_COLOUR, lw=0.9, ls=":", label="site hazard at the return periods")
-        text = f"{period:,.0f} yr"
+    for intensities, text in mark_groups(axis, marks, along):
+        for intensity in intensities:
+            line(intensity, color=MARK_COLOUR, lw=0.9, ls=":", label="site hazard at the return periods")
+        box = dict(facecolor="white", edgecolor="none", alpha=0.7, pad=0.5)
         if along == "x":
-            axis.text(intensity, 0.98, text, transform=axis.get_xaxis_transform(), rotation=90, fontsize=6.5,
-                      color=MARK_COLOUR, ha="right", va="top")
+            axis.text(intensities[-1], 0.98, text, transform=axis.get_xaxis_transform(), rotation=90,
+                      fontsize=MARK_SIZE, color=MARK_COLOUR, ha="right", va="top", bbox=box)
         else:
-            axis.text(0.98, intensity, text, transform=axis.get_yaxis_transform(), fontsize=6.5, color=MARK_COLOUR,
-                      ha="right", va="bottom")
+            axis.text(0.98, intensities[-1], text, transform=axis.get_yaxis_transform(), fontsize=MARK_SIZE,
+                      color=MARK_COLOUR, ha="right", va="bottom", bbox=box)
 
 
 def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
@@ -125,8 +158,7 @@ def showcase_ground_page(showcase, caption):
     ``showcase`` is the opened ``showcase.nc``: acceleration (drawn in g), velocity [m/s] and
     displacement [m] against time [s], under the page title and ``caption``.
     """
-    title = (f"{showcase.attrs.get('showcase_event', '')}, {showcase.attrs.get('showcase_station', '')} "
-             f"{showcase.attrs.get('showcase_component', '')} ({showcase.attrs['showcase_record']}): raw and processed")
+    title = f"{record_words(showcase)}: raw and processed"
     figure = new_page(title, caption)
     axes = panels(figure, 3, 1, sharex=True, gridspec_kw=dict(hspace=0.12))[:, 0]
     time = showcase.time_ground.values
@@ -144,6 +176,18 @@ def showcase_ground_page(showcase, caption):
     return figure
 
 
+def record_words(showcase) -> str:
+    """The showcase record as a reader names it: "Duzce 1999, Bolu, component 090" (its id when unnamed)."""
+    attrs = showcase.attrs
+    event, station = str(attrs.get("showcase_event", "")).strip(), str(attrs.get("showcase_station", "")).strip()
+    component = str(attrs.get("showcase_component", "")).strip()
+    component = re.sub(r"^[A-Za-z_-]+(?=\d)", "", component)  # BOL090 -> 090: the station is named already
+    if not (event or station):
+        return f"record {attrs.get('showcase_record', '')}"
+    words = ", ".join(part for part in (event, f"{station} station" if station else "") if part)
+    return words + (f", component {component}" if component else "")
+
+
 def _time_window(showcase):
     start = float(showcase.attrs.get("strong_motion_start_s", 0.0)) - WINDOW_BEFORE
     end = float(showcase.attrs.get("strong_motion_end_s", showcase.time.values[-1])) + WINDOW_AFTER
@@ -156,7 +200,7 @@ def showcase_response_page(showcase, caption, name: str | None = None):
     One y-scale per column, time cropped to the strong motion.
     """
     block = showcase.attrs["showcase_block"]
-    figure = new_page(f"{showcase.attrs['showcase_record']}, {name or block} (R = "
+    figure = new_page(f"{record_words(showcase)}, {name or block} (R = "
                       f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
                       "rad): rocking on each soil", caption)
     soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
@@ -164,15 +208,22 @@ def showcase_response_page(showcase, caption, name: str | None = None):
     styles = model_styles(models)
     start, end = _time_window(showcase)
     margins = dict(left=0.075, right=GRID["right"], wspace=0.22)
-    ground = figure.add_gridspec(1, 1, top=GRID["top"], bottom=0.79, **margins).subplots()
-    ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35", lw=0.7)
-    ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
-                   color="0.9", zorder=0, label="5-95% Arias window")
-    ground.set_ylabel("ground [g]")
-    ground.set_xlim(start, end)
-    ground.grid(alpha=0.3)
-    ground.tick_params(labelbottom=False)
-    grid = figure.add_gridspec(len(soils), 2, top=0.74, bottom=GRID["bottom"], hspace=0.12, **margins)
+    # the ground motion above each column, on the same time axis as the panels below it
+    grounds = figure.add_gridspec(1, 2, top=GRID["top"], bottom=0.785, **margins).subplots(sharex=True, sharey=True)
+    for column, ground in enumerate(grounds):
+        ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35",
+                    lw=0.7)
+        ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
+                       color="0.9", zorder=0, label="strong-motion window (5-95% Arias intensity)" if column == 0
+                       else None)
+        ground.set_xlim(start, end)
+        ground.grid(alpha=0.3)
+        ground.tick_params(labelsize=8)
+        ground.set_xlabel("time [s]", fontsize=8, labelpad=1)
+        ground.set_title("ground acceleration (processed record, unscaled)", fontsize=9)
+    grounds[0].set_ylabel("ground [g]", fontsize=9)
+    ground = grounds[0]
+    grid = figure.add_gridspec(len(soils), 2, top=0.69, bottom=GRID["bottom"], hspace=0.12, **margins)
     peak = np.nanmax(np.abs(showcase.theta.values)) if np.isfinite(showcase.theta.values).any() else 0.0
     scale, unit = (1000.0, "mrad") if peak < 0.1 else (1.0, "rad")
     theta_axes, settle_axes = [], []
@@ -192,16 +243,17 @@ def showcase_response_page(showcase, caption, name: str | None = None):
             if not model.rigid_base:
                 settle_axis.plot(showcase.time.values, showcase.settlement.values[index] * 1000,
                                  **styles[model.name])
-        theta_axis.set_ylabel(f"θ [{unit}]")
-        settle_axis.set_ylabel("Δy [mm], up +")
+        theta_axis.set_ylabel(f"θ [{unit}]", fontsize=9)
+        settle_axis.set_ylabel("Δy [mm]", fontsize=9)
         theta_axis.text(0.01, 0.92, soil, transform=theta_axis.transAxes, fontsize=9, weight="bold", va="top",
                         bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
         for axis in (theta_axis, settle_axis):
+            axis.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
+                         color="0.95", zorder=0)
             axis.grid(alpha=0.3)
             axis.tick_params(labelbottom=row == len(soils) - 1)
-    theta_axes[0].set_title("rocking angle θ (the rigid base is the same on every soil)", fontsize=9)
-    settle_axes[0].set_title("vertical displacement from the static position (up +, settlement −; each model's "
-                             "reference point)", fontsize=9)
+    theta_axes[0].set_title("rocking angle θ (the rigid base: the same on every soil)", fontsize=9)
+    settle_axes[0].set_title("vertical displacement Δy from rest (up +, settlement −)", fontsize=9)
     theta_axes[-1].set_xlabel("time [s]")
     settle_axes[-1].set_xlabel("time [s]")
     outside_legend(figure, [ground, *theta_axes])
@@ -212,49 +264,92 @@ def _finite_capped(values):
     return np.where(np.isfinite(values), np.minimum(values, IDA_CAP), IDA_CAP)
 
 
-def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
-    """One panel per rigid-base model and per foundation model x soil, filling the page in reading order.
+ROW_GAP = 0.5  # in between two rows of IDA panels: the row's heading and the panels' titles
 
-    Intensity on a log axis, the site's return-period intensities and the extrapolation by scaling marked.
+
+def _ida_rows(models, soils, per_soil=(), most_columns=5):
+    """The IDA page's rows: (heading, [(model, soil or None), ...]).
+
+    The rigid-base models share the first row, except those in ``per_soil`` (their runs differ by soil:
+    base friction lets the block slide on some soils), which get a row of their own like the foundation
+    models.
+    """
+    rigid = [m for m in models if m.rigid_base and m.name not in per_soil]
+    founded = [m for m in models if not m.rigid_base or m.name in per_soil]
+    columns = min(max(len(soils) if founded else 1, len(rigid), 1), most_columns)
+    rows = []
+    for start in range(0, len(rigid), columns):
+        rows.append(("rigid base: the same on every soil", [(m, None) for m in rigid[start:start + columns]]))
+    for model in founded:
+        heading = panel_label(model)
+        if model.rigid_base:
+            heading += " (rigid base; base friction: it slides on some soils)"
+        for start in range(0, len(soils), columns):
+            rows.append((heading, [(model, soil) for soil in soils[start:start + columns]]))
+    return rows, columns
+
+
+def _differs_by_soil(dataset, model, block) -> bool:
+    """The runs of a rigid-base model differ between soils (base friction, which depends on the soil)."""
+    edp = dataset.edp.sel(model=model.name, block=block).transpose("soil", ...).values
+    first = edp[0]
+    return any(not np.array_equal(first, other, equal_nan=True) for other in edp[1:])
+
+
+def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
+    """One row of panels per foundation model (a panel per soil), the rigid-base models in the first row.
+
+    Each row is headed by its model, each panel titled by its soil. Intensity on a log axis, the site's
+    return-period intensities and the extrapolation by scaling marked.
     """
     models = models_of(ida)
     soils = list(map(str, ida.soil.values))
-    drawn = [(m, None) for m in models if m.rigid_base]
-    drawn += [(m, soil) for m in models if not m.rigid_base for soil in soils]
-    columns = min(len(drawn), 3 if len(drawn) <= 6 else 4)
-    rows = math.ceil(len(drawn) / columns)
+    per_soil = [m.name for m in models if m.rigid_base and _differs_by_soil(ida, m, block)]
+    rows, columns = _ida_rows(models, soils, per_soil)
     figure = new_page(f"IDA curves: {name or block}", caption)
-    axes = panels(figure, rows, columns, sharex=True, sharey=True, gridspec_kw=dict(hspace=0.3))
+    top, bottom = 0.86, GRID["bottom"]
+    height = (top - bottom) * figure.get_figheight()
+    panel_height = (height - (len(rows) - 1) * ROW_GAP) / len(rows)
+    axes = panels(figure, len(rows), columns, sharex=True, sharey=True,
+                  gridspec_kw=dict(top=top, hspace=ROW_GAP / panel_height))
     levels = block_levels(ida, block)
-    low, high = axis_range(levels, marks)
-    for axis, (model, soil) in zip(axes.flat, drawn):
-        picked = cell(ida, model, block, soil)
-        for curve in picked.edp.transpose("record", "im_level").values:
-            axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
-        for q in ida.fractile.values:
-            style = FRACTILE_STYLES.get(round(float(q), 2), dict(color="C4", lw=1.2))
-            axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
-                      label=f"{float(q):.0%} fractile", **style)
-        axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
-        axis.set_title(short_label(model) if soil is None else f"{panel_label(model)}\non {soil}", fontsize=9)
-        axis.grid(alpha=0.3, which="both")
-        axis.set_xlim(0, IDA_CAP * 1.05)
-        log_y_axis(axis)
-        axis.set_ylim(low, high)
+    span = axis_range(levels, marks)
+    drawn = []
+    for row, (heading, cells) in enumerate(rows):
+        for column in range(columns):
+            axis = axes[row, column]
+            if column >= len(cells):
+                axis.set_visible(False)
+                continue
+            model, soil = cells[column]
+            drawn.append(axis)
+            picked = cell(ida, model, block, soil)
+            for curve in picked.edp.transpose("record", "im_level").values:
+                axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
+            for q in ida.fractile.values:
+                style = FRACTILE_STYLES.get(round(float(q), 2), dict(color="C4", lw=1.2))
+                axis.plot(_finite_capped(picked.edp_fractile.sel(fractile=q).values), levels,
+                          label=f"{float(q):.0%} fractile", **style)
+            axis.axvline(IDA_CAP, color="0.3", lw=0.6, ls=":")
+            axis.set_title(short_label(model) if soil is None else f"on {soil}", fontsize=8, pad=3)
+            axis.grid(alpha=0.3, which="both")
+            axis.set_xlim(0, IDA_CAP * 1.05)
+            axis.set_xticks([0, 0.5, 1.0, 1.5])
+            axis.tick_params(labelsize=8)
+            if column == 0:
+                axis.set_ylabel(measure_label(ida), fontsize=8)
+            if row == len(rows) - 1 or (row + 1 < len(rows) and column >= len(rows[row + 1][1])):
+                axis.set_xlabel("θmax/α [-]")
+                axis.tick_params(labelbottom=True)
+        first = axes[row, 0].get_position()
+        figure.text(first.x0, first.y1 + 0.027, heading, fontsize=9, weight="bold", va="bottom", ha="left")
+    for axis in drawn:
+        log_y_axis(axis, span)
+    for axis in drawn:
         mark_intensities(axis, marks, along="y")
-    axes.flat[0].plot([], [], color="0.65", lw=0.5, label="one record")
-    axes.flat[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at {IDA_CAP})")
-    for index, axis in enumerate(axes.flat):
-        if index >= len(drawn):
-            axis.set_visible(False)
-            continue
-        row, column = divmod(index, columns)
-        if column == 0:
-            axis.set_ylabel(measure_label(ida))
-        if index + columns >= len(drawn):  # nothing drawn below: label the x axis here
-            axis.set_xlabel("θmax/α [-]")
-            axis.tick_params(labelbottom=True)
-    outside_legend(figure, [axes.flat[0]])
+    drawn[0].plot([], [], color="0.65", lw=0.5, label="one record")
+    drawn[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at θmax/α = {IDA_CAP})")
+    outside_legend(figure, [drawn[0]])
     return figure
 
 
@@ -281,17 +376,23 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
         return ""
     axis.plot([], [], label=label, **style)  # listed once in the legend; the panel says why there is no curve
     status = str(values["status"].values) if "status" in values else ""
+    if status == NOT_APPLICABLE:  # e.g. a slip state of a model run with a tied base: nothing to explain
+        return ""
     reason = {"below-range": "reached by most records at the lowest level",
               "not-reached": "not reached at any level"}.get(status, plain(status) if status else "no fit")
-    return f"{label}: {reason}"
+    return f"{label.split(' (')[0]}: {reason}"
+
+
+NOTE_SIZE = 6.0  # pt, the no-curve note inside a panel
 
 
 def _no_curve_note(axis, reasons) -> None:
-    """Say in the panel which series have points but no curve, and why."""
+    """Say in the panel which series have points but no curve, and why (wrapped to the panel's width)."""
     reasons = [r for r in reasons if r]
     if reasons:
-        text = "\n".join(textwrap.fill(line, 55) for line in [NO_CURVE.rstrip(": ") + ":", *reasons])
-        axis.text(0.97, 0.5, text, transform=axis.transAxes, fontsize=6.5, va="center", ha="right",
+        width = chars_across(axis, NOTE_SIZE) - 3
+        text = "\n".join(textwrap.fill(line, width) for line in [NO_CURVE.rstrip(": ") + ":", *reasons])
+        axis.text(0.97, 0.5, text, transform=axis.transAxes, fontsize=NOTE_SIZE, va="center", ha="right",
                   bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.9, pad=2), zorder=10)
 
 
@@ -302,7 +403,7 @@ def _state_axes(figure, fragility, n_rows=1):
     else:
         rows, columns = n_rows, len(states)
     axes = panels(figure, rows, columns, sharex=True, sharey=True,
-                  gridspec_kw=dict(hspace=0.45 if n_rows > 1 else 0.32))
+                  gridspec_kw=dict(hspace=0.6 if n_rows > 1 else 0.55))
     for axis in axes.flat[len(states) * (1 if n_rows == 1 else n_rows):]:
         axis.set_visible(False)
     return states, axes
@@ -318,15 +419,16 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
     for axis in axes.flat:
         if not axis.get_visible():
             continue
-        log_axis(axis)
-        axis.set_xlim(*span)
+        log_axis(axis, span)
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
         mark_intensities(axis, marks, along="x")
+        axis.tick_params(labelbottom=True, labelsize=8)  # every row: a panel is read on its own
     for axis in axes[:, 0]:
         axis.set_ylabel(y_label)
-    for axis in axes[-1]:
-        axis.set_xlabel(x_label)
+    for axis in axes.flat:
+        if axis.get_visible():
+            axis.set_xlabel(x_label, fontsize=8, labelpad=1)
 
 
 def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMarks | None = None,
@@ -349,8 +451,8 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
             reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
                                              styles[reference.name], short_label(reference), span))
         _no_curve_note(axis, reasons)
-        axis.set_title(labels[state], fontsize=10)
-    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]", marks)
+        axis.set_title(textwrap.fill(state_title(labels[state]), chars_across(axis, 9)), fontsize=9)
+    _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
     outside_legend(figure, list(axes.flat))
     return figure
 
@@ -372,8 +474,9 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
             reasons = [_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                          styles[model.name], short_label(model), span) for model in models]
             _no_curve_note(axis, reasons)
-            axis.set_title(f"{labels[state]}\non {soil}", fontsize=9)
-    _probability_axes(axes, levels, measure_label(fragility), "P(damage state | IM) [-]", marks)
+            axis.set_title(textwrap.fill(f"{state_title(labels[state])} on {soil}", chars_across(axis, 8.5)),
+                           fontsize=8.5)
+    _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
     outside_legend(figure, list(axes.flat))
     return figure
 
@@ -401,7 +504,7 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
             axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
             if soil is None or len(soils) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
-        axis.set_title(short_label(model), fontsize=10)
+        axis.set_title(textwrap.fill(short_label(model), chars_across(axis, 9.5)), fontsize=9.5)
     _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
@@ -416,7 +519,9 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
 def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     """Median peak angle of each foundation model over the rigid-base reference against G_s, per block.
 
-    The soils are named on the top axis.
+    A model keeps its colour and dashes, a block its marker; the legend lists the models and the blocks
+    apart (blocks without a run in the band are left out and named in the legend). The soils are named on
+    the top axis.
     """
     models = models_of(cube)
     reference = next(m for m in models if m.rigid_base)
@@ -429,25 +534,38 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     shear = cube.soil_shear_modulus.values / 1e6
     order = np.argsort(shear)
     markers = "os^Dv"
+    drawn_blocks, missing = [], []
     for b_index, block in enumerate(cube.block.values):
         uplift = uplift_intensity(cube, block)
         levels = block_levels(cube, block)
         band = (levels >= 1.2 * uplift) & (levels <= 3.0 * uplift)
-        if not band.any():
-            continue
-        sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band))
-        rigid_angle = sub.peak_angle.sel(model=reference.name)
-        for model in founded:
+        sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band)) if band.any() else None
+        drew = False
+        for model in founded if sub is not None else []:
+            rigid_angle = sub.peak_angle.sel(model=reference.name)
             survived = (sub.outcome.sel(model=[reference.name, model.name]) == OUTCOME_ROCKING).all("model")
             ratio = (sub.peak_angle.sel(model=model.name).where(survived).median(["record", "im_level"]) /
                      rigid_angle.where(survived).median(["record", "im_level"])).values
-            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], color=f"C{b_index % 10}",
-                      ls=styles[model.name]["ls"], lw=1.4,
-                      label=f"{names.get(str(block), block)}, {panel_label(model)}")
+            if not np.isfinite(ratio).any():
+                continue
+            drew = True
+            style = styles[model.name]
+            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], ms=5, mfc="white",
+                      color=style["color"], ls=style["ls"], lw=1.3)
+        name = names.get(str(block), str(block))
+        (drawn_blocks if drew else missing).append((name, markers[b_index % len(markers)]))
+    for model in founded:
+        style = styles[model.name]
+        axis.plot([], [], color=style["color"], ls=style["ls"], lw=1.3, label=short_label(model))
+    for name, marker in drawn_blocks:
+        axis.plot([], [], ls="none", marker=marker, ms=5, mfc="white", color="0.2", label=f"block: {name}")
+    for name, _ in missing:
+        axis.plot([], [], ls="none", label=f"block: {name}: no run rocked without overturning in both models")
     axis.axhspan(1 - limit, 1 + limit, color="0.88", label=f"within ±{limit:.0%} of the rigid base", zorder=0)
-    axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, label="paper's limit: G_s = 300-1000 MPa", zorder=0)
+    axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0,
+                 label="300-1000 MPa: above it the paper finds the rigid base good enough")
     axis.axhline(1.0, color="k", lw=0.8)
-    log_axis(axis)
+    log_axis(axis, (0.7 * min(shear.min(), 300.0), 1.4 * max(shear.max(), 1000.0)))  # every soil on the top axis
     axis.set_xlabel("soil shear modulus G_s [MPa]")
     axis.set_ylabel(f"median θmax (model) / median θmax ({panel_label(reference)}) [-]")
     axis.grid(alpha=0.3, which="both")
@@ -479,7 +597,8 @@ def sweep_page(dataset, caption, names: dict | None = None):
             axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
             axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
             axis.axhline(1.0, color="k", lw=0.7)
-            axis.set_title(f"{(names or {}).get(str(block), block)}: {label}", fontsize=9)
+            axis.set_title(textwrap.fill(f"{(names or {}).get(str(block), block)}: {label}", chars_across(axis, 9)),
+                           fontsize=9)
             log_axis(axis)
             axis.set_xlabel("soil shear modulus G_s [MPa]")
             axis.grid(alpha=0.3, which="both")
@@ -491,47 +610,84 @@ def sweep_page(dataset, caption, names: dict | None = None):
 P_FLOOR = 1e-3  # p-values below this are drawn at it: "below 0.001" is all such a number supports
 
 
+MEASURE_WORDS = {"pulse_amplitude": "pulse acceleration", "pulse_period": "pulse period",
+                 "pga_ratio": "PGA/(g·tanα)", "pgv_ratio": "PGV·p/(g·tanα)"}
+"""Intensity measures whose registry label is a symbol (a_p) or a formula, as the efficiency page names them."""
+P_MARKERS = (("p_magnitude", "o", "black", "against magnitude"), ("p_distance", "s", "0.55", "against distance"),
+             ("p_pulse_period", "^", "#6a3d9a", "against pulse period"))
+"""Sufficiency p-values: marker, colour (none of the blocks' bar colours) and what each tests."""
+
+
+def measure_words(measure: str) -> str:
+    """An intensity measure as the efficiency page names it."""
+    if measure in MEASURE_WORDS:
+        return MEASURE_WORDS[measure]
+    return pretty(MEASURES[measure].short_label()) if measure in MEASURES else measure.replace("_", " ")
+
+
+NORMALISED = {"pga_ratio": "pga", "pgv_ratio": "pgv"}
+"""Measures that divide another by a constant of the block (g·tanα; p/(g·tanα)): measure -> the one it divides."""
+
+
+def efficiency_twins(dataset) -> dict[str, str]:
+    """Normalised measures (``NORMALISED``) whose results repeat their measure's in every cell: measure -> it.
+
+    Dividing an intensity by a constant of the block (g·tanα, the uplift acceleration) changes no
+    dispersion or p-value within a block, so PGA/(g·tanα) repeats PGA; the page draws one of each pair.
+    A pair that differs (a file written otherwise) is kept.
+    """
+    measures = [str(m) for m in dataset.measure.values]
+    twins = {}
+    for measure, base in NORMALISED.items():
+        if measure in measures and base in measures:
+            values = [np.asarray(dataset.dispersion.sel(measure=m).values, float) for m in (measure, base)]
+            if np.allclose(*values, rtol=1e-6, atol=1e-9, equal_nan=True):
+                twins[measure] = base
+    return twins
+
+
 def efficiency_page(dataset, caption, names: dict | None = None):
     """Which intensity measure predicts overturning best, from ``efficiency.nc``.
 
     Top: the dispersion of the overturning capacity per measure and block (median over soils and
     models, whiskers their range; smaller is better). Bottom: the sufficiency p-values against magnitude,
-    distance and pulse period (median over cells), on a log axis floored at ``P_FLOOR``.
+    distance and pulse period (median over cells), on a log axis floored at ``P_FLOOR``. A measure that
+    repeats another within every block (``efficiency_twins``) is left out; the caption says why.
     """
     names = names or {}
     figure = new_page("Efficiency of intensity measures: which one predicts overturning best", caption)
-    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45))[:, 0]
-    measures = [str(m) for m in dataset.measure.values]
-    labels = [pretty(MEASURES[m].short_label()) if m in MEASURES else m.replace("_", " ") for m in measures]
-    blocks = list(map(str, dataset.block.values))
+    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45, left=0.085))[:, 0]
+    twins = efficiency_twins(dataset)
+    measures = [str(m) for m in dataset.measure.values if str(m) not in twins]
+    labels = [measure_words(m) for m in measures]
+    blocks = [b for b in map(str, dataset.block.values)
+              if np.isfinite(dataset.dispersion.sel(block=b, measure=measures).values).any()]
     x = np.arange(len(measures))
     width = 0.8 / max(len(blocks), 1)
     for index, block in enumerate(blocks):
-        dispersion = dataset.dispersion.sel(block=block)
+        dispersion = dataset.dispersion.sel(block=block, measure=measures)
         middle = dispersion.median(["soil", "model"]).values
         low, high = dispersion.min(["soil", "model"]).values, dispersion.max(["soil", "model"]).values
         top.bar(x + (index - (len(blocks) - 1) / 2) * width, middle, width, label=names.get(block, block),
                 yerr=[middle - low, high - middle], capsize=2, color=f"C{index % 10}")
     top.set_xticks(x, labels, fontsize=8)
-    top.set_ylabel("dispersion of ln capacity [-]")
-    top.set_title("Efficiency: dispersion of the overturning capacity (smaller is better)", fontsize=10)
+    top.set_ylabel("dispersion of ln capacity [-]", fontsize=9)
+    top.set_title("Efficiency: dispersion of the overturning capacity per block (smaller is better)", fontsize=10)
     top.grid(alpha=0.3, axis="y")
-    for name, marker, what in (("p_magnitude", "o", "p-value against magnitude"),
-                               ("p_distance", "s", "p-value against distance"),
-                               ("p_pulse_period", "^", "p-value against pulse period")):
+    for name, marker, colour, what in P_MARKERS:
         if name not in dataset:
             continue
-        p = dataset[name].median(["soil", "model", "block"]).values
-        bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, label=what)
+        p = dataset[name].sel(measure=measures).median(["soil", "model", "block"]).values
+        bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, color=colour, label=f"p-value {what}")
     bottom.axhline(0.05, color="k", lw=0.8, ls="--", label="0.05: below it the measure is not sufficient")
     bottom.set_yscale("log")
     bottom.set_ylim(P_FLOOR * 0.7, 1.5)
     bottom.set_yticks([P_FLOOR, 0.01, 0.05, 0.1, 1.0], ["≤ 0.001", "0.01", "0.05", "0.1", "1"])
     bottom.minorticks_off()
     bottom.set_xticks(x, labels, fontsize=8)
-    bottom.set_ylabel("p-value, median over cells [-]")
-    bottom.set_title("Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake?",
-                     fontsize=10)
+    bottom.set_ylabel("p-value [-]", fontsize=9)
+    bottom.set_title("Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake? "
+                     "(median p-value over soils, models and blocks)", fontsize=10)
     bottom.grid(alpha=0.3, axis="y")
     outside_legend(figure, [top, bottom])
     return figure

@@ -10,6 +10,7 @@ Every page is A4 landscape (11.69 x 8.27 in). The title sits on top, the caption
 
 from __future__ import annotations
 
+import math
 import textwrap
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -20,21 +21,28 @@ import matplotlib.lines
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 PAGE_SIZE = (11.69, 8.27)  # A4 landscape [in]
 GRID = dict(left=0.07, right=0.835, bottom=0.145, top=0.885, wspace=0.2, hspace=0.32)  # axes area
 LEGEND_ANCHOR = (0.85, 0.885)  # upper left corner of the page legend, right of the axes
-CAPTION_Y = 0.07
-FOOTER_Y = 0.012
+CAPTION_Y = 0.082
+CAPTION_SIZE = 7.5
+CAPTION_WRAP = 205  # characters of 7.5 pt italic across the page width (tests check the drawn extent)
+CAPTION_LINES = 3  # lines between the axes' labels and the footer
+FOOTER_Y = 0.008
 TITLE_SIZE = 13
+TITLE_CHARS = 95  # characters of a bold 13 pt title across the page; a longer title is set smaller
 
 SOIL_COLOURS = {"clay": "#8c510a", "sand": "#d8a03a", "gravel": "#35978f", "rock": "#01665e",
                 "steel": "#5e3c99"}
 RIGID_STYLE = dict(color="black", ls="--", lw=1.5, zorder=4)  # on top: its dashes stay visible
-MODEL_STYLES = [dict(color="#d62728", ls="-", lw=1.4), dict(color="#1f77b4", ls="-.", lw=1.4),
-                dict(color="#2ca02c", ls=":", lw=1.6), dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4),
-                dict(color="#ff7f0e", ls="--", lw=1.4), dict(color="#8c564b", ls=(0, (3, 1, 1, 1, 1, 1)), lw=1.4)]
+RECOMMENDED_STYLE = dict(color="#d62728", ls="-", lw=2.8, zorder=5)  # the only solid coloured line: the answer
+MODEL_STYLES = [dict(color="#1f77b4", ls="-.", lw=1.4), dict(color="#2ca02c", ls=":", lw=1.6),
+                dict(color="#9467bd", ls=(0, (5, 1, 1, 1)), lw=1.4), dict(color="#ff7f0e", ls="--", lw=1.4),
+                dict(color="#8c564b", ls=(0, (3, 1, 1, 1, 1, 1)), lw=1.4),
+                dict(color="#e377c2", ls=(0, (1, 1)), lw=1.6)]
+"""Models other than the rigid base and the recommended curve: none solid, none red."""
 FRACTILE_STYLES = {0.16: dict(color="#1f77b4", ls="--", lw=1.5), 0.5: dict(color="black", ls="-", lw=2.2),
                    0.84: dict(color="#d62728", ls=":", lw=1.8)}
 OUTCOME_COLOURS = {"no_uplift": "#c7e9c0", "rocking": "#fdae6b", "overturned": "#d7301f",
@@ -61,6 +69,8 @@ class Page:
         The page's body as HTML for text pages; figure pages are embedded as their PNG.
     png : bytes
         The rendered page (empty until ``pipeline.report.render`` has drawn it).
+    also : tuple of str
+        Further sections that start on this page (text sections packed onto one page when they fit).
     """
 
     name: str
@@ -70,6 +80,7 @@ class Page:
     caption: str = ""
     html: str | None = None
     png: bytes = field(default=b"", repr=False)
+    also: tuple[str, ...] = ()
 
 
 def new_page(title: str, caption: str = "") -> Figure:
@@ -79,10 +90,15 @@ def new_page(title: str, caption: str = "") -> Figure:
     and keeps pages alike.
     """
     figure = plt.figure(figsize=PAGE_SIZE)
-    figure.text(0.015, 0.975, title, fontsize=TITLE_SIZE, weight="bold", va="top", ha="left")
+    size = TITLE_SIZE if len(title) <= TITLE_CHARS else max(9.0, TITLE_SIZE * TITLE_CHARS / len(title))
+    figure.text(0.015, 0.975, title, fontsize=size, weight="bold", va="top", ha="left")
     if caption:
-        figure.text(0.015, CAPTION_Y, "\n".join(textwrap.wrap(caption, 200)[:2]), fontsize=8, style="italic",
-                    va="top", ha="left")
+        for size in (CAPTION_SIZE, 7.0, 6.5, 6.0):  # a long caption in smaller type: three lines above the footer
+            lines = textwrap.wrap(caption, int(CAPTION_WRAP * CAPTION_SIZE / size))
+            if len(lines) <= CAPTION_LINES:
+                break
+        figure.text(0.015, CAPTION_Y, "\n".join(lines), fontsize=size, style="italic", va="top", ha="left",
+                    linespacing=1.25)
     return figure
 
 
@@ -95,26 +111,73 @@ def panels(figure, rows=1, columns=1, **options):
 
 def add_footer(figure, left: str, number: int, total: int) -> None:
     """Report title on the left, page number on the right, a rule above both."""
-    figure.add_artist(matplotlib.lines.Line2D([0.015, 0.985], [FOOTER_Y + 0.02] * 2, color="0.6", lw=0.6,
+    figure.add_artist(matplotlib.lines.Line2D([0.015, 0.985], [FOOTER_Y + 0.018] * 2, color="0.6", lw=0.6,
                                               transform=figure.transFigure))
     figure.text(0.015, FOOTER_Y, left, fontsize=7.5, color="0.3", va="bottom", ha="left")
     figure.text(0.985, FOOTER_Y, f"page {number} of {total}", fontsize=7.5, color="0.3", va="bottom", ha="right")
 
 
-def log_axis(axis) -> None:
-    """Log x axis with plain-number tick labels at 1, 2, 5 x 10^n (no overlapping minor labels)."""
+def log_ticks(low: float, high: float, most: int = 8) -> list[float]:
+    """Tick values of a log axis from ``low`` to ``high``: 1, 2, 5 x 10^n, or every 1-9 x 10^n on a short range.
+
+    Parameters
+    ----------
+    low, high : float
+        The axis limits (positive).
+    most : int, optional
+        At most this many ticks; a wide range keeps the decades (or every other 1-2-5 value) only.
+
+    Returns
+    -------
+    list of float
+        At least two values inside ``[low, high]`` whenever the range holds two of 1-9 x 10^n.
+    """
+    low, high = sorted((float(low), float(high)))
+    decades = range(math.floor(math.log10(low)) - 1, math.ceil(math.log10(high)) + 1)
+    for mantissas in ((1, 2, 5), (1, 2, 3, 5, 7), tuple(range(1, 10))):
+        values = [float(f"{m}e{d}") for d in decades for m in mantissas]
+        values = [v for v in values if low * (1 - 1e-9) <= v <= high * (1 + 1e-9)]
+        if len(values) >= 3 or mantissas[-1] == 9:
+            break
+    if len(values) > most:
+        decade_ticks = [v for v in values if f"{v:g}".lstrip("0.").startswith("1")]
+        values = decade_ticks if len(decade_ticks) >= 3 else values[::2]
+    return values
+
+
+def _log_ticks_on(axis, limits) -> None:
+    """Fixed tick values of ``log_ticks`` on one matplotlib Axis (x or y), labelled as plain numbers.
+
+    As many values as fit the axis's length: 2.2 label heights apart on a y axis, 3.5 on an x axis.
+    """
+    figure, box = axis.axes.figure, axis.axes.get_position()
+    vertical = axis.axis_name == "y"
+    length = (box.height * figure.get_figheight() if vertical else box.width * figure.get_figwidth()) * 72.0
+    size = axis.get_ticklabels()[0].get_fontsize() if axis.get_ticklabels() else matplotlib.rcParams["font.size"]
+    most = max(3, int(length / ((2.2 if vertical else 3.5) * float(size))))
+    axis.set_major_locator(FixedLocator(log_ticks(*limits, most=most)))
+    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.set_minor_locator(LogLocator(subs="auto"))
+    axis.set_minor_formatter(NullFormatter())
+
+
+def log_axis(axis, limits: tuple[float, float] | None = None) -> None:
+    """Log x axis with plain-number tick values (``log_ticks``) over ``limits`` (default: the current limits).
+
+    Call it after the limits are set, or give them: a short range gets 1-9 x 10^n labels, never none.
+    """
     axis.set_xscale("log")
-    axis.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-    axis.xaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-    axis.xaxis.set_minor_formatter(NullFormatter())
+    if limits is not None:
+        axis.set_xlim(*limits)
+    _log_ticks_on(axis.xaxis, axis.get_xlim())
 
 
-def log_y_axis(axis) -> None:
-    """Log y axis with plain-number tick labels at 1, 2, 5 x 10^n (the intensity axis of the IDA pages)."""
+def log_y_axis(axis, limits: tuple[float, float] | None = None) -> None:
+    """Log y axis with plain-number tick values (``log_ticks``) over ``limits`` (default: the current limits)."""
     axis.set_yscale("log")
-    axis.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-    axis.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-    axis.yaxis.set_minor_formatter(NullFormatter())
+    if limits is not None:
+        axis.set_ylim(*limits)
+    _log_ticks_on(axis.yaxis, axis.get_ylim())
 
 
 def soil_colour(soil: str, index: int) -> str:
@@ -134,6 +197,12 @@ def outside_legend(figure, axes, **options):
     if handles:
         figure.legend(handles, labels, loc="upper left", bbox_to_anchor=LEGEND_ANCHOR, fontsize=7.5, frameon=False,
                       **options)
+
+
+def chars_across(axis, size: float) -> int:
+    """How many characters of ``size`` pt fit across an axes (for wrapping panel titles and notes)."""
+    width_pt = axis.get_position().width * axis.figure.get_figwidth() * 72.0
+    return max(12, int(width_pt / (0.6 * size)))
 
 
 def pretty(text: str) -> str:

@@ -214,21 +214,39 @@ def title_items(results: Results) -> list[Item]:
     names = [block_name(config, b) for b in cube.block.values]
     labels = [m.label for m in models_of(cube)]
     items = [
-        paragraph(f"Study '{config.name}' ({config.source}); configuration hash {cube.attrs.get('config_hash', '')}; "
-                  f"computed with rockfrag {cube.attrs.get('rockfrag_version', __version__)}."),
         paragraph(f"{cube.sizes['record']} record components, {cube.sizes['im_level']} intensity levels, "
                   f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
-                  f"{n_runs(cube)} solver runs."),
+                  f"{n_runs(cube)} simulations."),
         paragraph("The next pages answer the question for each block: at the site's return periods, how likely it "
                   "is to rock or overturn, how likely in its design life, and what to do. Then the fragility of "
                   "each block on each soil for each model, the methods and assumptions behind the numbers, and "
-                  "where the models are outside their validity (page 'Limitations'). Every number is read from "
-                  f"the result files in the same folder ({', '.join(_result_files(results))})."),
+                  "where the models are outside their validity (page 'Limitations'). Where the study's files and "
+                  "software version are recorded: page 'Provenance', at the end."),
     ]
-    if np.isfinite(results.runtime_s):
-        items.append(note(f"Run time of the pipeline run that wrote this report: {results.runtime_s:.0f} s."))
     return items
+
+
+def run_time_words(runtime_s: float) -> str:
+    """The pipeline run's wall time in words; "not recorded" when unknown or under a second (read back, not run)."""
+    if not np.isfinite(runtime_s) or runtime_s < 1.0:
+        return "not recorded (this report was drawn from result files written earlier)"
+    return f"{runtime_s / 60:.0f} min" if runtime_s >= 120 else f"{runtime_s:.0f} s"
+
+
+def provenance_items(results: Results) -> list[Item]:
+    """The colophon at the end: the study file, configuration fingerprint, software version, seed, run time, files."""
+    config, cube, fragility = results.config, results.cube, results.fragility
+    rows = [["study", f"'{config.name}', read from {config.source}"],
+            ["configuration fingerprint", str(cube.attrs.get("config_hash", "not recorded"))],
+            ["software", f"rockfrag {cube.attrs.get('rockfrag_version', __version__)}"],
+            ["random seed of the bootstrap", str(fragility.attrs.get("bootstrap_seed", "not recorded"))],
+            ["simulations", f"{n_runs(cube)}"],
+            ["run time", run_time_words(results.runtime_s)],
+            ["result files read", ", ".join(_result_files(results))]]
+    return [paragraph("What this report was computed from, to reproduce it. The configuration fingerprint changes "
+                      "with any setting of the study; the same fingerprint, software version and records give the "
+                      "same numbers."), table(["item", "value"], rows)]
 
 
 def _ordered_models(results: Results):
@@ -255,9 +273,10 @@ def summary_items(results: Results) -> list[Item]:
     for block in fragility.block.values:
         largest = results.largest_recorded.get(str(block), np.inf)
         for model in _ordered_models(results):
-            soils = ["(any)"] if model.rigid_base else list(fragility.soil.values)
+            once = model.rigid_base and not _differs_by_soil(fragility["median"].sel(model=model.name, block=block))
+            soils = ["(any)"] if once else list(fragility.soil.values)
             for soil in soils:
-                picked = cell(fragility, model, block, None if model.rigid_base else soil)
+                picked = cell(fragility, model, block, None if once else soil)
                 row = [block_name(results.config, block), short_label(model), str(soil)]
                 for state in states:
                     median = float(picked["median"].sel(damage_state=state)) * scale
@@ -275,7 +294,8 @@ def summary_items(results: Results) -> list[Item]:
                     row.append(percent(p))
                 rows.append(row)
     items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β), the answering model "
-                       "first. Rigid-base models do not depend on the soil and have one row per block."),
+                       "first. A rigid-base model has one row per block (soil '(any)') unless base friction lets "
+                       "the block slide on some soils: then one row per soil."),
              table(header, rows)]
     if "*" in marks:
         items.append(note("* the median lies outside the studied intensity range (an extrapolation of the fit; see "
@@ -289,6 +309,12 @@ def summary_items(results: Results) -> list[Item]:
     if has_risk:
         items.append(note(f"Hazard: {fragility.attrs.get('hazard_source', 'see Methods')}."))
     return items
+
+
+def _differs_by_soil(values: xr.DataArray) -> bool:
+    """A rigid base's results differ between soils (base friction lets it slide on some): one row per soil."""
+    rows = values.transpose("soil", ...).values
+    return any(not np.array_equal(rows[0], other, equal_nan=True) for other in rows[1:])
 
 
 def _beta(value: float) -> str:
@@ -355,7 +381,9 @@ def methods_items(results: Results) -> list[Item]:
             role = f"on a foundation of interface stiffness k (the paper's eq. 19) and the soil's damping ratio; {rule}"
         items.append(bullet(pretty(f"{model.label}: {model.description}; {role}.")))
     items.append(paragraph(
-        f"All models: planar rocking of a rigid block; the base does not slide; "
+        f"All models: planar rocking of a rigid block; the base does not slide unless the study's friction runs "
+        "let it (a block whose base friction coefficient is below its width over height slides before it can "
+        "rock: Shenton 1996); "
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
         f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
         f"failed integration (excluded from the fits){_vertical_outcome(cube)}."))
@@ -417,10 +445,11 @@ def methods_items(results: Results) -> list[Item]:
                         "check (fragility.csv). "
                         f"Confidence bounds ({config.confidence:.0%}) from "
                         f"{fragility.attrs.get('bootstrap_samples', '?')} "
-                        f"bootstrap samples of the records (seed {fragility.attrs.get('bootstrap_seed', '?')}). States "
+                        f"bootstrap samples of the records (seeded: see Provenance). States "
                         "that would cross inside the studied range are refitted with one shared β; a state reached at "
                         "one intensity by every record is a deterministic threshold. Fit methods used: "
                         f"{'; '.join(plain(m) for m in methods)}.")]
+    items += sources_items(results)
     if "annual_frequency" in fragility:
         periods = ", ".join(f"{t:,.0f}" for t in results.return_periods)
         items += [heading("Hazard and risk"),
@@ -430,6 +459,58 @@ def methods_items(results: Results) -> list[Item]:
                             "interpolated log-log (Cornell et al. 2002); probability in the design life "
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
                             f"1 − exp(−λ·years). Return periods of the answer pages: {periods} years.")]
+    return items
+
+
+STUDY_CHOICE = "the study's choice (its study file, else the shipped defaults, pipeline/defaults.toml)"
+LIMIT_SOURCES = {
+    "overturning": "the 1% probability of collapse in 50 years that ASCE 7-22's risk-targeted ground motions aim at "
+                   "(ASCE 7-22)",
+    "rocking-0.5": "the 10% in 50 years of the design-basis earthquake (475-year return period), "
+                   "applied here to damage short of collapse: " + STUDY_CHOICE,
+    "slip-0.30": "the 10% in 50 years of the design-basis earthquake, as for θmax/α ≥ 0.5: " + STUDY_CHOICE,
+}
+"""Where the shipped verdict limits (pipeline.answer.DEFAULT_LIMITS) come from."""
+
+
+def sources_items(results: Results) -> list[Item]:
+    """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
+    from pipeline.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
+    from pipeline.models.variants import DEFAULT_BAND
+    from pipeline.soils import SOILS
+
+    config, fragility = results.config, results.fragility
+    labels = state_labels(fragility)
+    items = [heading("Where the numbers come from")]
+    for state, limit in results.decision["max_probability_in_life"].items():
+        if state not in labels:  # a limit on a state this study did not compute judges nothing
+            continue
+        shipped = SHIPPED_LIMITS.get(state) == limit and state in LIMIT_SOURCES
+        items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', {limit:.0%} in the "
+                            f"design life: {LIMIT_SOURCES[state] if shipped else 'the study file (its own limit)'}."))
+    life = float(fragility.attrs.get("design_life_years", config.design_life))
+    items.append(bullet(f"Design life {life:g} years: {STUDY_CHOICE}; 50 years is the span over which ASCE 7-22 "
+                        "and the return periods below are stated."))
+    items.append(bullet("Return periods 475, 975 and 2,475 years: 10%, 5% and 2% probability of exceedance in 50 "
+                        "years, the conventional design levels (ASCE 7-22 uses the 2% level)."))
+    shipped_soils = [soil for soil in config.soils if SOILS.get(soil.name) == soil]
+    own = [soil.name for soil in config.soils if soil not in shipped_soils]
+    if shipped_soils:
+        names = ", ".join(soil.name for soil in shipped_soils)
+        items.append(bullet(f"Soil moduli of {names}: the paper's Table 1 (shear modulus, Poisson's ratio, "
+                            "density); clay from the paper's text (E_d = 130 MPa, Poisson's ratio 0.3 assumed)."))
+        items.append(bullet(f"Base friction μ_s of {names} ({results.friction_text}): the ultimate friction factor "
+                            "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
+                            "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
+                            "360-16, J3.8). Kinetic friction 0.8 × static: " + STUDY_CHOICE + "."))
+    if own:
+        items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
+    band = tuple(float(v) for v in config.restitution_band)
+    if any(not m.rigid_base and m.uses_bed for m in models_of(fragility)):
+        source = ("the range experiments on rigid bases support (ElGawady et al. 2011; Kalliontzis et al. 2016; "
+                  "Ther & Kollár 2017)") if band == tuple(DEFAULT_BAND) else "the study file's own range"
+        items.append(bullet(f"Restitution band {band[0]:g} to {band[1]:g} × Housner's r = 1 − 1.5 sin²α, each edge "
+                            f"at most 0.99: {source}."))
     return items
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import html
 import textwrap
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import matplotlib.lines
 
@@ -20,16 +20,22 @@ LINE = 0.021  # one line of 9.5 pt text on the A4-landscape page [figure fractio
 WRAP = 150  # characters per line of 9.5 pt text across the page
 CHAR = 0.0062  # width of one 8.5 pt table character [figure fraction], for column positions
 LEFT = 0.02
+STRETCH = 7  # lines the last page of a run may hold beyond its capacity, set closer together
+MIN_HEADER = 12  # characters: a header is not wrapped narrower than this to make a table fit
 
 
 @dataclass
 class Item:
-    """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table."""
+    """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table.
+
+    ``part`` is the index of the section the item belongs to when several sections share pages (``pack``).
+    """
 
     kind: str
     text: str = ""
     header: list = field(default_factory=list)
     rows: list = field(default_factory=list)
+    part: int = 0
 
 
 def heading(text: str) -> Item:
@@ -62,11 +68,15 @@ def table(header, rows) -> Item:
     return Item("table", header=[str(h) for h in header], rows=[[str(c) for c in row] for row in rows])
 
 
+def _header_lines(item) -> int:
+    return len(table_layout(item)[0][0]) if item.header else 1
+
+
 def _lines(item) -> int:
     if item.kind == "heading":
         return 2
     if item.kind == "table":
-        return len(item.rows) + 2
+        return len(item.rows) + 1 + _header_lines(item)
     width = WRAP - (4 if item.kind == "bullet" else 0)
     return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind in ("paragraph", "strong") else 0)
 
@@ -74,24 +84,33 @@ def _lines(item) -> int:
 def paginate(items, capacity=None) -> list[list[Item]]:
     """Split items into pages of ``capacity`` lines (default: a full page).
 
-    A table longer than a page is split with its header repeated; a heading never ends a page.
+    A table longer than a page is split with its header repeated; a heading never ends a page. When what
+    is left overflows the last page by at most ``STRETCH`` lines, it goes on that page with its lines set
+    closer (``draw_text_page``) rather than alone on a near-empty page.
     """
     capacity = capacity or int((TOP - BOTTOM) / LINE)
     pages, current, used = [], [], 0
     queue = list(items)
     while queue:
+        if sum(_lines(rest) for rest in queue) <= capacity - used + STRETCH:  # the rest fits, a little closer
+            current += queue
+            break
         item = queue.pop(0)
         need = _lines(item)
         if item.kind == "table" and need > capacity - used:
-            room = capacity - used - 2
+            room = capacity - used - 1 - _header_lines(item)
             if room < 3 and current:
-                pages.append(current)
-                current, used = [], 0
+                carried = []
+                while current and current[-1].kind == "heading":  # a heading goes with its table
+                    carried.insert(0, current.pop())
+                if current:
+                    pages.append(current)
+                current, used = carried, sum(_lines(c) for c in carried)
                 queue.insert(0, item)
                 continue
             room = max(room, 3)
-            head = Item("table", header=item.header, rows=item.rows[:room])
-            tail = Item("table", header=item.header, rows=item.rows[room:])
+            head = replace(item, rows=item.rows[:room])
+            tail = replace(item, rows=item.rows[room:])
             current.append(head)
             pages.append(current)
             current, used = [], 0
@@ -112,49 +131,86 @@ def paginate(items, capacity=None) -> list[list[Item]]:
     return pages
 
 
-def _column_positions(item) -> list[float]:
-    widths = [max(len(item.header[c]), *(len(row[c]) for row in item.rows)) if item.rows else len(item.header[c])
-              for c in range(len(item.header))]
+TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type across the page
+
+
+TABLE_SIZE = 8.5  # pt, table type; smaller (down to MIN_TABLE_SIZE) only for a table too wide for the page
+MIN_TABLE_SIZE = 6.0
+
+
+def table_layout(item) -> tuple[list[list[str]], list[float], float]:
+    """Where a table goes: its header wrapped so the table fits the page width, each column's x, the type size.
+
+    A header is wrapped (never cut) only as far as the page needs: the longest header line shrinks until
+    the columns fit ``TABLE_CHARS`` or reach the cells' own width. A table still too wide is set in
+    smaller type, never cut.
+
+    Returns
+    -------
+    header : list of list of str
+        Per column, the lines of its header (every column the same number of lines, blank-padded).
+    positions : list of float
+        The figure x of each column.
+    size : float
+        The type size [pt].
+    """
+    cells = [max((len(row[c]) for row in item.rows), default=0) for c in range(len(item.header))]
+    limit = max((len(h) for h in item.header), default=1)
+    while True:
+        wrapped = [textwrap.wrap(h, max(limit, 1), break_long_words=False) or [""] for h in item.header]
+        widths = [max(cell, *(len(line) for line in lines)) for cell, lines in zip(cells, wrapped)]
+        if sum(w + 2 for w in widths) <= TABLE_CHARS or limit <= MIN_HEADER:
+            break
+        limit -= 1
+    height = max((len(lines) for lines in wrapped), default=1)
+    wrapped = [lines + [""] * (height - len(lines)) for lines in wrapped]
+    total = sum(w + 2 for w in widths)
+    size = max(MIN_TABLE_SIZE, min(TABLE_SIZE, TABLE_SIZE * TABLE_CHARS / total)) if total else TABLE_SIZE
+    char = CHAR * size / TABLE_SIZE
     positions, x = [], LEFT + 0.01
     for width in widths:
         positions.append(x)
-        x += (width + 2) * CHAR
-    return positions
+        x += (width + 2) * char
+    return wrapped, positions, size
 
 
 def draw_text_page(title, items, caption="", top=TOP, figure=None):
     """One page figure with the items drawn top-down from ``top``."""
     figure = figure or new_page(title, caption)
     y = top
+    lines = sum(_lines(item) for item in items)
+    line = min(LINE, (top - BOTTOM) / lines) if lines else LINE  # a stretched last page: lines set closer
     for item in items:
         if item.kind == "heading":
-            y -= 0.4 * LINE
+            y -= 0.4 * line
             figure.text(LEFT, y, item.text, fontsize=11, weight="bold", va="top")
-            y -= 1.6 * LINE
+            y -= 1.6 * line
         elif item.kind == "table":
-            positions = _column_positions(item)
-            for x, text in zip(positions, item.header):
-                figure.text(x, y, text, fontsize=8.5, weight="bold", va="top")
-            y -= LINE
-            figure.add_artist(_rule(y + 0.25 * LINE, positions[-1] + (len(item.header[-1]) + 12) * CHAR))
+            header, positions, size = table_layout(item)
+            for level in range(len(header[0])):
+                for x, column in zip(positions, header):
+                    figure.text(x, y, column[level], fontsize=size, weight="bold", va="top")
+                y -= line
+            right = positions[-1] + (max(len(text) for text in header[-1]) + 12) * CHAR * size / TABLE_SIZE
+            figure.add_artist(_rule(y + 0.25 * line, right))
             for row in item.rows:
                 for x, text in zip(positions, row):
-                    figure.text(x, y, text, fontsize=8.5, va="top")
-                y -= LINE
-            y -= LINE
+                    figure.text(x, y, text, fontsize=size, va="top")
+                y -= line
+            y -= line
         else:
             indent = 0.02 if item.kind == "bullet" else 0.0
             width = WRAP - (4 if item.kind == "bullet" else 0)
-            lines = textwrap.wrap(item.text, width) or [""]
-            for number, line in enumerate(lines):
+            wrapped = textwrap.wrap(item.text, width) or [""]
+            for number, text_line in enumerate(wrapped):
                 if item.kind == "bullet" and number == 0:
                     figure.text(LEFT + 0.006, y, "•", fontsize=9.5, va="top")
-                figure.text(LEFT + indent, y, line, fontsize=9.5 if item.kind != "note" else 8.5, va="top",
+                figure.text(LEFT + indent, y, text_line, fontsize=9.5 if item.kind != "note" else 8.5, va="top",
                             style="italic" if item.kind == "note" else "normal",
                             weight="bold" if item.kind == "strong" else "normal")
-                y -= LINE
+                y -= line
             if item.kind in ("paragraph", "strong"):
-                y -= LINE
+                y -= line
     return figure
 
 

@@ -84,6 +84,19 @@ REFERENCES = {
                          "foundation uplift. Journal of Structural Engineering 111(4), 906-930.",
     "Shenton 1996": "Shenton, H. W. (1996). Criteria for initiation of slide, rock, and slide-rock rigid-body modes. "
                     "Journal of Engineering Mechanics 122(7), 690-693.",
+    "Luco & Cornell 2007": "Luco, N., Cornell, C. A. (2007). Structure-specific scalar intensity measures for "
+                           "near-source and ordinary earthquake ground motions. Earthquake Spectra 23(2), 357-392 "
+                           "(efficiency and sufficiency of intensity measures).",
+    "Kalliontzis et al. 2016": "Kalliontzis, D., Sritharan, S., Schultz, A. E. (2016). Improved coefficient of "
+                               "restitution estimation for free rocking members. Journal of Structural Engineering "
+                               "142(12), 06016002.",
+    "Ther & Kollár 2017": "Ther, T., Kollár, L. P. (2017). Refinement of Housner's model on rocking blocks. "
+                          "Bulletin of Earthquake Engineering 15(5), 2305-2319.",
+    "NAVFAC DM-7.02": "NAVFAC (1986). Foundations and Earth Structures, Design Manual 7.02. Naval Facilities "
+                      "Engineering Command, Alexandria VA (Table 1: ultimate friction factors for dissimilar "
+                      "materials).",
+    "AISC 360-16": "AISC (2016). Specification for Structural Steel Buildings, ANSI/AISC 360-16. American Institute "
+                   "of Steel Construction, Chicago (J3.8: slip coefficient of faying surfaces).",
     "Makris & Vassiliou 2012": "Makris, N., Vassiliou, M. F. (2012). Sizing the slenderness of free-standing rocking "
                                "columns to withstand earthquake shaking. Archive of Applied Mechanics 82, 1497-1511.",
 }
@@ -99,8 +112,10 @@ def references_items() -> list[Item]:
 
 GLOSSARY = (
     ("θmax/α", "the largest rocking angle of a run over the block's slenderness angle α; 1 is the tipping point "
-               "of a block at rest, and a block that overturns is drawn at the top of the IDA axis."),
-    ("α, R", "slenderness angle (tan α = half-width over half-height) and the half-diagonal of the block."),
+               "of a block at rest; on the IDA pages a run that overturns is drawn at θmax/α = 1.6, the right "
+               "edge of each panel."),
+    ("α, R", "slenderness angle (tan α = half-width over half-height) and the half-diagonal of the block; of two "
+             "blocks with the same α the larger (larger R) is the more stable (Makris & Vassiliou 2012)."),
     ("uplift threshold", "the ground acceleration at which the block starts to rock on a rigid base: g·tanα."),
     ("damage state", "an outcome the fragility gives the probability of: uplift, θmax/α above a limit, "
                      "overturning."),
@@ -109,7 +124,17 @@ GLOSSARY = (
     ("β (dispersion)", "the standard deviation of the logarithm of the intensity at which the state is reached; "
                        "from record to record, plus the model's own uncertainty where the recommended curve "
                        "adds it."),
-    ("band", "the confidence bounds of a median from re-fitting with the records resampled (bootstrap)."),
+    ("band", "two meanings, named apart on the pages: the confidence band of a fitted curve (the bounds of its "
+             "median from re-fitting with the records resampled, bootstrap), and the restitution band (the "
+             "range of impact restitution the recommended curve runs: its low edge, centre and high edge)."),
+    ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
+                               "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, the "
+                               "integral of the squared acceleration), D5-95 (the time between 5% and 95% of Ia)."),
+    ("G_s, E_d, ξ, k", "the soil's shear modulus, its constrained (oedometric) modulus, the damping ratio of the "
+                       "foundation's dashpot, and the foundation's vertical stiffness under the block (the "
+                       "paper's eq. 19)."),
+    ("μ_s (base friction)", "the static friction coefficient between the block's base and the ground: below the "
+                            "block's width over height the block slides before it can rock (Shenton 1996)."),
     ("IDA (incremental dynamic analysis)", "each record is scaled to a ladder of intensities and run at each "
                                            "(Vamvatsikos & Cornell 2002)."),
     ("extrapolation by scaling", "an intensity above the largest any record of the set reached unscaled: there the "
@@ -121,7 +146,10 @@ GLOSSARY = (
                                                          "the site's hazard curve, and the chance that it happens at "
                                                          "least once in the design life."),
     ("restitution", "the share of rocking speed a block keeps at each impact; Housner's rigid base gives "
-                    "r = 1 − 1.5 sin²α."),
+                    "r = 1 − 1.5 sin²α, and experiments on rigid bases find about that value or a few percent more "
+                    "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
+    ("record sets", "the earthquake records the study runs; the far-field and near-field sets (with and without a "
+                    "velocity pulse) are those of FEMA P695."),
     ("resurrection", "a record that overturns the block at one level but not at a higher one; counted as "
                      "overturned from its first overturning level on."),
     ("friction demand", "the base friction coefficient a run needs to rock without sliding; above the assumed one "
@@ -131,7 +159,7 @@ GLOSSARY = (
     ("SSI-rocking model (the paper's)", "a rigid block on one vertical spring and dashpot under the active corner "
                                         "(the paper); its spring can pull on the block, which a soil cannot."),
     ("tensionless Winkler bed", "a rigid block on a bed of springs and dashpots that push but never pull: the block "
-                                "lifts off instead (Psycharis & Jennings 1983)."),
+                                "lifts off instead (Psycharis & Jennings 1983; Chopra & Yim 1985)."),
     ("recommended curve", "the tensionless bed run over the experimental range of impact restitution, its spread "
                           "added to β (FEMA P-58's combination)."),
 )

@@ -1,0 +1,439 @@
+"""Report legibility (issue 20, "Words a client reads"; the client read's FINDINGS 12, 18, 22, 24-28, 30, 32):
+one test per defect, each able to catch it again. Overprinting is measured on the drawn figure (matplotlib's
+text extents), never from the code's own layout numbers; the figures come from the small study's results
+(fixture ``small_pipeline``) or from hand-made datasets."""
+
+from __future__ import annotations
+
+import html as html_module
+import re
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+import xarray as xr
+
+from pipeline.report import figures
+from pipeline.report.layout import add_footer, log_ticks, new_page
+from pipeline.report.text import draw_text_page, heading, paragraph, table
+
+# ---------------------------------------------------------------- what the drawn page shows
+
+
+def _shown_texts(figure):
+    """Every text a reader sees on the drawn figure, with its extent in pixels.
+
+    Tick labels count only for the ticks inside the axis's view (matplotlib keeps the others, undrawn).
+    """
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    all_ticks, drawn_ticks = set(), set()
+    for axis in [a for parent in figure.axes for a in (parent, *parent.child_axes)]:
+        for side in (axis.xaxis, axis.yaxis):
+            for tick in side.get_major_ticks() + side.get_minor_ticks():
+                all_ticks.update((id(tick.label1), id(tick.label2)))
+            if axis.get_visible():
+                for tick in side._update_ticks():  # the ticks matplotlib draws
+                    drawn_ticks.update((id(tick.label1), id(tick.label2)))
+    shown = []
+    for text in figure.findobj(plt.Text):
+        if not text.get_visible() or not text.get_text().strip():
+            continue
+        if id(text) in all_ticks and id(text) not in drawn_ticks:
+            continue
+        if text.axes is not None and not text.axes.get_visible():
+            continue
+        shown.append((text, text.get_window_extent(renderer)))
+    return shown
+
+
+def overprinted(figure, shown=None) -> list[tuple[str, str]]:
+    """Pairs of texts whose boxes overlap by more than a pixel each way (a sweep along x: fast on tables)."""
+    shown = sorted(shown if shown is not None else _shown_texts(figure), key=lambda item: item[1].x0)
+    pairs = []
+    for index, (first, box) in enumerate(shown):
+        for second, other in shown[index + 1:]:
+            if other.x0 >= box.x1 - 1:
+                break
+            common_width = min(box.x1, other.x1) - max(box.x0, other.x0)
+            common_height = min(box.y1, other.y1) - max(box.y0, other.y0)
+            if common_width > 1 and common_height > 1:
+                pairs.append((first.get_text()[:40], second.get_text()[:40]))
+    return pairs
+
+
+def off_page(figure, shown=None) -> list[str]:
+    """Texts that run past an edge of the page."""
+    width, height = figure.bbox.width, figure.bbox.height
+    return [text.get_text()[:50] for text, box in (shown if shown is not None else _shown_texts(figure))
+            if box.x0 < -0.5 or box.y0 < -0.5 or box.x1 > width + 0.5 or box.y1 > height + 0.5]
+
+
+def _assert_legible(figure, name):
+    """No overprinted text and none off the page, with the footer drawn."""
+    add_footer(figure, "a report title", 1, 1)
+    assert overprinted(figure) == [], name
+    assert off_page(figure) == [], name
+
+
+def _results(folder, study, **changes):
+    from pipeline.config import load_study
+    from pipeline.report import Results
+
+    opened = {}
+    for name in ("cube", "ida", "fragility", "showcase", "efficiency"):
+        with xr.open_dataset(folder / f"{name}.nc") as dataset:
+            opened[name] = dataset.load()
+    values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
+                  output=folder, showcase=opened["showcase"], efficiency=opened["efficiency"])
+    values.update(changes)
+    return Results(**values)
+
+
+def test_the_overprint_check_catches_overprinted_texts():
+    """The check itself can fail: two labels at one place, and one running off the page."""
+    figure = new_page("A title")
+    figure.text(0.5, 0.5, "2,475 yr")
+    figure.text(0.5, 0.5, "975 yr")
+    figure.text(0.99, 0.3, "a label that runs past the right edge of the page")
+    try:
+        assert overprinted(figure) == [("2,475 yr", "975 yr")]
+        assert off_page(figure) == ["a label that runs past the right edge of the page"]
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.slow
+def test_no_page_of_the_report_overprints_or_leaves_the_page(small_pipeline):
+    """FINDINGS 24-28, 12: panel titles, return-period labels, y labels, subtitles, legend entries and table
+    cells never overlap, and no text is cut at the page edge, on one page of each kind of the small study's
+    report (the first block's; every text page) as the report draws it, footer included. About 8 s."""
+    from pipeline.report import build_plan
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    planned = build_plan(results)
+    assert {"ida-paper", "showcase-response", "applicability", "efficiency"} <= {page.name for page in planned}
+    kinds = set()
+    for number, page in enumerate(planned, start=1):
+        kind = (page.section, page.name.split("-")[1] if page.section == "Fragility" else "")
+        if page.html is None and kind in kinds:
+            continue  # the same figure for another block or model
+        kinds.add(kind)
+        figure = page.draw()
+        try:
+            add_footer(figure, "a report title", number, len(planned))
+            shown = _shown_texts(figure)
+            assert overprinted(figure, shown) == [], page.name
+            assert off_page(figure, shown) == [], page.name
+        finally:
+            plt.close(figure)
+
+
+# ---------------------------------------------------------------- IDA pages (FINDINGS 24)
+
+def _marked_axis(intensities, low=0.1, high=50.0):
+    figure = new_page("marks")
+    axis = figure.add_axes([0.1, 0.2, 0.3, 0.2])
+    axis.set_yscale("log")
+    axis.set_ylim(low, high)
+    marks = figures.CredibleMarks(tuple(range(len(intensities))), tuple(intensities), None)
+    return figure, axis, marks
+
+
+def test_close_return_period_marks_share_one_label_and_far_ones_keep_their_own():
+    figure, axis, _ = _marked_axis([])
+    try:
+        marks = figures.CredibleMarks((475.0, 975.0, 2475.0, 10000.0), (0.30, 0.39, 0.57, 20.0), None)
+        groups = figures.mark_groups(axis, marks, along="y")
+        assert [label for _, label in groups] == ["475 / 975 / 2,475 yr", "10,000 yr"]
+        figures.mark_intensities(axis, marks, along="y")
+        labels = [t.get_text() for t in axis.texts]
+        assert labels == ["475 / 975 / 2,475 yr", "10,000 yr"]
+        assert overprinted(figure) == []
+        for intensity in marks.intensities:  # every intensity keeps its own line
+            assert any(np.allclose(line.get_ydata(), intensity) for line in axis.lines)
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.parametrize("low, high", [(0.3, 0.9), (0.1, 20.0), (0.235, 47.1), (0.06, 0.11), (2.0, 2000.0)])
+def test_a_log_axis_always_has_tick_values(low, high):
+    """FINDINGS 24 (p. 23: the PGA axis had no tick values): at least two labelled ticks on any range that holds
+    two of 1-9 x 10^n, each of that form and inside the range."""
+    values = log_ticks(low, high)
+    assert len(values) >= 2
+    for value in values:
+        assert low <= value <= high
+        mantissa = value / 10 ** np.floor(np.log10(value) + 1e-12)
+        assert abs(mantissa - round(mantissa)) < 1e-9
+
+
+def test_drawn_log_axes_label_their_ticks_on_a_short_range():
+    figure = new_page("short range")
+    axis = figure.add_axes([0.1, 0.2, 0.2, 0.15])
+    axis.plot([1, 2], [0.3, 0.9])
+    from pipeline.report.layout import log_y_axis
+
+    log_y_axis(axis, (0.3, 0.9))
+    try:
+        shown = [text.get_text() for text, _ in _shown_texts(figure) if text in axis.get_yticklabels()]
+        assert len([t for t in shown if t]) >= 2
+        assert all(0.3 <= float(t) <= 0.9 for t in shown)
+    finally:
+        plt.close(figure)
+
+
+def test_long_captions_are_wrapped_whole_inside_the_page():
+    """FINDINGS 24: captions were cut at the page edge (and at two lines): every word is drawn, inside the page,
+    clear of the footer."""
+    from pipeline.report import CAPTIONS
+
+    caption = CAPTIONS["ida"] + " " + CAPTIONS["fragility-soils"][:220]  # longer than any caption of the report
+    figure = new_page("A page", caption)
+    try:
+        add_footer(figure, "a report title", 3, 9)
+        drawn = next(t for t in figure.texts if t.get_text().startswith(caption[:20]))
+        assert drawn.get_text().split() == caption.split()
+        assert off_page(figure) == [] and overprinted(figure) == []
+    finally:
+        plt.close(figure)
+
+
+# ---------------------------------------------------------------- response page (FINDINGS 25)
+
+def test_the_ground_motion_shares_the_time_axis_of_the_response_and_has_one(small_pipeline):
+    results = _results(small_pipeline.output, small_pipeline.study)
+    figure = figures.showcase_response_page(results.showcase, "")
+    try:
+        figure.canvas.draw()
+        ground = [a for a in figure.axes if a.get_ylabel().startswith("ground") or
+                  "ground acceleration" in a.get_title()]
+        response = [a for a in figure.axes if a.get_ylabel().startswith(("θ", "Δy"))]
+        assert len(ground) == 2 and response
+        for axis in ground:
+            assert axis.get_xlim() == response[0].get_xlim()
+            assert axis.get_xlabel() == "time [s]"
+            assert [t.get_text() for t in axis.get_xticklabels() if t.get_visible() and t.get_text()]
+            # above its column, as wide as it: one time on the page is one time in the ground and the response
+            column = [a for a in response if abs(a.get_position().x0 - axis.get_position().x0) < 1e-6]
+            assert column and abs(column[0].get_position().width - axis.get_position().width) < 1e-6
+    finally:
+        plt.close(figure)
+
+
+# ---------------------------------------------------------------- fragility pages (FINDINGS 26)
+
+def test_the_recommended_curve_has_a_style_of_its_own():
+    from pipeline.report.adapters import model_styles, models_of
+
+    names = ["housner", "recommended", "ssi", "winkler-low", "winkler-centre", "winkler-high"]
+    models = models_of(xr.Dataset(coords={"model": names}))
+    styles = model_styles(models)
+    keys = {name: (style["color"], str(style["ls"])) for name, style in styles.items()}
+    assert len(set(keys.values())) == len(names)
+    solid = [name for name, (_, ls) in keys.items() if ls in ("-", "solid")]
+    assert solid == ["recommended"]  # the answer's curve is the only solid one
+    assert styles["recommended"]["lw"] > max(s["lw"] for n, s in styles.items() if n != "recommended")
+
+
+@pytest.mark.slow
+def test_every_fragility_panel_has_x_tick_values(small_pipeline):
+    """FINDINGS 26: the top-row panels had no x tick labels. About 1 s."""
+    results = _results(small_pipeline.output, small_pipeline.study)
+    block = str(results.cube.block.values[0])
+    soils = [str(s) for s in results.cube.soil.values]
+    figure = figures.fragility_by_model_page(results.fragility, block, [soils[0], soils[-1]], "",
+                                             marks=results.marks(block))
+    try:
+        figure.canvas.draw()
+        for axis in (a for a in figure.axes if a.get_visible()):
+            labels = [t.get_text() for t in axis.get_xticklabels() if t.get_visible() and t.get_text()]
+            assert len(labels) >= 2, axis.get_title()
+    finally:
+        plt.close(figure)
+
+
+# ---------------------------------------------------------------- applicability and efficiency (FINDINGS 27, 28)
+
+def test_the_applicability_legend_names_each_model_each_block_and_each_band(small_pipeline):
+    from pipeline.report.adapters import models_of, short_label
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    figure = figures.applicability_page(results.cube, "")
+    try:
+        labels = [t.get_text().replace("\n", " ") for legend in figure.legends for t in legend.get_texts()]
+        for model in (m for m in models_of(results.cube) if not m.rigid_base):
+            assert sum(label == short_label(model) for label in labels) == 1, labels
+        for block in results.cube.block.values:
+            assert sum(label.startswith(f"block: {block}") for label in labels) == 1, labels
+        assert any("300-1000 MPa" in label and "paper" in label and "rigid base" in label for label in labels)
+        assert any("±10%" in label for label in labels)
+    finally:
+        plt.close(figure)
+
+
+def _efficiency(measures=("pga", "pgv", "pga_ratio")):
+    rng = np.random.default_rng(0)
+    shape = (len(measures), 2, 2, 2)  # measure, block, soil, model
+    dispersion = rng.uniform(0.2, 0.9, shape)
+    if "pga_ratio" in measures:  # PGA divided by a constant of the block: the same dispersion
+        dispersion[measures.index("pga_ratio")] = dispersion[measures.index("pga")]
+    p = rng.uniform(0.0, 1.0, shape)
+    dims = ("measure", "block", "soil", "model")
+    return xr.Dataset({"dispersion": (dims, dispersion), "p_magnitude": (dims, p), "p_distance": (dims, p[::-1])},
+                      coords={"measure": list(measures), "block": ["paper", "cabinet"], "soil": ["sand", "rock"],
+                              "model": ["housner", "ssi"]})
+
+
+def test_efficiency_leaves_out_a_measure_identical_by_construction_and_says_why():
+    from pipeline.report import _twins_words
+
+    dataset = _efficiency()
+    assert figures.efficiency_twins(dataset) == {"pga_ratio": "pga"}
+    assert figures.efficiency_twins(_efficiency(("pga", "pgv"))) == {}
+    equal = _efficiency(("pga", "pgv"))
+    equal["dispersion"][:] = 0.4
+    assert figures.efficiency_twins(equal) == {}  # equal by chance, not by construction: both drawn
+    figure = figures.efficiency_page(dataset, "caption")
+    try:
+        top = figure.axes[0]
+        assert [t.get_text() for t in top.get_xticklabels()] == ["PGA", "PGV"]
+        bars = {patch.get_facecolor() for patch in top.patches}
+        markers = {tuple(c) for collection in figure.axes[1].collections for c in collection.get_facecolor()}
+        assert not bars & markers  # p-value markers do not reuse the blocks' colours
+        _assert_legible(figure, "efficiency")
+    finally:
+        plt.close(figure)
+    words = _twins_words(dataset)
+    assert "PGA/(g·tanα) repeats PGA" in words and "identical by construction" in words
+
+
+# ---------------------------------------------------------------- text pages (FINDINGS 12, 32)
+
+def test_table_headers_wrap_and_are_never_cut():
+    """FINDINGS 12: "P(the block ove": a last header past the page edge. Every header word is drawn, inside."""
+    header = ["block", "model", "soil", "θmax/α ≥ 0.5: median / β", "The block overturns: median / β",
+              "P(the block overturns) in 50 years"]
+    rows = [["squat machinery skid", "Winkler bed, tensionless, band high edge (restitution band)", "gravel",
+             "203† / 1.41", "203† / 1.27", "<0.01%"]] * 3
+    figure = draw_text_page("Summary", [table(header, rows)])
+    try:
+        drawn = " ".join(t.get_text() for t in figure.texts)
+        for title in header:
+            assert all(word in drawn.split() for word in title.split()), title
+        assert off_page(figure) == [] and overprinted(figure) == []
+    finally:
+        plt.close(figure)
+
+
+def test_a_short_section_shares_the_page_of_the_one_before():
+    """FINDINGS 32: pages holding a few rows or one line. The next section starts where the last one ends."""
+    from pipeline.report import _packed_pages, contents_page, html_document
+
+    long_rows = [[f"row {n}", "x"] for n in range(45)]
+    parts = [("limitations", "Limitations", "Limitations", [heading("Tension"), table(["a", "b"], long_rows),
+                                                             heading("Solver"), paragraph("Every run finished.")]),
+             ("records-table", "Records", "Intensity measures of the records", [table(["record"], [["r1"], ["r2"]])])]
+    pages = _packed_pages(parts)
+    assert len(pages) == 2
+    assert pages[1].section == "Limitations" and pages[1].also == ("Records",)
+    assert "Every run finished." in pages[1].html and "r2" in pages[1].html
+    assert pages[0].title == "Limitations (1/2)" and pages[1].title == "Limitations (2/2)"
+    contents = contents_page(pages, "Report")
+    assert "href='#section-records'" in contents.html
+    document = html_document("Report", [contents, *pages])
+    assert "id='section-records'" in document
+
+
+def test_what_is_left_of_a_run_goes_on_its_last_page_when_it_overflows_a_little():
+    """FINDINGS 32 (a page with 2 records of a table): a few rows more than a page hold go on it, set closer,
+    inside the page; many more start a page of their own."""
+    from pipeline.report.text import BOTTOM, LINE, STRETCH, TOP, paginate
+
+    capacity = int((TOP - BOTTOM) / LINE)
+    rows = [[f"record {n}", "0.41"] for n in range(capacity - 4 + STRETCH)]  # heading 2, header 1, gap 1
+    assert len(paginate([heading("Records"), table(["record", "PGA [g]"], rows)])) == 1
+    figure = draw_text_page("Records", [heading("Records"), table(["record", "PGA [g]"], rows)])
+    try:
+        add_footer(figure, "a report title", 1, 1)
+        assert overprinted(figure) == [] and off_page(figure) == []
+        last = next(t for t in figure.texts if t.get_text() == rows[-1][0])
+        assert last.get_position()[1] > BOTTOM - 0.01  # above the caption and footer area
+    finally:
+        plt.close(figure)
+    more = [[f"record {n}", "0.41"] for n in range(capacity + 2 * STRETCH)]
+    pages = paginate([heading("Records"), table(["record", "PGA [g]"], more)])
+    assert len(pages) == 2 and len(pages[1][0].rows) > STRETCH
+
+
+def test_a_table_too_wide_for_the_page_is_set_smaller_not_cut():
+    from pipeline.report.text import TABLE_SIZE, table_layout
+
+    wide = table(["block", "model", "why no median"], [["squat machinery skid", "Winkler bed, tensionless, band high "
+                                                        "edge (restitution band)", "reached only at the highest "
+                                                        "levels: median above the studied range " * 2]])
+    _, _, size = table_layout(wide)
+    assert size < TABLE_SIZE
+    figure = draw_text_page("Limitations", [wide])
+    try:
+        assert off_page(figure) == []
+    finally:
+        plt.close(figure)
+
+
+# ---------------------------------------------------------------- title page and provenance (FINDINGS 22)
+
+@pytest.mark.slow
+def test_the_title_page_has_no_code_identifiers_and_the_provenance_keeps_them(small_pipeline):
+    from pipeline.report.sections import provenance_items, run_time_words, title_items
+
+    results = _results(small_pipeline.output, small_pipeline.study, runtime_s=0.0)
+    title = " ".join(item.text for item in title_items(results))
+    fingerprint = str(results.cube.attrs["config_hash"])
+    for word in (fingerprint, "hash", "rockfrag", "seed", ".toml", "Run time"):
+        assert word not in title, word
+    provenance = provenance_items(results)
+    cells = " ".join(cell for item in provenance for row in item.rows for cell in row)
+    assert fingerprint in cells and "configuration fingerprint" in cells
+    assert str(results.fragility.attrs["bootstrap_seed"]) in cells
+    run_time = next(row[1] for item in provenance for row in item.rows if row[0] == "run time")
+    assert run_time.startswith("not recorded") and "0 s" not in run_time
+    assert run_time_words(315.0) == "5 min" and run_time_words(42.0) == "42 s"
+
+
+# ---------------------------------------------------------------- sources and references (FINDINGS 28, 30, 18)
+
+CITATION = re.compile(r"\b((?:[A-Z][\w-]*(?: et al\.| & [A-Z][\w-]*)?) (?:19|20)\d\d)\b")
+
+
+@pytest.mark.slow
+def test_every_reference_is_cited_and_every_citation_listed(small_pipeline):
+    """FINDINGS 30: works listed but never cited (ElGawady, ASCE 7-22, Chopra & Yim, Shenton, Makris &
+    Vassiliou) and a citation never listed (Luco & Cornell 2007). Read from the report's HTML."""
+    from pipeline.report.words import REFERENCES
+
+    html = (small_pipeline.output / "report.html").read_text()
+    text = html_module.unescape(re.sub(r"<[^>]+>", " ", re.sub(r"<img[^>]*>", " ", html)))
+    references = text.index("The pages cite these works")
+    body = text[:references] + text[text.index("Provenance", references):]
+    for key in REFERENCES:
+        if key != "paper":
+            assert key in body, f"{key} is listed but never cited"
+    for cited in set(CITATION.findall(body)):
+        assert cited in REFERENCES, f"{cited} is cited but not listed"
+
+
+def test_the_stated_limits_and_values_carry_their_source(small_pipeline):
+    """FINDINGS 30, 18: the 1% and 10% limits, the 50-year life, μ per soil, the moduli: a source or the study's
+    choice in plain words."""
+    from pipeline.report.sections import sources_items
+
+    results = _results(small_pipeline.output, small_pipeline.study)
+    bullets = [item.text for item in sources_items(results)]
+    overturning = next(b for b in bullets if "overturns" in b and "1%" in b)
+    assert "ASCE 7-22" in overturning
+    assert any("θmax/α ≥ 0.5" in b and "10%" in b and "study's choice" in b for b in bullets)
+    assert any(b.startswith("Design life 50 years") and "study's choice" in b for b in bullets)
+    friction = next(b for b in bullets if "μ_s" in b)
+    assert "NAVFAC DM-7.02" in friction and results.friction_text in friction
+    assert any("Table 1" in b and "moduli" in b for b in bullets)
