@@ -177,8 +177,9 @@ def test_fragility_ends_with_the_answer_and_skips_the_sweep_of_a_study_file(tiny
     if row.status.iloc[0] in ("fitted", "extrapolated", "separated"):  # a number, as fragility.csv has it
         assert cells[2] == f"{row['median'].iloc[0]:.3g}"
     assert answer[-1] == f"Results: {output / 'report.pdf'}, {output / 'fragility.csv'}, {output / 'fragility.nc'}"
-    read_from = (output / "report.html").read_text().split("read from the result files in the same folder")[1]
-    assert "applicability.nc" not in read_from.split(")")[0]  # the sweep did not run: the report does not cite it
+    html = (output / "report.html").read_text()
+    read_from = html.split("result files read")[1].split("</tr>")[0]  # the provenance table's row
+    assert "fragility.nc" in read_from and "applicability.nc" not in read_from  # the sweep did not run
 
 
 def test_quiet_hides_the_answer_and_the_flag_runs_the_sweep(tiny_run, capsys, monkeypatch):
