@@ -35,8 +35,9 @@ def main(output, study=None, workers=None):
     pdf, pngs = report_stage(config, datasets["cube"], datasets["ida"], datasets["fragility"], None, output,
                              progress=False, workers=int(workers) if workers else None)
     elapsed, cpu = time.perf_counter() - started, _cpu_seconds() - cpu
+    pages = (output / "report.html").read_text(encoding="utf-8").count("<section id='page-")
     print(f"report stage: {elapsed:.1f} s wall, {cpu:.1f} s CPU (this process and its PNG worker) for "
-          f"{len(pngs)} pages ({elapsed / len(pngs):.2f} s per page); {pdf}")
+          f"{pages} pages, {len(pngs)} of them figures ({elapsed / pages:.2f} s per page); {pdf}")
     return elapsed
 
 

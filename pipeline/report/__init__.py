@@ -7,7 +7,7 @@ Input : the study configuration and the datasets written by the earlier stages: 
 Output: ``report.pdf`` (A4 landscape, every page numbered, the contents after the answer pages),
         ``report.html`` (the same pages in the same order: text pages as HTML text, figures embedded as
         PNG, a linked contents, an anchor per section and a way back to the contents from every page)
-        and ``figures/NN-name.png`` (one per page). Neither file carries a creation date: the same
+        and ``figures/NN-name.png`` (one per figure page). Neither file carries a creation date: the same
         results give the same files.
 
 Page order: title, one answer page per block (pipeline.report.answer_page), contents, summary, methods,
@@ -397,13 +397,16 @@ def _page_png(task) -> bytes:
 
 
 def _png_pages(planned, footer, workers):
-    """PNG bytes of every page, in order, and the pool drawing them (None: drawn here).
+    """PNG bytes of every figure page, in order, and the pool drawing them (None: drawn here).
+
+    A text page (``Page.html`` set) is HTML text in report.html and a page of report.pdf: it has no PNG (its
+    image was used nowhere, and drawing text pages at 100 dpi was a third of the report's drawing time).
 
     The pages are drawn in one forked worker process while this process writes the PDF (both cores
     busy; about 40% less wall time), or here, page by page, when ``workers`` is 1 or the platform
     cannot fork.
     """
-    tasks = [(index, footer, len(planned)) for index in range(len(planned))]
+    tasks = [(index, footer, len(planned)) for index, page in enumerate(planned) if page.html is None]
     if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
         return None, (_page_png(task) for task in tasks)
     pool = multiprocessing.get_context("fork").Pool(1)
@@ -411,7 +414,7 @@ def _png_pages(planned, footer, workers):
 
 
 def render(planned: list[Page], footer: str, output_dir, progress=True, workers=None) -> list[Page]:
-    """Draw each page, number it, write it to the PDF and its PNG, close it; one figure open at a time."""
+    """Draw each page, number it, write it to the PDF and (a figure page) its PNG, close it: one at a time."""
     global _PLANNED
     output_dir = Path(output_dir)
     figure_dir = output_dir / "figures"
@@ -433,9 +436,10 @@ def render(planned: list[Page], footer: str, output_dir, progress=True, workers=
                         document.savefig(figure)
                     finally:
                         plt.close(figure)
-                    png = next(pngs)
-                    with atomic_path(figure_dir / f"{number:02d}-{page.name}.png") as path:
-                        path.write_bytes(png)
+                    png = next(pngs) if page.html is None else None
+                    if png is not None:
+                        with atomic_path(figure_dir / f"{number:02d}-{page.name}.png") as path:
+                            path.write_bytes(png)
                     rendered.append(replace(page, png=png))
     finally:
         if pool is not None:
@@ -455,7 +459,8 @@ def write_report(planned: list[Page], output_dir, title="rockfrag report", foote
     rendered = render(planned, footer or title, output_dir, progress, workers)
     with atomic_path(output_dir / "report.html") as temporary:
         temporary.write_text(html_document(title, rendered), encoding="utf-8")
-    pngs = [output_dir / "figures" / f"{n:02d}-{p.name}.png" for n, p in enumerate(rendered, start=1)]
+    pngs = [output_dir / "figures" / f"{n:02d}-{p.name}.png" for n, p in enumerate(rendered, start=1)
+            if p.png is not None]
     return output_dir / "report.pdf", pngs
 
 
@@ -509,7 +514,7 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
     pdf : pathlib.Path
         ``output/report.pdf`` (``report.html`` beside it).
     pngs : list of pathlib.Path
-        ``output/figures/NN-name.png``, one per page in page order.
+        ``output/figures/NN-name.png``, one per figure page (NN its page number), in page order.
     """
     output = Path(output)
     if risk is not None and risk is not fragility and "probability_in_life" not in fragility:
