@@ -21,6 +21,7 @@ import matplotlib.lines
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.font_manager import FontProperties  # noqa: E402
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 PAGE_SIZE = (11.69, 8.27)  # A4 landscape [in]
@@ -153,7 +154,9 @@ def _log_ticks_on(axis, limits) -> None:
     figure, box = axis.axes.figure, axis.axes.get_position()
     vertical = axis.axis_name == "y"
     length = (box.height * figure.get_figheight() if vertical else box.width * figure.get_figwidth()) * 72.0
-    size = axis.get_ticklabels()[0].get_fontsize() if axis.get_ticklabels() else matplotlib.rcParams["font.size"]
+    # the style's tick-label size: asking the axis for its labels would first make the default locator's ticks
+    # (a log axis's minor ticks: about 50 ms an axis, a fifth of a fragility page's drawing)
+    size = FontProperties(size=matplotlib.rcParams[f"{axis.axis_name}tick.labelsize"]).get_size_in_points()
     most = max(3, int(length / ((2.2 if vertical else 3.5) * float(size))))
     axis.set_major_locator(FixedLocator(log_ticks(*limits, most=most)))
     axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
