@@ -43,6 +43,7 @@ Differences built into the laws, reported rather than hidden:
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 import warnings
@@ -58,6 +59,7 @@ from pipeline.models import simulate  # noqa: E402
 from pipeline.processing import load_recipe, process_record  # noqa: E402
 from pipeline.records import load_records  # noqa: E402
 from pipeline.units import STANDARD_GRAVITY as G  # noqa: E402
+from tests.physics.winkler_reference import reference_winkler  # noqa: E402
 
 SQUAT = Block(name="squat", R=math.hypot(1.0, 0.5), alpha=math.atan2(1.0, 0.5), mass=5000.0)  # b/h = 2
 SLIDE_ROCK = Block(name="slide-rock", R=2.0, alpha=math.atan(0.6), mass=5000.0)  # b/h = tan(alpha) = 0.6
@@ -75,6 +77,7 @@ TAIL = 3.0  # s after the record: the slip has stopped
 OPENSEES_STEP = 2e-4  # s, as the tied benchmark
 STICK_FREQUENCY = 5000.0  # rad/s: omega_h = sqrt(2 k0 / m) of the block stuck on its two bearings
 LARGE_MU = 10.0  # OpenSees' stand-in for a tied base (no corner slides)
+TINY_MU = 1e-6  # OpenSees' frictionless corners, where the base centre is held instead
 PULSE = (0.6 * G, 0.5, 1e-3)  # Newmark's rectangular pulse: amplitude [m/s^2], duration [s], sampling [s]
 
 
@@ -106,7 +109,21 @@ def rectangular_pulse(amplitude, duration, dt):
     return ag, n * dt + dt / 2
 
 
-def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_frequency=STICK_FREQUENCY):
+def bearing_force(theta, theta_dot, y, y_dot, b, K, C, bed="two-spring"):
+    """The flatSliderBearing's vertical law as a bed law of tests/physics/winkler_reference.py: each corner
+    carries max(0, (K/2) delta + (C/2) delta') with delta = y + s sin(theta) of either sign, so the dashpot
+    already pushes on a corner just above the ground (our bed: only once delta > 0)."""
+    force = moment = 0.0
+    for s in (-b, b):
+        pressure = 0.5 * K * (y + s * math.sin(theta)) + 0.5 * C * (y_dot + s * math.cos(theta) * theta_dot)
+        if pressure > 0.0:
+            force += pressure
+            moment += s * pressure
+    return force, moment
+
+
+def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_frequency=STICK_FREQUENCY,
+                     hold_centre=False):
     """The block on two flatSliderBearing corners in OpenSees.
 
     Parameters
@@ -129,6 +146,8 @@ def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_
         Fixed Newmark step [s].
     stick_frequency : float
         omega_h = sqrt(2 k0 / m) [rad/s], which sets the bearings' elastic shear stiffness k0.
+    hold_centre : bool
+        Fix the base centre horizontally, as our tied bed (give a tiny ``mu``: the corners then slide freely).
 
     Returns
     -------
@@ -143,6 +162,7 @@ def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_
     b, h, m = block.b, block.h, block.mass
     C = 2 * xi * math.sqrt(K * m)
     ops.wipe()
+    ops.logFile(os.devnull, "-noEcho")  # a step that fails is retried (counted in ``retries``), not printed
     ops.model("basic", "-ndm", 2, "-ndf", 3)
     ops.node(1, 0.0, h)      # centre of mass
     ops.node(2, -b, 0.0)     # base corners
@@ -150,6 +170,8 @@ def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_
     ops.node(4, 0.0, 0.0)    # base centre (free: the slip is measured here)
     ops.node(5, -b, 0.0)     # ground under the corners
     ops.node(6, b, 0.0)
+    if hold_centre:
+        ops.fix(4, 1, 0, 0)
     ops.fix(5, 1, 1, 1)
     ops.fix(6, 1, 1, 1)
     ops.mass(1, m, m, m * (b * b + h * h) / 3)
@@ -331,23 +353,31 @@ def convergence_check(row, xi, mu, block, print):
 
 
 def tied_check(rows, xi, block, print):
-    """The same runs with the base held (ours: friction=None; OpenSees: mu = LARGE_MU at both corners): how much
-    of the peak-angle difference is there without any sliding (bed law, stiff shear, corner vs centre tie)."""
+    """The runs with the base held, to split the peak-angle difference into its parts: ours (friction=None: the
+    base centre held, our bed law); the scipy reference (tests/physics/winkler_reference.py) with the bearing's
+    law (``bearing_force``); OpenSees with the base centre held and frictionless corners (the same law: a
+    solver check); OpenSees with the corners held (mu = LARGE_MU): a block that rocks on a corner that stays
+    put, where our tied bed holds the base centre and lets the corner move by b (1 - cos theta)."""
     out = []
     for row in rows:
-        mine = simulate("winkler", row["scaled"], row["dt"], block, k=row["K"], xi=xi, bed="two-spring",
-                        t_end=row["t_end"])
-        theirs = opensees_sliding(row["scaled"], row["dt"], block, row["K"], xi, LARGE_MU, row["t_end"])
-        out.append(relative(theirs["peak_angle"], mine.peak_angle))
-        print(f"      {row['record']:14} x{row['scale']:<4g} omega_v/p {row['bed']:3.0f}: tied peak angle ours "
-              f"{mine.peak_angle * 1e3:7.2f} mrad, OpenSees (mu {LARGE_MU:g}) {theirs['peak_angle'] * 1e3:7.2f} mrad: "
-              f"{out[-1]:+.1%}   (sliding: {row['d_angle']:+.1%})")
+        args = (row["scaled"], row["dt"])
+        mine = simulate("winkler", *args, block, k=row["K"], xi=xi, bed="two-spring", t_end=row["t_end"])
+        law = reference_winkler(*args, block.b, block.h, block.mass, row["K"], xi, "two-spring", t_end=row["t_end"],
+                                law=bearing_force)["peak_angle"]
+        centre = opensees_sliding(*args, block, row["K"], xi, TINY_MU, row["t_end"], hold_centre=True)["peak_angle"]
+        corners = opensees_sliding(*args, block, row["K"], xi, LARGE_MU, row["t_end"])["peak_angle"]
+        parts = (relative(law, mine.peak_angle), relative(centre, law), relative(corners, centre),
+                 relative(corners, mine.peak_angle))
+        out.append(parts)
+        print(f"      {row['record']:14} x{row['scale']:<4g}| {mine.peak_angle * 1e3:7.2f} {law * 1e3:9.2f} "
+              f"{centre * 1e3:10.2f} {corners * 1e3:11.2f} | {parts[0]:+7.1%} {parts[1]:+8.3%} {parts[2]:+7.1%} "
+              f"{parts[3]:+7.1%} | {row['d_angle']:+7.1%}")
     return out
 
 
-def spread(values):
+def spread(values, digits=1):
     values = [v for v in values if not math.isnan(v)]
-    return f"{min(values):+.1%} to {max(values):+.1%}" if values else "-"
+    return f"{min(values):+.{digits}%} to {max(values):+.{digits}%}" if values else "-"
 
 
 def run(print=print):
@@ -397,7 +427,12 @@ def run(print=print):
     largest_rocking = max(soft_rocking, key=lambda r: r["ours"].peak_angle)
     rocking_changes = convergence_check(largest_rocking, XI_SLIDE_ROCK, MU_SLIDE_ROCK, SLIDE_ROCK, print)
 
-    print(f"\n   b') the soft-bed runs of b) with the base held (ours friction=None, OpenSees mu = {LARGE_MU:g}):")
+    print(f"\n   b') the soft-bed runs of b) with the base held: peak angle [mrad] of ours (friction=None: base centre "
+          "held, our bed law),\n      the scipy reference with the bearing's law (base centre held), OpenSees with "
+          f"the base centre held (corners mu = {TINY_MU:g}),\n      OpenSees with the corners held (mu = "
+          f"{LARGE_MU:g}); the parts: bed law, solver, where the base is held, all; and b)'s sliding difference")
+    print(f"      {'record':14} {'scale':5}| {'ours':>7} {'ref law':>9} {'OS centre':>10} {'OS corners':>11} | "
+          f"{'law':>7} {'solver':>8} {'held':>7} {'all':>7} | {'sliding':>7}")
     tied = tied_check(soft_rocking, XI_SLIDE_ROCK, SLIDE_ROCK, print)
 
     rows = flat + rocking + bouncing
@@ -423,7 +458,10 @@ def run(print=print):
               f"{spread([r['d_slip'] for r in part])}, peak angle {spread([r['d_angle'] for r in part])}, residual "
               f"{spread([r['d_residual'] for r in part])}; ours+0.1% within "
               f"{max(max(abs(r['nudge_slip']), abs(r['nudge_angle'])) for r in part):.1%}")
-    print(f"   b') held base, soft bed: peak angle {spread(tied)} (the part of b)'s differences that is not sliding)")
+    print(f"   b') held base, soft bed, OpenSees against ours: peak angle {spread([t[3] for t in tied])}; of which "
+          f"the bearing's dashpot law {spread([t[0] for t in tied])}, the solver (OpenSees against the reference with "
+          f"that law) {spread([t[1] for t in tied])},\n       corners held instead of the centre "
+          f"{spread([t[2] for t in tied])}")
     print(f"   c) xi = {XI_BOUNCING}: peak slip {spread([r['d_slip'] for r in bouncing])}, peak angle "
           f"{spread([r['d_angle'] for r in bouncing])}; a 0.1% change of amplitude moves our peaks by "
           f"{spread([r['nudge_slip'] for r in bouncing] + [r['nudge_angle'] for r in bouncing])}: bouncing is "
