@@ -445,22 +445,23 @@ def run(print=print):
           f"{np.median([r['theirs']['cpu'] for r in rows]):.1f} s/run")
     at_default = [e for bed, f, s, e in pulse if f == STICK_FREQUENCY and s == OPENSEES_STEP]
     print(f"   0) pulse: housner {relative(rigid_slip, exact):+.1e} of Newmark; OpenSees at omega_h "
-          f"{STICK_FREQUENCY:g} rad/s {spread(at_default)}; at omega_h {STICK_FREQUENCY / 2:g} / "
-          f"{2 * STICK_FREQUENCY:g}: " + ", ".join(f"{e:+.1e}" for bed, f, s, e in pulse if f != STICK_FREQUENCY))
+          f"{STICK_FREQUENCY:g} rad/s " + ", ".join(f"{e:+.1e}" for e in at_default)
+          + f" (soft, stiff bed); at omega_h {STICK_FREQUENCY / 2:g} / {2 * STICK_FREQUENCY:g} and at half the step: "
+          + ", ".join(f"{e:+.1e}" for bed, f, s, e in pulse if f != STICK_FREQUENCY or s != OPENSEES_STEP))
     print(f"   a) flat sliding ({len(flat)} runs): peak slip {spread([r['d_slip'] for r in flat])}, residual slip "
           f"{spread([r['d_residual'] for r in flat])}; ours against housner on the stiff bed: "
           f"{spread([relative(r['ours'].peak_slip, r['rigid'].peak_slip) for r in flat if r['bed'] == BEDS[1]])}")
     for bed in BEDS:
         part = [r for r in rocking if r["bed"] == bed]
         print(f"   b) slide-rock, omega_v/p = {bed:g} ({len(part)} runs, peak angles "
-              f"{min(r['ours'].peak_angle for r in part) / SLIDE_ROCK.alpha:.3f}-"
-              f"{max(r['ours'].peak_angle for r in part) / SLIDE_ROCK.alpha:.3f} alpha): peak slip "
+              f"{min(r['ours'].peak_angle for r in part) * 1e3:.2f}-{max(r['ours'].peak_angle for r in part) * 1e3:.2f}"
+              f" mrad, alpha = {SLIDE_ROCK.alpha * 1e3:.0f} mrad): peak slip "
               f"{spread([r['d_slip'] for r in part])}, peak angle {spread([r['d_angle'] for r in part])}, residual "
               f"{spread([r['d_residual'] for r in part])}; ours+0.1% within "
               f"{max(max(abs(r['nudge_slip']), abs(r['nudge_angle'])) for r in part):.1%}")
     print(f"   b') held base, soft bed, OpenSees against ours: peak angle {spread([t[3] for t in tied])}; of which "
           f"the bearing's dashpot law {spread([t[0] for t in tied])}, the solver (OpenSees against the reference with "
-          f"that law) {spread([t[1] for t in tied])},\n       corners held instead of the centre "
+          f"that law) {spread([t[1] for t in tied], 3)},\n       corners held instead of the centre "
           f"{spread([t[2] for t in tied])}")
     print(f"   c) xi = {XI_BOUNCING}: peak slip {spread([r['d_slip'] for r in bouncing])}, peak angle "
           f"{spread([r['d_angle'] for r in bouncing])}; a 0.1% change of amplitude moves our peaks by "
