@@ -9,7 +9,7 @@ Input : a rectangular acceleration pulse (Newmark's closed form) and far-field r
 Output: printed tables: peak slip, residual slip and peak angle of ``simulate("winkler", ..., bed="two-spring",
         friction=mu)`` and of OpenSees, their differences, flights, CPU time per run of each tool, speed-up;
         ``housner`` with friction (the rigid-base limit) beside them; convergence of OpenSees in its shear
-        stiffness and step.
+        stiffness and step; the parts of the peak-angle difference with the base held (b').
 
 The OpenSees model (openseespy 3.7.1.2, optional extra ``bench``): the rigid block of
 ``benchmarks/opensees_winkler.py`` (a triangle of very stiff corotational elastic beams from the centre of mass,
@@ -37,7 +37,12 @@ Differences built into the laws, reported rather than hidden:
 * The dashpot: the bearing carries max(0, k delta + c delta') with delta the corner's penetration of either
   sign, so its dashpot already pushes on a corner that approaches the ground from less than c v / k above
   it; our bed pushes only once the corner is in the ground (delta > 0). With xi = 0 the laws are the same,
-  but an undamped bed makes a rocking block bounce (chaotic, see part c).
+  but on an undamped bed a rocking block bounces, and already at xi = 0.05 its peaks are chaotic (part c);
+  part b runs at xi = 0.2.
+* Where the base is held without sliding: OpenSees' stuck corners stay put, so the base centre of a block
+  rocking on one moves by b (1 - cos theta); our tied bed holds the base centre instead. Part b' measures this
+  and the dashpot law on the runs of b with the base held (OpenSees with the base centre fixed against the scipy
+  reference of tests/physics/winkler_reference.py run with the bearing's law, ``bearing_force``).
 """
 
 from __future__ import annotations
