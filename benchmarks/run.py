@@ -23,6 +23,7 @@ warnings.simplefilter("ignore")
 import calibration  # noqa: E402  (benchmarks/calibration.py)
 import fragility as fragility_benchmark  # noqa: E402  (benchmarks/fragility.py)
 import sliding as sliding_benchmark  # noqa: E402  (benchmarks/sliding.py)
+from opensees_sliding import run as sliding_against_opensees  # noqa: E402  (benchmarks/opensees_sliding.py)
 from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/opensees_winkler.py)
 
 from pipeline.blocks import Block  # noqa: E402
@@ -252,6 +253,7 @@ if __name__ == "__main__":
     study_timing()
     hunt_and_fill_savings(records)
     winkler_against_opensees()
+    sliding_against_opensees()  # prints one line and skips without openseespy, as the tied section
     print("\n5. ", end="")
     calibration.run()
     print("\n6. ", end="")
