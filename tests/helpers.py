@@ -104,3 +104,34 @@ def consumer_python(name: str) -> Path:
     if os.environ.get(CONSUMERS_REQUIRED) == "required":
         pytest.fail(reason)
     pytest.skip(reason)
+
+
+def pipeline_results(folder: Path, study: Path, **changes):
+    """The report's ``Results`` of a pipeline run's output folder (its netCDF files read back), with ``changes``.
+
+    Parameters
+    ----------
+    folder : Path
+        The output folder of a ``rockfrag fragility`` run (``PipelineRun.output``).
+    study : Path
+        The study file the run read.
+    **changes
+        Fields of ``pipeline.report.Results`` to replace (e.g. ``fragility=``, ``runtime_s=``).
+
+    Returns
+    -------
+    pipeline.report.Results
+    """
+    import xarray as xr
+
+    from pipeline.config import load_study
+    from pipeline.report import Results
+
+    opened = {}
+    for name in ("cube", "ida", "fragility", "showcase", "efficiency"):
+        with xr.open_dataset(folder / f"{name}.nc") as dataset:
+            opened[name] = dataset.load()
+    values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
+                  output=folder, showcase=opened["showcase"], efficiency=opened["efficiency"])
+    values.update(changes)
+    return Results(**values)

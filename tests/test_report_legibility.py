@@ -16,6 +16,7 @@ import xarray as xr
 from pipeline.report import figures
 from pipeline.report.layout import add_footer, log_ticks, new_page
 from pipeline.report.text import draw_text_page, heading, paragraph, table
+from tests.helpers import pipeline_results
 
 # ---------------------------------------------------------------- what the drawn page shows
 
@@ -76,20 +77,6 @@ def _assert_legible(figure, name):
     assert off_page(figure) == [], name
 
 
-def _results(folder, study, **changes):
-    from pipeline.config import load_study
-    from pipeline.report import Results
-
-    opened = {}
-    for name in ("cube", "ida", "fragility", "showcase", "efficiency"):
-        with xr.open_dataset(folder / f"{name}.nc") as dataset:
-            opened[name] = dataset.load()
-    values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
-                  output=folder, showcase=opened["showcase"], efficiency=opened["efficiency"])
-    values.update(changes)
-    return Results(**values)
-
-
 def test_the_overprint_check_catches_overprinted_texts():
     """The check itself can fail: two labels at one place, and one running off the page."""
     figure = new_page("A title")
@@ -110,7 +97,7 @@ def test_no_page_of_the_report_overprints_or_leaves_the_page(small_pipeline):
     report (the first block's; every text page) as the report draws it, footer included. About 8 s."""
     from pipeline.report import build_plan
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     planned = build_plan(results)
     assert {"ida-paper", "showcase-response", "applicability", "efficiency"} <= {page.name for page in planned}
     kinds = set()
@@ -202,7 +189,7 @@ def test_long_captions_are_wrapped_whole_inside_the_page():
 # ---------------------------------------------------------------- response page (FINDINGS 25)
 
 def test_the_ground_motion_shares_the_time_axis_of_the_response_and_has_one(small_pipeline):
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     figure = figures.showcase_response_page(results.showcase, "")
     try:
         figure.canvas.draw()
@@ -239,7 +226,7 @@ def test_the_recommended_curve_has_a_style_of_its_own():
 @pytest.mark.slow
 def test_every_fragility_panel_has_x_tick_values(small_pipeline):
     """FINDINGS 26: the top-row panels had no x tick labels. About 1 s."""
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     block = str(results.cube.block.values[0])
     soils = [str(s) for s in results.cube.soil.values]
     figure = figures.fragility_by_model_page(results.fragility, block, [soils[0], soils[-1]], "",
@@ -258,7 +245,7 @@ def test_every_fragility_panel_has_x_tick_values(small_pipeline):
 def test_the_applicability_legend_names_each_model_each_block_and_each_band(small_pipeline):
     from pipeline.report.adapters import models_of, short_label
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     figure = figures.applicability_page(results.cube, "")
     try:
         labels = [t.get_text().replace("\n", " ") for legend in figure.legends for t in legend.get_texts()]
@@ -387,7 +374,7 @@ def test_a_table_too_wide_for_the_page_is_set_smaller_not_cut():
 def test_the_title_page_has_no_code_identifiers_and_the_provenance_keeps_them(small_pipeline):
     from pipeline.report.sections import provenance_items, run_time_words, title_items
 
-    results = _results(small_pipeline.output, small_pipeline.study, runtime_s=0.0)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study, runtime_s=0.0)
     title = " ".join(item.text for item in title_items(results))
     fingerprint = str(results.cube.attrs["config_hash"])
     for word in (fingerprint, "hash", "rockfrag", "seed", ".toml", "Run time"):
@@ -428,7 +415,7 @@ def test_the_stated_limits_and_values_carry_their_source(small_pipeline):
     choice in plain words."""
     from pipeline.report.sections import sources_items
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     bullets = [item.text for item in sources_items(results)]
     overturning = next(b for b in bullets if "overturns" in b and "1%" in b)
     assert "ASCE 7-22" in overturning

@@ -13,22 +13,9 @@ import pytest
 import xarray as xr
 
 from pipeline.report.words import CODE_IDENTIFIERS
+from tests.helpers import pipeline_results
 
 K0, K = 1e-4, 2.5  # the shipped example hazard: lambda(s) = K0 s^-K
-
-
-def _results(folder, study, **changes):
-    from pipeline.config import load_study
-    from pipeline.report import Results
-
-    opened = {}
-    for name in ("cube", "ida", "fragility", "showcase", "efficiency"):
-        with xr.open_dataset(folder / f"{name}.nc") as dataset:
-            opened[name] = dataset.load()
-    values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
-                  output=folder, showcase=opened["showcase"], efficiency=opened["efficiency"])
-    values.update(changes)
-    return Results(**values)
 
 
 def _visible_text(html: str) -> str:
@@ -77,7 +64,7 @@ def test_references_and_glossary_pages_cite_the_sources(small_pipeline):
 def test_every_figure_has_a_caption_that_says_what_to_read(small_pipeline):
     from pipeline.report import plan
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     figures = [page for page in plan(results) if page.html is None and page.name != "title"]
     assert "efficiency" in [page.name for page in figures]
     assert [page.name for page in figures if not page.caption.startswith("Read ")] == []
@@ -89,7 +76,7 @@ def test_no_orphan_footnote_mark(small_pipeline, tmp_path):
     """A footnote is printed only when a row carries its mark, and every mark has its footnote."""
     from pipeline.report.sections import summary_items
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
 
     def marks_and_notes(items):
         cells = " ".join(c for item in items if item.kind == "table" for row in item.rows for c in row)
@@ -101,7 +88,7 @@ def test_no_orphan_footnote_mark(small_pipeline, tmp_path):
     fragility = results.fragility.copy()
     middle = float(np.median(results.fragility.intensity.values))
     fragility["median"] = fragility["median"].where(False, middle)  # every median inside the studied range
-    inside = _results(small_pipeline.output, small_pipeline.study, fragility=fragility, output=tmp_path)
+    inside = pipeline_results(small_pipeline.output, small_pipeline.study, fragility=fragility, output=tmp_path)
     inside.largest_recorded.update({b: np.inf for b in inside.largest_recorded})
     assert marks_and_notes(summary_items(inside)) == (set(), set())
 
@@ -109,7 +96,7 @@ def test_no_orphan_footnote_mark(small_pipeline, tmp_path):
 def test_curves_without_a_median_carry_the_counts_that_justify_it(small_pipeline):
     from pipeline.report.sections import limitations_items
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     items = limitations_items(results)
     text = " ".join(item.text for item in items)
     assert "too few exceedances" not in text
@@ -133,7 +120,7 @@ def test_curves_without_a_median_carry_the_counts_that_justify_it(small_pipeline
 def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline):
     from pipeline.report import figures
 
-    showcase = _results(small_pipeline.output, small_pipeline.study).showcase
+    showcase = pipeline_results(small_pipeline.output, small_pipeline.study).showcase
     assert "y - y_static" in showcase.settlement.attrs["long_name"]  # positive up, as the file defines it
     figure = figures.showcase_response_page(showcase, "")
     try:
@@ -150,7 +137,7 @@ def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline
 def test_contents_and_station_names_are_not_cut(small_pipeline):
     from pipeline.report import build_plan, records_items
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     planned = build_plan(results)
     contents = next(page for page in planned if page.name == "contents")
     figure = contents.draw()
@@ -227,7 +214,7 @@ def test_intensity_axes_are_log_and_mark_the_hazard_and_the_extrapolation(small_
     from pipeline.report import figures
     from pipeline.report.adapters import models_of
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     block = str(results.cube.block.values[1])
     marks = results.marks(block)
     assert marks.return_periods == (475.0, 975.0, 2475.0)
@@ -259,7 +246,7 @@ def test_intensity_axes_are_log_and_mark_the_hazard_and_the_extrapolation(small_
 def test_the_methods_page_states_the_scale_factors(small_pipeline):
     from pipeline.report.sections import methods_items
 
-    results = _results(small_pipeline.output, small_pipeline.study)
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
     with xr.open_dataset(small_pipeline.output / "cube.nc") as cube:
         factors = cube.scale_factor.values
     text = " ".join(item.text for item in methods_items(results))
