@@ -84,13 +84,14 @@ def _lines(item) -> int:
 def paginate(items, capacity=None) -> list[list[Item]]:
     """Split items into pages of ``capacity`` lines (default: a full page).
 
-    A table longer than a page is split with its header repeated; a heading never ends a page. When what
+    A table too wide for the page is split first (``fit_table``); a table longer than a page is split with its
+    header repeated; a heading never ends a page. When what
     is left overflows the last page by at most ``STRETCH`` lines, it goes on that page with its lines set
     closer (``draw_text_page``) rather than alone on a near-empty page.
     """
     capacity = capacity or int((TOP - BOTTOM) / LINE)
     pages, current, used = [], [], 0
-    queue = list(items)
+    queue = [part for item in items for part in fit_table(item)]
     while queue:
         if sum(_lines(rest) for rest in queue) <= capacity - used + STRETCH:  # the rest fits, a little closer
             current += queue
@@ -135,7 +136,70 @@ TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type acr
 
 
 TABLE_SIZE = 8.5  # pt, table type; smaller (down to MIN_TABLE_SIZE) only for a table too wide for the page
-MIN_TABLE_SIZE = 6.0
+MIN_TABLE_SIZE = 7.5  # pt: below it a client cannot read a printed table; a wider table is split (fit_table)
+
+
+def _column_widths(item) -> list[int]:
+    """Characters each column needs: its widest cell, or its header wrapped no narrower than ``MIN_HEADER``."""
+    return [max(max((len(row[c]) for row in item.rows), default=0),
+                min(len(item.header[c]), MIN_HEADER)) for c in range(len(item.header))]
+
+
+def fit_table(item) -> list[Item]:
+    """A table as one or more tables that each fit the page width in type of at least ``MIN_TABLE_SIZE``.
+
+    A table that fits is returned as it is. A wider one is split by columns, each part repeating the first
+    column (the row's key: soil, block, damage state); a column still too wide with the key beside it has
+    its cells wrapped onto continuation rows (the other cells blank). Nothing is cut. Any other item is
+    returned as it is.
+
+    Parameters
+    ----------
+    item : Item
+        A table (or any item).
+
+    Returns
+    -------
+    list of Item
+    """
+    if item.kind != "table" or not item.header:
+        return [item]
+    room = int(TABLE_CHARS * TABLE_SIZE / MIN_TABLE_SIZE)  # characters across the page at the smallest type
+    widths = _column_widths(item)
+    if sum(w + 2 for w in widths) <= room or len(widths) < 2:
+        return [_wrapped_rows(item, room)]
+    groups, current = [], []
+    for column in range(1, len(widths)):
+        if current and widths[0] + 2 + sum(widths[c] + 2 for c in current + [column]) > room:
+            groups.append(current)
+            current = []
+        current.append(column)
+    groups.append(current)
+    parts = []
+    for columns in groups:
+        keep = [0, *columns]
+        part = replace(item, header=[item.header[c] for c in keep], rows=[[row[c] for c in keep] for row in item.rows])
+        parts.append(_wrapped_rows(part, room))
+    return parts
+
+
+def _wrapped_rows(item, room: int):
+    """The table with the cells of its widest columns wrapped onto continuation rows until it fits ``room``."""
+    widths = _column_widths(item)
+    while sum(w + 2 for w in widths) > room:
+        widest = max(range(len(widths)), key=widths.__getitem__)
+        target = max(MIN_HEADER, room - sum(w + 2 for c, w in enumerate(widths) if c != widest) - 2)
+        if target >= widths[widest]:
+            break  # the other columns alone fill the page: nothing more to gain
+        rows = []
+        for row in item.rows:
+            lines = [textwrap.wrap(cell, target, break_long_words=False) or [""] if c == widest else [cell]
+                     for c, cell in enumerate(row)]
+            for index in range(max(len(cell) for cell in lines)):
+                rows.append([cell[index] if index < len(cell) else "" for cell in lines])
+        item = replace(item, rows=rows)
+        widths = _column_widths(item)
+    return item
 
 
 def table_layout(item) -> tuple[list[list[str]], list[float], float]:
@@ -143,7 +207,7 @@ def table_layout(item) -> tuple[list[list[str]], list[float], float]:
 
     A header is wrapped (never cut) only as far as the page needs: the longest header line shrinks until
     the columns fit ``TABLE_CHARS`` or reach the cells' own width. A table still too wide is set in
-    smaller type, never cut.
+    smaller type, never below ``MIN_TABLE_SIZE`` (``fit_table`` splits a wider one first), never cut.
 
     Returns
     -------
@@ -177,6 +241,7 @@ def table_layout(item) -> tuple[list[list[str]], list[float], float]:
 def draw_text_page(title, items, caption="", top=TOP, figure=None):
     """One page figure with the items drawn top-down from ``top``."""
     figure = figure or new_page(title, caption)
+    items = [part for item in items for part in fit_table(item)]  # a no-op on the items paginate returned
     y = top
     lines = sum(_lines(item) for item in items)
     line = min(LINE, (top - BOTTOM) / lines) if lines else LINE  # a stretched last page: lines set closer
