@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -246,6 +246,16 @@ class StateAnswer:
     not_reached_below : float or None
         The largest recorded intensity when no record reached the state at any level up to it (the
         fitted curve there would be an extrapolation by scaling); None when some record did.
+    records : tuple of (int, int, float)
+        Per return period, what the records did at the level run nearest at or below its intensity: how
+        many reached the state, of how many, and that level (shown unit); (-1, n, NaN) where no level
+        lies at or below the intensity, and an empty tuple without the records' fractions.
+    first_reached : float or None
+        The lowest level (shown unit) at which a record reached the state; None: no record did.
+    supported_probability : float
+        The probability in the design life from the intensities at and above ``first_reached`` only (0
+        when no record reached the state, NaN when unknown): what is left when the fitted curve's tail
+        below the data is cut off.
     """
 
     state: str
@@ -254,12 +264,32 @@ class StateAnswer:
     probability_in_life: float
     limit: float | None
     not_reached_below: float | None
+    records: tuple = ()
+    first_reached: float | None = None
+    supported_probability: float = float("nan")
 
     @property
     def exceeds(self) -> bool:
         """True when the probability in the design life is above the study's limit."""
         return self.limit is not None and bool(np.isfinite(self.probability_in_life)) \
             and self.probability_in_life > self.limit
+
+    @property
+    def tail_only(self) -> bool:
+        """True when the state exceeds its limit only through the fitted curve's tail below every record.
+
+        Without the intensities below the lowest level at which a record reached the state, the
+        probability in the design life would be within the limit.
+        """
+        return self.exceeds and self.not_reached_below is None and bool(np.isfinite(self.supported_probability)) \
+            and self.supported_probability <= self.limit
+
+    def fit_only(self, index: int) -> bool:
+        """True when no record reached the state at any level at or below return period ``index``'s intensity."""
+        if not self.records:
+            return False
+        level = self.records[index][2]
+        return self.first_reached is None or not np.isfinite(level) or self.first_reached > level * (1 + 1e-9)
 
 
 @dataclass(frozen=True)
@@ -311,6 +341,24 @@ def _empirical(fragility: xr.Dataset, model: str, block, soil, state) -> np.ndar
         if np.isfinite(values).any():
             return np.asarray(values, float)
     return np.asarray(values, float)
+
+
+def records_reaching(fraction: float, n_records: int) -> int:
+    """How many of ``n_records`` records a fraction of them is (the fractions of fragility.nc are counts over n)."""
+    return int(round(float(fraction) * n_records))
+
+
+def _records_at(levels: np.ndarray, empirical: np.ndarray, n_records: int, im: float) -> tuple:
+    """(records reaching the state, of how many, the level) at the level nearest at or below ``im``."""
+    below = np.flatnonzero(levels <= im * (1 + 1e-9))
+    if not below.size or not empirical.size or not np.isfinite(empirical[below[-1]]):
+        return (-1, n_records, float("nan"))
+    return (records_reaching(empirical[below[-1]], n_records), n_records, float(levels[below[-1]]))
+
+
+def _first_reached(levels: np.ndarray, empirical: np.ndarray) -> float | None:
+    reached = np.flatnonzero(np.nan_to_num(empirical) > 0) if empirical.size else np.array([], int)
+    return float(levels[reached[0]]) if reached.size else None
 
 
 def _levels(fragility: xr.Dataset, block, scale: float) -> np.ndarray:
@@ -366,7 +414,10 @@ def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnsw
                             for a, b in zip(milder.at_return_periods, severe.at_return_periods))
             frequency = float(np.fmax(milder.annual_frequency, severe.annual_frequency))
             probability = float(np.fmax(milder.probability_in_life, severe.probability_in_life))
-            rows[family[position]] = StateAnswer(milder.state, periods, frequency, probability, milder.limit, None)
+            supported = float(np.fmax(milder.supported_probability, severe.supported_probability))
+            rows[family[position]] = replace(milder, at_return_periods=periods, annual_frequency=frequency,
+                                             probability_in_life=probability, not_reached_below=None,
+                                             supported_probability=supported)
     return rows
 
 
@@ -413,6 +464,7 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     intensities = tuple(intensity_at_frequency(hazard, 1.0 / t) for t in periods)
     states = [str(s) for s in fragility.damage_state.values]
     families = nested_families(fragility)
+    n_records = int(fragility["n_records"]) if "n_records" in fragility else 0
     answers = []
     for block in map(str, fragility.block.values):
         levels = _levels(fragility, block, scale)
@@ -436,8 +488,17 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                     frequency = float(hazard_frequency(hazard, not_reached))
                 probability = float(risk_probability_in_life(frequency, design_life)) if np.isfinite(frequency) \
                     else np.nan
+                first = _first_reached(levels, empirical)
+                supported = np.nan
+                if hazard is not None and empirical.size and np.isfinite(probability):
+                    # the curve's tail below the first level any record reached it cut off
+                    supported = 0.0 if first is None else float(risk_probability_in_life(risk_annual_frequency(
+                        float(row["median"]) * scale, float(row["beta"]), hazard, lower=first), design_life))
+                records = tuple(_records_at(levels, empirical, n_records, im) for im in intensities) \
+                    if n_records and empirical.size else ()
                 rows.append(StateAnswer(state, tuple(_at(row, im, scale, levels, empirical) for im in intensities),
-                                        frequency, probability, limits.get(state), not_reached))
+                                        frequency, probability, limits.get(state), not_reached, records, first,
+                                        supported))
             rows = nested(rows, families)
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:
@@ -507,8 +568,20 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
                 return f"{100 * value:.3g}%" if percent(value) == percent(limit) else percent(value)
             shown = near(min(values)) if len(values) == 1 else f"{near(min(values))} to {near(max(values))}"
             reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
-                           f"{percent(limit)} limit")
+                           f"{percent(limit)} limit{tail_words(soils, state)}")
         return "; ".join(reasons)
+
+    def tail_words(soils, state) -> str:
+        """Where the exceedance comes from the fitted curve's tail below every record alone, say so."""
+        tails = [(s.soil, r) for s in soils for r in s.states if r.state == state and r.tail_only]
+        if not tails:
+            return ""
+        where = f" on {_and([soil for soil, _ in tails])}" if len(soils) > 1 else ""
+        firsts = sorted({f"{r.first_reached:.2g} {answer.unit}" for _, r in tails if r.first_reached is not None})
+        below = f"below {_and(firsts)}" if firsts else "at any level"
+        kept = ", ".join(percent(r.supported_probability) for _, r in tails)
+        return (f", a verdict that rests on the fitted curve's tail alone{where}: no record reached the state "
+                f"{below}, and the intensities from there on give {kept}, within the limit")
 
     parts = []
     for verdict in (CHECK_SLIDING, ANCHOR, NO_ACTION):
@@ -540,5 +613,5 @@ def _and(words: Sequence[str]) -> str:
 
 __all__ = ["ANCHOR", "ANSWER_MODELS", "ANSWER_STATE", "CHECK_SLIDING", "NO_ACTION", "NO_VERDICT", "RECOMMENDED",
            "BlockAnswer", "SoilAnswer", "StateAnswer", "answer_model", "answer_rows", "answer_table", "block_answers",
-           "nested",
+           "nested", "records_reaching",
            "display_scale", "intensity_at_frequency", "percent", "verdict_sentence"]

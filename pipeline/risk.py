@@ -19,17 +19,24 @@ from pipeline.hazard import HazardCurve, hazard_frequency
 from pipeline.hazard import study_hazard as study_hazard  # re-exported: cli.py imports it from here
 
 
-def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, points: int = 4000) -> float:
+def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, points: int = 4000,
+                     lower: float | None = None) -> float:
     """Mean annual frequency of reaching a damage state with a lognormal fragility [1/yr].
 
-    beta = 0 is a step at the median: lambda_DS = lambda(median).
+    beta = 0 is a step at the median: lambda_DS = lambda(median). ``lower`` (IM units) keeps only the
+    intensities from it on: the part of lambda_DS above the lowest level at which a record reached the
+    state (pipeline.answer), the rest being the fitted curve's tail alone.
     """
     if hazard is None or not (np.isfinite(median) and np.isfinite(beta)):
         return np.nan
     if beta == 0:
-        return float(hazard_frequency(hazard, median))
+        return float(hazard_frequency(hazard, median if lower is None else max(median, lower)))
     low = min(hazard.intensity[0], median * np.exp(-8 * beta))
     high = median * np.exp(8 * beta)
+    if lower is not None:
+        if lower >= high:
+            return float(ndtr(np.log(lower / median) / beta) * hazard_frequency(hazard, lower))
+        low = max(low, lower)
     grid = np.geomspace(low, high, points)
     frequency = hazard_frequency(hazard, grid)
     probability = ndtr(np.log(grid / median) / beta)

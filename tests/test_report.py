@@ -84,8 +84,8 @@ def test_no_figure_warning_and_no_open_figures(small_pipeline):
 @pytest.mark.slow
 def test_report_reads_results_and_never_simulates(small_pipeline, monkeypatch, tmp_path):
     """Drawn again from the result files alone, every solver forbidden, the report is byte for byte the one the
-    fragility run drew from its datasets in memory: no creation dates, nothing but the files (the run time, which
-    the title page states, is passed back)."""
+    fragility run drew from its datasets in memory: no creation dates, nothing but the files (the run time and
+    the run's statistics, which the title and provenance pages state, are passed back)."""
     import shutil
 
     import pipeline.models as models
@@ -105,10 +105,14 @@ def test_report_reads_results_and_never_simulates(small_pipeline, monkeypatch, t
         (copy / name).unlink()
     shutil.rmtree(copy / "figures")
     html = (output / "report.html").read_text()
-    runtime = re.search(r"<td>run time</td><td>(\d+) s</td>", html)  # the provenance page
+    runtime = re.search(r"<td>run time</td><td>(\d+) s up to this report", html)  # the provenance page
+    computed = re.search(r"this run computed ([\d,]+) grid runs and took (\d+) of its (\d+) cells", html)
+    run = {"runs_computed": int(computed.group(1).replace(",", "")), "cells_reused": int(computed.group(2)),
+           "cells": int(computed.group(3))} if computed else \
+        {"runs_computed": 1, "cells_reused": 0, "cells": 1} if "none taken from checkpoints" in html else None
     opened = _datasets(copy)
     pdf, pngs = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
-                             runtime_s=float(runtime.group(1)) if runtime else float("nan"), progress=False)
+                             runtime_s=float(runtime.group(1)) if runtime else float("nan"), progress=False, run=run)
     assert pdf.read_bytes() == (output / "report.pdf").read_bytes()
     assert (copy / "report.html").read_text() == html
     assert [png.read_bytes() for png in pngs] == [(output / "figures" / png.name).read_bytes() for png in pngs]

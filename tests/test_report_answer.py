@@ -226,3 +226,101 @@ def test_the_answer_says_where_the_bed_could_not_reach_the_band():
     text = _band_reach(cube)
     assert "On clay the bed" in text and "clay, rock" not in text and "0.866" in text and "0.836" in text
     assert _band_reach(cube.assign(restitution_target=cube.restitution_requested)) == ""
+
+
+# ---------------------------------------------------------------- verdicts from the fit's tail (issue 20, report)
+
+def _tail_case(first_reached_index):
+    """Overturning median 1 g, beta 0.6; no record overturned below level ``first_reached_index`` (10 records)."""
+    levels = np.geomspace(0.1, 4.0, 8)
+    shape = (levels.size, 2, 1, 2, 2)
+    reached = np.clip((np.arange(levels.size) - first_reached_index + 1) * 0.3, 0.0, 1.0)
+    empirical = reached[:, None, None, None, None] * np.ones(shape)
+    fragility = _fragility([[[[0.5, 1.0]]]], betas=0.6, empirical=empirical).assign(n_records=10)
+    return levels, block_answers(fragility, _power_law(), limits={"overturning": 0.01})[0]
+
+
+def _supported(lower, median=1.0, beta=0.6):
+    """P(overturning in 50 years) from the intensities above ``lower`` only, by quadrature of the power law."""
+    from scipy.integrate import quad
+
+    rate = quad(lambda s: lognorm.cdf(s, beta, scale=median) * K * K0 * s ** (-K - 1), lower, np.inf)[0]
+    return 1 - math.exp(-50 * rate)
+
+
+def test_a_verdict_from_the_fits_tail_below_every_record_is_said_so():
+    """The client read 2.2% at 0.3 g where no record overturned: each cell says what the records did at the level
+    at or below the intensity, and the verdict says when it rests on the fitted curve's tail alone."""
+    from pipeline.report.answer_page import _at_cell, _period_header
+
+    levels, answer = _tail_case(5)  # first overturning at 1.39 g, far above the 2,475-year 0.57 g
+    overturning = answer.soils[0].states[1]
+    assert overturning.first_reached == pytest.approx(levels[5])
+    assert overturning.probability_in_life > 0.01  # above the limit ...
+    assert overturning.supported_probability == pytest.approx(_supported(levels[5]), rel=0.02)
+    assert overturning.supported_probability < 0.01 and overturning.tail_only  # ... only through the tail
+    sentence = verdict_sentence(answer, "cabinet", {"overturning": "the block overturns"})
+    assert "anchor it on clay and rock" in sentence
+    assert f"rests on the fitted curve's tail alone on clay and rock: no record reached the state below " \
+           f"{levels[5]:.2g} g" in sentence
+    assert percent(overturning.supported_probability) in sentence
+    im = (K0 * 475.0) ** (1 / K)
+    below = levels[levels <= im][-1]
+    assert overturning.records[0] == (0, 10, pytest.approx(below))
+    p = lognorm.cdf(im, 0.6, scale=1.0)
+    assert _at_cell(overturning, 0, answer).startswith(percent(p))
+    assert _at_cell(overturning, 0, answer).endswith("; fit only, 0 of 10 records")
+    assert _period_header(answer, answer.soils[0], 0, "PGA").endswith(f"(records at {below:.2g}\u00a0g)")
+
+    levels, answer = _tail_case(2)  # 3 of 10 overturned at 0.29 g, below the 475-year 0.30 g
+    overturning = answer.soils[0].states[1]
+    assert not overturning.tail_only and "tail" not in verdict_sentence(answer, "cabinet")
+    assert overturning.supported_probability == pytest.approx(_supported(levels[2]), rel=0.02)
+    assert _at_cell(overturning, 0, answer).endswith("; 3 of 10 records")
+    no_records = block_answers(_fragility([[[[0.5, 1.0]]]], betas=0.6), _power_law())[0]
+    assert not no_records.soils[0].states[1].records  # no n_records: the cell keeps its value and band only
+
+
+def test_the_data_supported_part_of_the_annual_frequency_is_the_integral_above_the_lower_limit():
+    from pipeline.risk import annual_frequency
+
+    hazard = _power_law()
+    whole = annual_frequency(1.0, 0.6, hazard)
+    assert annual_frequency(1.0, 0.6, hazard, lower=1e-3) == pytest.approx(whole, rel=1e-3)
+    assert annual_frequency(1.0, 0.6, hazard, lower=1.5) == pytest.approx(-math.log(1 - _supported(1.5)) / 50,
+                                                                          rel=0.01)
+    assert annual_frequency(1.0, 0.0, hazard, lower=2.0) == pytest.approx(K0 * 2.0 ** -K)  # a step below it
+
+
+def test_each_answer_page_states_the_planar_model_and_where_the_friction_comes_from(small_pipeline):
+    """A client took the soil's friction for the plinth's, and the planar model's limits were on another page."""
+    from pipeline.report.answer_page import answer_items
+    from pipeline.report.sections import limitations_items, sources_items
+    from tests.helpers import pipeline_results
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    for answer in results.answers:
+        text = " ".join(item.text for item in answer_items(results, answer))
+        b = float(results.cube.block_b.sel(block=answer.block))
+        assert f"b = {b:.3g} m is its half-width" in text and "bottom edge" in text
+        assert "twisting (wobbling)" in text and "three-dimensional rocking" in text
+        for soil in results.config.soils:
+            assert f"{soil.name} {soil.friction_static:g}/{soil.friction_kinetic:g}" in text
+        assert "soil class's default coefficient" in text and "plinth" in text and "shim" in text
+        assert "[soils_custom.NAME]" in text and "friction_static" in text and "friction_kinetic" in text
+    limitations = " ".join(item.text for item in limitations_items(results))
+    assert "Planar model" in limitations and results.friction_words in limitations
+    assert results.friction_words in [item.text for item in sources_items(results)]
+
+
+def test_the_seed_paper_is_cited_from_its_copy_and_named_in_full_on_the_methods_page(small_pipeline):
+    from pipeline.report.sections import methods_items
+    from pipeline.report.words import PAPER_CITATION, PAPER_TITLE, REFERENCES
+    from tests.helpers import ROOT, pipeline_results
+
+    assert REFERENCES["paper"].startswith(PAPER_CITATION) and "doi:10.20944/" in PAPER_CITATION
+    copy = ROOT.parent / "shared" / "seed" / "rocking-ssi-paper.txt"
+    if copy.is_file():  # the title as the copy gives it (no authors, journal or year there: none invented)
+        assert PAPER_TITLE in copy.read_text(encoding="utf-8").splitlines()[:5]
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    assert any(PAPER_CITATION in item.text for item in methods_items(results))

@@ -482,7 +482,7 @@ def _open_optional(path):
 def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragility: xr.Dataset,
                  risk: xr.Dataset | None, output: str | os.PathLike, runtime_s: float = float("nan"),
                  applicability: xr.Dataset | None = None, progress: bool = True,
-                 workers: int | None = None) -> tuple[Path, list[Path]]:
+                 workers: int | None = None, run: dict | None = None) -> tuple[Path, list[Path]]:
     """Read what the report needs beyond the given datasets from ``output`` and write the report.
 
     The report reads ``showcase.nc`` for the records, never the records themselves, and runs no solver.
@@ -508,6 +508,9 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
         Show a progress bar over the pages.
     workers : int, optional
         1 draws every page in this process; otherwise the PNGs are drawn in one forked worker.
+    run : dict, optional
+        The study's statistics (``pipeline.study.run_study``: ``runs_computed``, ``cells_reused``, ``cells``):
+        the title page says how many runs this run computed and how many cells came from checkpoints.
 
     Returns
     -------
@@ -526,7 +529,9 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
     comparison = open_comparison(cube, output)
     vertical = None if comparison is None else vertical_effect(cube, comparison, damage_states_from_config(config.raw))
     results = Results(config, cube, ida, fragility, output, showcase=_open_optional(output / "showcase.nc"),
-                      applicability=applicability, efficiency=efficiency, runtime_s=runtime_s, vertical=vertical)
+                      applicability=applicability, efficiency=efficiency, runtime_s=runtime_s, vertical=vertical,
+                      run=None if run is None else {key: run[key] for key in ("runs_computed", "cells_reused", "cells")
+                                                    if key in run})
     settings = results.settings
     footer = " · ".join(str(part) for part in (settings.get("project"), results.title, f"study '{config.name}'")
                         if part)

@@ -113,7 +113,8 @@ def panel_label(model: ModelInfo) -> str:
 def cell(dataset, model: ModelInfo, block, soil=None):
     """The results of one model and block on ``soil``; without a soil, on the first.
 
-    A rigid base's soils are equal unless base friction lets it slide on some: then the caller names the soil.
+    A rigid base's soils are equal unless base friction lets it slide on some: then the caller names the soil
+    (``soils_of`` says which soils a model's results need).
     """
     if "soil" in dataset.dims and soil is None:
         soil = dataset.soil.values[0]
@@ -121,6 +122,28 @@ def cell(dataset, model: ModelInfo, block, soil=None):
     if "soil" in dataset.dims:
         selection["soil"] = soil
     return dataset.sel(selection)
+
+
+def differs_by_soil(values) -> bool:
+    """True when a DataArray with a ``soil`` dimension differs between its soils (NaNs equal)."""
+    if "soil" not in values.dims:
+        return False
+    rows = np.asarray(values.transpose("soil", ...).values)
+    return any(not np.array_equal(rows[0], other, equal_nan=True) for other in rows[1:])
+
+
+def soils_of(dataset, model: ModelInfo, block, variable: str) -> list:
+    """The soils whose results of ``model`` a page shows: every soil, or [None] (once) for a rigid base.
+
+    A rigid base's results are the same on every soil unless base friction lets the block slide on some (the
+    friction differs by soil): then each soil has its own results, and each is shown (``variable`` says which
+    results are compared).
+    """
+    soils = list(map(str, dataset.soil.values)) if "soil" in dataset.dims else [None]
+    if not model.rigid_base:
+        return soils
+    picked = dataset[variable].sel(model=model.name, block=block)
+    return soils if differs_by_soil(picked) else [None]
 
 
 def block_levels(dataset, block) -> np.ndarray:
@@ -345,6 +368,18 @@ def block_description(config, block) -> str:
         if item.name == str(block):
             return pretty(item.description)
     return ""
+
+
+def planar_words(cube, block) -> str:
+    """The planar model's limitation for one block in one sentence, naming the direction its b is taken in.
+
+    The answer pages and the limitations page state it (one place).
+    """
+    b, h = float(cube.block_b.sel(block=block)), float(cube.block_h.sel(block=block))
+    return (f"Planar model: the block rocks about one bottom edge, in the vertical plane across that edge, in which "
+            f"b = {b:.3g} m is its half-width (h = {h:.3g} m its half-height); rocking in the other direction, "
+            "twisting (wobbling) and three-dimensional rocking on a corner are not modelled: check the other "
+            "direction as a block of its own b.")
 
 
 @dataclass(frozen=True)

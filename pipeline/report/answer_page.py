@@ -19,7 +19,14 @@ import numpy as np
 from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
 from pipeline.models.base import Outcome
 from pipeline.models.variants import split_variant
-from pipeline.report.adapters import block_description, block_name, measure_label, model_info, state_labels
+from pipeline.report.adapters import (
+    block_description,
+    block_name,
+    measure_label,
+    model_info,
+    planar_words,
+    state_labels,
+)
 from pipeline.report.text import Item, note, paragraph, strong, table
 from pipeline.report.words import state_short_label
 
@@ -164,6 +171,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
     items.append(strong(verdict_sentence(answer, name, words)))
     items.append(paragraph(curve_reason(results, answer.model)))
+    items.append(paragraph(planar_words(results.cube, answer.block)))
+    items.append(paragraph(results.friction_words))
     largest = results.largest_recorded.get(answer.block)
     hazard = results.hazard
     if answer.return_periods:
@@ -174,21 +183,19 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(paragraph(f"Site hazard ({source}): {measure} {at}. The largest {measure} of the records, "
                                f"unscaled, is {largest:.2g} {unit}; above it every result comes from records scaled "
                                "up beyond what they recorded (extrapolation by scaling)."))
-        header = ["soil", "return period", f"{measure} [{unit}]"] + [f"P({short[s]})" for s in labels]
-        rows = []
-        for soil in answer.soils:
-            for index, (period, im) in enumerate(zip(answer.return_periods, answer.intensities)):
-                cells = [soil.soil if index == 0 else "", f"{period:,.0f} years", f"{im:.2g}"]
-                for state in soil.states:
-                    p, low, high = state.at_return_periods[index]
-                    if state.not_reached_below is not None and im <= state.not_reached_below:
-                        cells.append("not reached")
-                    elif np.isfinite(low) and np.isfinite(high) and high - low > 0.005:
-                        cells.append(f"{percent(p)} ({percent(low)}-{percent(high)})")
-                    else:
-                        cells.append(percent(p))
-                rows.append(cells)
-        items.append(table(header, rows))
+        for soil in answer.soils:  # one table per soil, the states down the side: as wide for 3 soils as for 1
+            header = [f"on {soil.soil}: P(damage state)"] + [_period_header(answer, soil, index, measure)
+                                                            for index in range(len(answer.return_periods))]
+            rows = [[short[state.state], *(_at_cell(state, index, answer)
+                                           for index in range(len(answer.return_periods)))]
+                    for state in soil.states]
+            items.append(table(header, rows))
+        items.append(note(f"P(damage state) at each return period's intensity, in brackets its band: the "
+                          f"{_confidence(fragility)} confidence bounds of the median, records resampled. Then how "
+                          "many records reached the state at the level run nearest at or below that intensity "
+                          "(in the column's head); 'fit only': no record reached it at or below that level, so the "
+                          f"value is the fitted curve's tail alone. 'not reached': no record reached the state up "
+                          f"to {largest:.2g} {unit}."))
         cube = getattr(results, "cube", None)
         scale = display_scale(cube.intensity.attrs.get("units", ""))[0] if cube is not None and "intensity" in cube \
             else 1.0
@@ -202,26 +209,24 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                    "state or worse', so a milder state is never less likely than a more severe "
                                    "one:"))
             items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], modes))
-        items.append(note(f"P(damage state) at each return period's intensity, in brackets its band: the "
-                          f"{_confidence(fragility)} confidence bounds of the median, records resampled. 'not "
-                          f"reached': no record reached the state up to {largest:.2g} {unit}."))
         limits = {s: s_limit for s, s_limit in results.decision["max_probability_in_life"].items() if s in labels}
         life = f"{answer.design_life:g} years"
-        header = ["soil"] + [f"{short[s]}" + (f" (limit {percent(limits[s])})" if s in limits else "")
-                             for s in labels] + ["verdict"]
+        header = ["damage state", f"limit in {life}", *(f"on {soil.soil}" for soil in answer.soils)]
         rows = []
-        for soil in answer.soils:
-            cells = [soil.soil]
-            for state in soil.states:
-                if state.not_reached_below is not None:
-                    cells.append(f"<{percent(state.probability_in_life)}, not reached below "
-                                 f"{state.not_reached_below:.2g} {unit}")
-                elif np.isfinite(state.probability_in_life):
-                    cells.append(f"{percent(state.probability_in_life)}, {_years(state.annual_frequency)}")
+        for index, state in enumerate(labels):
+            cells = [short[state], percent(limits[state]) if state in limits else "none"]
+            for soil in answer.soils:
+                row = soil.states[index]
+                if row.not_reached_below is not None:
+                    cells.append(f"<{percent(row.probability_in_life)}, not reached below "
+                                 f"{row.not_reached_below:.2g} {unit}")
+                elif np.isfinite(row.probability_in_life):
+                    cells.append(f"{percent(row.probability_in_life)}, {_years(row.annual_frequency)}"
+                                 + (" (fit's tail)" if row.tail_only else ""))
                 else:
-                    cells.append(_no_curve(fragility, answer, soil.soil, state.state, unit))
-            cells.append(soil.verdict)
+                    cells.append(_no_curve(fragility, answer, soil.soil, row.state, unit))
             rows.append(cells)
+        rows.append(["verdict", "", *(soil.verdict for soil in answer.soils)])
         items.append(paragraph(f"Probability of each damage state in the design life of {life} (and how often it "
                                "happens on average), per soil:"))
         items.append(table(header, rows))
@@ -233,11 +238,46 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                           f"soil's μ_s ({results.friction_text}) on a tied base (the runs with friction answer with "
                           "their slip damage states); else 'no action'. States "
                           "without a limit are reported, not judged. 'not reached below X': no record reached the "
-                          "state at any level up to X, so its probability is at most that of exceeding X."))
+                          "state at any level up to X, so its probability is at most that of exceeding X. 'fit's "
+                          "tail': above the limit only through intensities below every record that reached the "
+                          "state (the verdict says so)."))
     else:
         items.append(paragraph(f"The study has no hazard curve for {measure}: no return-period intensities and no "
                                "probability in the design life. The fragility curves are on the pages that follow."))
     return items
+
+
+def _period_header(answer: BlockAnswer, soil, index: int, measure: str) -> str:
+    """A return period's column head: its intensity, and the level run whose records the cells count."""
+    head = f"{answer.return_periods[index]:,.0f} years, {measure} {answer.intensities[index]:.2g} {answer.unit}"
+    levels = [state.records[index][2] for state in soil.states if state.records]
+    level = next((value for value in levels if np.isfinite(value)), np.nan)
+    if np.isfinite(level):
+        return f"{head} (records at {level:.2g}\u00a0{answer.unit})"
+    return f"{head} (no level run this low)" if levels else head
+
+
+def _at_cell(state, index: int, answer: BlockAnswer) -> str:
+    """P(state) at a return period's intensity with its band, and what the records did there.
+
+    "24% (9.3%-40%); 2 of 10 records", or where no record reached the state at or below the intensity
+    "2.2% (0.6%-6.1%); fit only, 0 of 10 records": the value is the fitted curve's tail alone.
+    """
+    p, low, high = state.at_return_periods[index]
+    im = answer.intensities[index]
+    if state.not_reached_below is not None and im <= state.not_reached_below:
+        return "not reached"
+    if not np.isfinite(p):
+        return "-"
+    text = percent(p)
+    if np.isfinite(low) and np.isfinite(high) and high - low > 0.005:
+        text += f" ({percent(low)}-{percent(high)})"
+    if not state.records:
+        return text
+    reached, total, _ = state.records[index]
+    if state.fit_only(index):
+        return text + (f"; fit only, {max(reached, 0)} of {total} records" if reached >= 0 else "; fit only")
+    return text + f"; {reached} of {total} records"
 
 
 def _confidence(fragility) -> str:

@@ -27,6 +27,7 @@ from pipeline.report.adapters import (
     models_of,
     panel_label,
     short_label,
+    soils_of,
     state_labels,
     state_title,
     uplift_intensity,
@@ -289,13 +290,6 @@ def _ida_rows(models, soils, per_soil=(), most_columns=5):
     return rows, columns
 
 
-def _differs_by_soil(dataset, model, block) -> bool:
-    """The runs of a rigid-base model differ between soils (base friction, which depends on the soil)."""
-    edp = dataset.edp.sel(model=model.name, block=block).transpose("soil", ...).values
-    first = edp[0]
-    return any(not np.array_equal(first, other, equal_nan=True) for other in edp[1:])
-
-
 def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
     """One row of panels per foundation model (a panel per soil), the rigid-base models in the first row.
 
@@ -304,7 +298,7 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     """
     models = models_of(ida)
     soils = list(map(str, ida.soil.values))
-    per_soil = [m.name for m in models if m.rigid_base and _differs_by_soil(ida, m, block)]
+    per_soil = [m.name for m in models if m.rigid_base and soils_of(ida, m, block, "edp") != [None]]
     rows, columns = _ida_rows(models, soils, per_soil)
     figure = new_page(f"IDA curves: {name or block}", caption)
     top, bottom = 0.86, GRID["bottom"]
@@ -448,8 +442,12 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
             reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                              style, f"{panel_label(model)} on {soil}", span))
         for reference in (m for m in models if m.rigid_base):
-            reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block), state,
-                                             styles[reference.name], short_label(reference), span))
+            own = soils_of(fragility, reference, block, "median")  # [None]: the same on every soil
+            for index, soil in enumerate(own):
+                style = dict(styles[reference.name], **({} if soil is None else {"color": soil_colour(soil, index)}))
+                label = short_label(reference) + ("" if soil is None else f" on {soil}")
+                reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block, soil),
+                                                 state, style, label, span))
         _no_curve_note(axis, reasons)
         axis.set_title(textwrap.fill(state_title(labels[state]), chars_across(axis, 9)), fontsize=9)
     _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
@@ -493,7 +491,7 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
     levels = block_levels(fragility, block)
     probability = fragility.outcome_probability
     for axis, model in zip(axes.flat, models):
-        soils = [None] if model.rigid_base else list(map(str, fragility.soil.values))
+        soils = soils_of(probability.to_dataset(name="p"), model, block, "p")
         for index, soil in enumerate(soils):
             picked = cell(probability.to_dataset(name="p"), model, block, soil)["p"]
             colour = "black" if soil is None else soil_colour(soil, index)

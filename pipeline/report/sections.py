@@ -45,11 +45,13 @@ from pipeline.report.adapters import (
     measure_label,
     model_info,
     models_of,
+    planar_words,
     record_pga_g,
     run_fraction,
     scale_factor_summary,
     short_label,
     sliding_share,
+    soils_of,
     state_labels,
     tension_flag,
     vertical_applied,
@@ -57,7 +59,7 @@ from pipeline.report.adapters import (
 from pipeline.report.layout import pretty
 from pipeline.report.text import Item, bullet, heading, note, paragraph, table
 from pipeline.report.vertical import VerticalEffect
-from pipeline.report.words import plain, state_short_label
+from pipeline.report.words import PAPER_CITATION, plain, state_short_label
 
 EXTRAPOLATION_ROWS = 30
 
@@ -74,7 +76,8 @@ class Results:
     showcase: xr.Dataset | None = None
     applicability: xr.Dataset | None = None
     efficiency: xr.Dataset | None = None
-    runtime_s: float = float("nan")  # wall time of the pipeline run [s]; NaN: not stated
+    runtime_s: float = float("nan")  # wall time of the pipeline run up to the report [s]; NaN: not stated
+    run: dict | None = None  # the study's statistics (pipeline.study.run_study): runs computed, cells reused
     vertical: VerticalEffect | None = None  # [study] vertical = true: the runs with and without the verticals
 
     @property
@@ -96,6 +99,22 @@ class Results:
     def friction_text(self) -> str:
         """Each soil's static friction coefficient, as the sliding check compares with: "clay 0.35, sand 0.45"."""
         return ", ".join(f"{soil.name} {soil.friction_static:g}" for soil in self.config.soils)
+
+    @property
+    def friction_words(self) -> str:
+        """Where the base friction comes from and how to set the block's own: the answer pages, methods, limitations."""
+        from pipeline.soils import SOILS
+
+        pairs = ", ".join(f"{soil.name} {soil.friction_static:g}/{soil.friction_kinetic:g}"
+                          for soil in self.config.soils)
+        shipped = [soil.name for soil in self.config.soils if SOILS.get(soil.name) == soil]
+        own = [soil.name for soil in self.config.soils if soil.name not in shipped]
+        sources = ([f"the soil class's default coefficient ({', '.join(shipped)}: a concrete base on that soil)"]
+                   if shipped else []) + ([f"the study file's own value ({', '.join(own)})"] if own else [])
+        return (f"Base friction: static/kinetic μ_s/μ_k {pairs}, {' and '.join(sources)}, not a value of this "
+                "block's own base: a plinth, a grout bed or a steel shim under the block changes it. To use yours, "
+                "give the soil a [soils_custom.NAME] table (its moduli with friction_static and friction_kinetic) "
+                "and list NAME in soils.")
 
     @cached_property
     def hazard(self) -> HazardCurve | None:
@@ -171,9 +190,57 @@ def _percent(value):
 
 
 def n_runs(cube) -> int:
-    """Solver runs of the study: rigid-base models once per block, the others once per soil."""
-    per_soil = cube.sizes["record"] * cube.sizes["im_level"] * cube.sizes["block"]
-    return int(sum(per_soil * (1 if m.rigid_base else cube.sizes["soil"]) for m in models_of(cube)))
+    """Solver runs on the intensity grid, counted as the study counts its cells ("N runs to do" in its log).
+
+    A model on a foundation runs once per soil; a rigid base once per block on the soils where its base is
+    tied, and once per friction pair where it slides (``friction_static``/``friction_kinetic`` of the cube).
+    A study with the vertical component runs every cell twice (with and without it).
+    """
+    cells = 0
+    for model in models_of(cube):
+        for block in cube.block.values:
+            if not model.rigid_base:
+                cells += cube.sizes["soil"]
+                continue
+            if "friction_static" not in cube:
+                cells += 1
+                continue
+            pairs = {(float(cube.friction_static.sel(soil=s, block=block, model=model.name)),
+                      float(cube.friction_kinetic.sel(soil=s, block=block, model=model.name))
+                      if "friction_kinetic" in cube else 0.0) for s in cube.soil.values}
+            tied = any(not np.isfinite(pair[0]) for pair in pairs)
+            cells += int(tied) + sum(1 for pair in pairs if np.isfinite(pair[0]))
+    twice = 2 if vertical_applied(cube) else 1
+    return int(cells * cube.sizes["record"] * cube.sizes["im_level"] * twice)
+
+
+def capacity_runs(cube) -> int | None:
+    """Solver runs added to the grid to refine the overturning capacities (the study's log line), or None."""
+    value = cube.attrs.get("capacity_runs")
+    return None if value is None else int(value)
+
+
+def runs_words(results) -> str:
+    """The run's size as its log states it: grid runs, refining runs, and what checkpoints of an earlier run gave.
+
+    One fact for the title page and the provenance: the grid runs are the log's "N runs to do" on a fresh run
+    and the refining runs its "capacities to 2%: M refining runs"; ``Results.run`` (the study's statistics,
+    given when the report is drawn by the run itself) says how many were computed in this run.
+    """
+    cube = results.cube
+    text = f"{n_runs(cube):,} simulations on the intensity grid"
+    refining = capacity_runs(cube)
+    if refining:
+        text += f" and {refining:,} more refining the overturning capacities"
+    run = results.run or {}
+    if "cells" in run and "cells_reused" in run and "runs_computed" in run:
+        if int(run["cells_reused"]):
+            text += (f"; this run computed {int(run['runs_computed']):,} grid runs and took {int(run['cells_reused'])}"
+                     f" of its {int(run['cells'])} cells (record × block × soil × model) from the checkpoints of an "
+                     "earlier run")
+        else:
+            text += "; all computed in this run (none taken from checkpoints)"
+    return text
 
 
 STIFF_BASE = 1e10
@@ -217,7 +284,7 @@ def title_items(results: Results) -> list[Item]:
         paragraph(f"{cube.sizes['record']} record components, {cube.sizes['im_level']} intensity levels, "
                   f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
-                  f"{n_runs(cube)} simulations."),
+                  f"{runs_words(results)}."),
         paragraph("The next pages answer the question for each block: at the site's return periods, how likely it "
                   "is to rock or overturn, how likely in its design life, and what to do. Then the fragility of "
                   "each block on each soil for each model, the methods and assumptions behind the numbers, and "
@@ -228,10 +295,21 @@ def title_items(results: Results) -> list[Item]:
 
 
 def run_time_words(runtime_s: float) -> str:
-    """The pipeline run's wall time in words; "not recorded" when unknown or under a second (read back, not run)."""
+    """The pipeline run's wall time up to the report in words (the log's "results in N s").
+
+    "not recorded" when unknown or under a second (read back, not run).
+    """
     if not np.isfinite(runtime_s) or runtime_s < 1.0:
         return "not recorded (this report was drawn from result files written earlier)"
     return f"{runtime_s / 60:.0f} min" if runtime_s >= 120 else f"{runtime_s:.0f} s"
+
+
+def run_time_line(runtime_s: float) -> str:
+    """The run time as the title page and the provenance state it: what it covers, as the log says it."""
+    words = run_time_words(runtime_s)
+    if words.startswith("not recorded"):
+        return words
+    return f"{words} up to this report (simulations, fits and result files; drawing the report not included)"
 
 
 def provenance_items(results: Results) -> list[Item]:
@@ -241,8 +319,8 @@ def provenance_items(results: Results) -> list[Item]:
             ["configuration fingerprint", str(cube.attrs.get("config_hash", "not recorded"))],
             ["software", f"rockfrag {cube.attrs.get('rockfrag_version', __version__)}"],
             ["random seed of the bootstrap", str(fragility.attrs.get("bootstrap_seed", "not recorded"))],
-            ["simulations", f"{n_runs(cube)}"],
-            ["run time", run_time_words(results.runtime_s)],
+            ["simulations", runs_words(results)],
+            ["run time", run_time_line(results.runtime_s)],
             ["result files read", ", ".join(_result_files(results))]]
     return [paragraph("What this report was computed from, to reproduce it. The configuration fingerprint changes "
                       "with any setting of the study; the same fingerprint, software version and records give the "
@@ -273,7 +351,7 @@ def summary_items(results: Results) -> list[Item]:
     for block in fragility.block.values:
         largest = results.largest_recorded.get(str(block), np.inf)
         for model in _ordered_models(results):
-            once = model.rigid_base and not _differs_by_soil(fragility["median"].sel(model=model.name, block=block))
+            once = soils_of(fragility, model, block, "median") == [None]
             soils = ["(any)"] if once else list(fragility.soil.values)
             for soil in soils:
                 picked = cell(fragility, model, block, None if once else soil)
@@ -309,12 +387,6 @@ def summary_items(results: Results) -> list[Item]:
     if has_risk:
         items.append(note(f"Hazard: {fragility.attrs.get('hazard_source', 'see Methods')}."))
     return items
-
-
-def _differs_by_soil(values: xr.DataArray) -> bool:
-    """A rigid base's results differ between soils (base friction lets it slide on some): one row per soil."""
-    rows = values.transpose("soil", ...).values
-    return any(not np.array_equal(rows[0], other, equal_nan=True) for other in rows[1:])
 
 
 def _beta(value: float) -> str:
@@ -371,7 +443,8 @@ def _vertical_records(cube) -> str:
 def methods_items(results: Results) -> list[Item]:
     """The methods pages: models, soils and blocks, records and processing, scaling, fits, hazard and risk."""
     config, cube, fragility = results.config, results.cube, results.fragility
-    items = [heading("Models and their assumptions")]
+    items = [heading("Models and their assumptions"),
+             paragraph(f"'The paper' on these pages is the seed paper of this project: {PAPER_CITATION}")]
     bed = (config.raw.get("solver", {}) or {}).get("bed", "continuous")
     for model in models_of(cube):
         if model.rigid_base:
@@ -503,6 +576,7 @@ def sources_items(results: Results) -> list[Item]:
                             "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
                             "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
                             "360-16, J3.8). Kinetic friction 0.8 × static: " + STUDY_CHOICE + "."))
+    items.append(bullet(results.friction_words))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
     band = tuple(float(v) for v in config.restitution_band)
@@ -571,8 +645,11 @@ def limitations_items(results: Results) -> list[Item]:
     elif not found:
         items.append(paragraph("No foundation model of this study can pull on the block: tension does not arise."))
 
+    items.append(heading("Planar model"))
+    items += [paragraph(f"{block_name(config, block)}: {planar_words(cube, block)}") for block in cube.block.values]
     coefficient = f"the soil's μ_s ({results.friction_text})"
     items.append(heading("Sliding"))
+    items.append(paragraph(results.friction_words))
     flag = friction_flag(cube)
     found = False
     for model in models:
@@ -597,9 +674,12 @@ def limitations_items(results: Results) -> list[Item]:
 
     items.append(heading("Extrapolated fragility medians"))
     status = extrapolation(fragility, results.output)
-    rigid = {m.name for m in models_of(fragility) if m.rigid_base}
+    # a rigid base once per block (on the first soil, soil "(any)"), unless friction makes its soils differ
+    rigid = {(m.name, str(b)) for m in models_of(fragility) if m.rigid_base for b in fragility.block.values
+             if soils_of(fragility, m, b, "median") == [None]}
     first_soil = str(fragility.soil.values[0])
-    status = status[~status.model.isin(rigid) | (status.soil == first_soil)]  # a rigid base once per block
+    once = [(m, str(b)) in rigid for m, b in zip(status.model, status.block)]
+    status = status[~np.asarray(once, bool) | (status.soil == first_soil).values]
     outside = status[~status.status.isin(["within", "no fit"])]
     order = {name: {str(v): i for i, v in enumerate(fragility[name].values)} for name in ("block", "model", "soil")}
     outside = outside.sort_values(["block", "model", "soil"], key=lambda column: column.map(order[column.name]))
@@ -615,7 +695,8 @@ def limitations_items(results: Results) -> list[Item]:
         for row in outside.head(EXTRAPOLATION_ROWS).itertuples():
             levels = block_levels(fragility, row.block) * scale
             rows.append([block_name(config, row.block), model_info(row.model).label,
-                         "(any)" if row.model in rigid else row.soil, labels.get(row.damage_state, row.damage_state),
+                         "(any)" if (row.model, str(row.block)) in rigid else row.soil,
+                         labels.get(row.damage_state, row.damage_state),
                          _g(row.median * scale), f"{levels.min():.2g} to {levels.max():.2g}", plain(row.status)])
         items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
                             "what it is"], rows))
@@ -640,7 +721,8 @@ def limitations_items(results: Results) -> list[Item]:
             why = str(fitted_status.sel(soil=row.soil, block=row.block, model=row.model,
                                         damage_state=row.damage_state).values) if fitted_status is not None else ""
             rows.append([block_name(config, row.block), short_label(model_info(row.model)),
-                         "(any)" if row.model in rigid else row.soil, short_states.get(row.damage_state, ""),
+                         "(any)" if (row.model, str(row.block)) in rigid else row.soil,
+                         short_states.get(row.damage_state, ""),
                          _counts(fragility, row.model, row.block, row.soil, row.damage_state, n_records),
                          NO_MEDIAN.get(why, plain(why) if why else "no fit")])
         items.append(table(["block", "model", "soil", "damage state", "records reaching it: lowest, highest level",

@@ -28,7 +28,15 @@ from pipeline.cube import COMPARISON_CUBE, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, 
 from pipeline.damage_states import DamageState
 from pipeline.fragility import exceedance, first_overturn_outcomes, fragility_dataset, lognormal_cdf
 from pipeline.ida import ida_dataset
-from pipeline.report.adapters import block_levels, cell, measure_label, model_styles, models_of, panel_label
+from pipeline.report.adapters import (
+    block_levels,
+    cell,
+    measure_label,
+    model_styles,
+    models_of,
+    panel_label,
+    soils_of,
+)
 from pipeline.report.figures import axis_range, mark_intensities
 from pipeline.report.layout import OUTCOME_COLOURS, log_axis, log_y_axis, new_page, outside_legend, panels
 from pipeline.report.text import Item, heading, note, paragraph, table
@@ -213,8 +221,9 @@ def vertical_items(effect: VerticalEffect) -> list[Item]:
     rows = []
     for block in map(str, cube.block.values):
         for model in models_of(cube):
-            for soil in ["(any)"] if model.rigid_base else list(map(str, cube.soil.values)):
-                picked = {applied: cell(fits[applied], model, block, None if model.rigid_base else soil)
+            own = soils_of(fits[True], model, block, "median")  # [None]: a rigid base the same on every soil
+            for soil in ["(any)" if s is None else s for s in own]:
+                picked = {applied: cell(fits[applied], model, block, None if soil == "(any)" else soil)
                           for applied in (True, False)}
                 row = [block, model.name, soil]
                 for state in shown_states:
@@ -222,7 +231,7 @@ def vertical_items(effect: VerticalEffect) -> list[Item]:
                 row.append(_pair(*(float(picked[a]["capacity_median"].sel(damage_state=shown_states[-1]))
                                    for a in (True, False))))
                 share = float(cell(flew.mean("im_level").to_dataset(name="f"), model, block,
-                                   None if model.rigid_base else soil)["f"])
+                                   None if soil == "(any)" else soil)["f"])
                 row.append(f"{share:.0%}" if np.isfinite(share) else "-")
                 rows.append(row)
     n_with = int(cube.vertical_applied.sum()) if "vertical_applied" in cube else cube.sizes["record"]

@@ -55,10 +55,16 @@ CODE_IDENTIFIERS = ("exact-g-tan-alpha", "mle-binomial", "pga_ratio", "pgv_ratio
                     "capacity_median", "rocking-0.2", "rocking-0.5", "peak_friction_demand", "theta_max")
 """Strings no page of the report may show (tests also look for any snake_case word outside file names)."""
 
+PAPER_TITLE = "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations"
+PAPER_CITATION = (f"{PAPER_TITLE}. Article; preprint at Preprints.org, 2026, doi:10.20944/preprints202603.1401.v1. "
+                  "The copy the project holds (shared/seed/rocking-ssi-paper.txt) names no authors, journal, volume "
+                  "or pages, so none are given here; the DOI is that of the preprint of the same title and abstract.")
+"""The seed paper as far as its copy and the preprint's DOI state it: cited in full wherever the report names it."""
+
 REFERENCES = {
-    "paper": "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations (the SSI-rocking "
-             "model this project implements: a rigid block on one vertical spring-dashpot, derived from the "
-             "Lagrangian; interface stiffness k of its eq. 19).",
+    "paper": PAPER_CITATION + " The SSI-rocking model this project implements (a rigid block on one vertical "
+             "spring-dashpot, derived from the Lagrangian; interface stiffness k of its eq. 19), its soils (Table "
+             "1) and its record (Duzce, Bolu).",
     "Housner 1963": "Housner, G. W. (1963). The behavior of inverted pendulum structures during earthquakes. "
                     "Bulletin of the Seismological Society of America 53(2), 403-417.",
     "ElGawady et al. 2011": "ElGawady, M. A., Ma, Q., Butterworth, J. W., Ingham, J. (2011). Effects of interface "
