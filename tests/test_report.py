@@ -345,3 +345,69 @@ def test_efficiency_page_is_drawn_on_the_page_size_from_efficiency_nc():
     labels = [t.get_text() for legend in figure.legends for t in legend.get_texts()]
     assert "cabinet A" in labels and "b" in labels
     plt.close(figure)
+
+
+def _housner_slides_on_rock(fragility):
+    """The fragility with Housner's rock cells changed, as base friction that lets it slide on rock would."""
+    changed = fragility.copy(deep=True)
+    where = dict(model="housner", soil="rock")
+    changed["median"].loc[where] = changed["median"].loc[where] * 1.5
+    changed["outcome_probability"].loc[where] = changed["outcome_probability"].loc[where] * 0.5
+    return changed
+
+
+def test_a_rigid_base_that_slides_on_some_soils_is_drawn_from_each_soils_own_cell(small_pipeline):
+    """The fragility-by-soil reference and the outcomes page took Housner from the first soil's cell."""
+    from pipeline.lognormal_fit import lognormal_cdf
+    from pipeline.report import figures
+    from pipeline.report.adapters import model_info
+
+    output, study, _ = small_pipeline
+    fragility = _datasets(output)["fragility"]
+    block = "paper"
+    for dataset, per_soil in ((fragility, False), (_housner_slides_on_rock(fragility), True)):
+        figure = figures.fragility_by_soil_page(dataset, block, model_info("ssi"), "caption")
+        try:
+            state = next(s for s in map(str, dataset.damage_state.values)
+                         if np.isfinite(dataset["median"].sel(model="housner", block=block, damage_state=s)).all())
+            axis = figure.axes[list(map(str, dataset.damage_state.values)).index(state)]
+            housner = {line.get_label(): line for line in axis.get_lines() if line.get_label().startswith("Housner")}
+            if not per_soil:
+                assert [label for label in housner if " on " in label] == []
+                continue
+            assert sorted(housner) == sorted(f"{model_info('housner').label} on {s}" for s in ("sand", "rock"))
+            for soil, line in ((s, housner[f"{model_info('housner').label} on {s}"]) for s in ("sand", "rock")):
+                row = dataset.sel(model="housner", block=block, soil=soil, damage_state=state)
+                expected = lognormal_cdf(line.get_xdata(), float(row["median"]), float(row["beta"]))
+                np.testing.assert_allclose(line.get_ydata(), expected)
+        finally:
+            plt.close(figure)
+        figure = figures.outcomes_page(dataset, block, "caption")
+        try:
+            axis = next(a for a in figure.axes if a.get_title().startswith("Housner"))
+            labels = [line.get_label() for line in axis.get_lines()
+                      if not line.get_label().startswith(("_", "P("))]  # not the key's entries
+            assert labels == (["sand", "rock"] if per_soil else ["any soil (rigid base)"])
+        finally:
+            plt.close(figure)
+
+
+def test_the_run_count_is_the_studys_cells_a_sliding_rigid_base_once_per_friction_pair():
+    """The title page counted a rigid base once per block, where the study runs it per friction pair."""
+    from pipeline.report.sections import Results, n_runs, runs_words
+
+    dims = ("soil", "block", "model")
+    friction = np.full((2, 3, 2), np.nan)  # soils sand, rock; blocks a (tied), b (slides on sand), c (both)
+    friction[0, 1, 0] = 0.45
+    friction[:, 2, 0] = [0.45, 0.7]
+    cube = xr.Dataset({"friction_static": (dims, friction), "friction_kinetic": (dims, friction * 0.8)},
+                      coords={"soil": ["sand", "rock"], "block": ["a", "b", "c"], "model": ["housner", "ssi"],
+                              "record": range(4), "im_level": range(5)}, attrs={"capacity_runs": 17})
+    cells = (1 + 2 + 2) + 3 * 2  # housner: tied once; tied + sand; sand + rock. ssi: per soil
+    assert n_runs(cube) == cells * 4 * 5
+    results = Results(None, cube, None, None, None, run={"runs_computed": 20, "cells_reused": 9, "cells": 11})
+    words = runs_words(results)
+    assert words.startswith(f"{cells * 20} simulations on the intensity grid and 17 more refining")
+    assert "this run computed 20 grid runs and took 9 of its 11 cells" in words
+    assert "none taken from checkpoints" in runs_words(Results(None, cube, None, None, None, run={
+        "runs_computed": 220, "cells_reused": 0, "cells": 11}))
