@@ -25,8 +25,9 @@ def _visible_text(html: str) -> str:
 
 
 def _snake_case(text: str) -> list[str]:
-    """snake_case words that are not file names (cube.nc, fragility.csv, ...)."""
-    return [w for w in re.findall(r"\b[a-z]{2,}_[a-z0-9_]+\b(?!\.(?:nc|csv|png|pdf|html|toml))", text)]
+    """snake_case words that are not file names (cube.nc, fragility.csv, ...) nor study-file settings written as
+    the TOML a user types ("[soils_custom.NAME]", "friction_static = μ_s": how to set the block's friction)."""
+    return [w for w in re.findall(r"(?<!\[)\b[a-z]{2,}_[a-z0-9_]+\b(?!\.(?:nc|csv|png|pdf|html|toml))(?! = )", text)]
 
 
 def _figure_text(figure) -> str:

@@ -113,8 +113,8 @@ class Results:
                    if shipped else []) + ([f"the study file's own value ({', '.join(own)})"] if own else [])
         return (f"Base friction: static/kinetic μ_s/μ_k {pairs}, {' and '.join(sources)}, not a value of this "
                 "block's own base: a plinth, a grout bed or a steel shim under the block changes it. To use yours, "
-                "give the soil a [soils_custom.NAME] table (its moduli with friction_static and friction_kinetic) "
-                "and list NAME in soils.")
+                "give the soil a table of its own in the study file, [soils_custom.NAME] with its moduli and "
+                "friction_static = μ_s, friction_kinetic = μ_k, and list NAME in soils = [...].")
 
     @cached_property
     def hazard(self) -> HazardCurve | None:
