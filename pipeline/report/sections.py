@@ -27,6 +27,7 @@ from pipeline.answer import (
     display_scale,
     intensity_at_frequency,
     percent,
+    records_reaching,
 )
 from pipeline.config import StudyConfig
 from pipeline.damage_states import NOT_APPLICABLE
@@ -604,7 +605,8 @@ def _counts(fragility, model, block, soil, state, n_records) -> str:
     shown = []
     for index in (0, -1):
         if np.isfinite(fraction[index]):
-            shown.append(f"{round(fraction[index] * n_records)} of {n_records} at {levels[index] * scale:.2g} {unit}")
+            shown.append(f"{records_reaching(fraction[index], n_records)} of {n_records} at "
+                         f"{levels[index] * scale:.2g} {unit}")
     return ", ".join(shown) or "-"
 
 
