@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.damage_states import SLIP_EDPS
+from pipeline.damage_states import families_of
 from pipeline.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
 from pipeline.lognormal_fit import lognormal_cdf
 from pipeline.models.variants import RECOMMENDED
@@ -388,11 +388,9 @@ def _at(row: xr.Dataset, im: float, scale: float, levels: np.ndarray, empirical:
 
 def nested_families(fragility: xr.Dataset) -> list[list[int]]:
     """Indices of the damage states by family (rocking, slip), each in the dataset's order of severity."""
-    edps = [str(e) for e in fragility["damage_state_edp"].values] if "damage_state_edp" in fragility.coords \
-        else [""] * fragility.damage_state.size
-    families = [[i for i, e in enumerate(edps) if e not in SLIP_EDPS],
-                [i for i, e in enumerate(edps) if e in SLIP_EDPS]]
-    return [family for family in families if family]
+    edps = fragility["damage_state_edp"].values if "damage_state_edp" in fragility.coords \
+        else ["uplifted"] * fragility.damage_state.size
+    return list(families_of(edps).values())
 
 
 def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnswer]:

@@ -73,9 +73,37 @@ def is_slip_state(state: DamageState) -> bool:
     return state.edp in SLIP_EDPS
 
 
+def edp_family(edp: str) -> str:
+    """The family of a state with this EDP, "slip" or "rocking".
+
+    States of one family nest (more severe: reached later); the two families do not. The one rule every reader of
+    families uses (the fits, the answer pages, the exchange files).
+    """
+    return "slip" if edp in SLIP_EDPS else "rocking"
+
+
 def state_family(state: DamageState) -> str:
-    """"slip" or "rocking": states of one family nest (more severe: reached later); the two families do not."""
-    return "slip" if is_slip_state(state) else "rocking"
+    """``edp_family`` of a state."""
+    return edp_family(state.edp)
+
+
+def families_of(edps) -> dict[str, list[int]]:
+    """Indices of the states of each family, in the given order (of severity): {"rocking": [...], "slip": [...]}.
+
+    Parameters
+    ----------
+    edps : sequence of str
+        Each state's EDP (a cube's ``damage_state_edp``), in order of severity.
+
+    Returns
+    -------
+    dict of str to list of int
+        The families that have states, rocking first.
+    """
+    families: dict[str, list[int]] = {"rocking": [], "slip": []}
+    for index, edp in enumerate(edps):
+        families[edp_family(str(edp))].append(index)
+    return {family: members for family, members in families.items() if members}
 
 
 def damage_states_from_config(raw: dict) -> list[DamageState]:

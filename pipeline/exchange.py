@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pipeline.damage_states import NOT_APPLICABLE, SLIP_EDPS
+from pipeline.damage_states import NOT_APPLICABLE, families_of
 from pipeline.errors import ConfigError
 from pipeline.measures import MEASURES, Measure, convert_units, unit_label
 from pipeline.models.variants import RECOMMENDED
@@ -182,14 +182,12 @@ def state_families(dataset: xr.Dataset) -> dict[str, list[str]]:
 
     A component's limit states must nest (each more severe one reached later), which the rocking and the slip
     states do not; so each family is a component (pelicun) or a file (OpenQuake) of its own. The family of a
-    state is that of its EDP (``damage_state_edp``; pipeline.damage_states.SLIP_EDPS).
+    state is that of its EDP (``damage_state_edp``; pipeline.damage_states.families_of).
     """
     states = [str(s) for s in dataset.damage_state.values]
-    edps = [str(e) for e in dataset["damage_state_edp"].values] if "damage_state_edp" in dataset.coords \
-        else [""] * len(states)
-    families = {"": [s for s, e in zip(states, edps) if e not in SLIP_EDPS],
-                SLIP_SUFFIX: [s for s, e in zip(states, edps) if e in SLIP_EDPS]}
-    return {suffix: members for suffix, members in families.items() if members}
+    edps = dataset["damage_state_edp"].values if "damage_state_edp" in dataset.coords else ["uplifted"] * len(states)
+    suffix = {"rocking": "", "slip": SLIP_SUFFIX}
+    return {suffix[family]: [states[i] for i in members] for family, members in families_of(edps).items()}
 
 
 def _applies(cell: xr.Dataset, states: list[str]) -> bool:

@@ -15,7 +15,7 @@ from scipy.special import log_ndtr
 from scipy.stats import norm
 
 from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.damage_states import DAMAGE_STATES, damage_states_from_config
+from pipeline.damage_states import DAMAGE_STATES, damage_states_from_config, families_of, state_family
 from pipeline.fragility import (
     STATUS,
     curves_cross,
@@ -434,3 +434,11 @@ def test_censored_capacity_fit_matches_an_independent_scipy_refit():
     assert row.capacity_median.item() == pytest.approx(median, rel=1e-6)
     assert row.capacity_beta.item() == pytest.approx(beta, rel=1e-6)
     assert row.capacity_median.item() > np.exp(np.nanmean(np.log(capacities)))  # censoring raises the median
+
+
+def test_families_nest_by_edp_in_one_rule():
+    """Slip states are one family, every other EDP (uplift, angles, overturning) the rocking one, in given order."""
+    edps = ["uplifted", "peak_slip", "peak_slip", "peak_angle_ratio", "overturned"]
+    assert families_of(edps) == {"rocking": [0, 3, 4], "slip": [1, 2]}
+    assert families_of(["uplifted", "overturned"]) == {"rocking": [0, 1]}
+    assert {state_family(s) for s in DAMAGE_STATES.values() if s.edp == "peak_slip"} == {"slip"}
