@@ -59,6 +59,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.opensees_winkler import gravity_then_excitation, rigid_block_frame  # noqa: E402
 from pipeline.blocks import Block  # noqa: E402
 from pipeline.models import simulate  # noqa: E402
 from pipeline.processing import load_recipe, process_record  # noqa: E402
@@ -179,12 +180,7 @@ def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_
         ops.fix(4, 1, 0, 0)
     ops.fix(5, 1, 1, 1)
     ops.fix(6, 1, 1, 1)
-    ops.mass(1, m, m, m * (b * b + h * h) / 3)
-    ops.geomTransf("Corotational", 1)
-    longest = 2 * math.hypot(b, h)
-    modulus = 1e4 * K * max(longest, longest**3)  # beams 1e4 times stiffer than the bed: a rigid block
-    for tag, (i, j) in enumerate(((1, 2), (1, 3), (2, 4), (4, 3), (1, 4)), start=1):
-        ops.element("elasticBeamColumn", tag, i, j, 1.0, modulus, 1.0, 1)
+    rigid_block_frame(ops, b, h, m, K)
     ops.uniaxialMaterial("Elastic", 1, K / 2, C / 2)  # axial: the bearing itself carries no tension
     ops.uniaxialMaterial("Elastic", 2, 0.0)  # no moment across the bearing
     ops.frictionModel("Coulomb", 1, mu)
@@ -194,30 +190,7 @@ def opensees_sliding(ag, dt, block, K, xi, mu, t_end, step=OPENSEES_STEP, stick_
         ops.element("flatSliderBearing", tag, ground, corner, 1, k0, "-P", 1, "-Mz", 2,
                     "-orient", 0.0, 1.0, 0.0, -1.0, 0.0, 0.0)
 
-    ops.timeSeries("Linear", 1)
-    ops.pattern("Plain", 1, 1)
-    ops.load(1, 0.0, -m * G, 0.0)
-    ops.constraints("Plain")
-    ops.numberer("RCM")
-    ops.system("BandGeneral")
-    ops.test("NormDispIncr", 1e-12, 50)
-    ops.algorithm("Newton")
-    ops.integrator("LoadControl", 0.1)
-    ops.analysis("Static")
-    if ops.analyze(10) != 0:
-        raise RuntimeError("OpenSees gravity analysis failed")
-    ops.loadConst("-time", 0.0)
-
-    ops.timeSeries("Path", 2, "-dt", dt, "-values", *np.append(ag, 0.0).tolist())
-    ops.pattern("UniformExcitation", 2, 1, "-accel", 2)
-    ops.wipeAnalysis()
-    ops.constraints("Plain")
-    ops.numberer("RCM")
-    ops.system("BandGeneral")
-    ops.test("NormDispIncr", 1e-10, 50)
-    ops.algorithm("Newton")
-    ops.integrator("Newmark", 0.5, 0.25)
-    ops.analysis("Transient")
+    gravity_then_excitation(ops, m, ag, dt)
     peak_slip = peak_angle = slip = 0.0
     flew = False
     retries = 0
