@@ -29,6 +29,7 @@ from pipeline.measures import MEASURES, file_units, parse_units
 from pipeline.models import get_model, model_label
 from pipeline.models.base import Outcome
 from pipeline.models.fields import FIELDS_BY_NAME, MODE_TIME_FIELDS
+from pipeline.models.ssi import PAPER_CITATION
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
 OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = (
@@ -247,8 +248,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "record_checksums": json.dumps({r.id: r.metadata.get("sha256", "") for r in records}),
         "processing": json.dumps(provenance.get("processing", {})),
         "processing_steps": json.dumps(provenance.get("processing_steps", {})),
-        "references": "Housner (1963); SSI-rocking model from the Lagrangian of the paper "
-                      "'A Simplified Mechanical Model for Rocking Structures on Compliant Foundations'; "
+        "references": f"Housner (1963); SSI-rocking model from the Lagrangian of the paper: {PAPER_CITATION}; "
                       "tensionless Winkler bed (Psycharis & Jennings 1983; Chopra & Yim 1985)",
         "winkler_bed": config.bed,
         "restitution": str(config.restitution),

@@ -48,6 +48,14 @@ from pipeline.models.base import RockingModel
 from pipeline.models.fields import SSI
 from pipeline.models.jit import njit
 
+PAPER_TITLE = "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations"
+PAPER_CITATION = (f"{PAPER_TITLE}. Article; preprint at Preprints.org, 2026, doi:10.20944/preprints202603.1401.v1. "
+                  "The copy the project holds (shared/seed/rocking-ssi-paper.txt) names no authors, journal, volume "
+                  "or pages, so none are given here; the DOI is that of the preprint of the same title and abstract.")
+"""The seed paper as far as its copy and the preprint's DOI state it: cited in full wherever a page or a file
+names it (the report, cube.nc's ``references``)."""
+
+
 
 @njit(cache=True)
 def ssi_rest_rhs(x, gravity, params, out):

@@ -10,6 +10,7 @@ Output: plain words for each (``FIT_METHODS``, ``STATUS_WORDS``, ``SWITCH_WORDS`
 
 from __future__ import annotations
 
+from pipeline.models.ssi import PAPER_CITATION, PAPER_TITLE  # noqa: F401 (the report's names for them)
 from pipeline.report.text import Item, bullet, heading, paragraph
 
 FIT_METHODS = {
@@ -55,11 +56,6 @@ CODE_IDENTIFIERS = ("exact-g-tan-alpha", "mle-binomial", "pga_ratio", "pgv_ratio
                     "capacity_median", "rocking-0.2", "rocking-0.5", "peak_friction_demand", "theta_max")
 """Strings no page of the report may show (tests also look for any snake_case word outside file names)."""
 
-PAPER_TITLE = "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations"
-PAPER_CITATION = (f"{PAPER_TITLE}. Article; preprint at Preprints.org, 2026, doi:10.20944/preprints202603.1401.v1. "
-                  "The copy the project holds (shared/seed/rocking-ssi-paper.txt) names no authors, journal, volume "
-                  "or pages, so none are given here; the DOI is that of the preprint of the same title and abstract.")
-"""The seed paper as far as its copy and the preprint's DOI state it: cited in full wherever the report names it."""
 
 REFERENCES = {
     "paper": PAPER_CITATION + " The SSI-rocking model this project implements (a rigid block on one vertical "
