@@ -33,7 +33,7 @@ from pipeline.outputs import write_dataset
 from pipeline.processing import integrate, process_record
 from pipeline.records import load_records
 from pipeline.soils import soil_block_stiffness
-from pipeline.study import StudyRecords, study_records
+from pipeline.study import StudyRecords, cell_friction, study_records
 
 PAPER_RECORD = "DUZCE/BOL090"
 SPECTRUM_PERIODS = np.geomspace(0.02, 10.0, 60)
@@ -114,13 +114,19 @@ def ground_motion_variables(raw, processed) -> dict:
 
 
 def response_cases(config, block):
-    """(model name, soil or None) for every case of the showcase: rigid-base models once."""
+    """(model name, soil or None, friction) for every case of the showcase, as the study runs its cells.
+
+    A rigid-base model runs once (soil None) while its base is tied on every soil; where base friction lets it
+    slide on some soil (``study.cell_friction``) it runs once per soil, as the study does. friction is the
+    base's (mu_s, mu_k) [-] or None (tied).
+    """
     cases = []
     for name in config.models:
-        if is_rigid_base(get_model(name)):
-            cases.append((name, None))
+        slides = [cell_friction(block, soil, name, config.friction) for soil in config.soils]
+        if is_rigid_base(get_model(name)) and not any(slides):
+            cases.append((name, None, None))
         else:
-            cases.extend((name, soil) for soil in config.soils)
+            cases.extend((name, soil, friction) for soil, friction in zip(config.soils, slides))
     return cases
 
 
@@ -129,11 +135,12 @@ def simulate_cases(config, block, record):
     t_end = record.duration + config.tail
     thetas, settlements, support = [], [], []
     time = None
-    for name, soil in response_cases(config, block):
-        options = {}
-        if soil is not None:
-            options = dict(k=soil_block_stiffness(soil, block), xi=soil.damping_ratio)
-        if soil is not None and config.calibrates_bed and get_model(name).uses_bed:  # as the study runs it
+    for name, soil, friction in response_cases(config, block):
+        rigid = is_rigid_base(get_model(name))
+        options = {"friction": friction}
+        if not rigid:
+            options.update(k=soil_block_stiffness(soil, block), xi=soil.damping_ratio)
+        if not rigid and config.calibrates_bed and get_model(name).uses_bed:  # as the study runs it
             calibration = calibrate_models([block], [soil.name], np.array([[options["k"]]]), [name],
                                            config.restitution, config.restitution_band, config.bed)
             options.update(xi=float(calibration.xi[0, 0, 0]), bed=calibration.law)
@@ -145,7 +152,7 @@ def simulate_cases(config, block, record):
                               t_end=t_end, overturn_angle=config.overturn_angle, **options)
         time = result.t if time is None or result.t.size > time.size else time
         thetas.append(result.theta)
-        if soil is None:
+        if rigid:
             settlements.append(np.full(result.t.size, np.nan))
             support.append(np.nan)
         else:
@@ -187,16 +194,19 @@ def showcase_dataset(config, records, recipe, load=None) -> xr.Dataset:
                 "units": "m"}),
             "min_support_force": ("case", support, {"long_name": "minimum vertical foundation force "
                                                                "(negative: the foundation pulled)", "units": "N"}),
-            "interface_stiffness": ("case", [np.nan if soil is None else soil_block_stiffness(soil, block)
-                                             for _, soil in cases],
+            "interface_stiffness": ("case", [np.nan if is_rigid_base(get_model(name))
+                                             else soil_block_stiffness(soil, block) for name, soil, _ in cases],
                                     {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"}),
         })
         coords.update({
             "time_ground": ("time_ground", ground_time, {"long_name": "time", "units": "s"}),
             "time": ("time", time, {"long_name": "time", "units": "s"}),
-            "case_model": ("case", [name for name, _ in cases], {"long_name": "rocking model"}),
-            "case_soil": ("case", ["" if soil is None else soil.name for _, soil in cases],
-                          {"long_name": "soil class (empty: rigid base)"}),
+            "case_model": ("case", [name for name, _, _ in cases], {"long_name": "rocking model"}),
+            "case_soil": ("case", ["" if soil is None else soil.name for _, soil, _ in cases],
+                          {"long_name": "soil class (empty: a rigid base tied on every soil)"}),
+            "case_friction_static": ("case", [np.nan if friction is None else friction[0] for _, _, friction in cases],
+                                     {"long_name": "static friction coefficient of the base (NaN: tied base)",
+                                      "units": "1"}),
         })
         attrs.update({
             "showcase_record": raw.id, "showcase_event": str(raw.metadata.get("event", "")),
@@ -216,7 +226,8 @@ def input_hash(config, records, recipe) -> str:
                "records": [r.metadata.get("sha256", r.id) for r in records],
                "soils": [repr(s) for s in config.soils], "blocks": [repr(b) for b in config.blocks],
                "showcase": [settings.get("showcase_record", ""), settings.get("showcase_block", "")],
-               "solver": [config.switch, config.tail, config.overturn_angle]}
+               "solver": [config.switch, config.tail, config.overturn_angle, config.bed, str(config.restitution),
+                          list(config.restitution_band), config.friction]}
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 

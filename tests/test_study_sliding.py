@@ -182,3 +182,25 @@ def test_slip_damage_states_are_fitted_where_cells_slide_and_not_applicable_wher
     counted = ((cube.peak_slip >= 0.05) | (cube.outcome == 2)).sel(soil="slick", model="housner",
                                                                    block="squat-machinery").mean("record")
     np.testing.assert_allclose(fraction.values, counted.values)
+
+
+def test_showcase_runs_each_case_as_the_study_runs_its_cell():
+    """The showcase's histories take the study's base friction: a rigid base that slides on some soil is drawn per
+    soil (not once, tied), and a bed model slides where its cell does."""
+    from pipeline.showcase import response_cases
+
+    config = load_study()
+    paper = next(b for b in config.blocks if b.name == "paper")  # tan(alpha) = 0.47: slides on clay and sand
+    cases = response_cases(config, paper)
+    for model in config.models:
+        of_model = [(soil, friction) for name, soil, friction in cases if name == model]
+        if model == "ssi":
+            assert [friction for _, friction in of_model] == [None] * len(config.soils)  # tied, as the paper has it
+            continue
+        assert [soil.name for soil, _ in of_model] == [soil.name for soil in config.soils]
+        for soil, friction in of_model:
+            assert friction == cell_friction(paper, soil, model, config.friction)
+        assert any(friction is not None for _, friction in of_model)
+    cabinet = next(b for b in config.blocks if b.name == "slender-cabinet")  # b/h = 0.2: never slides
+    assert [(soil, friction) for name, soil, friction in response_cases(config, cabinet)
+            if name == "housner"] == [(None, None)]

@@ -234,8 +234,11 @@ def showcase_response_page(showcase, caption, name: str | None = None):
         theta_axes.append(theta_axis)
         settle_axes.append(settle_axis)
         for model in models:
-            mask = (showcase.case_model.values == model.name) & (
-                (showcase.case_soil.values == "") if model.rigid_base else (showcase.case_soil.values == soil))
+            # a rigid base tied on every soil is one case (soil ""), drawn on each; one that slides is per soil
+            of_model = showcase.case_model.values == model.name
+            mask = of_model & (showcase.case_soil.values == soil)
+            if model.rigid_base and not mask.any():
+                mask = of_model & (showcase.case_soil.values == "")
             if not mask.any():
                 continue
             index = int(np.flatnonzero(mask)[0])
