@@ -487,6 +487,8 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     group_dims = ("soil", "block", "model")
     models = [str(m) for m in cube.model.values]
     rigid = {m: uplift_is_rigid_threshold(m) for m in models}
+    sliding = np.isfinite(cube["friction_static"].transpose(*group_dims).values) if "friction_static" in cube \
+        else np.zeros(tuple(cube.sizes[d] for d in group_dims), bool)
     shape = tuple(cube.sizes[d] for d in group_dims) + (len(states),)
     out = {name: np.full(shape, np.nan) for name in ROW_VARIABLES}
     text = {name: np.full(shape, "", dtype=object) for name in ("fit_method", "status", "fit_warning")}
@@ -510,7 +512,10 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         data = (slice(None), slice(None), *index)
         exceed = reached[data].sum(0).T  # (state, level)
         total = valid[data].sum(0).T.astype(float)
-        threshold = thresholds[block] if thresholds is not None and rigid[models[model]] else None
+        # the exact step is the rigid base's only where the base is tied: one that slides before it can rock
+        # (base friction, Shenton 1996) need not lift at g tan(alpha), so its uplift is fitted from its runs
+        threshold = thresholds[block] if thresholds is not None and rigid[models[model]] \
+            and not sliding[index] else None
         rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, label)
         if n_bootstrap:
             boot_exceed = np.einsum("br,rls->bsl", weights, reached[data])
