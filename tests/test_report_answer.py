@@ -159,9 +159,10 @@ def test_the_study_states_the_limits_and_return_periods(tmp_path):
         assert error.value.field == field
 
 
-def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nearest_level():
+def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_level_at_or_below():
     """Issue 19: which mode governs at each return-period intensity. Mode times where the base slides; the
-    outcome where it is tied (no mode times); the recommended curve reads the band centre's runs."""
+    outcome where it is tied (no mode times); the recommended curve reads the band centre's runs; the level is
+    the one at or below the intensity, as the probability table reads it (issue 20, finding 4)."""
     import xarray as xr
 
     from pipeline.models.fields import MODE_TIME_FIELDS
@@ -184,11 +185,61 @@ def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nea
                       {"outcome": (dims, outcome)},
                       coords={"soil": ["clay"], "block": ["skid"], "model": ["winkler-centre", "housner"],
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
-    assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.28, 0.9], 1.0) == \
+    assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.32, 1.1], 1.0) == \
         ["at rest (100% of the records)", "slides (100% of the records)", "slides and rocks (100% of the records)"]
     assert governing_modes(cube, "skid", "housner", "clay", [0.1, 0.3, 1.0], 1.0) == \
         ["at rest (100% of the records)", "rocks (100% of the records)", "overturns (75% of the records)"]
+    # 0.28 g reads the 0.1 g level (at or below, as the P table), not the nearer 0.3 g; below 0.1 g no level
+    assert governing_modes(cube, "skid", "housner", "clay", [0.28, 0.09], 1.0) == \
+        ["at rest (100% of the records)", "no level run this low"]
     assert governing_modes(None, "skid", "housner", "clay", [0.1], 1.0) == ["-"]
+
+
+def _tied_cube(outcome):
+    """A cube of one tied cell (housner, no mode times) from outcome codes (record, level), levels 0.1/0.3/1 g."""
+    levels = np.array([0.1, 0.3, 1.0])
+    dims = ("record", "im_level", "soil", "block", "model")
+    return xr.Dataset({"outcome": (dims, np.asarray(outcome, np.int8)[:, :, None, None, None])},
+                      coords={"soil": ["sand"], "block": ["cabinet"], "model": ["housner"],
+                              "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
+
+
+def test_the_governing_motion_counts_as_the_fits_do_and_a_milder_motion_is_never_below_100_percent():
+    """The client read "at rest (98%)" (at rest or worse is always 100%), "rocks (50%)" where 22 of 44 rocked
+    and 22 overturned, and a record that overturned at a lower level counted as rocking (resurrection)."""
+    from pipeline.report.answer_page import governing_modes
+
+    outcome = np.zeros((44, 3), int)
+    outcome[0, 0] = 1                     # one record of 44 lifts off at 0.1 g: the rest stay at rest
+    outcome[:22, 1], outcome[22:, 1] = 1, 2  # 22 rock, 22 overturn at 0.3 g
+    outcome[:, 2] = 1                     # at 1 g every record rocks: the 22 overturned at 0.3 g resurrect
+    outcome[0, 2] = 2
+    modes = governing_modes(_tied_cube(outcome), "cabinet", "housner", "sand", [0.1, 0.3, 1.0], 1.0)
+    assert modes == ["at rest (100% of the records)", "overturns (50% of the records)",
+                     "overturns (52% of the records)"]
+
+
+def test_the_motion_table_and_the_probability_table_agree_on_one_cell():
+    """One definition, level and counting rule: the share of records that overturn in the motion table is the
+    count of records in the probability table's cell, at the same level (issue 20, finding 4)."""
+    from pipeline.answer import _records_at
+    from pipeline.damage_states import DAMAGE_STATES
+    from pipeline.fragility import exceedance
+    from pipeline.report.answer_page import governing_modes
+
+    outcome = np.zeros((10, 3), int)
+    outcome[:, 1:] = 1
+    outcome[:3, 1] = 2  # 3 of 10 overturn at 0.3 g; at 1 g 2 more do, and the first 3 resurrect (rock)
+    outcome[3:5, 2] = 2
+    cube = _tied_cube(outcome)
+    fraction = exceedance(cube, DAMAGE_STATES["overturning"]).sel(soil="sand", block="cabinet", model="housner") \
+        .mean("record").values
+    for im in (0.5, 2.0):
+        reached, total, level = _records_at(np.array([0.1, 0.3, 1.0]), fraction, 10, im)
+        mode = governing_modes(cube, "cabinet", "housner", "sand", [im], 1.0)[0]
+        shown = percent(reached / total)
+        assert f"overturns: {shown})" in mode or mode == f"overturns ({shown} of the records)", (im, level, mode)
+    assert reached == 5  # the resurrected records count as overturned at 1 g
 
 
 def test_curves_that_cross_below_the_data_are_read_as_this_state_or_worse():

@@ -90,25 +90,49 @@ def curve_reason(results, model: str) -> str:
 
 
 MODE_WORDS = {"time_at_rest": "at rest", "time_sliding": "slides", "time_rocking": "rocks",
-              "time_slide_rocking": "slides and rocks", "time_in_flight": "flies"}
-"""The contact modes of a run (the time fields pipeline.models.fields.MODE_TIME_FIELDS) in words."""
+              "time_slide_rocking": "slides and rocks", "time_in_flight": "flies", "overturns": "overturns"}
+"""The contact modes of a run (the time fields pipeline.models.fields.MODE_TIME_FIELDS) and overturning in words."""
 
 
-MODE_SEVERITY = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight")
-"""The contact modes from the mildest to the most severe (a record's motion is the most severe it enters)."""
+MODE_SEVERITY = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight", "overturns")
+"""The motions from the mildest to the most severe (a record's motion is the most severe it enters); the last is
+overturning, read from the outcome as the fits read it (from a record's first overturning level on)."""
+
+NO_LEVEL = "no level run this low"
+"""A return-period intensity below every level run: the page says so (the P table's head does too), no motion."""
+
+
+def _motions(runs, overturned) -> np.ndarray | None:
+    """Each record's most severe motion (an index of ``MODE_SEVERITY``), -1 for a failed run.
+
+    From the mode times where the base slides; from the outcome where it is tied (no mode times). ``overturned``:
+    the record has overturned at this level or a lower one (``pipeline.fragility.first_overturn_outcomes``).
+    """
+    outcome = np.asarray(runs.outcome.values)
+    times = {field: np.asarray(runs[field].values, float) for field in MODE_SEVERITY[:-1] if field in runs}
+    if len(times) == len(MODE_SEVERITY) - 1 and all(np.isfinite(v).any() for v in times.values()):
+        entered = np.stack([np.nan_to_num(times[field]) > 0.0 for field in MODE_SEVERITY[:-1]])  # (mode, record)
+        worst = np.max(np.where(entered, np.arange(len(MODE_SEVERITY) - 1)[:, None], 0), axis=0)
+    else:
+        worst = np.select([outcome == int(Outcome.ROCKING), outcome == int(Outcome.FREE_FLIGHT)],
+                          [MODE_SEVERITY.index("time_rocking"), MODE_SEVERITY.index("time_in_flight")], 0)
+    worst = np.where(overturned, len(MODE_SEVERITY) - 1, worst)
+    return np.where(outcome == int(Outcome.FAILED), -1, worst)
 
 
 def governing_modes(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
-    """What the block does at each intensity: the most severe mode that at least half the records enter.
+    """What the block does at each intensity: the most severe motion that at least half the records reach.
 
-    Each record's motion is the most severe mode it spends any time in (a block that rocks for 2 s of a 40 s
-    record rocks; the longest mode would say "at rest"), ``MODE_SEVERITY``; the page shows the mode that half
-    the records reach or pass, with the share of records that reach it.
-
-    At the cube's level nearest each intensity (in the answer's unit, ``scale`` times the cube's), from the runs
-    of ``model`` (the recommended curve's: the band centre). A tied base has no mode times: there the outcome
-    says it ("at rest" without uplift, "rocks", "overturns" for most records).
+    One definition, level and counting rule with the probability table (``pipeline.answer``): each record's
+    motion is the most severe it enters (a block that rocks for 2 s of a 40 s record rocks), ``MODE_SEVERITY``,
+    overturning counted from the record's first overturning level on (as the fits count it: resurrection); the
+    share is that of the records reaching the motion or a more severe one, so "at rest" is always 100%. Read at
+    the level run nearest at or below each intensity (in the answer's unit, ``scale`` times the cube's), as the
+    probability table reads its records; ``NO_LEVEL`` where no level lies that low. From the runs of ``model``
+    (the recommended curve's: the band centre).
     """
+    from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule, in one place
+
     if cube is None or "intensity" not in cube:
         return ["-"] * len(intensities)
     centres = [str(m) for m in cube.model.values if split_variant(str(m))[1] == "centre"]  # the band's centre
@@ -117,27 +141,24 @@ def governing_modes(cube, block: str, model: str, soil: str, intensities, scale:
         return ["-"] * len(intensities)
     levels = np.asarray(cube.intensity.sel(block=block).values, float) * scale
     cell = cube.sel(block=block, soil=soil, model=name)
+    overturned = first_overturn_outcomes(cell).transpose("record", "im_level").values == int(Outcome.OVERTURNED)
     out = []
     for im in intensities:
-        level = int(np.argmin(np.abs(np.log(levels / im))))
-        runs = cell.isel(im_level=level)
-        times = {field: np.asarray(runs[field].values, float) for field in MODE_SEVERITY if field in runs}
-        if len(times) == len(MODE_SEVERITY) and all(np.isfinite(v).any() for v in times.values()):
-            entered = np.stack([np.nan_to_num(times[field]) > 0.0 for field in MODE_SEVERITY])  # (mode, record)
-            worst = np.max(np.where(entered, np.arange(len(MODE_SEVERITY))[:, None], 0), axis=0)
-            reach = [float(np.mean(worst >= m)) for m in range(len(MODE_SEVERITY))]
-            mode = max(m for m in range(len(MODE_SEVERITY)) if reach[m] >= 0.5)
-            overturned = float(np.mean(runs.outcome.values == int(Outcome.OVERTURNED)))
-            text = MODE_WORDS[MODE_SEVERITY[mode]]
-            text += f" ({percent(reach[mode])} of the records"
-            out.append(text + (f"; overturns: {percent(overturned)})" if overturned > 0 else ")"))
+        below = np.flatnonzero(levels <= im * (1 + 1e-9))
+        if not below.size:
+            out.append(NO_LEVEL)
             continue
-        outcome = runs.outcome.values
-        shares = {"at rest": np.mean(outcome == int(Outcome.NO_UPLIFT)),
-                  "rocks": np.mean(outcome == int(Outcome.ROCKING)),
-                  "overturns": np.mean(outcome == int(Outcome.OVERTURNED))}
-        mode = max(shares, key=shares.get)
-        out.append(f"{mode} ({percent(shares[mode])} of the records)")
+        level = int(below[-1])
+        worst = _motions(cell.isel(im_level=level), overturned[:, level])
+        worst = worst[worst >= 0]
+        if not worst.size:
+            out.append("-")
+            continue
+        reach = [float(np.mean(worst >= m)) for m in range(len(MODE_SEVERITY))]
+        mode = max(m for m in range(len(MODE_SEVERITY)) if reach[m] >= 0.5)
+        text = f"{MODE_WORDS[MODE_SEVERITY[mode]]} ({percent(reach[mode])} of the records"
+        out.append(text + (f"; overturns: {percent(reach[-1])})" if 0 < reach[-1] and mode < len(reach) - 1
+                           else ")"))
     return out
 
 
@@ -202,12 +223,14 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         modes = [[soil.soil, *governing_modes(cube, answer.block, answer.model, soil.soil, answer.intensities, scale)]
                  for soil in answer.soils]
         if any(cell != "-" for row in modes for cell in row[1:]):
-            items.append(paragraph("What the block does at each return period's intensity, at the nearest level "
-                                   "run: the most severe motion that at least half the records reach (at rest, "
-                                   "slides, rocks, slides and rocks, flies), with the share of records that reach "
-                                   "it or a more severe one. The probabilities above read each state as 'this "
-                                   "state or worse', so a milder state is never less likely than a more severe "
-                                   "one:"))
+            items.append(paragraph("What the block does at each return period's intensity, at the level run "
+                                   "nearest at or below it (the level whose records the table above counts): the "
+                                   "most severe motion that at least half the records reach (at rest, slides, "
+                                   "rocks, slides and rocks, flies, overturns), with the share of records that "
+                                   "reach it or a more severe one. A record that overturned at a lower level "
+                                   "counts as overturned, as in the table above. The probabilities above read "
+                                   "each state as 'this state or worse', so a milder state is never less likely "
+                                   "than a more severe one:"))
             items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], modes))
         limits = {s: s_limit for s, s_limit in results.decision["max_probability_in_life"].items() if s in labels}
         life = f"{answer.design_life:g} years"
