@@ -256,6 +256,12 @@ class StateAnswer:
         The probability in the design life from the intensities at and above ``first_reached`` only (0
         when no record reached the state, NaN when unknown): what is left when the fitted curve's tail
         below the data is cut off.
+    below_lowest : tuple of (float, int, int) or None
+        Where the fitted median lies below the lowest level run (the records reached the state already
+        there): that level (shown unit) and how many of how many records reached the state at it. The
+        fitted curve below it is an extrapolation, so the probabilities are lower bounds from the records:
+        at each return period the fraction at the level at or below it, in the design life that fraction at
+        the lowest level times P(intensity > that level). None otherwise.
     """
 
     state: str
@@ -267,6 +273,7 @@ class StateAnswer:
     records: tuple = ()
     first_reached: float | None = None
     supported_probability: float = float("nan")
+    below_lowest: tuple | None = None
 
     @property
     def exceeds(self) -> bool:
@@ -386,6 +393,15 @@ def _at(row: xr.Dataset, im: float, scale: float, levels: np.ndarray, empirical:
     return np.nan, np.nan, np.nan
 
 
+def _lower_bound(levels: np.ndarray, empirical: np.ndarray, im: float) -> tuple:
+    """(the records' fraction at the level at or below ``im``, NaN, NaN): a lower bound on P(state | im).
+
+    Exceedance grows with the intensity, so the fraction at a lower level bounds it; NaN where no level lies that low.
+    """
+    below = np.flatnonzero(levels <= im * (1 + 1e-9))
+    return (float(empirical[below[-1]]) if below.size else np.nan, np.nan, np.nan)
+
+
 def nested_families(fragility: xr.Dataset) -> list[list[int]]:
     """Indices of the damage states by family (rocking, slip), each in the dataset's order of severity."""
     edps = fragility["damage_state_edp"].values if "damage_state_edp" in fragility.coords \
@@ -494,9 +510,20 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                         float(row["median"]) * scale, float(row["beta"]), hazard, lower=first), design_life))
                 records = tuple(_records_at(levels, empirical, n_records, im) for im in intensities) \
                     if n_records and empirical.size else ()
-                rows.append(StateAnswer(state, tuple(_at(row, im, scale, levels, empirical) for im in intensities),
-                                        frequency, probability, limits.get(state), not_reached, records, first,
-                                        supported))
+                at = tuple(_at(row, im, scale, levels, empirical) for im in intensities)
+                below = None
+                median = float(row["median"]) * scale
+                if empirical.size and levels.size and np.isfinite(empirical[0]) and empirical[0] > 0 \
+                        and np.isfinite(median) and median < levels[0] * (1 - 1e-9):
+                    # the fit's median below every level run: its tail there is no data; bound it by the records
+                    below = (float(levels[0]), records_reaching(empirical[0], n_records), n_records)
+                    at = tuple(_lower_bound(levels, empirical, im) for im in intensities)
+                    if hazard is not None:
+                        frequency = float(empirical[0] * hazard_frequency(hazard, float(levels[0])))
+                        probability = float(risk_probability_in_life(frequency, design_life))
+                        supported = probability
+                rows.append(StateAnswer(state, at, frequency, probability, limits.get(state), not_reached, records,
+                                        first, supported, below))
             rows = nested(rows, families)
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:

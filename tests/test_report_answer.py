@@ -375,3 +375,25 @@ def test_the_seed_paper_is_cited_from_its_copy_and_named_in_full_on_the_methods_
         assert PAPER_TITLE in copy.read_text(encoding="utf-8").splitlines()[:5]
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     assert any(PAPER_CITATION in item.text for item in methods_items(results))
+
+
+def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from_the_fits_tail():
+    """The client read "uplift 98%, once in 13 years" from a median of 0.069 g, below the lowest level run (0.1 g),
+    where every record had already lifted off: the page gives the records' fraction there as a lower bound."""
+    from pipeline.report.answer_page import _at_cell, _below_lowest
+
+    levels = np.geomspace(0.1, 4.0, 8)
+    empirical = np.ones((levels.size, 2, 1, 2, 2))
+    empirical[:, :, :, :, 1] = np.where(levels >= 1.0, 0.5, 0.0)[:, None, None, None]  # overturning: in range
+    fragility = _fragility([[[[0.069, 1.5]]]], betas=0.3, empirical=empirical).assign(n_records=10)
+    answer = block_answers(fragility, _power_law())[0]
+    uplift, overturning = answer.soils[0].states
+    assert uplift.below_lowest == (pytest.approx(0.1), 10, 10) and overturning.below_lowest is None
+    # in life: the records' 100% at 0.1 g times P(PGA > 0.1 g), not the fit's P(PGA > 0.069 g)-like value
+    assert uplift.annual_frequency == pytest.approx(K0 * 0.1 ** -K, rel=1e-6)
+    fitted = K0 * 0.069 ** -K * math.exp(K ** 2 * 0.3 ** 2 / 2)
+    assert uplift.annual_frequency < 0.5 * fitted
+    cell = _below_lowest(uplift, "g")
+    assert cell.startswith("\u2265") and "every record at the lowest level run (0.1 g)" in cell
+    assert _at_cell(uplift, 0, answer) == "\u2265100%; 10 of 10 records"
+    assert not _at_cell(overturning, 0, answer).startswith("\u2265")

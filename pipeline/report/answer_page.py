@@ -240,7 +240,9 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
             cells = [short[state], percent(limits[state]) if state in limits else "none"]
             for soil in answer.soils:
                 row = soil.states[index]
-                if row.not_reached_below is not None:
+                if row.below_lowest is not None:
+                    cells.append(_below_lowest(row, unit))
+                elif row.not_reached_below is not None:
                     cells.append(f"<{percent(row.probability_in_life)}, not reached below "
                                  f"{row.not_reached_below:.2g} {unit}")
                 elif np.isfinite(row.probability_in_life):
@@ -263,7 +265,10 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                           "without a limit are reported, not judged. 'not reached below X': no record reached the "
                           "state at any level up to X, so its probability is at most that of exceeding X. 'fit's "
                           "tail': above the limit only through intensities below every record that reached the "
-                          "state (the verdict says so)."))
+                          "state (the verdict says so). '\u2265' with the records at the lowest level run: the fitted "
+                          "median lies below every level run, so instead of the fit's extrapolated tail the page "
+                          "gives the records' fraction at the level (in life: times the probability of exceeding "
+                          "the lowest level), a lower bound."))
     else:
         items.append(paragraph(f"The study has no hazard curve for {measure}: no return-period intensities and no "
                                "probability in the design life. The fragility curves are on the pages that follow."))
@@ -290,6 +295,11 @@ def _at_cell(state, index: int, answer: BlockAnswer) -> str:
     im = answer.intensities[index]
     if state.not_reached_below is not None and im <= state.not_reached_below:
         return "not reached"
+    if state.below_lowest is not None:  # the fit's median is below every level: the records' fraction bounds P
+        if not np.isfinite(p) or not state.records:
+            return NO_LEVEL if not np.isfinite(p) else f"\u2265{percent(p)}"
+        reached, total, _ = state.records[index]
+        return f"\u2265{percent(p)}; {reached} of {total} records"
     if not np.isfinite(p):
         return "-"
     text = percent(p)
@@ -301,6 +311,17 @@ def _at_cell(state, index: int, answer: BlockAnswer) -> str:
     if state.fit_only(index):
         return text + (f"; fit only, {max(reached, 0)} of {total} records" if reached >= 0 else "; fit only")
     return text + f"; {reached} of {total} records"
+
+
+def _below_lowest(row, unit: str) -> str:
+    """The design-life cell of a state whose fitted median lies below the lowest level run: a lower bound.
+
+    "≥98%, every record at the lowest level run (0.1 g)": the fitted curve below that level is an extrapolation,
+    so the page gives the records' fraction there times P(intensity above it), mirroring "not reached below X".
+    """
+    level, reached, total = row.below_lowest
+    who = "every record" if reached == total else f"{reached} of {total} records"
+    return f"\u2265{percent(row.probability_in_life)}, {who} at the lowest level run ({level:.2g} {unit})"
 
 
 def _confidence(fragility) -> str:
