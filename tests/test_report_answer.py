@@ -397,3 +397,41 @@ def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from
     assert cell.startswith("\u2265") and "every record at the lowest level run (0.1 g)" in cell
     assert _at_cell(uplift, 0, answer) == "\u2265100%; 10 of 10 records"
     assert not _at_cell(overturning, 0, answer).startswith("\u2265")
+
+
+def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run():
+    """The client read the study-wide β ranges and the cabinet's r on the crane's and the skid's pages, and the skid's
+    page did not say that its band's three runs were one run (beta_model 0 by construction)."""
+    from types import SimpleNamespace
+
+    from pipeline.report.answer_page import curve_reason
+
+    models = ["recommended", "winkler-low", "winkler-centre", "winkler-high"]
+    dims = ("soil", "block", "model")
+    requested = np.array([[0.73, 0.75, 0.76], [0.94, 0.97, 0.99], [0.46, 0.47, 0.48]])  # crane, cabinet, skid
+    reached = np.array([[0.73, 0.75, 0.76], [0.94, 0.95, 0.95], [np.nan] * 3])
+    xi = np.array([[0.5, 0.4, 0.3], [0.4, 0.16, 0.16], [0.15, 0.15, 0.15]])
+
+    def per_cell(values):  # (block, variant) -> (soil, block, model), the recommended row NaN
+        return np.concatenate([np.full((2, 3, 1), np.nan), np.broadcast_to(values, (2, 3, 3))], axis=2)
+
+    blocks = ["crane", "cabinet", "skid"]
+    cube = xr.Dataset({"restitution_requested": (dims, per_cell(requested)),
+                       "restitution_target": (dims, per_cell(reached)),
+                       "damping_ratio_calibrated": (dims, per_cell(xi))},
+                      coords={"soil": ["clay", "rock"], "block": blocks, "model": models})
+    fdims = ("soil", "block", "model", "damage_state")
+    beta_model = np.zeros((2, 3, 4, 1))
+    beta_model[:, 0], beta_model[:, 1] = 0.3, 0.41
+    r2r = np.broadcast_to(np.array([0.5, 1.17, 0.2])[None, :, None, None], (2, 3, 4, 1))
+    fragility = xr.Dataset({"beta_model": (fdims, beta_model), "beta_record_to_record": (fdims, r2r)},
+                           coords={"soil": ["clay", "rock"], "block": blocks, "model": models,
+                                   "damage_state": ["overturning"]})
+    results = SimpleNamespace(fragility=fragility, cube=cube)
+    crane, cabinet, skid = (curve_reason(results, "recommended", b) for b in blocks)
+    assert "record to record is 0.50 to 0.50 and β of the model 0.30 to 0.30" in crane
+    assert "cannot dissipate" not in crane and "collapses" not in crane
+    assert "0.990" in cabinet and "0.950" in cabinet and "collapses" not in cabinet
+    assert "0.41" in cabinet and "1.17" not in crane and "1.17" not in skid
+    assert "On every soil the band collapses to one run" in skid and "ξ = 0.15" in skid
+    assert "it reaches none of them" in skid and "because there is one run" in skid and "0.990" not in skid

@@ -43,11 +43,16 @@ def _years(frequency: float) -> str:
     return f"once in {years:,.0f} years"
 
 
-def _band_reach(cube) -> str:
-    """A sentence on the cells where the bed could not reach the band's restitution (empty when it did)."""
+def _band_reach(cube, block=None) -> str:
+    """A sentence on the cells where the bed could not reach the band's restitution (empty when it did).
+
+    Of one block when ``block`` is given (its answer page), else of the whole study.
+    """
     if cube is None or "restitution_requested" not in cube or "restitution_target" not in cube:
         return ""
     requested, target = cube.restitution_requested, cube.restitution_target
+    if block is not None and "block" in requested.dims:
+        requested, target = requested.sel(block=block), target.sel(block=block)
     short = (requested - target) > 5e-4  # the bed ran at a lower r than the band asked for
     if not bool(short.any()):
         return ""
@@ -59,20 +64,57 @@ def _band_reach(cube) -> str:
             "rocks more.")
 
 
-def curve_reason(results, model: str) -> str:
-    """Which curve answers and why, in words."""
+def _band_collapse(cube, block) -> str:
+    """A sentence on the soils where the band's three runs of ``block`` are one run (empty where none are).
+
+    The variants run the bed's damping ratio xi calibrated to their restitution; where the bed reaches none of the
+    band's targets, all three run at the same xi: β of the model is 0 there because there is one run, not because
+    the model is certain.
+    """
+    if cube is None or "damping_ratio_calibrated" not in cube:
+        return ""
+    band = [str(m) for m in cube.model.values if split_variant(str(m))[1] is not None]
+    if len(band) < 2:
+        return ""
+    xi = cube.damping_ratio_calibrated.sel(block=block, model=band)
+    collapsed = [str(s) for s in cube.soil.values
+                 if np.isfinite(values := np.asarray(xi.sel(soil=s).values, float)).all()
+                 and np.ptp(values) <= 1e-9 * max(abs(values).max(), 1.0)]
+    if not collapsed:
+        return ""
+    values = sorted({f"{float(xi.sel(soil=s).isel(model=0)):.3g}" for s in collapsed})
+    asked = ""
+    if "restitution_requested" in cube:
+        requested = cube.restitution_requested.sel(block=block, model=band, soil=collapsed)
+        asked = f"r {float(requested.min()):.3f} to {float(requested.max()):.3f} asked"
+        if "restitution_target" in cube:
+            reached = cube.restitution_target.sel(block=block, model=band, soil=collapsed)
+            asked += f"; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any()) \
+                else "; it reaches none of them"
+        asked = f" ({asked})"
+    where = "every soil" if len(collapsed) == cube.soil.size else ", ".join(collapsed)
+    return (f" On {where} the band collapses to one run for this block: the bed cannot tell the band's "
+            f"restitutions apart{asked}, so its three runs use the same damping ratio ξ = {' / '.join(values)}; β "
+            "of the model there is 0 because there is one run, not because the model is certain.")
+
+
+def curve_reason(results, model: str, block=None) -> str:
+    """Which curve answers and why, in words: β ranges and the band's reach of ``block`` (every block: None)."""
     fragility = results.fragility
     if model == RECOMMENDED:
         text = ("The answer uses the recommended curve: the tensionless Winkler bed run over the experimental range "
                 "of impact restitution (the edges and the centre of the band), its spread added to the "
                 "record-to-record dispersion (FEMA P-58).")
         if "beta_model" in fragility and "beta_record_to_record" in fragility:
-            rows = fragility.sel(model=RECOMMENDED)
+            rows = fragility.sel(model=RECOMMENDED) if block is None else fragility.sel(model=RECOMMENDED,
+                                                                                         block=block)
             r2r, model_beta = rows.beta_record_to_record.values, rows.beta_model.values
             if np.isfinite(r2r).any() and np.isfinite(model_beta).any():
                 text += (f" Here β from record to record is {np.nanmin(r2r):.2f} to {np.nanmax(r2r):.2f} and β of the "
                          f"model {np.nanmin(model_beta):.2f} to {np.nanmax(model_beta):.2f}.")
-        text += _band_reach(getattr(results, "cube", None))
+        text += _band_reach(getattr(results, "cube", None), block)
+        if block is not None:
+            text += _band_collapse(getattr(results, "cube", None), block)
         models = {str(m) for m in fragility.model.values}
         if "housner" in models and any(m.startswith("ssi") for m in models):
             text += (" Housner's rigid base and the paper's model are references, not inputs: the first ignores "
@@ -191,7 +233,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if description:
         items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
     items.append(strong(verdict_sentence(answer, name, words)))
-    items.append(paragraph(curve_reason(results, answer.model)))
+    items.append(paragraph(curve_reason(results, answer.model, answer.block)))
     items.append(paragraph(planar_words(results.cube, answer.block)))
     items.append(paragraph(results.friction_words))
     largest = results.largest_recorded.get(answer.block)
