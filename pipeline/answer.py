@@ -301,12 +301,17 @@ class StateAnswer:
 
 @dataclass(frozen=True)
 class SoilAnswer:
-    """One block on one soil: its states, the share of runs that would slide and the verdict."""
+    """One block on one soil: its states, the share of records that would slide, and the verdict.
+
+    ``sliding_share`` is read at ``sliding_level`` (shown unit), the level run at or below the decision's
+    return-period intensity (the largest of the study's; NaN where no level lies that low).
+    """
 
     soil: str
     states: tuple
     sliding_share: float
     verdict: str
+    sliding_level: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -326,6 +331,8 @@ class BlockAnswer:
         Years of the probability in life.
     unit : str
         The shown unit of the intensities (``display_scale``).
+    max_sliding_share : float
+        ``[decision] max_sliding_share``: above it a tied base that needs more friction is told to check sliding.
     """
 
     block: str
@@ -336,6 +343,7 @@ class BlockAnswer:
     example_hazard: bool
     design_life: float
     unit: str
+    max_sliding_share: float = DEFAULT_SLIDING_SHARE
 
 
 def _empirical(fragility: xr.Dataset, model: str, block, soil, state) -> np.ndarray:
@@ -460,8 +468,10 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
         Block -> the largest intensity of the unscaled records (shown unit): below it the levels are
         what records did; a state no record reached below it is "not reached below" it.
     sliding : mapping, optional
-        (block, soil) -> share of the answer model's runs up to the largest return-period intensity
-        that need more base friction than the study's coefficient (NaN or absent: unknown).
+        (block, soil) -> share of the records of a tied base that need more base friction than the soil's
+        coefficient, at the level run at or below the largest return-period intensity (the decision's;
+        ``pipeline.report.adapters.sliding_share``); NaN or absent: unknown, or the cell runs with friction
+        and its slip states answer.
     max_sliding_share : float, optional
         Above this share the verdict is ``CHECK_SLIDING``.
 
@@ -482,6 +492,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     answers = []
     for block in map(str, fragility.block.values):
         levels = _levels(fragility, block, scale)
+        decided = levels[levels <= intensities[-1] * (1 + 1e-9)] if intensities else np.array([])
+        decision_level = float(decided[-1]) if decided.size else np.nan  # the level the sliding share reads
         credible = (largest_recorded or {}).get(block)
         soils = []
         for soil in map(str, fragility.soil.values):
@@ -534,9 +546,10 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                 verdict = CHECK_SLIDING
             else:
                 verdict = NO_ACTION
-            soils.append(SoilAnswer(soil, tuple(rows), share, verdict))
+            soils.append(SoilAnswer(soil, tuple(rows), share, verdict, decision_level))
         example = hazard is not None and EXAMPLE_HAZARD in hazard.source
-        answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit))
+        answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit,
+                                   float(max_sliding_share)))
     return answers
 
 
@@ -619,9 +632,14 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
         elif verdict == CHECK_SLIDING:
             shares = [s.sliding_share for s in soils]
             shown = percent(min(shares)) if len(shares) == 1 else f"{percent(min(shares))} to {percent(max(shares))}"
-            text = (f"check sliding {where} ({shown} of the runs up to the {answer.return_periods[-1]:,.0f}-year "
-                    "intensity need more base friction than assumed: the block would slide, which the rocking "
-                    "results do not describe)")
+            level = sorted({f"{s.sliding_level:.2g} {answer.unit}" for s in soils if np.isfinite(s.sliding_level)})
+            at = f" at {_and(level)}, the level run at or below" if level else " at"
+            text = (f"check sliding {where} ({shown} of the records{at} the {answer.return_periods[-1]:,.0f}-year "
+                    "intensity need more base friction than the soil's μ_s, above the "
+                    f"{percent(answer.max_sliding_share)} the study allows ([decision] max_sliding_share, the "
+                    "study's choice): the block would slide, and sliding was not computed there (its base was "
+                    'tied); compute it with [solver] friction = "all", whose slip damage states then give the '
+                    "verdict)")
             rocking = exceeded(soils)
             parts.append(text + (f", and anchor it against rocking there ({rocking})" if rocking else ""))
         else:

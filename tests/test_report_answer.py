@@ -435,3 +435,49 @@ def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run(
     assert "0.41" in cabinet and "1.17" not in crane and "1.17" not in skid
     assert "On every soil the band collapses to one run" in skid and "ξ = 0.15" in skid
     assert "it reaches none of them" in skid and "because there is one run" in skid and "0.990" not in skid
+
+
+def _friction_cube():
+    """20 records at 0.24/0.31/0.41/0.54 g on gravel (mu_s 0.55): 0, 0, 0 and 9 records need more friction. The
+    band centre is tied on gravel and slides (friction computed) on clay; the low edge is tied on both."""
+    levels = np.array([0.24, 0.31, 0.41, 0.54])
+    demand = np.full((20, 4, 2, 1, 2), 0.3)
+    demand[:9, 3] = 0.8
+    friction = np.array([[[0.45, np.nan]], [[np.nan, np.nan]]])  # (soil, block, model): clay centre slides
+    dims = ("record", "im_level", "soil", "block", "model")
+    return xr.Dataset({"peak_friction_demand": (dims, demand), "outcome": (dims, np.ones(demand.shape, np.int8)),
+                       "friction_static": (("soil", "block", "model"), friction),
+                       "soil_friction_static": (("soil",), [0.45, 0.55])},
+                      coords={"soil": ["clay", "gravel"], "block": ["crane"], "model": ["winkler-centre",
+                                                                                        "winkler-low"],
+                              "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
+
+
+def test_the_sliding_share_is_the_records_at_the_level_at_or_below_the_intensity_not_a_grid_average():
+    """The client read 11-12% (an unweighted average over the levels up to the 2,475-year PGA) where 41-45% of the
+    records at the 0.54 g level needed more friction; and a cell that slides was judged by another model's ties."""
+    from pipeline.report.adapters import sliding_at, sliding_share
+
+    cube = _friction_cube()
+    models = ["recommended", "winkler-centre", "winkler-low"]
+    assert sliding_share(cube, models, "crane", "gravel", None, 0.57) == pytest.approx(0.45)
+    assert sliding_at(cube, models, "crane", "gravel", 0.57) == (pytest.approx(0.45), pytest.approx(0.54), False)
+    assert sliding_at(cube, models, "crane", "gravel", 0.5)[:2] == (0.0, pytest.approx(0.41))
+    assert np.isnan(sliding_at(cube, models, "crane", "gravel", 0.2)[1])  # no level run this low
+    share, _, computed = sliding_at(cube, models, "crane", "clay", 0.57)
+    assert computed and np.isnan(share)  # friction computed: the slip states answer, not the low edge's ties
+
+
+def test_check_sliding_names_its_level_its_threshold_and_how_to_compute_the_sliding():
+    fragility = _fragility([[[[0.3, 3.0]]]])
+    answer = block_answers(fragility, _power_law(), limits={"overturning": 0.01}, max_sliding_share=0.1,
+                           sliding={("cabinet", "clay"): 0.45, ("cabinet", "rock"): np.nan})[0]
+    clay, rock = answer.soils
+    assert (clay.verdict, rock.verdict) == (CHECK_SLIDING, NO_ACTION)
+    im = (K0 * 2475.0) ** (1 / K)
+    levels = np.geomspace(0.1, 4.0, 8)
+    assert clay.sliding_level == pytest.approx(levels[levels <= im][-1])
+    sentence = verdict_sentence(answer, "crane")
+    assert f"45% of the records at {clay.sliding_level:.2g} g, the level run at or below the 2,475-year" in sentence
+    assert "10% the study allows ([decision] max_sliding_share" in sentence
+    assert "sliding was not computed there" in sentence and '[solver] friction = "all"' in sentence

@@ -25,6 +25,8 @@ from pipeline.report.adapters import (
     measure_label,
     model_info,
     planar_words,
+    sliding_at,
+    sliding_candidates,
     state_labels,
 )
 from pipeline.report.text import Item, note, paragraph, strong, table
@@ -274,6 +276,13 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                    "each state as 'this state or worse', so a milder state is never less likely "
                                    "than a more severe one:"))
             items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], modes))
+        sliding = sliding_rows(cube, answer, scale)
+        if sliding:
+            items.append(paragraph("Share of the records whose tied base needs more base friction than the soil's "
+                                   f"μ_s ({results.friction_text}), at the level run at or below each return "
+                                   "period's intensity (the verdict reads the "
+                                   f"{answer.return_periods[-1]:,.0f}-year one):"))
+            items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], sliding))
         limits = {s: s_limit for s, s_limit in results.decision["max_probability_in_life"].items() if s in labels}
         life = f"{answer.design_life:g} years"
         header = ["damage state", f"limit in {life}", *(f"on {soil.soil}" for soil in answer.soils)]
@@ -300,10 +309,12 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         judged = ", ".join(f"{short[s]} {percent(v)}" for s, v in limits.items())
         items.append(note(f"Verdict: 'anchor' where a probability in {life} exceeds the study's limit "
                           f"({judged or 'none set'}; an anchorage holds the block against sliding too); else 'check "
-                          f"sliding' where more than {percent(results.decision['max_sliding_share'])} of the runs up "
-                          f"to the {answer.return_periods[-1]:,.0f}-year intensity need a base friction above the "
-                          f"soil's μ_s ({results.friction_text}) on a tied base (the runs with friction answer with "
-                          "their slip damage states); else 'no action'. States "
+                          f"sliding' where more than {percent(answer.max_sliding_share)} ([decision] "
+                          "max_sliding_share, the study's choice) of the records at the level run at or below the "
+                          f"{answer.return_periods[-1]:,.0f}-year intensity need a base friction above the soil's "
+                          f"μ_s ({results.friction_text}) on a tied base, where sliding was not computed (compute "
+                          'it with [solver] friction = "all"); where the base runs with friction, its slip damage '
+                          "states give the verdict; else 'no action'. States "
                           "without a limit are reported, not judged. 'not reached below X': no record reached the "
                           "state at any level up to X, so its probability is at most that of exceeding X. 'fit's "
                           "tail': above the limit only through intensities below every record that reached the "
@@ -315,6 +326,31 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(paragraph(f"The study has no hazard curve for {measure}: no return-period intensities and no "
                                "probability in the design life. The fragility curves are on the pages that follow."))
     return items
+
+
+def sliding_rows(cube, answer: BlockAnswer, scale: float) -> list[list[str]]:
+    """Per soil, the share of records whose tied base needs more friction than μ_s at each return period's level.
+
+    ``pipeline.report.adapters.sliding_at`` at the level run at or below each intensity (``scale``: the answer's
+    unit per the cube's); "sliding computed" where the cell runs with friction (its slip states answer). Empty
+    when the cube has no friction demand.
+    """
+    if cube is None or "peak_friction_demand" not in cube or not answer.intensities:
+        return []
+    candidates = sliding_candidates(cube, answer.model)
+    rows = []
+    for soil in answer.soils:
+        cells = []
+        for im in answer.intensities:
+            share, level, computed = sliding_at(cube, candidates, answer.block, soil.soil, im / scale)
+            if computed:
+                cells.append("sliding computed: see the slip states")
+            elif not np.isfinite(level):
+                cells.append(NO_LEVEL)
+            else:
+                cells.append(f"{percent(share)} (records at {level * scale:.2g}\u00a0{answer.unit})")
+        rows.append([soil.soil, *cells])
+    return rows
 
 
 def _period_header(answer: BlockAnswer, soil, index: int, measure: str) -> str:
