@@ -478,6 +478,7 @@ def test_check_sliding_names_its_level_its_threshold_and_how_to_compute_the_slid
     levels = np.geomspace(0.1, 4.0, 8)
     assert clay.sliding_level == pytest.approx(levels[levels <= im][-1])
     sentence = verdict_sentence(answer, "crane")
-    assert f"45% of the records at {clay.sliding_level:.2g} g, the level run at or below the 2,475-year" in sentence
+    assert f"45% of the records at {clay.sliding_level:.2g} g, the level run at or below the 2,475-year " \
+           "intensity, need" in sentence
     assert "10% the study allows ([decision] max_sliding_share" in sentence
     assert "sliding was not computed there" in sentence and '[solver] friction = "all"' in sentence
