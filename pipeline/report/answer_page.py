@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
+from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule (resurrection), in one place
 from pipeline.models.base import Outcome
 from pipeline.models.variants import split_variant
 from pipeline.report.adapters import (
@@ -175,8 +176,6 @@ def governing_modes(cube, block: str, model: str, soil: str, intensities, scale:
     probability table reads its records; ``NO_LEVEL`` where no level lies that low. From the runs of ``model``
     (the recommended curve's: the band centre).
     """
-    from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule, in one place
-
     if cube is None or "intensity" not in cube:
         return ["-"] * len(intensities)
     centres = [str(m) for m in cube.model.values if split_variant(str(m))[1] == "centre"]  # the band's centre
