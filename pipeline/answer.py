@@ -605,6 +605,8 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
             def near(value, limit=limit):  # a value that rounds to the limit is shown to three digits
                 return f"{100 * value:.3g}%" if percent(value) == percent(limit) else percent(value)
             shown = near(min(values)) if len(values) == 1 else f"{near(min(values))} to {near(max(values))}"
+            if any(r.below_lowest is not None for s in soils for r in s.states if r.state == state and r.exceeds):
+                shown = f"at least {shown}"  # a lower bound from the records at the lowest level (StateAnswer)
             reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
                            f"{percent(limit)} limit{tail_words(soils, state)}")
         return "; ".join(reasons)

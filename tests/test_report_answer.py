@@ -397,6 +397,8 @@ def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from
     assert cell.startswith("\u2265") and "every record at the lowest level run (0.1 g)" in cell
     assert _at_cell(uplift, 0, answer) == "\u2265100%; 10 of 10 records"
     assert not _at_cell(overturning, 0, answer).startswith("\u2265")
+    judged = block_answers(fragility, _power_law(), limits={"rocking-0.5": 0.1})[0]
+    assert "in 50 years at least " in verdict_sentence(judged, "cabinet")  # a lower bound is said so in the verdict
 
 
 def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run():
