@@ -256,6 +256,12 @@ class StateAnswer:
         The probability in the design life from the intensities at and above ``first_reached`` only (0
         when no record reached the state, NaN when unknown): what is left when the fitted curve's tail
         below the data is cut off.
+    below_lowest : tuple of (float, int, int) or None
+        Where the fitted median lies below the lowest level run (the records reached the state already
+        there): that level (shown unit) and how many of how many records reached the state at it. The
+        fitted curve below it is an extrapolation, so the probabilities are lower bounds from the records:
+        at each return period the fraction at the level at or below it, in the design life that fraction at
+        the lowest level times P(intensity > that level). None otherwise.
     """
 
     state: str
@@ -267,6 +273,7 @@ class StateAnswer:
     records: tuple = ()
     first_reached: float | None = None
     supported_probability: float = float("nan")
+    below_lowest: tuple | None = None
 
     @property
     def exceeds(self) -> bool:
@@ -294,12 +301,17 @@ class StateAnswer:
 
 @dataclass(frozen=True)
 class SoilAnswer:
-    """One block on one soil: its states, the share of runs that would slide and the verdict."""
+    """One block on one soil: its states, the share of records that would slide, and the verdict.
+
+    ``sliding_share`` is read at ``sliding_level`` (shown unit), the level run at or below the decision's
+    return-period intensity (the largest of the study's; NaN where no level lies that low).
+    """
 
     soil: str
     states: tuple
     sliding_share: float
     verdict: str
+    sliding_level: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -319,6 +331,8 @@ class BlockAnswer:
         Years of the probability in life.
     unit : str
         The shown unit of the intensities (``display_scale``).
+    max_sliding_share : float
+        ``[decision] max_sliding_share``: above it a tied base that needs more friction is told to check sliding.
     """
 
     block: str
@@ -329,6 +343,7 @@ class BlockAnswer:
     example_hazard: bool
     design_life: float
     unit: str
+    max_sliding_share: float = DEFAULT_SLIDING_SHARE
 
 
 def _empirical(fragility: xr.Dataset, model: str, block, soil, state) -> np.ndarray:
@@ -384,6 +399,15 @@ def _at(row: xr.Dataset, im: float, scale: float, levels: np.ndarray, empirical:
     if below.size and empirical.size and np.isfinite(empirical[below[-1]]):
         return float(empirical[below[-1]]), np.nan, np.nan
     return np.nan, np.nan, np.nan
+
+
+def _lower_bound(levels: np.ndarray, empirical: np.ndarray, im: float) -> tuple:
+    """(the records' fraction at the level at or below ``im``, NaN, NaN): a lower bound on P(state | im).
+
+    Exceedance grows with the intensity, so the fraction at a lower level bounds it; NaN where no level lies that low.
+    """
+    below = np.flatnonzero(levels <= im * (1 + 1e-9))
+    return (float(empirical[below[-1]]) if below.size else np.nan, np.nan, np.nan)
 
 
 def nested_families(fragility: xr.Dataset) -> list[list[int]]:
@@ -444,8 +468,10 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
         Block -> the largest intensity of the unscaled records (shown unit): below it the levels are
         what records did; a state no record reached below it is "not reached below" it.
     sliding : mapping, optional
-        (block, soil) -> share of the answer model's runs up to the largest return-period intensity
-        that need more base friction than the study's coefficient (NaN or absent: unknown).
+        (block, soil) -> share of the records of a tied base that need more base friction than the soil's
+        coefficient, at the level run at or below the largest return-period intensity (the decision's;
+        ``pipeline.report.adapters.sliding_share``); NaN or absent: unknown, or the cell runs with friction
+        and its slip states answer.
     max_sliding_share : float, optional
         Above this share the verdict is ``CHECK_SLIDING``.
 
@@ -466,6 +492,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     answers = []
     for block in map(str, fragility.block.values):
         levels = _levels(fragility, block, scale)
+        decided = levels[levels <= intensities[-1] * (1 + 1e-9)] if intensities else np.array([])
+        decision_level = float(decided[-1]) if decided.size else np.nan  # the level the sliding share reads
         credible = (largest_recorded or {}).get(block)
         soils = []
         for soil in map(str, fragility.soil.values):
@@ -494,9 +522,20 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                         float(row["median"]) * scale, float(row["beta"]), hazard, lower=first), design_life))
                 records = tuple(_records_at(levels, empirical, n_records, im) for im in intensities) \
                     if n_records and empirical.size else ()
-                rows.append(StateAnswer(state, tuple(_at(row, im, scale, levels, empirical) for im in intensities),
-                                        frequency, probability, limits.get(state), not_reached, records, first,
-                                        supported))
+                at = tuple(_at(row, im, scale, levels, empirical) for im in intensities)
+                below = None
+                median = float(row["median"]) * scale
+                if empirical.size and levels.size and np.isfinite(empirical[0]) and empirical[0] > 0 \
+                        and np.isfinite(median) and median < levels[0] * (1 - 1e-9):
+                    # the fit's median below every level run: its tail there is no data; bound it by the records
+                    below = (float(levels[0]), records_reaching(empirical[0], n_records), n_records)
+                    at = tuple(_lower_bound(levels, empirical, im) for im in intensities)
+                    if hazard is not None:
+                        frequency = float(empirical[0] * hazard_frequency(hazard, float(levels[0])))
+                        probability = float(risk_probability_in_life(frequency, design_life))
+                        supported = probability
+                rows.append(StateAnswer(state, at, frequency, probability, limits.get(state), not_reached, records,
+                                        first, supported, below))
             rows = nested(rows, families)
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:
@@ -507,9 +546,10 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                 verdict = CHECK_SLIDING
             else:
                 verdict = NO_ACTION
-            soils.append(SoilAnswer(soil, tuple(rows), share, verdict))
+            soils.append(SoilAnswer(soil, tuple(rows), share, verdict, decision_level))
         example = hazard is not None and EXAMPLE_HAZARD in hazard.source
-        answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit))
+        answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit,
+                                   float(max_sliding_share)))
     return answers
 
 
@@ -565,6 +605,8 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
             def near(value, limit=limit):  # a value that rounds to the limit is shown to three digits
                 return f"{100 * value:.3g}%" if percent(value) == percent(limit) else percent(value)
             shown = near(min(values)) if len(values) == 1 else f"{near(min(values))} to {near(max(values))}"
+            if any(r.below_lowest is not None for s in soils for r in s.states if r.state == state and r.exceeds):
+                shown = f"at least {shown}"  # a lower bound from the records at the lowest level (StateAnswer)
             reasons.append(f"P({labels.get(state, state)}) in {answer.design_life:g} years {shown}, above the "
                            f"{percent(limit)} limit{tail_words(soils, state)}")
         return "; ".join(reasons)
@@ -592,9 +634,14 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
         elif verdict == CHECK_SLIDING:
             shares = [s.sliding_share for s in soils]
             shown = percent(min(shares)) if len(shares) == 1 else f"{percent(min(shares))} to {percent(max(shares))}"
-            text = (f"check sliding {where} ({shown} of the runs up to the {answer.return_periods[-1]:,.0f}-year "
-                    "intensity need more base friction than assumed: the block would slide, which the rocking "
-                    "results do not describe)")
+            level = sorted({f"{s.sliding_level:.2g} {answer.unit}" for s in soils if np.isfinite(s.sliding_level)})
+            at = f" at {_and(level)}, the level run at or below" if level else " at"
+            text = (f"check sliding {where} ({shown} of the records{at} the {answer.return_periods[-1]:,.0f}-year "
+                    f"intensity{',' if level else ''} need more base friction than the soil's μ_s, above the "
+                    f"{percent(answer.max_sliding_share)} the study allows ([decision] max_sliding_share, the "
+                    "study's choice): the block would slide, and sliding was not computed there (its base was "
+                    'tied); compute it with [solver] friction = "all", whose slip damage states then give the '
+                    "verdict)")
             rocking = exceeded(soils)
             parts.append(text + (f", and anchor it against rocking there ({rocking})" if rocking else ""))
         else:

@@ -159,9 +159,10 @@ def test_the_study_states_the_limits_and_return_periods(tmp_path):
         assert error.value.field == field
 
 
-def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nearest_level():
+def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_level_at_or_below():
     """Issue 19: which mode governs at each return-period intensity. Mode times where the base slides; the
-    outcome where it is tied (no mode times); the recommended curve reads the band centre's runs."""
+    outcome where it is tied (no mode times); the recommended curve reads the band centre's runs; the level is
+    the one at or below the intensity, as the probability table reads it (issue 20, finding 4)."""
     import xarray as xr
 
     from pipeline.models.fields import MODE_TIME_FIELDS
@@ -184,11 +185,61 @@ def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_nea
                       {"outcome": (dims, outcome)},
                       coords={"soil": ["clay"], "block": ["skid"], "model": ["winkler-centre", "housner"],
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
-    assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.28, 0.9], 1.0) == \
+    assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.32, 1.1], 1.0) == \
         ["at rest (100% of the records)", "slides (100% of the records)", "slides and rocks (100% of the records)"]
     assert governing_modes(cube, "skid", "housner", "clay", [0.1, 0.3, 1.0], 1.0) == \
         ["at rest (100% of the records)", "rocks (100% of the records)", "overturns (75% of the records)"]
+    # 0.28 g reads the 0.1 g level (at or below, as the P table), not the nearer 0.3 g; below 0.1 g no level
+    assert governing_modes(cube, "skid", "housner", "clay", [0.28, 0.09], 1.0) == \
+        ["at rest (100% of the records)", "no level run this low"]
     assert governing_modes(None, "skid", "housner", "clay", [0.1], 1.0) == ["-"]
+
+
+def _tied_cube(outcome):
+    """A cube of one tied cell (housner, no mode times) from outcome codes (record, level), levels 0.1/0.3/1 g."""
+    levels = np.array([0.1, 0.3, 1.0])
+    dims = ("record", "im_level", "soil", "block", "model")
+    return xr.Dataset({"outcome": (dims, np.asarray(outcome, np.int8)[:, :, None, None, None])},
+                      coords={"soil": ["sand"], "block": ["cabinet"], "model": ["housner"],
+                              "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
+
+
+def test_the_governing_motion_counts_as_the_fits_do_and_a_milder_motion_is_never_below_100_percent():
+    """The client read "at rest (98%)" (at rest or worse is always 100%), "rocks (50%)" where 22 of 44 rocked
+    and 22 overturned, and a record that overturned at a lower level counted as rocking (resurrection)."""
+    from pipeline.report.answer_page import governing_modes
+
+    outcome = np.zeros((44, 3), int)
+    outcome[0, 0] = 1                     # one record of 44 lifts off at 0.1 g: the rest stay at rest
+    outcome[:22, 1], outcome[22:, 1] = 1, 2  # 22 rock, 22 overturn at 0.3 g
+    outcome[:, 2] = 1                     # at 1 g every record rocks: the 22 overturned at 0.3 g resurrect
+    outcome[0, 2] = 2
+    modes = governing_modes(_tied_cube(outcome), "cabinet", "housner", "sand", [0.1, 0.3, 1.0], 1.0)
+    assert modes == ["at rest (100% of the records)", "overturns (50% of the records)",
+                     "overturns (52% of the records)"]
+
+
+def test_the_motion_table_and_the_probability_table_agree_on_one_cell():
+    """One definition, level and counting rule: the share of records that overturn in the motion table is the
+    count of records in the probability table's cell, at the same level (issue 20, finding 4)."""
+    from pipeline.answer import _records_at
+    from pipeline.damage_states import DAMAGE_STATES
+    from pipeline.fragility import exceedance
+    from pipeline.report.answer_page import governing_modes
+
+    outcome = np.zeros((10, 3), int)
+    outcome[:, 1:] = 1
+    outcome[:3, 1] = 2  # 3 of 10 overturn at 0.3 g; at 1 g 2 more do, and the first 3 resurrect (rock)
+    outcome[3:5, 2] = 2
+    cube = _tied_cube(outcome)
+    fraction = exceedance(cube, DAMAGE_STATES["overturning"]).sel(soil="sand", block="cabinet", model="housner") \
+        .mean("record").values
+    for im in (0.5, 2.0):
+        reached, total, level = _records_at(np.array([0.1, 0.3, 1.0]), fraction, 10, im)
+        mode = governing_modes(cube, "cabinet", "housner", "sand", [im], 1.0)[0]
+        shown = percent(reached / total)
+        assert f"overturns: {shown})" in mode or mode == f"overturns ({shown} of the records)", (im, level, mode)
+    assert reached == 5  # the resurrected records count as overturned at 1 g
 
 
 def test_curves_that_cross_below_the_data_are_read_as_this_state_or_worse():
@@ -324,3 +375,112 @@ def test_the_seed_paper_is_cited_from_its_copy_and_named_in_full_on_the_methods_
         assert PAPER_TITLE in copy.read_text(encoding="utf-8").splitlines()[:5]
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     assert any(PAPER_CITATION in item.text for item in methods_items(results))
+
+
+def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from_the_fits_tail():
+    """The client read "uplift 98%, once in 13 years" from a median of 0.069 g, below the lowest level run (0.1 g),
+    where every record had already lifted off: the page gives the records' fraction there as a lower bound."""
+    from pipeline.report.answer_page import _at_cell, _below_lowest
+
+    levels = np.geomspace(0.1, 4.0, 8)
+    empirical = np.ones((levels.size, 2, 1, 2, 2))
+    empirical[:, :, :, :, 1] = np.where(levels >= 1.0, 0.5, 0.0)[:, None, None, None]  # overturning: in range
+    fragility = _fragility([[[[0.069, 1.5]]]], betas=0.3, empirical=empirical).assign(n_records=10)
+    answer = block_answers(fragility, _power_law())[0]
+    uplift, overturning = answer.soils[0].states
+    assert uplift.below_lowest == (pytest.approx(0.1), 10, 10) and overturning.below_lowest is None
+    # in life: the records' 100% at 0.1 g times P(PGA > 0.1 g), not the fit's P(PGA > 0.069 g)-like value
+    assert uplift.annual_frequency == pytest.approx(K0 * 0.1 ** -K, rel=1e-6)
+    fitted = K0 * 0.069 ** -K * math.exp(K ** 2 * 0.3 ** 2 / 2)
+    assert uplift.annual_frequency < 0.5 * fitted
+    cell = _below_lowest(uplift, "g")
+    assert cell.startswith("\u2265") and "every record at the lowest level run (0.1 g)" in cell
+    assert _at_cell(uplift, 0, answer) == "\u2265100%; 10 of 10 records"
+    assert not _at_cell(overturning, 0, answer).startswith("\u2265")
+    judged = block_answers(fragility, _power_law(), limits={"rocking-0.5": 0.1})[0]
+    assert "in 50 years at least " in verdict_sentence(judged, "cabinet")  # a lower bound is said so in the verdict
+
+
+def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run():
+    """The client read the study-wide β ranges and the cabinet's r on the crane's and the skid's pages, and the skid's
+    page did not say that its band's three runs were one run (beta_model 0 by construction)."""
+    from types import SimpleNamespace
+
+    from pipeline.report.answer_page import curve_reason
+
+    models = ["recommended", "winkler-low", "winkler-centre", "winkler-high"]
+    dims = ("soil", "block", "model")
+    requested = np.array([[0.73, 0.75, 0.76], [0.94, 0.97, 0.99], [0.46, 0.47, 0.48]])  # crane, cabinet, skid
+    reached = np.array([[0.73, 0.75, 0.76], [0.94, 0.95, 0.95], [np.nan] * 3])
+    xi = np.array([[0.5, 0.4, 0.3], [0.4, 0.16, 0.16], [0.15, 0.15, 0.15]])
+
+    def per_cell(values):  # (block, variant) -> (soil, block, model), the recommended row NaN
+        return np.concatenate([np.full((2, 3, 1), np.nan), np.broadcast_to(values, (2, 3, 3))], axis=2)
+
+    blocks = ["crane", "cabinet", "skid"]
+    cube = xr.Dataset({"restitution_requested": (dims, per_cell(requested)),
+                       "restitution_target": (dims, per_cell(reached)),
+                       "damping_ratio_calibrated": (dims, per_cell(xi))},
+                      coords={"soil": ["clay", "rock"], "block": blocks, "model": models})
+    fdims = ("soil", "block", "model", "damage_state")
+    beta_model = np.zeros((2, 3, 4, 1))
+    beta_model[:, 0], beta_model[:, 1] = 0.3, 0.41
+    r2r = np.broadcast_to(np.array([0.5, 1.17, 0.2])[None, :, None, None], (2, 3, 4, 1))
+    fragility = xr.Dataset({"beta_model": (fdims, beta_model), "beta_record_to_record": (fdims, r2r)},
+                           coords={"soil": ["clay", "rock"], "block": blocks, "model": models,
+                                   "damage_state": ["overturning"]})
+    results = SimpleNamespace(fragility=fragility, cube=cube)
+    crane, cabinet, skid = (curve_reason(results, "recommended", b) for b in blocks)
+    assert "record to record is 0.50 to 0.50 and β of the model 0.30 to 0.30" in crane
+    assert "cannot dissipate" not in crane and "collapses" not in crane
+    assert "0.990" in cabinet and "0.950" in cabinet and "collapses" not in cabinet
+    assert "0.41" in cabinet and "1.17" not in crane and "1.17" not in skid
+    assert "On every soil the band collapses to one run" in skid and "ξ = 0.15" in skid
+    assert "it reaches none of them" in skid and "because there is one run" in skid and "0.990" not in skid
+
+
+def _friction_cube():
+    """20 records at 0.24/0.31/0.41/0.54 g on gravel (mu_s 0.55): 0, 0, 0 and 9 records need more friction. The
+    band centre is tied on gravel and slides (friction computed) on clay; the low edge is tied on both."""
+    levels = np.array([0.24, 0.31, 0.41, 0.54])
+    demand = np.full((20, 4, 2, 1, 2), 0.3)
+    demand[:9, 3] = 0.8
+    friction = np.array([[[0.45, np.nan]], [[np.nan, np.nan]]])  # (soil, block, model): clay centre slides
+    dims = ("record", "im_level", "soil", "block", "model")
+    return xr.Dataset({"peak_friction_demand": (dims, demand), "outcome": (dims, np.ones(demand.shape, np.int8)),
+                       "friction_static": (("soil", "block", "model"), friction),
+                       "soil_friction_static": (("soil",), [0.45, 0.55])},
+                      coords={"soil": ["clay", "gravel"], "block": ["crane"], "model": ["winkler-centre",
+                                                                                        "winkler-low"],
+                              "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
+
+
+def test_the_sliding_share_is_the_records_at_the_level_at_or_below_the_intensity_not_a_grid_average():
+    """The client read 11-12% (an unweighted average over the levels up to the 2,475-year PGA) where 41-45% of the
+    records at the 0.54 g level needed more friction; and a cell that slides was judged by another model's ties."""
+    from pipeline.report.adapters import sliding_at, sliding_share
+
+    cube = _friction_cube()
+    models = ["recommended", "winkler-centre", "winkler-low"]
+    assert sliding_share(cube, models, "crane", "gravel", None, 0.57) == pytest.approx(0.45)
+    assert sliding_at(cube, models, "crane", "gravel", 0.57) == (pytest.approx(0.45), pytest.approx(0.54), False)
+    assert sliding_at(cube, models, "crane", "gravel", 0.5)[:2] == (0.0, pytest.approx(0.41))
+    assert np.isnan(sliding_at(cube, models, "crane", "gravel", 0.2)[1])  # no level run this low
+    share, _, computed = sliding_at(cube, models, "crane", "clay", 0.57)
+    assert computed and np.isnan(share)  # friction computed: the slip states answer, not the low edge's ties
+
+
+def test_check_sliding_names_its_level_its_threshold_and_how_to_compute_the_sliding():
+    fragility = _fragility([[[[0.3, 3.0]]]])
+    answer = block_answers(fragility, _power_law(), limits={"overturning": 0.01}, max_sliding_share=0.1,
+                           sliding={("cabinet", "clay"): 0.45, ("cabinet", "rock"): np.nan})[0]
+    clay, rock = answer.soils
+    assert (clay.verdict, rock.verdict) == (CHECK_SLIDING, NO_ACTION)
+    im = (K0 * 2475.0) ** (1 / K)
+    levels = np.geomspace(0.1, 4.0, 8)
+    assert clay.sliding_level == pytest.approx(levels[levels <= im][-1])
+    sentence = verdict_sentence(answer, "crane")
+    assert f"45% of the records at {clay.sliding_level:.2g} g, the level run at or below the 2,475-year " \
+           "intensity, need" in sentence
+    assert "10% the study allows ([decision] max_sliding_share" in sentence
+    assert "sliding was not computed there" in sentence and '[solver] friction = "all"' in sentence

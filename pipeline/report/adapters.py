@@ -326,34 +326,52 @@ def scale_factor_summary(cube) -> tuple[float, float]:
     return float(np.nanmedian(values)), float(np.nanmax(values))
 
 
-def sliding_share(cube, models, block, soil, coefficient: float | None, up_to: float) -> float:
-    """Share of the runs at levels up to ``up_to`` (unit of the levels) that need more friction than ``coefficient``.
+def sliding_candidates(cube, model: str) -> list[str]:
+    """The models whose runs tell whether a tied base slides, first preferred: the answer's, then the bed's."""
+    return [model, "winkler-centre", "winkler", *[str(m) for m in cube.model.values if str(m).startswith("winkler")]]
 
-    ``coefficient`` None: the soil's mu_s. From the first of ``models`` that the cube holds and that reports the
-    friction demand on a tied base; NaN when none does (a cell that runs with friction slides where it must: its
-    slip damage states answer instead). At least the lowest level counts, so a block whose levels all lie above
-    ``up_to`` still gets an answer from its mildest runs.
+
+def sliding_at(cube, models, block, soil, intensity: float, coefficient: float | None = None) -> tuple:
+    """(share, level, computed): the records whose tied base needs more friction than ``coefficient`` at a level.
+
+    The level is the one run nearest at or below ``intensity`` (unit of the levels), as the answer page's
+    probability table reads its records; ``share`` is the fraction of that level's valid records whose peak friction
+    demand exceeds ``coefficient`` (None: the soil's mu_s). From the first of ``models`` that the cube holds.
+    ``computed`` is True where that model's cell runs with friction (it slides where it must, and its slip damage
+    states answer: share NaN). Share and level are NaN where no level lies at or below ``intensity`` or the cube
+    has no friction demand.
     """
-    if "peak_friction_demand" not in cube:
-        return float("nan")
+    names = [m for m in models if m in set(map(str, cube.model.values))]
+    if not names:
+        return float("nan"), float("nan"), False
+    name = names[0]
+    ties = tied(cube)
+    if ties is not True and not bool(ties.sel(model=name, block=block, soil=soil)):
+        return float("nan"), float("nan"), True
+    levels = block_levels(cube, block)
+    below = np.flatnonzero(levels <= intensity * (1 + 1e-9))
+    if "peak_friction_demand" not in cube or not below.size:
+        return float("nan"), float("nan"), False
     if coefficient is None:
         friction = soil_friction(cube)
         coefficient = float(friction.sel(soil=soil)) if hasattr(friction, "sel") else float(friction)
-    ties = tied(cube)
-    names = [m for m in models if m in set(map(str, cube.model.values))]
-    levels = block_levels(cube, block)
-    keep = np.flatnonzero(levels <= up_to * (1 + 1e-9))
-    keep = keep if keep.size else np.array([0])
-    for name in names:
-        if ties is not True and not bool(ties.sel(model=name, block=block, soil=soil)):
-            continue
-        demand = cube.peak_friction_demand.sel(model=name, block=block, soil=soil).isel(im_level=keep)
-        valid = demand.notnull() & (cube.outcome.sel(model=name, block=block, soil=soil).isel(im_level=keep)
-                                    != OUTCOME_FAILED)
-        if int(valid.sum()) == 0:
-            continue
-        return float(((demand > coefficient) & valid).sum() / valid.sum())
-    return float("nan")
+    level = int(below[-1])
+    demand = cube.peak_friction_demand.sel(model=name, block=block, soil=soil).isel(im_level=level)
+    valid = demand.notnull() & (cube.outcome.sel(model=name, block=block, soil=soil).isel(im_level=level)
+                                != OUTCOME_FAILED)
+    if int(valid.sum()) == 0:
+        return float("nan"), float(levels[level]), False
+    return float(((demand > coefficient) & valid).sum() / valid.sum()), float(levels[level]), False
+
+
+def sliding_share(cube, models, block, soil, coefficient: float | None, up_to: float) -> float:
+    """Share of the records at the level at or below ``up_to`` that need more friction than ``coefficient``.
+
+    ``sliding_at``'s share: the decision's return-period intensity ``up_to`` (unit of the levels) read at one
+    level, as the probability table reads it, not an average over the levels below it (which depended on the grid's
+    spacing). NaN where the cell runs with friction (its slip damage states answer) or no level lies that low.
+    """
+    return sliding_at(cube, models, block, soil, up_to, coefficient)[0]
 
 
 def block_name(config, block) -> str:

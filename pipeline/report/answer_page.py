@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
+from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule (resurrection), in one place
 from pipeline.models.base import Outcome
 from pipeline.models.variants import split_variant
 from pipeline.report.adapters import (
@@ -25,6 +26,8 @@ from pipeline.report.adapters import (
     measure_label,
     model_info,
     planar_words,
+    sliding_at,
+    sliding_candidates,
     state_labels,
 )
 from pipeline.report.text import Item, note, paragraph, strong, table
@@ -43,11 +46,16 @@ def _years(frequency: float) -> str:
     return f"once in {years:,.0f} years"
 
 
-def _band_reach(cube) -> str:
-    """A sentence on the cells where the bed could not reach the band's restitution (empty when it did)."""
+def _band_reach(cube, block=None) -> str:
+    """A sentence on the cells where the bed could not reach the band's restitution (empty when it did).
+
+    Of one block when ``block`` is given (its answer page), else of the whole study.
+    """
     if cube is None or "restitution_requested" not in cube or "restitution_target" not in cube:
         return ""
     requested, target = cube.restitution_requested, cube.restitution_target
+    if block is not None and "block" in requested.dims:
+        requested, target = requested.sel(block=block), target.sel(block=block)
     short = (requested - target) > 5e-4  # the bed ran at a lower r than the band asked for
     if not bool(short.any()):
         return ""
@@ -59,20 +67,57 @@ def _band_reach(cube) -> str:
             "rocks more.")
 
 
-def curve_reason(results, model: str) -> str:
-    """Which curve answers and why, in words."""
+def _band_collapse(cube, block) -> str:
+    """A sentence on the soils where the band's three runs of ``block`` are one run (empty where none are).
+
+    The variants run the bed's damping ratio xi calibrated to their restitution; where the bed reaches none of the
+    band's targets, all three run at the same xi: β of the model is 0 there because there is one run, not because
+    the model is certain.
+    """
+    if cube is None or "damping_ratio_calibrated" not in cube:
+        return ""
+    band = [str(m) for m in cube.model.values if split_variant(str(m))[1] is not None]
+    if len(band) < 2:
+        return ""
+    xi = cube.damping_ratio_calibrated.sel(block=block, model=band)
+    collapsed = [str(s) for s in cube.soil.values
+                 if np.isfinite(values := np.asarray(xi.sel(soil=s).values, float)).all()
+                 and np.ptp(values) <= 1e-9 * max(abs(values).max(), 1.0)]
+    if not collapsed:
+        return ""
+    values = sorted({f"{float(xi.sel(soil=s).isel(model=0)):.3g}" for s in collapsed})
+    asked = ""
+    if "restitution_requested" in cube:
+        requested = cube.restitution_requested.sel(block=block, model=band, soil=collapsed)
+        asked = f"r {float(requested.min()):.3f} to {float(requested.max()):.3f} asked"
+        if "restitution_target" in cube:
+            reached = cube.restitution_target.sel(block=block, model=band, soil=collapsed)
+            asked += f"; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any()) \
+                else "; it reaches none of them"
+        asked = f" ({asked})"
+    where = "every soil" if len(collapsed) == cube.soil.size else ", ".join(collapsed)
+    return (f" On {where} the band collapses to one run for this block: the bed cannot tell the band's "
+            f"restitutions apart{asked}, so its three runs use the same damping ratio ξ = {' / '.join(values)}; β "
+            "of the model there is 0 because there is one run, not because the model is certain.")
+
+
+def curve_reason(results, model: str, block=None) -> str:
+    """Which curve answers and why, in words: β ranges and the band's reach of ``block`` (every block: None)."""
     fragility = results.fragility
     if model == RECOMMENDED:
         text = ("The answer uses the recommended curve: the tensionless Winkler bed run over the experimental range "
                 "of impact restitution (the edges and the centre of the band), its spread added to the "
                 "record-to-record dispersion (FEMA P-58).")
         if "beta_model" in fragility and "beta_record_to_record" in fragility:
-            rows = fragility.sel(model=RECOMMENDED)
+            rows = fragility.sel(model=RECOMMENDED) if block is None else fragility.sel(model=RECOMMENDED,
+                                                                                         block=block)
             r2r, model_beta = rows.beta_record_to_record.values, rows.beta_model.values
             if np.isfinite(r2r).any() and np.isfinite(model_beta).any():
                 text += (f" Here β from record to record is {np.nanmin(r2r):.2f} to {np.nanmax(r2r):.2f} and β of the "
                          f"model {np.nanmin(model_beta):.2f} to {np.nanmax(model_beta):.2f}.")
-        text += _band_reach(getattr(results, "cube", None))
+        text += _band_reach(getattr(results, "cube", None), block)
+        if block is not None:
+            text += _band_collapse(getattr(results, "cube", None), block)
         models = {str(m) for m in fragility.model.values}
         if "housner" in models and any(m.startswith("ssi") for m in models):
             text += (" Housner's rigid base and the paper's model are references, not inputs: the first ignores "
@@ -90,24 +135,46 @@ def curve_reason(results, model: str) -> str:
 
 
 MODE_WORDS = {"time_at_rest": "at rest", "time_sliding": "slides", "time_rocking": "rocks",
-              "time_slide_rocking": "slides and rocks", "time_in_flight": "flies"}
-"""The contact modes of a run (the time fields pipeline.models.fields.MODE_TIME_FIELDS) in words."""
+              "time_slide_rocking": "slides and rocks", "time_in_flight": "flies", "overturns": "overturns"}
+"""The contact modes of a run (the time fields pipeline.models.fields.MODE_TIME_FIELDS) and overturning in words."""
 
 
-MODE_SEVERITY = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight")
-"""The contact modes from the mildest to the most severe (a record's motion is the most severe it enters)."""
+MODE_SEVERITY = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight", "overturns")
+"""The motions from the mildest to the most severe (a record's motion is the most severe it enters); the last is
+overturning, read from the outcome as the fits read it (from a record's first overturning level on)."""
+
+NO_LEVEL = "no level run this low"
+"""A return-period intensity below every level run: the page says so (the P table's head does too), no motion."""
+
+
+def _motions(runs, overturned) -> np.ndarray | None:
+    """Each record's most severe motion (an index of ``MODE_SEVERITY``), -1 for a failed run.
+
+    From the mode times where the base slides; from the outcome where it is tied (no mode times). ``overturned``:
+    the record has overturned at this level or a lower one (``pipeline.fragility.first_overturn_outcomes``).
+    """
+    outcome = np.asarray(runs.outcome.values)
+    times = {field: np.asarray(runs[field].values, float) for field in MODE_SEVERITY[:-1] if field in runs}
+    if len(times) == len(MODE_SEVERITY) - 1 and all(np.isfinite(v).any() for v in times.values()):
+        entered = np.stack([np.nan_to_num(times[field]) > 0.0 for field in MODE_SEVERITY[:-1]])  # (mode, record)
+        worst = np.max(np.where(entered, np.arange(len(MODE_SEVERITY) - 1)[:, None], 0), axis=0)
+    else:
+        worst = np.select([outcome == int(Outcome.ROCKING), outcome == int(Outcome.FREE_FLIGHT)],
+                          [MODE_SEVERITY.index("time_rocking"), MODE_SEVERITY.index("time_in_flight")], 0)
+    worst = np.where(overturned, len(MODE_SEVERITY) - 1, worst)
+    return np.where(outcome == int(Outcome.FAILED), -1, worst)
 
 
 def governing_modes(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
-    """What the block does at each intensity: the most severe mode that at least half the records enter.
+    """What the block does at each intensity: the most severe motion that at least half the records reach.
 
-    Each record's motion is the most severe mode it spends any time in (a block that rocks for 2 s of a 40 s
-    record rocks; the longest mode would say "at rest"), ``MODE_SEVERITY``; the page shows the mode that half
-    the records reach or pass, with the share of records that reach it.
-
-    At the cube's level nearest each intensity (in the answer's unit, ``scale`` times the cube's), from the runs
-    of ``model`` (the recommended curve's: the band centre). A tied base has no mode times: there the outcome
-    says it ("at rest" without uplift, "rocks", "overturns" for most records).
+    One definition, level and counting rule with the probability table (``pipeline.answer``): each record's
+    motion is the most severe it enters (a block that rocks for 2 s of a 40 s record rocks), ``MODE_SEVERITY``,
+    overturning counted from the record's first overturning level on (as the fits count it: resurrection); the
+    share is that of the records reaching the motion or a more severe one, so "at rest" is always 100%. Read at
+    the level run nearest at or below each intensity (in the answer's unit, ``scale`` times the cube's), as the
+    probability table reads its records; ``NO_LEVEL`` where no level lies that low. From the runs of ``model``
+    (the recommended curve's: the band centre).
     """
     if cube is None or "intensity" not in cube:
         return ["-"] * len(intensities)
@@ -117,27 +184,24 @@ def governing_modes(cube, block: str, model: str, soil: str, intensities, scale:
         return ["-"] * len(intensities)
     levels = np.asarray(cube.intensity.sel(block=block).values, float) * scale
     cell = cube.sel(block=block, soil=soil, model=name)
+    overturned = first_overturn_outcomes(cell).transpose("record", "im_level").values == int(Outcome.OVERTURNED)
     out = []
     for im in intensities:
-        level = int(np.argmin(np.abs(np.log(levels / im))))
-        runs = cell.isel(im_level=level)
-        times = {field: np.asarray(runs[field].values, float) for field in MODE_SEVERITY if field in runs}
-        if len(times) == len(MODE_SEVERITY) and all(np.isfinite(v).any() for v in times.values()):
-            entered = np.stack([np.nan_to_num(times[field]) > 0.0 for field in MODE_SEVERITY])  # (mode, record)
-            worst = np.max(np.where(entered, np.arange(len(MODE_SEVERITY))[:, None], 0), axis=0)
-            reach = [float(np.mean(worst >= m)) for m in range(len(MODE_SEVERITY))]
-            mode = max(m for m in range(len(MODE_SEVERITY)) if reach[m] >= 0.5)
-            overturned = float(np.mean(runs.outcome.values == int(Outcome.OVERTURNED)))
-            text = MODE_WORDS[MODE_SEVERITY[mode]]
-            text += f" ({percent(reach[mode])} of the records"
-            out.append(text + (f"; overturns: {percent(overturned)})" if overturned > 0 else ")"))
+        below = np.flatnonzero(levels <= im * (1 + 1e-9))
+        if not below.size:
+            out.append(NO_LEVEL)
             continue
-        outcome = runs.outcome.values
-        shares = {"at rest": np.mean(outcome == int(Outcome.NO_UPLIFT)),
-                  "rocks": np.mean(outcome == int(Outcome.ROCKING)),
-                  "overturns": np.mean(outcome == int(Outcome.OVERTURNED))}
-        mode = max(shares, key=shares.get)
-        out.append(f"{mode} ({percent(shares[mode])} of the records)")
+        level = int(below[-1])
+        worst = _motions(cell.isel(im_level=level), overturned[:, level])
+        worst = worst[worst >= 0]
+        if not worst.size:
+            out.append("-")
+            continue
+        reach = [float(np.mean(worst >= m)) for m in range(len(MODE_SEVERITY))]
+        mode = max(m for m in range(len(MODE_SEVERITY)) if reach[m] >= 0.5)
+        text = f"{MODE_WORDS[MODE_SEVERITY[mode]]} ({percent(reach[mode])} of the records"
+        out.append(text + (f"; overturns: {percent(reach[-1])})" if 0 < reach[-1] and mode < len(reach) - 1
+                           else ")"))
     return out
 
 
@@ -170,7 +234,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if description:
         items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
     items.append(strong(verdict_sentence(answer, name, words)))
-    items.append(paragraph(curve_reason(results, answer.model)))
+    items.append(paragraph(curve_reason(results, answer.model, answer.block)))
     items.append(paragraph(planar_words(results.cube, answer.block)))
     items.append(paragraph(results.friction_words))
     largest = results.largest_recorded.get(answer.block)
@@ -202,13 +266,22 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         modes = [[soil.soil, *governing_modes(cube, answer.block, answer.model, soil.soil, answer.intensities, scale)]
                  for soil in answer.soils]
         if any(cell != "-" for row in modes for cell in row[1:]):
-            items.append(paragraph("What the block does at each return period's intensity, at the nearest level "
-                                   "run: the most severe motion that at least half the records reach (at rest, "
-                                   "slides, rocks, slides and rocks, flies), with the share of records that reach "
-                                   "it or a more severe one. The probabilities above read each state as 'this "
-                                   "state or worse', so a milder state is never less likely than a more severe "
-                                   "one:"))
+            items.append(paragraph("What the block does at each return period's intensity, at the level run "
+                                   "nearest at or below it (the level whose records the table above counts): the "
+                                   "most severe motion that at least half the records reach (at rest, slides, "
+                                   "rocks, slides and rocks, flies, overturns), with the share of records that "
+                                   "reach it or a more severe one. A record that overturned at a lower level "
+                                   "counts as overturned, as in the table above. The probabilities above read "
+                                   "each state as 'this state or worse', so a milder state is never less likely "
+                                   "than a more severe one:"))
             items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], modes))
+        sliding = sliding_rows(cube, answer, scale)
+        if sliding:
+            items.append(paragraph("Share of the records whose tied base needs more base friction than the soil's "
+                                   f"μ_s ({results.friction_text}), at the level run at or below each return "
+                                   "period's intensity (the verdict reads the "
+                                   f"{answer.return_periods[-1]:,.0f}-year one):"))
+            items.append(table(["soil", *(f"{t:,.0f} years" for t in answer.return_periods)], sliding))
         limits = {s: s_limit for s, s_limit in results.decision["max_probability_in_life"].items() if s in labels}
         life = f"{answer.design_life:g} years"
         header = ["damage state", f"limit in {life}", *(f"on {soil.soil}" for soil in answer.soils)]
@@ -217,7 +290,9 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
             cells = [short[state], percent(limits[state]) if state in limits else "none"]
             for soil in answer.soils:
                 row = soil.states[index]
-                if row.not_reached_below is not None:
+                if row.below_lowest is not None:
+                    cells.append(_below_lowest(row, unit))
+                elif row.not_reached_below is not None:
                     cells.append(f"<{percent(row.probability_in_life)}, not reached below "
                                  f"{row.not_reached_below:.2g} {unit}")
                 elif np.isfinite(row.probability_in_life):
@@ -233,18 +308,48 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         judged = ", ".join(f"{short[s]} {percent(v)}" for s, v in limits.items())
         items.append(note(f"Verdict: 'anchor' where a probability in {life} exceeds the study's limit "
                           f"({judged or 'none set'}; an anchorage holds the block against sliding too); else 'check "
-                          f"sliding' where more than {percent(results.decision['max_sliding_share'])} of the runs up "
-                          f"to the {answer.return_periods[-1]:,.0f}-year intensity need a base friction above the "
-                          f"soil's μ_s ({results.friction_text}) on a tied base (the runs with friction answer with "
-                          "their slip damage states); else 'no action'. States "
+                          f"sliding' where more than {percent(answer.max_sliding_share)} ([decision] "
+                          "max_sliding_share, the study's choice) of the records at the level run at or below the "
+                          f"{answer.return_periods[-1]:,.0f}-year intensity need a base friction above the soil's "
+                          f"μ_s ({results.friction_text}) on a tied base, where sliding was not computed (compute "
+                          'it with [solver] friction = "all"); where the base runs with friction, its slip damage '
+                          "states give the verdict; else 'no action'. States "
                           "without a limit are reported, not judged. 'not reached below X': no record reached the "
                           "state at any level up to X, so its probability is at most that of exceeding X. 'fit's "
                           "tail': above the limit only through intensities below every record that reached the "
-                          "state (the verdict says so)."))
+                          "state (the verdict says so). '\u2265' with the records at the lowest level run: the fitted "
+                          "median lies below every level run, so instead of the fit's extrapolated tail the page "
+                          "gives the records' fraction at the level (in life: times the probability of exceeding "
+                          "the lowest level), a lower bound."))
     else:
         items.append(paragraph(f"The study has no hazard curve for {measure}: no return-period intensities and no "
                                "probability in the design life. The fragility curves are on the pages that follow."))
     return items
+
+
+def sliding_rows(cube, answer: BlockAnswer, scale: float) -> list[list[str]]:
+    """Per soil, the share of records whose tied base needs more friction than μ_s at each return period's level.
+
+    ``pipeline.report.adapters.sliding_at`` at the level run at or below each intensity (``scale``: the answer's
+    unit per the cube's); "sliding computed" where the cell runs with friction (its slip states answer). Empty
+    when the cube has no friction demand.
+    """
+    if cube is None or "peak_friction_demand" not in cube or not answer.intensities:
+        return []
+    candidates = sliding_candidates(cube, answer.model)
+    rows = []
+    for soil in answer.soils:
+        cells = []
+        for im in answer.intensities:
+            share, level, computed = sliding_at(cube, candidates, answer.block, soil.soil, im / scale)
+            if computed:
+                cells.append("sliding computed: see the slip states")
+            elif not np.isfinite(level):
+                cells.append(NO_LEVEL)
+            else:
+                cells.append(f"{percent(share)} (records at {level * scale:.2g}\u00a0{answer.unit})")
+        rows.append([soil.soil, *cells])
+    return rows
 
 
 def _period_header(answer: BlockAnswer, soil, index: int, measure: str) -> str:
@@ -267,6 +372,11 @@ def _at_cell(state, index: int, answer: BlockAnswer) -> str:
     im = answer.intensities[index]
     if state.not_reached_below is not None and im <= state.not_reached_below:
         return "not reached"
+    if state.below_lowest is not None:  # the fit's median is below every level: the records' fraction bounds P
+        if not np.isfinite(p) or not state.records:
+            return NO_LEVEL if not np.isfinite(p) else f"\u2265{percent(p)}"
+        reached, total, _ = state.records[index]
+        return f"\u2265{percent(p)}; {reached} of {total} records"
     if not np.isfinite(p):
         return "-"
     text = percent(p)
@@ -278,6 +388,17 @@ def _at_cell(state, index: int, answer: BlockAnswer) -> str:
     if state.fit_only(index):
         return text + (f"; fit only, {max(reached, 0)} of {total} records" if reached >= 0 else "; fit only")
     return text + f"; {reached} of {total} records"
+
+
+def _below_lowest(row, unit: str) -> str:
+    """The design-life cell of a state whose fitted median lies below the lowest level run: a lower bound.
+
+    "≥98%, every record at the lowest level run (0.1 g)": the fitted curve below that level is an extrapolation,
+    so the page gives the records' fraction there times P(intensity above it), mirroring "not reached below X".
+    """
+    level, reached, total = row.below_lowest
+    who = "every record" if reached == total else f"{reached} of {total} records"
+    return f"\u2265{percent(row.probability_in_life)}, {who} at the lowest level run ({level:.2g} {unit})"
 
 
 def _confidence(fragility) -> str:
