@@ -638,7 +638,8 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
             at = f" at {_and(level)}, the level run at or below" if level else " at"
             text = (f"check sliding {where} ({shown} of the records{at} the {answer.return_periods[-1]:,.0f}-year "
                     f"intensity{',' if level else ''} need more base friction than the soil's μ_s, above the "
-                    f"{percent(answer.max_sliding_share)} the study allows ([decision] max_sliding_share, the "
+                    f"{percent(answer.max_sliding_share)} the study allows ([decision] max_sliding_share = "
+                    f"{answer.max_sliding_share:g}, the "
                     "study's choice): the block would slide, and sliding was not computed there (its base was "
                     'tied); compute it with [solver] friction = "all", whose slip damage states then give the '
                     "verdict)")

@@ -484,3 +484,24 @@ def test_check_sliding_names_its_level_its_threshold_and_how_to_compute_the_slid
            "intensity, need" in sentence
     assert "10% the study allows ([decision] max_sliding_share" in sentence
     assert "sliding was not computed there" in sentence and '[solver] friction = "all"' in sentence
+
+
+def test_answer_page_says_when_the_measure_is_not_sufficient():
+    """The efficiency stage's sufficiency test reaches the answer: p < 0.05 for a parameter of the study's measure is
+    one sentence naming it; sufficient (or no test for the block) is none."""
+    import xarray as xr
+
+    from pipeline.report.answer_page import sufficiency_words
+
+    dims = ("soil", "block", "model", "measure")
+    p = np.full((1, 2, 1, 2), 0.5)
+    p[0, 0, 0, 0] = 1e-5  # block a, study measure pga: depends on the pulse period
+    efficiency = xr.Dataset({"p_pulse_period": (dims, p), "p_magnitude": (dims, np.full_like(p, 0.3))},
+                            coords={"soil": ["clay"], "block": ["a", "b"], "model": ["housner"],
+                                    "measure": ["pga", "pgv"]})
+    words = sufficiency_words(efficiency, "a", "pga", "PGA")
+    assert "pulse period (p < 0.001)" in words and "magnitude" not in words and "PGA" in words
+    assert sufficiency_words(efficiency, "b", "pga", "PGA") == ""
+    assert sufficiency_words(efficiency, "a", "pgv", "PGV") == ""
+    assert sufficiency_words(efficiency, "missing", "pga", "PGA") == ""
+    assert sufficiency_words(None, "a", "pga", "") == ""

@@ -236,6 +236,10 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     items.append(strong(verdict_sentence(answer, name, words)))
     items.append(paragraph(curve_reason(results, answer.model, answer.block)))
     items.append(paragraph(planar_words(results.cube, answer.block)))
+    sufficiency = sufficiency_words(results.efficiency, answer.block, results.cube.attrs.get("intensity_measure", ""),
+                                    measure_label(results.cube).split(" [")[0])
+    if sufficiency:
+        items.append(paragraph(sufficiency))
     items.append(paragraph(results.friction_words))
     largest = results.largest_recorded.get(answer.block)
     hazard = results.hazard
@@ -309,7 +313,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(note(f"Verdict: 'anchor' where a probability in {life} exceeds the study's limit "
                           f"({judged or 'none set'}; an anchorage holds the block against sliding too); else 'check "
                           f"sliding' where more than {percent(answer.max_sliding_share)} ([decision] "
-                          "max_sliding_share, the study's choice) of the records at the level run at or below the "
+                          f"max_sliding_share = {answer.max_sliding_share:g}, the study's choice) of the records at "
+                          "the level run at or below the "
                           f"{answer.return_periods[-1]:,.0f}-year intensity need a base friction above the soil's "
                           f"μ_s ({results.friction_text}) on a tied base, where sliding was not computed (compute "
                           'it with [solver] friction = "all"); where the base runs with friction, its slip damage '
@@ -417,3 +422,37 @@ def _no_curve(fragility, answer: BlockAnswer, soil, state, unit) -> str:
     if status == "deterministic-threshold":
         return "at the uplift threshold"
     return "-"
+
+
+SUFFICIENCY_PARAMETERS = {"p_pulse_period": "the records' pulse period", "p_magnitude": "the earthquake's magnitude",
+                          "p_distance": "the distance to the fault"}
+"""The efficiency stage's sufficiency tests (efficiency.nc, Luco & Cornell 2007) and the words for each."""
+
+SUFFICIENCY_LEVEL = 0.05
+"""Below this p-value the overturning capacity in the study's measure still depends on the parameter."""
+
+
+def sufficiency_words(efficiency, block: str, study_measure: str, measure: str) -> str:
+    """One sentence when the study's measure is not sufficient for this block's overturning ("" when it is).
+
+    Reads the smallest p-value over the block's soils and models of each parameter of ``SUFFICIENCY_PARAMETERS``
+    for the study's measure (``study_measure``, its name in efficiency.nc; ``measure``, its label). A parameter
+    with p < 0.05 still moves the capacity at a given intensity: the curve holds for records like the study's.
+    """
+    if efficiency is None or study_measure not in efficiency.coords.get("measure", []) \
+            or block not in efficiency.block.values:
+        return ""
+    failing = []
+    for variable, words in SUFFICIENCY_PARAMETERS.items():
+        if variable not in efficiency:
+            continue
+        values = efficiency[variable].sel(block=block, measure=study_measure).values
+        if np.isfinite(values).any() and float(np.nanmin(values)) < SUFFICIENCY_LEVEL:
+            smallest = float(np.nanmin(values))
+            failing.append(f"{words} (p {'< 0.001' if smallest < 0.001 else f'= {smallest:.2g}'})")
+    if not failing:
+        return ""
+    return (f"Sufficiency: at a given {measure} the overturning capacity still depends on {' and '.join(failing)} "
+            "(measure-efficiency page; Luco & Cornell 2007), so these curves hold for ground motions like the "
+            "study's records; for a site whose motions differ in that (near a fault: velocity pulses), run the "
+            "study with records like the site's (e.g. the near-field set).")
