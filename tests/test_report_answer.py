@@ -505,3 +505,20 @@ def test_answer_page_says_when_the_measure_is_not_sufficient():
     assert sufficiency_words(efficiency, "a", "pgv", "PGV") == ""
     assert sufficiency_words(efficiency, "missing", "pga", "PGA") == ""
     assert sufficiency_words(None, "a", "pga", "") == ""
+
+
+def test_an_anchor_verdict_says_how_the_anchorage_is_designed(small_pipeline):
+    """'Anchor it' came without a design basis (client read): the page points to the code procedure, exactly where a
+    soil's verdict is 'anchor'."""
+    from pipeline.report.answer_page import ANCHOR_DESIGN, answer_items
+    from tests.helpers import pipeline_results
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    assert "ASCE 7-22 Chapter 13" in ANCHOR_DESIGN and "F_p" in ANCHOR_DESIGN
+    from dataclasses import replace
+
+    for answer in results.answers:
+        for verdicts in ([s.verdict for s in answer.soils], [ANCHOR] + [s.verdict for s in answer.soils][1:]):
+            changed = replace(answer, soils=[replace(s, verdict=v) for s, v in zip(answer.soils, verdicts)])
+            texts = [item.text for item in answer_items(results, changed)]
+            assert (ANCHOR_DESIGN in texts) == (ANCHOR in verdicts)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.answer import RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
+from pipeline.answer import ANCHOR, RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
 from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule (resurrection), in one place
 from pipeline.models.base import Outcome
 from pipeline.models.variants import split_variant
@@ -309,6 +309,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(paragraph(f"Probability of each damage state in the design life of {life} (and how often it "
                                "happens on average), per soil:"))
         items.append(table(header, rows))
+        if any(soil.verdict.startswith(ANCHOR) for soil in answer.soils):
+            items.append(paragraph(ANCHOR_DESIGN))
         judged = ", ".join(f"{short[s]} {percent(v)}" for s, v in limits.items())
         items.append(note(f"Verdict: 'anchor' where a probability in {life} exceeds the study's limit "
                           f"({judged or 'none set'}; an anchorage holds the block against sliding too); else 'check "
@@ -423,6 +425,14 @@ def _no_curve(fragility, answer: BlockAnswer, soil, state, unit) -> str:
         return "at the uplift threshold"
     return "-"
 
+
+ANCHOR_DESIGN = ("'Anchor' says that the block must not stand free; it does not size the anchorage. Design it as a "
+                 "nonstructural component fixed to its support (ASCE 7-22 Chapter 13: the horizontal design force "
+                 "F_p from the site's design spectral acceleration S_DS, with the overturning moment and uplift it "
+                 "causes on the anchors; or the equipment's own seismic qualification standard, e.g. IEEE 693 for "
+                 "substation equipment). Once anchored the block no longer rocks, so this report's curves no "
+                 "longer apply to it.")
+"""What an 'anchor' verdict asks for and where its design comes from (the report computes no anchor force)."""
 
 SUFFICIENCY_PARAMETERS = {"p_pulse_period": "the records' pulse period", "p_magnitude": "the earthquake's magnitude",
                           "p_distance": "the distance to the fault"}
