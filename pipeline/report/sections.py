@@ -610,8 +610,47 @@ def _counts(fragility, model, block, soil, state, n_records) -> str:
     return ", ".join(shown) or "-"
 
 
-NO_MEDIAN = {"below-range": "reached below the lowest level", "not-reached": "never reached"}
-"""Why a curve has no median, in the limitations' table."""
+NO_MEDIAN = {"below-range": "reached below the lowest level", "above-range": "reached only at the highest levels",
+             "not-reached": "no record reached it"}
+"""Why a curve has no median: the reason column of the limitations' table (short: one table row each)."""
+OUTSIDE = {"below": "below the lowest level", "above": "above the highest level"}
+"""Where an extrapolated median lies: the reason column of the limitations' table."""
+
+
+def _models_words(labels, every_model) -> str:
+    """Models of a merged row in the fewest words: "every model", "every model but X", or the labels.
+
+    Labels with a shared start say it once: "Winkler bed, tensionless, band low edge / band centre".
+    """
+    if len(labels) == 1:
+        return labels[0]
+    if set(labels) == set(every_model):
+        return "every model"
+    groups: dict[str, list[str]] = {}
+    for label in labels:
+        start = label.rsplit(", ", 1)[0] + ", " if ", " in label else label
+        groups.setdefault(start, []).append(label[len(start):] if start != label else label)
+    listed = "; ".join(start + " / ".join(ends) if start not in ends else start for start, ends in groups.items())
+    missing = [label for label in every_model if label not in labels]
+    but = f"every model but {'; '.join(missing)}"
+    return but if len(but) < len(listed) else listed
+
+
+def _merged(rows, models_at, every_model) -> list[list[str]]:
+    """Rows that differ only in their model (column ``models_at``) as one row naming the models.
+
+    ``every_model`` lists the labels that together read "every model" (in their order).
+    """
+    merged: dict[tuple, list[str]] = {}
+    for row in rows:
+        key = tuple(row[:models_at] + row[models_at + 1:])
+        merged.setdefault(key, []).append(row[models_at])
+    out = []
+    for key, labels in merged.items():
+        labels = list(dict.fromkeys(labels))
+        shown = _models_words(labels, every_model)
+        out.append([*key[:models_at], shown, *key[models_at:]])
+    return out
 
 
 def limitations_items(results: Results) -> list[Item]:
@@ -686,6 +725,9 @@ def limitations_items(results: Results) -> list[Item]:
     order = {name: {str(v): i for i, v in enumerate(fragility[name].values)} for name in ("block", "model", "soil")}
     outside = outside.sort_values(["block", "model", "soil"], key=lambda column: column.map(order[column.name]))
     labels = state_labels(fragility)
+    short_states = {name: state_short_label(name, str(text)) for name, text in
+                    zip(map(str, fragility.damage_state.values), fragility["damage_state_description"].values)} \
+        if "damage_state_description" in fragility.coords else {}
     scale, unit = display_scale(_level_units(fragility))
     if outside.empty:
         items.append(paragraph("Every fitted median lies inside the studied intensity range."))
@@ -693,40 +735,33 @@ def limitations_items(results: Results) -> list[Item]:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
             "lognormal fit beyond the levels that were run (the summary marks them * for the states it shows)."))
+        every_model = [short_label(m) for m in models_of(fragility)]
         rows = []
-        for row in outside.head(EXTRAPOLATION_ROWS).itertuples():
+        for row in outside.itertuples():
             levels = block_levels(fragility, row.block) * scale
-            rows.append([block_name(config, row.block), model_info(row.model).label,
+            median = row.median * scale
+            rows.append([block_name(config, row.block), short_label(model_info(row.model)),
                          "(any)" if (row.model, str(row.block)) in rigid else row.soil,
-                         labels.get(row.damage_state, row.damage_state),
-                         _g(row.median * scale), f"{levels.min():.2g} to {levels.max():.2g}", plain(row.status)])
+                         short_states.get(row.damage_state) or labels.get(row.damage_state, row.damage_state),
+                         _g(median), f"{levels.min():.2g} to {levels.max():.2g}",
+                         OUTSIDE["below" if median < levels.min() else "above"]])
+        rows = _merged(rows, 1, every_model)
         items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
-                            "what it is"], rows))
-        if len(outside) > EXTRAPOLATION_ROWS:
-            items.append(note(f"... and {len(outside) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
+                            "median lies"], rows[:EXTRAPOLATION_ROWS]))
+        if len(rows) > EXTRAPOLATION_ROWS:
+            items.append(note(f"... and {len(rows) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
     unfitted = status[status.status == "no fit"]
     if "status" in fragility and not unfitted.empty:  # a tied cell's slip states have no curve by design
         applicable = [str(fragility["status"].sel(soil=r.soil, block=r.block, model=r.model,
                                                   damage_state=r.damage_state).values) != NOT_APPLICABLE
                       for r in unfitted.itertuples()]
         unfitted = unfitted[applicable]
-    short_states = {name: state_short_label(name, str(text)) for name, text in
-                    zip(map(str, fragility.damage_state.values), fragility["damage_state_description"].values)} \
-        if "damage_state_description" in fragility.coords else {}
     if not unfitted.empty:
         n_records = int(fragility.n_records) if "n_records" in fragility else results.cube.sizes["record"]
-        fitted_status = fragility["status"] if "status" in fragility else None
+        rows = _no_median_rows(fragility, config, unfitted, rigid, short_states, n_records)
         items.append(paragraph(f"{len(unfitted)} curves have no median. The records that reached the state at the "
-                               "lowest and the highest level of the block say why:"))
-        rows = []
-        for row in unfitted.itertuples():
-            why = str(fitted_status.sel(soil=row.soil, block=row.block, model=row.model,
-                                        damage_state=row.damage_state).values) if fitted_status is not None else ""
-            rows.append([block_name(config, row.block), short_label(model_info(row.model)),
-                         "(any)" if (row.model, str(row.block)) in rigid else row.soil,
-                         short_states.get(row.damage_state, ""),
-                         _counts(fragility, row.model, row.block, row.soil, row.damage_state, n_records),
-                         NO_MEDIAN.get(why, plain(why) if why else "no fit")])
+                               "lowest and the highest level of the block say why; a state no record reached at any "
+                               "level is one row per block and state, naming its models and soils:"))
         items.append(table(["block", "model", "soil", "damage state", "records reaching it: lowest, highest level",
                             "why no median"], rows))
 
@@ -742,6 +777,52 @@ def limitations_items(results: Results) -> list[Item]:
                 items.append(paragraph(f"{model.label}: {_percent(share)} of the runs stopped (too many events or "
                                        "steps); they are left out of the fits."))
     return items
+
+
+def _soils_words(names, every_soil) -> str:
+    """Soils of a summary row in the fewest words: "every soil", "every soil but rock", or "clay, sand"."""
+    if set(names) in ({"(any)"}, set(every_soil)):
+        return "every soil"
+    missing = [soil for soil in every_soil if soil not in names]
+    return f"every soil but {', '.join(missing)}" if len(missing) < len(names) else ", ".join(names)
+
+
+def _no_median_rows(fragility, config, unfitted, rigid, short_states, n_records) -> list[list[str]]:
+    """The rows of the "no median" table: one per curve; one per block and state for the states no record reached.
+
+    A summary row names its models and soils ("every model", "every soil", "every soil but rock").
+    """
+    fitted_status = fragility["status"] if "status" in fragility else None
+    every_model = [short_label(m) for m in models_of(fragility)]
+    every_soil = list(map(str, fragility.soil.values))
+    order = {str(state): index for index, state in enumerate(fragility.damage_state.values)}
+    blocks = {str(block): index for index, block in enumerate(fragility.block.values)}
+    rows, never = [], {}
+    for row in unfitted.itertuples():
+        why = str(fitted_status.sel(soil=row.soil, block=row.block, model=row.model,
+                                    damage_state=row.damage_state).values) if fitted_status is not None else ""
+        soil = "(any)" if (row.model, str(row.block)) in rigid else str(row.soil)
+        if why == "not-reached":  # the same words for every model and soil: one summary row per block and state
+            never.setdefault((str(row.block), str(row.damage_state)), {}).setdefault(
+                short_label(model_info(row.model)), []).append(soil)
+            continue
+        rows.append((blocks[str(row.block)], order[str(row.damage_state)],
+                     [block_name(config, row.block), short_label(model_info(row.model)), soil,
+                      short_states.get(row.damage_state, ""),
+                      _counts(fragility, row.model, row.block, row.soil, row.damage_state, n_records),
+                      NO_MEDIAN.get(why, plain(why) if why else "no fit")]))
+    for (block, state), soils in never.items():
+        by_soils: dict[tuple, list[str]] = {}
+        for model, names in soils.items():
+            by_soils.setdefault(tuple(names), []).append(model)
+        for names, models in by_soils.items():
+            shown_soils = _soils_words(names, every_soil)
+            shown_models = _models_words(models, every_model)
+            rows.append((blocks[block], order[state],
+                         [block_name(config, block), shown_models, shown_soils, short_states.get(state, ""),
+                          f"0 of {n_records} at every level", NO_MEDIAN["not-reached"]]))
+    rows.sort(key=lambda entry: entry[:2])  # stable: a block's states in order, each state's rows together
+    return _merged([row for *_, row in rows], 1, every_model)
 
 
 def free_flight_items(cube, models) -> list[Item]:

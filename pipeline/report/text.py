@@ -136,6 +136,7 @@ TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type acr
 
 
 TABLE_SIZE = 8.5  # pt, table type; smaller (down to MIN_TABLE_SIZE) only for a table too wide for the page
+WRAPPED_MIN = 24  # characters: a column wrapped no narrower stays readable, so its table is not split (fit_table)
 MIN_TABLE_SIZE = 7.5  # pt: below it a client cannot read a printed table; a wider table is split (fit_table)
 
 
@@ -148,10 +149,11 @@ def _column_widths(item) -> list[int]:
 def fit_table(item) -> list[Item]:
     """A table as one or more tables that each fit the page width in type of at least ``MIN_TABLE_SIZE``.
 
-    A table that fits is returned as it is. A wider one is split by columns, each part repeating the first
-    column (the row's key: soil, block, damage state); a column still too wide with the key beside it has
-    its cells wrapped onto continuation rows (the other cells blank). Nothing is cut. Any other item is
-    returned as it is.
+    A table that fits is returned as it is. A wider one whose long cells fit wrapped onto lines of at least
+    ``WRAPPED_MIN`` characters is returned wrapped (one table). Any other is split by columns, each part
+    repeating the first column (the row's key: soil, block, damage state); a column still too wide with the
+    key beside it has its cells wrapped onto continuation rows (the other cells blank). Nothing is cut. Any
+    other item is returned as it is.
 
     Parameters
     ----------
@@ -168,6 +170,10 @@ def fit_table(item) -> list[Item]:
     widths = _column_widths(item)
     if sum(w + 2 for w in widths) <= room or len(widths) < 2:
         return [_wrapped_rows(item, room)]
+    wrapped = _wrapped_rows(item, room)  # one table whose long cells wrap reads better than two halves of it
+    after = _column_widths(wrapped)
+    if sum(w + 2 for w in after) <= room and all(a >= min(b, WRAPPED_MIN) for a, b in zip(after, widths)):
+        return [wrapped]
     groups, current = [], []
     for column in range(1, len(widths)):
         if current and widths[0] + 2 + sum(widths[c] + 2 for c in current + [column]) > room:
