@@ -288,3 +288,26 @@ def test_the_methods_page_states_the_scale_factors(small_pipeline):
         factors = cube.scale_factor.values
     text = " ".join(item.text for item in methods_items(results))
     assert f"median {np.nanmedian(factors):.2g}, largest {np.nanmax(factors):.3g}" in text
+
+
+def test_the_kinetic_friction_ratio_is_read_from_the_soils_not_written_twice():
+    """Issue 20: the sources said "Kinetic friction 0.8 × static" while the shipped soils are 0.85 × (steel 0.8 ×)."""
+    import pipeline.soils
+    from pipeline.report.sections import _kinetic_words
+    from pipeline.soils import SOILS
+
+    words = _kinetic_words(list(SOILS.values()))
+    ratio = pipeline.soils.KINETIC_OVER_STATIC
+    usual = [s.name for s in SOILS.values() if round(ratio * s.friction_static, 2) == s.friction_kinetic]
+    assert usual and f"{ratio:g} × static (rounded to 0.01) on {', '.join(usual)}" in words
+    for soil in SOILS.values():
+        if soil.name not in usual:
+            assert f"on {soil.name} {soil.friction_kinetic / soil.friction_static:.2g} × static" in words
+
+
+def test_the_glossary_explains_flight_and_the_pulse_measures():
+    from pipeline.report.words import GLOSSARY
+
+    terms = " ".join(term for term, _ in GLOSSARY)
+    for word in ("flies", "free flight", "pulse period", "pulse acceleration"):
+        assert word in terms, word

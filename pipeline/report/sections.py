@@ -547,6 +547,21 @@ LIMIT_SOURCES = {
 """Where the shipped verdict limits (pipeline.answer.DEFAULT_LIMITS) come from."""
 
 
+def _kinetic_words(soils) -> str:
+    """Kinetic over static friction of the shipped soils, read from pipeline.soils.
+
+    "Kinetic friction 0.85 × static (rounded to 0.01) on clay, sand; on steel 0.8 × static".
+    """
+    from pipeline.soils import KINETIC_OVER_STATIC
+
+    usual = [soil.name for soil in soils
+             if round(KINETIC_OVER_STATIC * soil.friction_static, 2) == soil.friction_kinetic]
+    own = [f"on {soil.name} {soil.friction_kinetic / soil.friction_static:.2g} × static" for soil in soils
+           if soil.name not in usual]
+    words = [f"{KINETIC_OVER_STATIC:g} × static (rounded to 0.01) on {', '.join(usual)}"] if usual else []
+    return "Kinetic friction " + "; ".join(words + own)
+
+
 def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
     from pipeline.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
@@ -576,7 +591,7 @@ def sources_items(results: Results) -> list[Item]:
         items.append(bullet(f"Base friction μ_s of {names} ({results.friction_text}): the ultimate friction factor "
                             "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
                             "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
-                            "360-16, J3.8). Kinetic friction 0.8 × static: " + STUDY_CHOICE + "."))
+                            f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + STUDY_CHOICE + "."))
     items.append(bullet(results.friction_words))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
