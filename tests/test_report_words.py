@@ -311,3 +311,16 @@ def test_the_glossary_explains_flight_and_the_pulse_measures():
     terms = " ".join(term for term, _ in GLOSSARY)
     for word in ("flies", "free flight", "pulse period", "pulse acceleration"):
         assert word in terms, word
+
+
+def test_slip_states_carry_their_unit_in_table_headers():
+    """Issue 20: the answer tables headed the slip states "slip 0.05" and "slip 0.30", with no unit."""
+    from pipeline.damage_states import DAMAGE_STATES, is_slip_state
+    from pipeline.report.words import state_short_label
+
+    slips = [state for state in DAMAGE_STATES.values() if is_slip_state(state)]
+    assert slips
+    for state in slips:
+        label = state_short_label(state.name, state.description)
+        assert label.endswith(" m") and f"{state.threshold:.2f}" in label, label
+    assert state_short_label("rocking-0.5", "theta_max/alpha >= 0.5") == "θmax/α ≥ 0.5"

@@ -181,7 +181,15 @@ def glossary_items() -> list[Item]:
 
 
 def state_short_label(name: str, description: str) -> str:
-    """A damage state in a table header: its description when short ("θmax/α ≥ 0.5"), else its name in words."""
+    """A damage state in a table header: its description when short ("θmax/α ≥ 0.5"), else its name in words.
+
+    A slip state says its threshold with its unit ("slip ≥ 0.05 m"): its name alone ("slip 0.05") gives no unit.
+    """
+    from pipeline.damage_states import DAMAGE_STATES, is_slip_state
+
+    state = DAMAGE_STATES.get(name)
+    if state is not None and is_slip_state(state):
+        return f"slip ≥ {state.threshold:.2f} m"  # the slip EDP is in metres (pipeline.damage_states)
     text = description.replace("theta_max", "θmax").replace("alpha", "α").replace(">=", "≥")
     if text and len(text) <= 16:
         return text
