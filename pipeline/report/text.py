@@ -28,7 +28,8 @@ MIN_HEADER = 12  # characters: a header is not wrapped narrower than this to mak
 class Item:
     """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table.
 
-    ``part`` is the index of the section the item belongs to when several sections share pages (``pack``).
+    ``part`` is the index of the section the item belongs to when several sections share pages (``pack``);
+    ``anchor`` the HTML id of a heading that starts a section part-way down a page (the contents links it).
     """
 
     kind: str
@@ -36,6 +37,7 @@ class Item:
     header: list = field(default_factory=list)
     rows: list = field(default_factory=list)
     part: int = 0
+    anchor: str = ""
 
 
 def heading(text: str) -> Item:
@@ -300,7 +302,8 @@ def items_html(items) -> str:
             parts.append("</ul>")
             in_list = False
         if item.kind == "heading":
-            parts.append(f"<h3>{html.escape(item.text)}</h3>")
+            anchor = f" id='{html.escape(item.anchor, quote=True)}'" if item.anchor else ""
+            parts.append(f"<h3{anchor}>{html.escape(item.text)}</h3>")
         elif item.kind == "bullet":
             parts.append(f"<li>{html.escape(item.text)}</li>")
         elif item.kind == "strong":
