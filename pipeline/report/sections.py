@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from datetime import datetime, timezone
 from functools import cached_property
 from pathlib import Path
 
@@ -29,6 +30,7 @@ from pipeline.answer import (
     percent,
     records_reaching,
 )
+from pipeline.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
 from pipeline.config import StudyConfig
 from pipeline.damage_states import NOT_APPLICABLE
 from pipeline.errors import PipelineError
@@ -235,13 +237,36 @@ def runs_words(results) -> str:
         text += f" and {refining:,} more refining the overturning capacities"
     run = results.run or {}
     if "cells" in run and "cells_reused" in run and "runs_computed" in run:
-        if int(run["cells_reused"]):
-            text += (f"; this run computed {int(run['runs_computed']):,} grid runs and took {int(run['cells_reused'])}"
-                     f" of its {int(run['cells'])} cells (record × block × soil × model) from the checkpoints of an "
-                     "earlier run")
+        if int(run["cells_reused"]) and not int(run["runs_computed"]):
+            text += ("; all results were computed in an earlier run of the same study, and this report was "
+                     "redrawn from them")
+        elif int(run["cells_reused"]):
+            text += (f"; {int(run['runs_computed']):,} of them were computed for this report, the results of "
+                     f"{int(run['cells_reused'])} of its {int(run['cells'])} record, block, soil and model "
+                     "combinations in an earlier run of the same study")
         else:
-            text += "; all computed in this run (none taken from checkpoints)"
+            text += "; all computed for this report"
     return text
+
+
+CHECKPOINTS = ".checkpoints"
+"""The folder of a study's cell checkpoints inside its output folder (pipeline.study writes them there)."""
+
+
+def results_date(output) -> str | None:
+    """The date the results were computed: "26 November 2026" (UTC), or None when no result file is found.
+
+    The newest checkpoint of the study's cells (``<output>/.checkpoints``: a report redrawn from an earlier run's
+    results keeps that run's date), else the modification time of ``cube.nc`` (it records no creation time).
+    """
+    output = Path(output)
+    times = [path.stat().st_mtime for path in (output / CHECKPOINTS).glob(f"*{CHECKPOINT_SUFFIX}")]
+    if not times and (output / "cube.nc").is_file():
+        times = [(output / "cube.nc").stat().st_mtime]
+    if not times:
+        return None
+    day = datetime.fromtimestamp(max(times), tz=timezone.utc)
+    return f"{day.day} {day:%B %Y}"
 
 
 STIFF_BASE = 1e10
@@ -286,6 +311,7 @@ def title_items(results: Results) -> list[Item]:
                   f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
+        *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
         paragraph("The next pages answer the question for each block: at the site's return periods, how likely it "
                   "is to rock or overturn, how likely in its design life, and what to do. Then the fragility of "
                   "each block on each soil for each model, the methods and assumptions behind the numbers, and "
