@@ -436,9 +436,9 @@ def test_the_title_page_says_in_words_that_results_came_from_an_earlier_run_and_
     assert results_date(tmp_path) is None
     (tmp_path / "cube.nc").write_bytes(b"")
     os.utime(tmp_path / "cube.nc", (0, 1_700_000_000))  # 14 November 2023, 22:13 UTC
-    assert results_date(tmp_path) == "14 November 2023"
+    assert results_date(tmp_path) == "2023-11-14"
     checkpoints = tmp_path / ".checkpoints"
     checkpoints.mkdir()
     (checkpoints / "k.ckpt").write_bytes(b"")
     os.utime(checkpoints / "k.ckpt", (0, 1_600_000_000))  # 13 September 2020: when the cells were computed
-    assert results_date(tmp_path) == "13 September 2020"
+    assert results_date(tmp_path) == "2020-09-13"

@@ -254,7 +254,7 @@ CHECKPOINTS = ".checkpoints"
 
 
 def results_date(output) -> str | None:
-    """The date the results were computed: "26 November 2026" (UTC), or None when no result file is found.
+    """The date the results were computed, ISO 8601 ("2026-11-26", UTC), or None when no result file is found.
 
     The newest checkpoint of the study's cells (``<output>/.checkpoints``: a report redrawn from an earlier run's
     results keeps that run's date), else the modification time of ``cube.nc`` (it records no creation time).
@@ -266,7 +266,7 @@ def results_date(output) -> str | None:
     if not times:
         return None
     day = datetime.fromtimestamp(max(times), tz=timezone.utc)
-    return f"{day.day} {day:%B %Y}"
+    return f"{day:%Y-%m-%d}"  # not "26 November 2026": a capitalised word and a year read as a citation
 
 
 STIFF_BASE = 1e10
