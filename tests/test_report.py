@@ -306,6 +306,20 @@ def test_text_pages_split_long_tables_with_their_header():
     assert all(page[0].kind != "heading" or len(page) > 1 for page in pages)
 
 
+def test_a_wrapped_cell_is_not_split_across_two_pages():
+    """Issue 20: a limitations row's wrapped model name ended at the top of the next page ("low edge"), away
+    from its row."""
+    from pipeline.report.text import paginate, table
+
+    rows = [[f"row {i}", "x"] for i in range(26)] + [["row 26", "first line"], ["", "second line"],
+                                                       ["", "third line"]] + [["row 27", "y"]] * 30
+    for capacity in range(28, 34):  # wherever the page break falls
+        pages = paginate([table(["key", "value"], rows)], capacity=capacity)
+        tables = [item for page in pages for item in page if item.kind == "table"]
+        assert sum(len(t.rows) for t in tables) == len(rows)
+        assert all(t.rows[0][0] for t in tables), capacity  # no page starts with a continuation line
+
+
 def test_showcase_record_is_bolu_or_the_named_one():
     import tomllib
     from importlib.resources import files

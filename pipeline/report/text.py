@@ -112,6 +112,8 @@ def paginate(items, capacity=None) -> list[list[Item]]:
                 queue.insert(0, item)
                 continue
             room = max(room, 3)
+            while 1 < room < len(item.rows) and not item.rows[room][0]:  # a wrapped cell's lines stay on one page
+                room -= 1
             head = replace(item, rows=item.rows[:room])
             tail = replace(item, rows=item.rows[room:])
             current.append(head)
