@@ -50,10 +50,11 @@ def test_one_numbered_a4_document_with_an_html_twin(small_pipeline):
     assert sorted(int(png.name[:2]) for png in pngs) == [int(png.name[:2]) for png in pngs]  # NN: the page number
     sections = re.findall(r"<section id='page-(\d+)'>", html)
     assert [int(n) for n in sections] == list(range(1, pages + 1))
-    assert html.count(f"of {pages}</span>") == pages  # "page N of M" on every page
+    assert f"of {pages}</span>" not in html and not re.search(r"\(\d+/\d+\)</h2>", html)  # no PDF pagination
     for target in re.findall(r"href='#page-(\d+)'", html):  # the contents links every page it lists
         assert 1 <= int(target) <= pages
-    assert len(set(re.findall(r"href='#page-(\d+)'", html))) == pages  # every page; the contents by the back links
+    headed = set(re.findall(r"<section id='page-(\d+)'>\s*<h2>", html))  # a text section over pages: one heading
+    assert set(re.findall(r"href='#page-(\d+)'", html)) == headed  # each heading; the contents by the back links
     text_pages = r"\d+-(title|answer|contents|summary|methods|limitations|records-table|glossary|references|provenance)"
     assert not [png.name for png in pngs if re.match(text_pages, png.name)]  # text pages have no PNG
     assert html.count("data:image/png;base64,") == len(pngs)  # figure pages embedded, text pages as HTML
@@ -67,7 +68,8 @@ def test_title_project_author_and_sections_from_the_study(small_pipeline):
     for text in ("Rocking fragility of the yard equipment", "Harbour crane upgrade", "A. Engineer"):
         assert text in html
     # a section that starts part-way down a shared page is headed there (h3), not in the page title (h2)
-    order = [min(html.find(f"<h{level}>{title}") % (len(html) + 1) for level in (2, 3))
+    order = [min(found.start() if (found := re.search(f"<h{level}[^>]*>{title}", html)) else len(html) + 1
+                 for level in (2, 3))
              for title in ("Contents", "Summary", "Methods", "Limitations", "Intensity measures", "IDA curves")]
     assert order == sorted(order)
     assert "θmax/α ≥ 0.5" in html  # damage states by their registry description, not ids
@@ -106,10 +108,11 @@ def test_report_reads_results_and_never_simulates(small_pipeline, monkeypatch, t
     shutil.rmtree(copy / "figures")
     html = (output / "report.html").read_text()
     runtime = re.search(r"<td>run time</td><td>(\d+) s up to this report", html)  # the provenance page
-    computed = re.search(r"this run computed ([\d,]+) grid runs and took (\d+) of its (\d+) cells", html)
+    computed = re.search(r"([\d,]+) of them were computed for this report, the results of (\d+) of its (\d+) ", html)
     run = {"runs_computed": int(computed.group(1).replace(",", "")), "cells_reused": int(computed.group(2)),
            "cells": int(computed.group(3))} if computed else \
-        {"runs_computed": 1, "cells_reused": 0, "cells": 1} if "none taken from checkpoints" in html else None
+        {"runs_computed": 1, "cells_reused": 0, "cells": 1} if "all computed for this report" in html else \
+        {"runs_computed": 0, "cells_reused": 1, "cells": 1} if "computed in an earlier run" in html else None
     opened = _datasets(copy)
     pdf, pngs = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
                              runtime_s=float(runtime.group(1)) if runtime else float("nan"), progress=False, run=run)
@@ -303,6 +306,20 @@ def test_text_pages_split_long_tables_with_their_header():
     assert all(page[0].kind != "heading" or len(page) > 1 for page in pages)
 
 
+def test_a_wrapped_cell_is_not_split_across_two_pages():
+    """Issue 20: a limitations row's wrapped model name ended at the top of the next page ("low edge"), away
+    from its row."""
+    from pipeline.report.text import paginate, table
+
+    rows = [[f"row {i}", "x"] for i in range(26)] + [["row 26", "first line"], ["", "second line"],
+                                                       ["", "third line"]] + [["row 27", "y"]] * 30
+    for capacity in range(28, 34):  # wherever the page break falls
+        pages = paginate([table(["key", "value"], rows)], capacity=capacity)
+        tables = [item for page in pages for item in page if item.kind == "table"]
+        assert sum(len(t.rows) for t in tables) == len(rows)
+        assert all(t.rows[0][0] for t in tables), capacity  # no page starts with a continuation line
+
+
 def test_showcase_record_is_bolu_or_the_named_one():
     import tomllib
     from importlib.resources import files
@@ -412,6 +429,30 @@ def test_the_run_count_is_the_studys_cells_a_sliding_rigid_base_once_per_frictio
     results = Results(None, cube, None, None, None, run={"runs_computed": 20, "cells_reused": 9, "cells": 11})
     words = runs_words(results)
     assert words.startswith(f"{cells * 20} simulations on the intensity grid and 17 more refining")
-    assert "this run computed 20 grid runs and took 9 of its 11 cells" in words
-    assert "none taken from checkpoints" in runs_words(Results(None, cube, None, None, None, run={
+    assert ("20 of them were computed for this report, the results of 9 of its 11 record, block, soil and model "
+            "combinations in an earlier run of the same study") in words
+    assert "all computed for this report" in runs_words(Results(None, cube, None, None, None, run={
         "runs_computed": 220, "cells_reused": 0, "cells": 11}))
+
+
+def test_the_title_page_says_in_words_that_results_came_from_an_earlier_run_and_when_they_were_computed(tmp_path):
+    """Issue 20: "this run computed 0 grid runs and took 3036 of its 3036 cells from the checkpoints of an earlier
+    run" meant nothing to a client, and the report gave no date."""
+    import os
+
+    from pipeline.report.sections import Results, results_date, runs_words
+
+    cube = xr.Dataset(coords={"soil": ["sand"], "block": ["a"], "model": ["ssi"], "record": range(2),
+                              "im_level": range(3)})
+    words = runs_words(Results(None, cube, None, None, None, run={"runs_computed": 0, "cells_reused": 4, "cells": 4}))
+    assert "all results were computed in an earlier run of the same study, and this report was redrawn" in words
+    assert "checkpoint" not in words and "0 " not in words.split(";")[1]
+    assert results_date(tmp_path) is None
+    (tmp_path / "cube.nc").write_bytes(b"")
+    os.utime(tmp_path / "cube.nc", (0, 1_700_000_000))  # 14 November 2023, 22:13 UTC
+    assert results_date(tmp_path) == "2023-11-14"
+    checkpoints = tmp_path / ".checkpoints"
+    checkpoints.mkdir()
+    (checkpoints / "k.ckpt").write_bytes(b"")
+    os.utime(checkpoints / "k.ckpt", (0, 1_600_000_000))  # 13 September 2020: when the cells were computed
+    assert results_date(tmp_path) == "2020-09-13"

@@ -69,7 +69,7 @@ def test_every_page_leads_back_to_the_contents_and_sections_have_anchors(small_p
     for section in ("Answer", "Summary", "Methods", "Limitations", "Glossary", "References"):
         slug = "section-" + section.lower()
         assert f"id='{slug}'" in html and f"href='#{slug}'" in html, section
-    answers = [body for _, body in sections if "<h2>Answer:" in body]
+    answers = [body for number, body in sections if 1 < int(number) < int(contents)]  # one heading per block
     assert answers and all("<img" not in body and "<table>" in body for body in answers)  # text, not images
     assert int(contents) == len(answers) + 2  # title, the answer pages, then the contents
 
@@ -82,3 +82,24 @@ def test_a_missing_chromium_fails_under_make_test_with_the_install_command(monke
     monkeypatch.delenv(CONSUMERS_REQUIRED)
     with pytest.raises(pytest.skip.Exception, match=INSTALL):
         chromium()
+
+
+def test_each_section_link_lands_on_its_own_heading_without_the_pdfs_page_count():
+    """Issue 20: Methods -> "Summary (3/3)": a section starting part-way down a page was anchored before the page,
+    on the previous section's heading; headings copied the PDF's "(2/9)" and "page N of M"."""
+    from pipeline.report import _packed_pages, contents_page, html_document
+    from pipeline.report.text import paragraph
+
+    long = [paragraph(f"line {n} " + "word " * 20) for n in range(90)]  # over two pages
+    short = [paragraph("a few lines") for _ in range(3)]
+    parts = [("alpha", "Alpha", "Alpha section", long), ("beta", "Beta", "Beta section", short),
+             ("gamma", "Gamma", "Gamma section", short)]
+    pages = _packed_pages(parts)
+    assert len(pages) >= 2 and any(page.also for page in pages)  # beta starts part-way down a page
+    document = html_document("t", [contents_page(pages, "t", position=1), *pages])
+    for _, section, title, _ in parts:
+        at = document.index(f"id='section-{section.lower()}'")
+        following = re.search(r"<h[23][^>]*>(.*?)</h[23]>", document[at - 4:])
+        assert following and following.group(1) == title, (section, following and following.group(1))
+    assert "page 1 of" not in document and "(1/" not in document and "part-way" not in document
+    assert document.count("<h2>Alpha section</h2>") == 1

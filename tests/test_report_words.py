@@ -110,12 +110,48 @@ def test_curves_without_a_median_carry_the_counts_that_justify_it(small_pipeline
     n = int(fragility.n_records)
     for row in tables[0].rows:
         counts = row[4]
+        if row[5] == "no record reached it":  # a summary row: every model and soil it names
+            assert counts == f"0 of {n} at every level"
+            continue
         assert re.fullmatch(rf"\d+ of {n} at [\d.]+ g, \d+ of {n} at [\d.]+ g", counts), counts
         low = int(counts.split(" of ")[0])
         if row[5] == "reached below the lowest level":
             assert low > n / 2  # most records reached it at the lowest level
-        if row[5] == "never reached":
-            assert counts.startswith(f"0 of {n}") and ", 0 of" in counts
+
+
+def test_limitations_tables_are_one_table_each_with_the_reason_and_one_row_per_state_no_record_reached(
+        small_pipeline, tmp_path):
+    """Issue 20, finding 8: the extrapolated and no-median tables were split in two by width, and a state no record
+    reached took one row per model and soil."""
+    from pipeline.report.adapters import block_name
+    from pipeline.report.sections import limitations_items
+    from pipeline.report.text import fit_table
+    from pipeline.report.words import state_short_label
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    fragility = results.fragility.copy(deep=True)
+    block, state = str(fragility.block.values[0]), str(fragility.damage_state.values[-1])
+    label = state_short_label(state, str(fragility.damage_state_description.sel(damage_state=state).values))
+    never = (fragility.block == block) & (fragility.damage_state == state)
+    fragility["median"] = fragility["median"].where(~never)
+    fragility["status"] = fragility["status"].where(~never, "not-reached")
+    fragility["empirical_fraction"] = fragility["empirical_fraction"].where(~never, 0.0)
+    # one median above the range, so the extrapolated table is drawn too
+    other = str(fragility.damage_state.values[0])
+    high = float(fragility.intensity.max()) * 10
+    fragility["median"] = fragility["median"].where(~((fragility.block == block) & (fragility.damage_state == other)),
+                                                    high)
+    changed = pipeline_results(small_pipeline.output, small_pipeline.study, fragility=fragility, output=tmp_path)
+    items = limitations_items(changed)
+    tables = {item.header[-1]: item for item in items if item.kind == "table" and item.header[0] == "block"}
+    assert set(tables) == {"median lies", "why no median"}
+    for item in tables.values():
+        assert len(fit_table(item)) == 1, item.header  # one table, never split into halves
+    assert {row[-1] for row in tables["median lies"].rows} == {"above the highest level"}
+    name = block_name(changed.config, block)
+    summary = [row for row in tables["why no median"].rows if row[0] == name and row[3] == label]
+    assert len(summary) == 1, summary
+    assert summary[0][1:3] == ["every model", "every soil"] and summary[0][-1] == "no record reached it"
 
 
 def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline):
@@ -252,3 +288,39 @@ def test_the_methods_page_states_the_scale_factors(small_pipeline):
         factors = cube.scale_factor.values
     text = " ".join(item.text for item in methods_items(results))
     assert f"median {np.nanmedian(factors):.2g}, largest {np.nanmax(factors):.3g}" in text
+
+
+def test_the_kinetic_friction_ratio_is_read_from_the_soils_not_written_twice():
+    """Issue 20: the sources said "Kinetic friction 0.8 × static" while the shipped soils are 0.85 × (steel 0.8 ×)."""
+    import pipeline.soils
+    from pipeline.report.sections import _kinetic_words
+    from pipeline.soils import SOILS
+
+    words = _kinetic_words(list(SOILS.values()))
+    ratio = pipeline.soils.KINETIC_OVER_STATIC
+    usual = [s.name for s in SOILS.values() if round(ratio * s.friction_static, 2) == s.friction_kinetic]
+    assert usual and f"{ratio:g} × static (rounded to 0.01) on {', '.join(usual)}" in words
+    for soil in SOILS.values():
+        if soil.name not in usual:
+            assert f"on {soil.name} {soil.friction_kinetic / soil.friction_static:.2g} × static" in words
+
+
+def test_the_glossary_explains_flight_and_the_pulse_measures():
+    from pipeline.report.words import GLOSSARY
+
+    terms = " ".join(term for term, _ in GLOSSARY)
+    for word in ("flies", "free flight", "pulse period", "pulse acceleration"):
+        assert word in terms, word
+
+
+def test_slip_states_carry_their_unit_in_table_headers():
+    """Issue 20: the answer tables headed the slip states "slip 0.05" and "slip 0.30", with no unit."""
+    from pipeline.damage_states import DAMAGE_STATES, is_slip_state
+    from pipeline.report.words import state_short_label
+
+    slips = [state for state in DAMAGE_STATES.values() if is_slip_state(state)]
+    assert slips
+    for state in slips:
+        label = state_short_label(state.name, state.description)
+        assert label.endswith(" m") and f"{state.threshold:.2f}" in label, label
+    assert state_short_label("rocking-0.5", "theta_max/alpha >= 0.5") == "θmax/α ≥ 0.5"

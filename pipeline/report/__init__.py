@@ -7,8 +7,8 @@ Input : the study configuration and the datasets written by the earlier stages: 
 Output: ``report.pdf`` (A4 landscape, every page numbered, the contents after the answer pages),
         ``report.html`` (the same pages in the same order: text pages as HTML text, figures embedded as
         PNG, a linked contents, an anchor per section and a way back to the contents from every page)
-        and ``figures/NN-name.png`` (one per figure page). Neither file carries a creation date: the same
-        results give the same files.
+        and ``figures/NN-name.png`` (one per figure page). Neither file carries the date it was drawn: the
+        same results give the same files (the title page gives the date the results were computed).
 
 Page order: title, one answer page per block (pipeline.report.answer_page), contents, summary, methods,
 limitations, records, showcase record, IDA, fragility, outcomes, vertical component (a ``[study] vertical
@@ -71,7 +71,7 @@ def _text_pages(name, section, title, items, caption=""):
         suffix = f" ({number}/{len(chunks)})" if len(chunks) > 1 else ""
         planned.append(Page(f"{name}-{number}" if len(chunks) > 1 else name, section, title + suffix,
                             lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk, caption),
-                            caption, items_html(chunk)))
+                            caption, items_html(chunk), heading=title))
     return planned
 
 
@@ -85,8 +85,8 @@ def _packed_pages(parts) -> list[Page]:
     """
     flow = []
     for index, (_, _, title, items) in enumerate(parts):
-        if index:
-            flow.append(Item("heading", title, part=index))
+        if index:  # its anchor: the contents' link lands on this heading, not on the page's title above it
+            flow.append(Item("heading", title, part=index, anchor=_slug(parts[index][1])))
         flow += [replace(item, part=index) for item in items]
     chunks = paginate(flow)
     first_part = [chunk[0].part if chunk else 0 for chunk in chunks]
@@ -104,7 +104,7 @@ def _packed_pages(parts) -> list[Page]:
         also = tuple(dict.fromkeys(parts[item.part][1] for item in chunk if item.part != part))
         planned.append(Page(f"{name}-{counters[part]}" if pages_of_part > 1 else name, section, title + suffix,
                             lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk), "", items_html(chunk),
-                            also=also))
+                            also=also, heading=title))
     return planned
 
 
@@ -326,12 +326,18 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
                 figure.text(x + width - 0.03, y, str(number), fontsize=size, va="top", ha="right")
         return figure
 
-    items = []
-    for kind, text, number in rows:
-        if kind == "section":
-            items.append(f"<li class='section'><a href='#{_slug(text)}'>{html.escape(text)}</a></li>")
-        else:
-            items.append(f"<li><a href='#page-{number}'>{html.escape(text)}</a> <span>{number}</span></li>")
+    items, last, shown = [], None, None  # the HTML: one link per section and per heading, no "(2/9)"
+    for number, page in enumerate(planned, start=1):
+        number += 1 if number >= position else 0
+        if page.section != last:
+            items.append(f"<li class='section'><a href='#{_slug(page.section)}'>{html.escape(page.section)}</a></li>")
+        heading = page.heading or page.title
+        if heading != shown:
+            items.append(f"<li><a href='#page-{number}'>{html.escape(heading)}</a></li>")
+        shown = heading
+        for section in page.also:  # its link lands on its heading part-way down the page
+            items.append(f"<li class='section'><a href='#{_slug(section)}'>{html.escape(section)}</a></li>")
+        last = page.also[-1] if page.also else page.section
     return Page("contents", "Contents", "Contents", draw, "", "<ul class='contents'>" + "".join(items) + "</ul>")
 
 
@@ -352,21 +358,24 @@ ul.contents li span{color:#777}nav.back{font-size:.85em;margin:.3em 0}.verdict{f
 def html_document(title: str, rendered: list[Page]) -> str:
     """A self-contained HTML file: each page a section with an anchor, in the PDF's order.
 
-    The first page of each section also carries the section's anchor (``section-NAME``, the contents links
-    it); every page but the contents links back to the contents. Text pages are HTML text, figure pages
-    their PNG with an alternative text.
+    Each section's anchor (``section-NAME``, the contents links it) sits on its own heading: before the page
+    it starts, or on its heading part-way down a page. A text section over several PDF pages has one heading,
+    without the PDF's "(2/9)" or "page N of M". Every page but the contents links back to the contents. Text
+    pages are HTML text, figure pages their PNG with an alternative text.
     """
     contents = next((n for n, page in enumerate(rendered, start=1) if page.name == "contents"), None)
     parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}</title>"
              f"<style>{HTML_STYLE}</style></head><body>"]
-    last = None
+    last, shown = None, None
     for number, page in enumerate(rendered, start=1):
-        for section in (page.section, *page.also):
-            if section != last:
-                parts.append(f"<div id='{_slug(section)}'></div>")
-                last = section
-        parts.append(f"<section id='page-{number}'><span class='pageno'>page {number} of {len(rendered)}</span>"
-                     f"<h2>{html.escape(page.title)}</h2>")
+        if page.section != last:  # a section starting part-way down a page: its heading carries the anchor
+            parts.append(f"<div id='{_slug(page.section)}'></div>")
+        last = page.also[-1] if page.also else page.section
+        heading = page.heading or page.title
+        parts.append(f"<section id='page-{number}'>")
+        if heading != shown:  # a text section over several PDF pages: one heading, no "(2/9)", no "page N of M"
+            parts.append(f"<h2>{html.escape(heading)}</h2>")
+        shown = heading
         if contents is not None and number != contents:
             parts.append(f"<nav class='back'><a href='#page-{contents}'>Back to the contents</a></nav>")
         if page.html is not None:

@@ -72,6 +72,9 @@ class Page:
         The rendered page (empty until ``pipeline.report.render`` has drawn it).
     also : tuple of str
         Further sections that start on this page (text sections packed onto one page when they fit).
+    heading : str
+        The title without the PDF's page count ("Limitations", not "Limitations (2/9)"): the HTML heading,
+        printed once for a text section that runs over several PDF pages ("" when it is the title).
     """
 
     name: str
@@ -82,6 +85,7 @@ class Page:
     html: str | None = None
     png: bytes = field(default=b"", repr=False)
     also: tuple[str, ...] = ()
+    heading: str = ""
 
 
 def new_page(title: str, caption: str = "") -> Figure:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from datetime import datetime, timezone
 from functools import cached_property
 from pathlib import Path
 
@@ -29,6 +30,7 @@ from pipeline.answer import (
     percent,
     records_reaching,
 )
+from pipeline.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
 from pipeline.config import StudyConfig
 from pipeline.damage_states import NOT_APPLICABLE
 from pipeline.errors import PipelineError
@@ -235,13 +237,36 @@ def runs_words(results) -> str:
         text += f" and {refining:,} more refining the overturning capacities"
     run = results.run or {}
     if "cells" in run and "cells_reused" in run and "runs_computed" in run:
-        if int(run["cells_reused"]):
-            text += (f"; this run computed {int(run['runs_computed']):,} grid runs and took {int(run['cells_reused'])}"
-                     f" of its {int(run['cells'])} cells (record × block × soil × model) from the checkpoints of an "
-                     "earlier run")
+        if int(run["cells_reused"]) and not int(run["runs_computed"]):
+            text += ("; all results were computed in an earlier run of the same study, and this report was "
+                     "redrawn from them")
+        elif int(run["cells_reused"]):
+            text += (f"; {int(run['runs_computed']):,} of them were computed for this report, the results of "
+                     f"{int(run['cells_reused'])} of its {int(run['cells'])} record, block, soil and model "
+                     "combinations in an earlier run of the same study")
         else:
-            text += "; all computed in this run (none taken from checkpoints)"
+            text += "; all computed for this report"
     return text
+
+
+CHECKPOINTS = ".checkpoints"
+"""The folder of a study's cell checkpoints inside its output folder (pipeline.study writes them there)."""
+
+
+def results_date(output) -> str | None:
+    """The date the results were computed, ISO 8601 ("2026-11-26", UTC), or None when no result file is found.
+
+    The newest checkpoint of the study's cells (``<output>/.checkpoints``: a report redrawn from an earlier run's
+    results keeps that run's date), else the modification time of ``cube.nc`` (it records no creation time).
+    """
+    output = Path(output)
+    times = [path.stat().st_mtime for path in (output / CHECKPOINTS).glob(f"*{CHECKPOINT_SUFFIX}")]
+    if not times and (output / "cube.nc").is_file():
+        times = [(output / "cube.nc").stat().st_mtime]
+    if not times:
+        return None
+    day = datetime.fromtimestamp(max(times), tz=timezone.utc)
+    return f"{day:%Y-%m-%d}"  # not "26 November 2026": a capitalised word and a year read as a citation
 
 
 STIFF_BASE = 1e10
@@ -286,6 +311,7 @@ def title_items(results: Results) -> list[Item]:
                   f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
+        *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
         paragraph("The next pages answer the question for each block: at the site's return periods, how likely it "
                   "is to rock or overturn, how likely in its design life, and what to do. Then the fragility of "
                   "each block on each soil for each model, the methods and assumptions behind the numbers, and "
@@ -547,6 +573,21 @@ LIMIT_SOURCES = {
 """Where the shipped verdict limits (pipeline.answer.DEFAULT_LIMITS) come from."""
 
 
+def _kinetic_words(soils) -> str:
+    """Kinetic over static friction of the shipped soils, read from pipeline.soils.
+
+    "Kinetic friction 0.85 × static (rounded to 0.01) on clay, sand; on steel 0.8 × static".
+    """
+    from pipeline.soils import KINETIC_OVER_STATIC
+
+    usual = [soil.name for soil in soils
+             if round(KINETIC_OVER_STATIC * soil.friction_static, 2) == soil.friction_kinetic]
+    own = [f"on {soil.name} {soil.friction_kinetic / soil.friction_static:.2g} × static" for soil in soils
+           if soil.name not in usual]
+    words = [f"{KINETIC_OVER_STATIC:g} × static (rounded to 0.01) on {', '.join(usual)}"] if usual else []
+    return "Kinetic friction " + "; ".join(words + own)
+
+
 def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
     from pipeline.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
@@ -576,7 +617,7 @@ def sources_items(results: Results) -> list[Item]:
         items.append(bullet(f"Base friction μ_s of {names} ({results.friction_text}): the ultimate friction factor "
                             "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
                             "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
-                            "360-16, J3.8). Kinetic friction 0.8 × static: " + STUDY_CHOICE + "."))
+                            f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + STUDY_CHOICE + "."))
     items.append(bullet(results.friction_words))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
@@ -610,8 +651,47 @@ def _counts(fragility, model, block, soil, state, n_records) -> str:
     return ", ".join(shown) or "-"
 
 
-NO_MEDIAN = {"below-range": "reached below the lowest level", "not-reached": "never reached"}
-"""Why a curve has no median, in the limitations' table."""
+NO_MEDIAN = {"below-range": "reached below the lowest level", "above-range": "reached only at the highest levels",
+             "not-reached": "no record reached it"}
+"""Why a curve has no median: the reason column of the limitations' table (short: one table row each)."""
+OUTSIDE = {"below": "below the lowest level", "above": "above the highest level"}
+"""Where an extrapolated median lies: the reason column of the limitations' table."""
+
+
+def _models_words(labels, every_model) -> str:
+    """Models of a merged row in the fewest words: "every model", "every model but X", or the labels.
+
+    Labels with a shared start say it once: "Winkler bed, tensionless, band low edge / band centre".
+    """
+    if len(labels) == 1:
+        return labels[0]
+    if set(labels) == set(every_model):
+        return "every model"
+    groups: dict[str, list[str]] = {}
+    for label in labels:
+        start = label.rsplit(", ", 1)[0] + ", " if ", " in label else label
+        groups.setdefault(start, []).append(label[len(start):] if start != label else label)
+    listed = "; ".join(start + " / ".join(ends) if start not in ends else start for start, ends in groups.items())
+    missing = [label for label in every_model if label not in labels]
+    but = f"every model but {'; '.join(missing)}"
+    return but if len(but) < len(listed) else listed
+
+
+def _merged(rows, models_at, every_model) -> list[list[str]]:
+    """Rows that differ only in their model (column ``models_at``) as one row naming the models.
+
+    ``every_model`` lists the labels that together read "every model" (in their order).
+    """
+    merged: dict[tuple, list[str]] = {}
+    for row in rows:
+        key = tuple(row[:models_at] + row[models_at + 1:])
+        merged.setdefault(key, []).append(row[models_at])
+    out = []
+    for key, labels in merged.items():
+        labels = list(dict.fromkeys(labels))
+        shown = _models_words(labels, every_model)
+        out.append([*key[:models_at], shown, *key[models_at:]])
+    return out
 
 
 def limitations_items(results: Results) -> list[Item]:
@@ -686,6 +766,9 @@ def limitations_items(results: Results) -> list[Item]:
     order = {name: {str(v): i for i, v in enumerate(fragility[name].values)} for name in ("block", "model", "soil")}
     outside = outside.sort_values(["block", "model", "soil"], key=lambda column: column.map(order[column.name]))
     labels = state_labels(fragility)
+    short_states = {name: state_short_label(name, str(text)) for name, text in
+                    zip(map(str, fragility.damage_state.values), fragility["damage_state_description"].values)} \
+        if "damage_state_description" in fragility.coords else {}
     scale, unit = display_scale(_level_units(fragility))
     if outside.empty:
         items.append(paragraph("Every fitted median lies inside the studied intensity range."))
@@ -693,40 +776,33 @@ def limitations_items(results: Results) -> list[Item]:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
             "lognormal fit beyond the levels that were run (the summary marks them * for the states it shows)."))
+        every_model = [short_label(m) for m in models_of(fragility)]
         rows = []
-        for row in outside.head(EXTRAPOLATION_ROWS).itertuples():
+        for row in outside.itertuples():
             levels = block_levels(fragility, row.block) * scale
-            rows.append([block_name(config, row.block), model_info(row.model).label,
+            median = row.median * scale
+            rows.append([block_name(config, row.block), short_label(model_info(row.model)),
                          "(any)" if (row.model, str(row.block)) in rigid else row.soil,
-                         labels.get(row.damage_state, row.damage_state),
-                         _g(row.median * scale), f"{levels.min():.2g} to {levels.max():.2g}", plain(row.status)])
+                         short_states.get(row.damage_state) or labels.get(row.damage_state, row.damage_state),
+                         _g(median), f"{levels.min():.2g} to {levels.max():.2g}",
+                         OUTSIDE["below" if median < levels.min() else "above"]])
+        rows = _merged(rows, 1, every_model)
         items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
-                            "what it is"], rows))
-        if len(outside) > EXTRAPOLATION_ROWS:
-            items.append(note(f"... and {len(outside) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
+                            "median lies"], rows[:EXTRAPOLATION_ROWS]))
+        if len(rows) > EXTRAPOLATION_ROWS:
+            items.append(note(f"... and {len(rows) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
     unfitted = status[status.status == "no fit"]
     if "status" in fragility and not unfitted.empty:  # a tied cell's slip states have no curve by design
         applicable = [str(fragility["status"].sel(soil=r.soil, block=r.block, model=r.model,
                                                   damage_state=r.damage_state).values) != NOT_APPLICABLE
                       for r in unfitted.itertuples()]
         unfitted = unfitted[applicable]
-    short_states = {name: state_short_label(name, str(text)) for name, text in
-                    zip(map(str, fragility.damage_state.values), fragility["damage_state_description"].values)} \
-        if "damage_state_description" in fragility.coords else {}
     if not unfitted.empty:
         n_records = int(fragility.n_records) if "n_records" in fragility else results.cube.sizes["record"]
-        fitted_status = fragility["status"] if "status" in fragility else None
+        rows = _no_median_rows(fragility, config, unfitted, rigid, short_states, n_records)
         items.append(paragraph(f"{len(unfitted)} curves have no median. The records that reached the state at the "
-                               "lowest and the highest level of the block say why:"))
-        rows = []
-        for row in unfitted.itertuples():
-            why = str(fitted_status.sel(soil=row.soil, block=row.block, model=row.model,
-                                        damage_state=row.damage_state).values) if fitted_status is not None else ""
-            rows.append([block_name(config, row.block), short_label(model_info(row.model)),
-                         "(any)" if (row.model, str(row.block)) in rigid else row.soil,
-                         short_states.get(row.damage_state, ""),
-                         _counts(fragility, row.model, row.block, row.soil, row.damage_state, n_records),
-                         NO_MEDIAN.get(why, plain(why) if why else "no fit")])
+                               "lowest and the highest level of the block say why; a state no record reached at any "
+                               "level is one row per block and state, naming its models and soils:"))
         items.append(table(["block", "model", "soil", "damage state", "records reaching it: lowest, highest level",
                             "why no median"], rows))
 
@@ -742,6 +818,52 @@ def limitations_items(results: Results) -> list[Item]:
                 items.append(paragraph(f"{model.label}: {_percent(share)} of the runs stopped (too many events or "
                                        "steps); they are left out of the fits."))
     return items
+
+
+def _soils_words(names, every_soil) -> str:
+    """Soils of a summary row in the fewest words: "every soil", "every soil but rock", or "clay, sand"."""
+    if set(names) in ({"(any)"}, set(every_soil)):
+        return "every soil"
+    missing = [soil for soil in every_soil if soil not in names]
+    return f"every soil but {', '.join(missing)}" if len(missing) < len(names) else ", ".join(names)
+
+
+def _no_median_rows(fragility, config, unfitted, rigid, short_states, n_records) -> list[list[str]]:
+    """The rows of the "no median" table: one per curve; one per block and state for the states no record reached.
+
+    A summary row names its models and soils ("every model", "every soil", "every soil but rock").
+    """
+    fitted_status = fragility["status"] if "status" in fragility else None
+    every_model = [short_label(m) for m in models_of(fragility)]
+    every_soil = list(map(str, fragility.soil.values))
+    order = {str(state): index for index, state in enumerate(fragility.damage_state.values)}
+    blocks = {str(block): index for index, block in enumerate(fragility.block.values)}
+    rows, never = [], {}
+    for row in unfitted.itertuples():
+        why = str(fitted_status.sel(soil=row.soil, block=row.block, model=row.model,
+                                    damage_state=row.damage_state).values) if fitted_status is not None else ""
+        soil = "(any)" if (row.model, str(row.block)) in rigid else str(row.soil)
+        if why == "not-reached":  # the same words for every model and soil: one summary row per block and state
+            never.setdefault((str(row.block), str(row.damage_state)), {}).setdefault(
+                short_label(model_info(row.model)), []).append(soil)
+            continue
+        rows.append((blocks[str(row.block)], order[str(row.damage_state)],
+                     [block_name(config, row.block), short_label(model_info(row.model)), soil,
+                      short_states.get(row.damage_state, ""),
+                      _counts(fragility, row.model, row.block, row.soil, row.damage_state, n_records),
+                      NO_MEDIAN.get(why, plain(why) if why else "no fit")]))
+    for (block, state), soils in never.items():
+        by_soils: dict[tuple, list[str]] = {}
+        for model, names in soils.items():
+            by_soils.setdefault(tuple(names), []).append(model)
+        for names, models in by_soils.items():
+            shown_soils = _soils_words(names, every_soil)
+            shown_models = _models_words(models, every_model)
+            rows.append((blocks[block], order[state],
+                         [block_name(config, block), shown_models, shown_soils, short_states.get(state, ""),
+                          f"0 of {n_records} at every level", NO_MEDIAN["not-reached"]]))
+    rows.sort(key=lambda entry: entry[:2])  # stable: a block's states in order, each state's rows together
+    return _merged([row for *_, row in rows], 1, every_model)
 
 
 def free_flight_items(cube, models) -> list[Item]:

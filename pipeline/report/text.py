@@ -28,7 +28,8 @@ MIN_HEADER = 12  # characters: a header is not wrapped narrower than this to mak
 class Item:
     """kind: heading | paragraph | strong | bullet | table | note; text, or header + rows for a table.
 
-    ``part`` is the index of the section the item belongs to when several sections share pages (``pack``).
+    ``part`` is the index of the section the item belongs to when several sections share pages (``pack``);
+    ``anchor`` the HTML id of a heading that starts a section part-way down a page (the contents links it).
     """
 
     kind: str
@@ -36,6 +37,7 @@ class Item:
     header: list = field(default_factory=list)
     rows: list = field(default_factory=list)
     part: int = 0
+    anchor: str = ""
 
 
 def heading(text: str) -> Item:
@@ -110,6 +112,8 @@ def paginate(items, capacity=None) -> list[list[Item]]:
                 queue.insert(0, item)
                 continue
             room = max(room, 3)
+            while 1 < room < len(item.rows) and not item.rows[room][0]:  # a wrapped cell's lines stay on one page
+                room -= 1
             head = replace(item, rows=item.rows[:room])
             tail = replace(item, rows=item.rows[room:])
             current.append(head)
@@ -136,6 +140,7 @@ TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type acr
 
 
 TABLE_SIZE = 8.5  # pt, table type; smaller (down to MIN_TABLE_SIZE) only for a table too wide for the page
+WRAPPED_MIN = 24  # characters: a column wrapped no narrower stays readable, so its table is not split (fit_table)
 MIN_TABLE_SIZE = 7.5  # pt: below it a client cannot read a printed table; a wider table is split (fit_table)
 
 
@@ -148,10 +153,11 @@ def _column_widths(item) -> list[int]:
 def fit_table(item) -> list[Item]:
     """A table as one or more tables that each fit the page width in type of at least ``MIN_TABLE_SIZE``.
 
-    A table that fits is returned as it is. A wider one is split by columns, each part repeating the first
-    column (the row's key: soil, block, damage state); a column still too wide with the key beside it has
-    its cells wrapped onto continuation rows (the other cells blank). Nothing is cut. Any other item is
-    returned as it is.
+    A table that fits is returned as it is. A wider one whose long cells fit wrapped onto lines of at least
+    ``WRAPPED_MIN`` characters is returned wrapped (one table). Any other is split by columns, each part
+    repeating the first column (the row's key: soil, block, damage state); a column still too wide with the
+    key beside it has its cells wrapped onto continuation rows (the other cells blank). Nothing is cut. Any
+    other item is returned as it is.
 
     Parameters
     ----------
@@ -168,6 +174,10 @@ def fit_table(item) -> list[Item]:
     widths = _column_widths(item)
     if sum(w + 2 for w in widths) <= room or len(widths) < 2:
         return [_wrapped_rows(item, room)]
+    wrapped = _wrapped_rows(item, room)  # one table whose long cells wrap reads better than two halves of it
+    after = _column_widths(wrapped)
+    if sum(w + 2 for w in after) <= room and all(a >= min(b, WRAPPED_MIN) for a, b in zip(after, widths)):
+        return [wrapped]
     groups, current = [], []
     for column in range(1, len(widths)):
         if current and widths[0] + 2 + sum(widths[c] + 2 for c in current + [column]) > room:
@@ -294,7 +304,8 @@ def items_html(items) -> str:
             parts.append("</ul>")
             in_list = False
         if item.kind == "heading":
-            parts.append(f"<h3>{html.escape(item.text)}</h3>")
+            anchor = f" id='{html.escape(item.anchor, quote=True)}'" if item.anchor else ""
+            parts.append(f"<h3{anchor}>{html.escape(item.text)}</h3>")
         elif item.kind == "bullet":
             parts.append(f"<li>{html.escape(item.text)}</li>")
         elif item.kind == "strong":

@@ -152,6 +152,13 @@ GLOSSARY = (
                     "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
     ("record sets", "the earthquake records the study runs; the far-field and near-field sets (with and without a "
                     "velocity pulse) are those of FEMA P695."),
+    ("flies, free flight", "the ground drops faster than gravity (g + a_v < 0 under the vertical component) and "
+                           "the block leaves it: the pivot models stop there, the Winkler bed follows the block "
+                           "through the air until it lands."),
+    ("pulse period, pulse acceleration", "of a record's dominant velocity pulse, taken as one full sine cycle: "
+                                         "its period T_p and its acceleration amplitude a_p = 2π·PGV/T_p; the "
+                                         "efficiency page tests whether the capacity still "
+                                         "depends on T_p."),
     ("resurrection", "a record that overturns the block at one level but not at a higher one; counted as "
                      "overturned from its first overturning level on."),
     ("friction demand", "the base friction coefficient a run needs to rock without sliding; above the assumed one "
@@ -174,7 +181,15 @@ def glossary_items() -> list[Item]:
 
 
 def state_short_label(name: str, description: str) -> str:
-    """A damage state in a table header: its description when short ("θmax/α ≥ 0.5"), else its name in words."""
+    """A damage state in a table header: its description when short ("θmax/α ≥ 0.5"), else its name in words.
+
+    A slip state says its threshold with its unit ("slip ≥ 0.05 m"): its name alone ("slip 0.05") gives no unit.
+    """
+    from pipeline.damage_states import DAMAGE_STATES, is_slip_state
+
+    state = DAMAGE_STATES.get(name)
+    if state is not None and is_slip_state(state):
+        return f"slip ≥ {state.threshold:.2f} m"  # the slip EDP is in metres (pipeline.damage_states)
     text = description.replace("theta_max", "θmax").replace("alpha", "α").replace(">=", "≥")
     if text and len(text) <= 16:
         return text
