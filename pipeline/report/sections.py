@@ -53,6 +53,7 @@ from pipeline.report.adapters import (
     run_fraction,
     scale_factor_summary,
     short_label,
+    sliding_candidates,
     sliding_share,
     soils_of,
     state_labels,
@@ -157,8 +158,7 @@ class Results:
         sliding = {}
         if hazard is not None:
             top = intensity_at_frequency(hazard, 1.0 / max(periods)) / scale  # in the cube's unit
-            candidates = [model, "winkler-centre", "winkler", *[str(m) for m in self.cube.model.values
-                                                                 if str(m).startswith("winkler")]]
+            candidates = sliding_candidates(self.cube, model)  # the models the answer page reads, in one place
             sliding = {(str(b), str(s)): sliding_share(self.cube, candidates, b, s, None, top)
                        for b in self.cube.block.values for s in self.cube.soil.values}
         decision = self.decision
@@ -748,7 +748,8 @@ def limitations_items(results: Results) -> list[Item]:
             f"where they must, and their slip is in the cube and the slip damage states): holding the base needed "
             f"a friction coefficient above {coefficient} in {_percent(float(fraction.mean()))} of those runs (all "
             "levels); there the block would slide or slide-rock, which the rocking results do not describe. The "
-            "answer pages count the runs up to the largest return-period intensity. Fraction of runs above μ_s:"))
+            "answer pages count the records at the level run at or below each return-period intensity. Fraction of "
+            "runs above μ_s over all levels:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
     if not found:
         items.append(paragraph("No model of this study reports the friction demand (|H|/N at the base); every model "
