@@ -395,7 +395,7 @@ def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from
     assert uplift.annual_frequency < 0.5 * fitted
     cell = _below_lowest(uplift, "g")
     assert cell.startswith("\u2265") and "every record at the lowest level run (0.1 g)" in cell
-    assert _at_cell(uplift, 0, answer) == "\u2265100%; 10 of 10 records"
+    assert _at_cell(uplift, 0, answer) == "100%; 10 of 10 records"  # every record: a certainty
     assert not _at_cell(overturning, 0, answer).startswith("\u2265")
     judged = block_answers(fragility, _power_law(), limits={"rocking-0.5": 0.1})[0]
     assert "in 50 years at least " in verdict_sentence(judged, "cabinet")  # a lower bound is said so in the verdict
@@ -522,3 +522,10 @@ def test_an_anchor_verdict_says_how_the_anchorage_is_designed(small_pipeline):
             changed = replace(answer, soils=[replace(s, verdict=v) for s, v in zip(answer.soils, verdicts)])
             texts = [item.text for item in answer_items(results, changed)]
             assert (ANCHOR_DESIGN in texts) == (ANCHOR in verdicts)
+
+
+def test_a_lower_bound_of_every_record_is_printed_as_a_certainty():
+    """'\u2265100%' read oddly on the default report (every record uplifted at that level): it is 100%."""
+    from pipeline.report.answer_page import _at_least
+
+    assert _at_least(1.0) == "100%" and _at_least(0.61) == "\u226561%" and _at_least(0.996) == ">99%"

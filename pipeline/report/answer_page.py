@@ -369,6 +369,12 @@ def _period_header(answer: BlockAnswer, soil, index: int, measure: str) -> str:
     return f"{head} (no level run this low)" if levels else head
 
 
+def _at_least(p: float) -> str:
+    """A lower bound as printed: "\u226561%"; every record (p = 1) is a certainty, "100%", not "\u2265100%"."""
+    text = percent(p)
+    return text if p >= 1 or text.startswith(">") else f"\u2265{text}"
+
+
 def _at_cell(state, index: int, answer: BlockAnswer) -> str:
     """P(state) at a return period's intensity with its band, and what the records did there.
 
@@ -381,9 +387,9 @@ def _at_cell(state, index: int, answer: BlockAnswer) -> str:
         return "not reached"
     if state.below_lowest is not None:  # the fit's median is below every level: the records' fraction bounds P
         if not np.isfinite(p) or not state.records:
-            return NO_LEVEL if not np.isfinite(p) else f"\u2265{percent(p)}"
+            return NO_LEVEL if not np.isfinite(p) else _at_least(p)
         reached, total, _ = state.records[index]
-        return f"\u2265{percent(p)}; {reached} of {total} records"
+        return f"{_at_least(p)}; {reached} of {total} records"
     if not np.isfinite(p):
         return "-"
     text = percent(p)
@@ -405,7 +411,7 @@ def _below_lowest(row, unit: str) -> str:
     """
     level, reached, total = row.below_lowest
     who = "every record" if reached == total else f"{reached} of {total} records"
-    return f"\u2265{percent(row.probability_in_life)}, {who} at the lowest level run ({level:.2g} {unit})"
+    return f"{_at_least(row.probability_in_life)}, {who} at the lowest level run ({level:.2g} {unit})"
 
 
 def _confidence(fragility) -> str:
