@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import html as html_module
 import re
+from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -324,3 +325,21 @@ def test_slip_states_carry_their_unit_in_table_headers():
         label = state_short_label(state.name, state.description)
         assert label.endswith(" m") and f"{state.threshold:.2f}" in label, label
     assert state_short_label("rocking-0.5", "theta_max/alpha >= 0.5") == "θmax/α ≥ 0.5"
+
+
+def test_the_records_table_says_station_names_are_the_sources_own(small_pipeline):
+    """A client read 'Beverly Hills - Mulhol' as cut by the report: it is the catalogue's own abbreviation (the
+    manifest's, shown whole), and the table says so."""
+    import csv
+
+    from pipeline.report import STATION_NAMES, records_items
+    from tests.helpers import pipeline_results
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    items = records_items(results)
+    assert items[-1].text == STATION_NAMES
+    manifest = Path(__file__).resolve().parents[1] / "records" / "MANIFEST.csv"
+    with manifest.open(encoding="utf-8") as handle:
+        stations = {row["id"]: row["station"] for row in csv.DictReader(handle)}
+    for record, station in zip(results.cube.record.values, results.cube.record_station.values):
+        assert str(station) == stations[str(record)]

@@ -149,7 +149,13 @@ def records_items(results: Results) -> list[Item]:
     else:
         header = ["record", "event", "station", "PGA [g]"]
         rows = [[*m, f"{pga:.2f}"] for m, pga in zip(meta, record_pga_g(cube))]
-    return [table(header, rows)]
+    return [table(header, rows), note(STATION_NAMES)]
+
+
+STATION_NAMES = ("Stations are named as the records' source catalogue spells them (FEMA P695 Table A-4, from PEER's "
+                 "NGA database), its abbreviations included ('Beverly Hills - Mulhol'); the report does not shorten "
+                 "them.")
+"""The records table's note: the names are the source's own (abbreviated there), not cut by the report."""
 
 
 CAPTIONS = {
