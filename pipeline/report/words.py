@@ -80,6 +80,7 @@ REFERENCES = {
                  "and model uncertainty).",
     "ASCE 7-22": "ASCE (2022). Minimum Design Loads and Associated Criteria for Buildings and Other Structures, "
                  "ASCE/SEI 7-22 (risk-targeted ground motions: 1% probability of collapse in 50 years).",
+    "IEEE 693": "IEEE (2018). IEEE Recommended Practice for Seismic Design of Substations, IEEE Std 693-2018.",
     "Psycharis & Jennings 1983": "Psycharis, I. N., Jennings, P. C. (1983). Rocking of slender rigid bodies allowed "
                                  "to uplift. Earthquake Engineering & Structural Dynamics 11(1), 57-76.",
     "Chopra & Yim 1985": "Chopra, A. K., Yim, S. C.-S. (1985). Simplified earthquake analysis of structures with "
@@ -119,6 +120,9 @@ GLOSSARY = (
     ("α, R", "slenderness angle (tan α = half-width over half-height) and the half-diagonal of the block; of two "
              "blocks with the same α the larger (larger R) is the more stable (Makris & Vassiliou 2012)."),
     ("uplift threshold", "the ground acceleration at which the block starts to rock on a rigid base: g·tanα."),
+    ("anchor (verdict)", "the block must not stand free; the report does not size the anchorage, which is designed "
+                         "as a nonstructural component fixed to its support (ASCE 7-22 Chapter 13) or to the "
+                         "equipment's own qualification standard (IEEE 693 for substation equipment)."),
     ("damage state", "an outcome the fragility gives the probability of: uplift, θmax/α above a limit, "
                      "overturning."),
     ("fragility curve", "P(damage state | intensity), a lognormal distribution: median (the intensity at which "
