@@ -469,6 +469,7 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str) 
     if not failing:
         return ""
     return (f"Sufficiency: at a given {measure} the overturning capacity still depends on {' and '.join(failing)} "
-            "(measure-efficiency page; Luco & Cornell 2007), so these curves hold for ground motions like the "
+            "(the smallest p of its soils and models on the measure-efficiency page; Luco & Cornell 2007), so these "
+            "curves hold for ground motions like the "
             "study's records; for a site whose motions differ in that (near a fault: velocity pulses), run the "
             "study with records like the site's (e.g. the near-field set).")
