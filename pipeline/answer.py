@@ -363,12 +363,22 @@ def records_reaching(fraction: float, n_records: int) -> int:
     return int(round(float(fraction) * n_records))
 
 
+def level_at_or_below(levels: np.ndarray, intensity: float) -> int | None:
+    """Index of the level run nearest at or below ``intensity`` (same unit; None where every level is above it).
+
+    The one reading of "the records at a return period's intensity": the probability table, the motion table and
+    the sliding share all count the records of this level (relative tolerance 1e-9 for a level at the intensity).
+    """
+    below = np.flatnonzero(np.asarray(levels, float) <= intensity * (1 + 1e-9))
+    return int(below[-1]) if below.size else None
+
+
 def _records_at(levels: np.ndarray, empirical: np.ndarray, n_records: int, im: float) -> tuple:
     """(records reaching the state, of how many, the level) at the level nearest at or below ``im``."""
-    below = np.flatnonzero(levels <= im * (1 + 1e-9))
-    if not below.size or not empirical.size or not np.isfinite(empirical[below[-1]]):
+    level = level_at_or_below(levels, im)
+    if level is None or not empirical.size or not np.isfinite(empirical[level]):
         return (-1, n_records, float("nan"))
-    return (records_reaching(empirical[below[-1]], n_records), n_records, float(levels[below[-1]]))
+    return (records_reaching(empirical[level], n_records), n_records, float(levels[level]))
 
 
 def _first_reached(levels: np.ndarray, empirical: np.ndarray) -> float | None:
@@ -395,9 +405,9 @@ def _at(row: xr.Dataset, im: float, scale: float, levels: np.ndarray, empirical:
         if np.isfinite(low_median) and np.isfinite(high_median):
             return p, float(lognormal_cdf(im, high_median, beta)), float(lognormal_cdf(im, low_median, beta))
         return p, np.nan, np.nan
-    below = np.flatnonzero(levels <= im * (1 + 1e-9))
-    if below.size and empirical.size and np.isfinite(empirical[below[-1]]):
-        return float(empirical[below[-1]]), np.nan, np.nan
+    level = level_at_or_below(levels, im)
+    if level is not None and empirical.size and np.isfinite(empirical[level]):
+        return float(empirical[level]), np.nan, np.nan
     return np.nan, np.nan, np.nan
 
 
@@ -406,8 +416,8 @@ def _lower_bound(levels: np.ndarray, empirical: np.ndarray, im: float) -> tuple:
 
     Exceedance grows with the intensity, so the fraction at a lower level bounds it; NaN where no level lies that low.
     """
-    below = np.flatnonzero(levels <= im * (1 + 1e-9))
-    return (float(empirical[below[-1]]) if below.size else np.nan, np.nan, np.nan)
+    level = level_at_or_below(levels, im)
+    return (float(empirical[level]) if level is not None else np.nan, np.nan, np.nan)
 
 
 def nested_families(fragility: xr.Dataset) -> list[list[int]]:
@@ -492,8 +502,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     answers = []
     for block in map(str, fragility.block.values):
         levels = _levels(fragility, block, scale)
-        decided = levels[levels <= intensities[-1] * (1 + 1e-9)] if intensities else np.array([])
-        decision_level = float(decided[-1]) if decided.size else np.nan  # the level the sliding share reads
+        decided = level_at_or_below(levels, intensities[-1]) if intensities else None
+        decision_level = float(levels[decided]) if decided is not None else np.nan  # the level the sliding share reads
         credible = (largest_recorded or {}).get(block)
         soils = []
         for soil in map(str, fragility.soil.values):

@@ -28,6 +28,8 @@ MAGIC = b"rockfrag-checkpoint 1\n"
 
 SUFFIX = ".ckpt"
 QUARANTINE = "quarantine"
+FOLDER = ".checkpoints"
+"""The folder of a study's cell checkpoints inside its output folder (the study writes it, the report dates by it)."""
 
 
 class DamagedCheckpoint(Exception):

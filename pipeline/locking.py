@@ -24,6 +24,7 @@ import fcntl
 import os
 from pathlib import Path
 
+from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
 from pipeline.errors import PipelineError
 
 LOCK_NAME = ".rockfrag.lock"
@@ -64,7 +65,7 @@ def _owner(path) -> str:
 def stale_part_files(folder) -> list[Path]:
     """Temporary files of interrupted writes in ``folder`` and its ``.checkpoints``."""
     folder = Path(folder)
-    return [path for where in (folder, folder / ".checkpoints") if where.is_dir()
+    return [path for where in (folder, folder / CHECKPOINT_FOLDER) if where.is_dir()
             for path in where.glob(".*.part") if path.is_file()]
 
 

@@ -48,6 +48,7 @@ from tqdm import tqdm
 
 from pipeline import __version__
 from pipeline.blocks import Block
+from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
 from pipeline.checkpoints import CheckpointStore
 from pipeline.cube import COMPARISON_CUBE, build_cube
 from pipeline.errors import PipelineError, RecordError
@@ -617,7 +618,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         warn(line)
 
     n_levels = len(config.levels)
-    store = CheckpointStore(output / ".checkpoints", log=warn)
+    store = CheckpointStore(output / CHECKPOINT_FOLDER, log=warn)
     variants = (True, False) if config.vertical else (False,)  # with the vertical (cube.nc), then without it
     all_cells = {variant: [cells_for_record(record, config, recipe, scale_factors[index],
                                             vertical_key(record, verticals[index], variant) if config.vertical

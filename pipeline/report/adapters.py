@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from pipeline.answer import level_at_or_below
 from pipeline.damage_states import DAMAGE_STATES
 from pipeline.errors import SolverError
 from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
@@ -349,13 +350,12 @@ def sliding_at(cube, models, block, soil, intensity: float, coefficient: float |
     if ties is not True and not bool(ties.sel(model=name, block=block, soil=soil)):
         return float("nan"), float("nan"), True
     levels = block_levels(cube, block)
-    below = np.flatnonzero(levels <= intensity * (1 + 1e-9))
-    if "peak_friction_demand" not in cube or not below.size:
+    level = level_at_or_below(levels, intensity)
+    if "peak_friction_demand" not in cube or level is None:
         return float("nan"), float("nan"), False
     if coefficient is None:
         friction = soil_friction(cube)
         coefficient = float(friction.sel(soil=soil)) if hasattr(friction, "sel") else float(friction)
-    level = int(below[-1])
     demand = cube.peak_friction_demand.sel(model=name, block=block, soil=soil).isel(im_level=level)
     valid = demand.notnull() & (cube.outcome.sel(model=name, block=block, soil=soil).isel(im_level=level)
                                 != OUTCOME_FAILED)

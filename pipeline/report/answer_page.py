@@ -16,7 +16,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.answer import ANCHOR, RECOMMENDED, BlockAnswer, display_scale, percent, verdict_sentence
+from pipeline.answer import (
+    ANCHOR,
+    RECOMMENDED,
+    BlockAnswer,
+    display_scale,
+    level_at_or_below,
+    percent,
+    verdict_sentence,
+)
 from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule (resurrection), in one place
 from pipeline.models.base import Outcome
 from pipeline.models.variants import split_variant
@@ -187,11 +195,10 @@ def governing_modes(cube, block: str, model: str, soil: str, intensities, scale:
     overturned = first_overturn_outcomes(cell).transpose("record", "im_level").values == int(Outcome.OVERTURNED)
     out = []
     for im in intensities:
-        below = np.flatnonzero(levels <= im * (1 + 1e-9))
-        if not below.size:
+        level = level_at_or_below(levels, im)
+        if level is None:
             out.append(NO_LEVEL)
             continue
-        level = int(below[-1])
         worst = _motions(cell.isel(im_level=level), overturned[:, level])
         worst = worst[worst >= 0]
         if not worst.size:
@@ -366,7 +373,7 @@ def _period_header(answer: BlockAnswer, soil, index: int, measure: str) -> str:
     level = next((value for value in levels if np.isfinite(value)), np.nan)
     if np.isfinite(level):
         return f"{head} (records at {level:.2g}\u00a0{answer.unit})"
-    return f"{head} (no level run this low)" if levels else head
+    return f"{head} ({NO_LEVEL})" if levels else head
 
 
 def _at_least(p: float) -> str:

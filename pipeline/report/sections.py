@@ -30,6 +30,7 @@ from pipeline.answer import (
     percent,
     records_reaching,
 )
+from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
 from pipeline.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
 from pipeline.config import StudyConfig
 from pipeline.damage_states import NOT_APPLICABLE
@@ -64,6 +65,7 @@ from pipeline.report.layout import pretty
 from pipeline.report.text import Item, bullet, heading, note, paragraph, table
 from pipeline.report.vertical import VerticalEffect
 from pipeline.report.words import PAPER_CITATION, plain, state_short_label
+from pipeline.soils import SOILS
 
 EXTRAPOLATION_ROWS = 30
 
@@ -107,8 +109,6 @@ class Results:
     @property
     def friction_words(self) -> str:
         """Where the base friction comes from and how to set the block's own: the answer pages, methods, limitations."""
-        from pipeline.soils import SOILS
-
         pairs = ", ".join(f"{soil.name} {soil.friction_static:g}/{soil.friction_kinetic:g}"
                           for soil in self.config.soils)
         shipped = [soil.name for soil in self.config.soils if SOILS.get(soil.name) == soil]
@@ -249,10 +249,6 @@ def runs_words(results) -> str:
     return text
 
 
-CHECKPOINTS = ".checkpoints"
-"""The folder of a study's cell checkpoints inside its output folder (pipeline.study writes them there)."""
-
-
 def results_date(output) -> str | None:
     """The date the results were computed, ISO 8601 ("2026-11-26", UTC), or None when no result file is found.
 
@@ -260,7 +256,7 @@ def results_date(output) -> str | None:
     results keeps that run's date), else the modification time of ``cube.nc`` (it records no creation time).
     """
     output = Path(output)
-    times = [path.stat().st_mtime for path in (output / CHECKPOINTS).glob(f"*{CHECKPOINT_SUFFIX}")]
+    times = [path.stat().st_mtime for path in (output / CHECKPOINT_FOLDER).glob(f"*{CHECKPOINT_SUFFIX}")]
     if not times and (output / "cube.nc").is_file():
         times = [(output / "cube.nc").stat().st_mtime]
     if not times:
@@ -592,7 +588,6 @@ def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
     from pipeline.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
     from pipeline.models.variants import DEFAULT_BAND
-    from pipeline.soils import SOILS
 
     config, fragility = results.config, results.fragility
     labels = state_labels(fragility)
