@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import math
 
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 NAME = "continuous"  # selects this law: simulate(..., bed="continuous"), [solver] bed
 
 
-@njit(cache=True)
+@kernel
 def _clip(low, high, c0, c1):
     """Restrict [low, high] to where c0 + c1 s > 0."""
     if c1 > 0.0:
@@ -31,7 +31,7 @@ def _clip(low, high, c0, c1):
     return low, high
 
 
-@njit(cache=True)
+@kernel
 def force(x, params, sin_t, cos_t):
     """Vertical force F [m/s^2] and its moment M [m^2/s^2] about the base centre, per unit mass.
 
@@ -57,7 +57,7 @@ def force(x, params, sin_t, cos_t):
             pressure_centre * first + pressure_slope * second)
 
 
-@njit(cache=True)
+@kernel
 def indicator(index, x, params):
     """Contact indicator ``index`` (its sign changes where the contact changes).
 
@@ -73,7 +73,7 @@ def indicator(index, x, params):
     return delta + 2.0 * params["xi"] / omega * (x[3] + s * math.cos(x[0]) * x[1])
 
 
-@njit(cache=True)
+@kernel
 def indicators(x, params, out):
     """All four ``indicator`` values into out (4,), with one sin and one cos."""
     b = params["b"]
@@ -86,7 +86,7 @@ def indicators(x, params, out):
     out[3] = out[1] + base_rate + rate
 
 
-@njit(cache=True)
+@kernel
 def full_contact(x, params, sin_t):
     """The bed while the whole base is in the ground, per unit mass: (rocking stiffness, elastic energy).
 

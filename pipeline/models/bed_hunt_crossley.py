@@ -34,18 +34,18 @@ from pipeline.models.bed_continuous import (
     _clip,
     full_contact,  # noqa: F401  (the same springs: same elastic energy)
 )
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 NAME = "hunt-crossley"  # selects this law: simulate(..., bed="hunt-crossley"), [solver] bed
 
 
-@njit(cache=True)
+@kernel
 def damping_factor(params):
     """Hunt-Crossley c = lambda / k [s/m] of the bed: 2 xi omega / g (the vertical damping ratio xi at rest)."""
     return 2.0 * params["xi"] * params["omega"] / params["g"]
 
 
-@njit(cache=True)
+@kernel
 def force(x, params, sin_t, cos_t):
     """Vertical force F [m/s^2] and its moment M [m^2/s^2] about the base centre, per unit mass.
 
@@ -77,7 +77,7 @@ def force(x, params, sin_t, cos_t):
             stiffness_per_length * (q0 * i1 + q1 * i2 + q2 * i3))
 
 
-@njit(cache=True)
+@kernel
 def indicator(index, x, params):
     """Contact indicator ``index`` (its sign changes where the contact changes).
 
@@ -93,7 +93,7 @@ def indicator(index, x, params):
     return y_static * (1.0 + damping_factor(params) * (x[3] + s * math.cos(x[0]) * x[1]))
 
 
-@njit(cache=True)
+@kernel
 def indicators(x, params, out):
     """All four ``indicator`` values into out (4,), with one sin and one cos."""
     b = params["b"]

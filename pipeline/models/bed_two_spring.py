@@ -13,12 +13,12 @@ indicators are the continuous bed's.
 from __future__ import annotations
 
 from pipeline.models.bed_continuous import indicator, indicators  # noqa: F401  (the same Kelvin-Voigt corners)
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 NAME = "two-spring"  # selects this law: simulate(..., bed="two-spring"), [solver] bed
 
 
-@njit(cache=True)
+@kernel
 def force(x, params, sin_t, cos_t):
     """Vertical force F [m/s^2] and its moment M [m^2/s^2] about the base centre, per unit mass.
 
@@ -41,7 +41,7 @@ def force(x, params, sin_t, cos_t):
     return total, moment
 
 
-@njit(cache=True)
+@kernel
 def full_contact(x, params, sin_t):
     """The springs while both corners are in the ground, per unit mass: (rocking stiffness, elastic energy).
 

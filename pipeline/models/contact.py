@@ -30,7 +30,7 @@ as arguments, so the dispatch is an if/elif on the integer law code, written out
 from __future__ import annotations
 
 from pipeline.models import bed_continuous, bed_hunt_crossley, bed_two_spring
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 # contact indicators every law reports (see the module docstring)
 N_CONTACT_INDICATORS = 4
@@ -48,7 +48,7 @@ UNREGISTERED = "bed contact law code not registered in pipeline.models.contact"
 
 # ---- the dispatchers: one branch per registered law ---------------------------------------------
 
-@njit(cache=True)
+@kernel
 def bed_force_at(x, params, sin_t, cos_t):
     """The law's ``force``: (F [m/s^2], M [m^2/s^2]) of the bed on the block, per unit mass."""
     law = params["bed"]
@@ -61,7 +61,7 @@ def bed_force_at(x, params, sin_t, cos_t):
     raise ValueError(UNREGISTERED)
 
 
-@njit(cache=True)
+@kernel
 def contact_indicator(index, x, params):
     """The law's ``indicator``: contact indicator ``index`` at state x."""
     law = params["bed"]
@@ -74,7 +74,7 @@ def contact_indicator(index, x, params):
     raise ValueError(UNREGISTERED)
 
 
-@njit(cache=True)
+@kernel
 def contact_indicators(x, params, out):
     """The law's ``indicators``: all N_CONTACT_INDICATORS values into out."""
     law = params["bed"]
@@ -88,7 +88,7 @@ def contact_indicators(x, params, out):
         raise ValueError(UNREGISTERED)
 
 
-@njit(cache=True)
+@kernel
 def bed_full_contact(x, params, sin_t):
     """The law's ``full_contact``: (rocking stiffness K_r/m, elastic energy V/m) [m^2/s^2], whole base down."""
     law = params["bed"]

@@ -36,10 +36,10 @@ import math
 
 from pipeline.models.base import RockingModel
 from pipeline.models.fields import HOUSNER
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def housner_rhs(sigma, x, accel, gravity, params, out):
     """dx/dt while rocking on pivot sigma: theta'' = -(kappa/R)(g sin A + ag cos A), A = sigma alpha - theta.
 
@@ -52,14 +52,14 @@ def housner_rhs(sigma, x, accel, gravity, params, out):
     out[3] = 0.0
 
 
-@njit(cache=True)
+@kernel
 def housner_rest_rhs(out):
     """dx/dt at rest on a rigid base: nothing moves."""
     for i in range(out.size):
         out[i] = 0.0
 
 
-@njit(cache=True)
+@kernel
 def housner_support(gravity):
     """Vertical force of the rigid base on the block at rest per unit mass [m/s^2].
 
@@ -68,7 +68,7 @@ def housner_support(gravity):
     return gravity
 
 
-@njit(cache=True)
+@kernel
 def pivot_arm(sigma, theta, params):
     """(X, Z) [m]: the centre of mass relative to pivot sigma (horizontal, vertical), at tilt theta."""
     b = params["b"]
@@ -78,13 +78,13 @@ def pivot_arm(sigma, theta, params):
     return -sigma * b * cos_t + h * sin_t, sigma * b * sin_t + h * cos_t
 
 
-@njit(cache=True)
+@kernel
 def central_inertia(params):
     """I_c / m [m^2], the block's moment of inertia about its centre of mass per unit mass."""
     return params["R"] * params["R"] * (1.0 / params["kappa"] - 1.0)
 
 
-@njit(cache=True)
+@kernel
 def rock_forces(sigma, theta, theta_dot, accel, gravity, params):
     """(H, V) per unit mass [m/s^2]: the pivot's horizontal and vertical force while rocking on stuck pivot sigma.
 
@@ -97,7 +97,7 @@ def rock_forces(sigma, theta, theta_dot, accel, gravity, params):
     return accel + arm_z * theta_acc - arm_x * rate2, gravity - arm_x * theta_acc - arm_z * rate2
 
 
-@njit(cache=True)
+@kernel
 def slide_rock_accelerations(sigma, slip, theta, theta_dot, gravity, params):
     """(theta'', V, eta) rocking on pivot sigma that slides in direction ``slip`` (+1, -1); V per unit mass.
 
@@ -117,7 +117,7 @@ def slide_rock_accelerations(sigma, slip, theta, theta_dot, gravity, params):
     return theta_acc, normal, eta
 
 
-@njit(cache=True)
+@kernel
 def housner_slide_rock_rhs(sigma, slip, x, accel, gravity, params, out):
     """dx/dt rocking on pivot sigma while it slides in direction ``slip``: the pivot's friction is eta V."""
     theta_acc, normal, eta = slide_rock_accelerations(sigma, slip, x[0], x[1], gravity, params)
@@ -130,7 +130,7 @@ def housner_slide_rock_rhs(sigma, slip, x, accel, gravity, params, out):
     out[5] = eta * normal - accel - (arm_z * theta_acc - arm_x * x[1] * x[1])
 
 
-@njit(cache=True)
+@kernel
 def housner_slide_rhs(slip, x, accel, gravity, params, out):
     """dx/dt sliding flat in direction ``slip``: u'' = -ag - mu_k (g + a_v) slip."""
     for i in range(4):
@@ -139,7 +139,7 @@ def housner_slide_rhs(slip, x, accel, gravity, params, out):
     out[5] = -accel - params["mu_k"] * slip * gravity
 
 
-@njit(cache=True)
+@kernel
 def friction_impact(sigma, x, params):
     """Impact at theta = 0 onto the corner -sigma with friction: new theta' (x[1]) and slip rate (x[5]).
 

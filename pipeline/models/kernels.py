@@ -77,7 +77,7 @@ from pipeline.models.housner import (
     rock_forces,
     slide_rock_accelerations,
 )
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel, njit
 from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
 from pipeline.models.winkler import (
     bed_force,
@@ -201,7 +201,7 @@ def workspace():
 # ground motion, right-hand side and the Dormand-Prince step
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def sample(samples, row, index):
     """Ground acceleration sample [m/s^2] of component ``row``.
 
@@ -210,7 +210,7 @@ def sample(samples, row, index):
     return samples[row, index] if index < samples.shape[1] and row < samples.shape[0] else 0.0
 
 
-@njit(cache=True)
+@kernel
 def interpolate(motion, row, t):
     """Ground acceleration [m/s^2] of component ``row`` at time t [s]: linear between samples."""
     samples = motion.samples
@@ -222,13 +222,13 @@ def interpolate(motion, row, t):
     return a0 + (sample(samples, row, index + 1) - a0) * (position - index)
 
 
-@njit(cache=True)
+@kernel
 def ground(motion, t):
     """Horizontal ground acceleration [m/s^2] at time t [s] (linear between samples)."""
     return interpolate(motion, HORIZONTAL, t)
 
 
-@njit(cache=True)
+@kernel
 def vertical(motion, t):
     """Vertical ground acceleration a_v [m/s^2, up positive] at time t [s]; 0 without a vertical component."""
     if motion.samples.shape[0] <= VERTICAL:
@@ -236,13 +236,13 @@ def vertical(motion, t):
     return interpolate(motion, VERTICAL, t)
 
 
-@njit(cache=True)
+@kernel
 def effective_gravity(params, motion, t):
     """Effective gravity g + a_v(t) [m/s^2]: gravity in the frame of the vertically accelerating ground."""
     return params["g"] + vertical(motion, t)
 
 
-@njit(cache=True)
+@kernel
 def vertical_quiet(motion, t):
     """True when the vertical ground acceleration is zero over the whole sample interval of t."""
     samples = motion.samples
@@ -250,7 +250,7 @@ def vertical_quiet(motion, t):
     return sample(samples, VERTICAL, index) == 0.0 and sample(samples, VERTICAL, index + 1) == 0.0
 
 
-@njit(cache=True)
+@kernel
 def free_flight_time(motion, g):
     """First time [s] at which g + a_v(t) falls below zero; inf if never.
 
@@ -269,7 +269,7 @@ def free_flight_time(motion, g):
     return math.inf
 
 
-@njit(cache=True)
+@kernel
 def rhs(code, phase, sigma, x, accel, gravity, params, out, slip=0.0):
     """dx/dt into out for state x = [theta, theta_dot, y, y_dot, u, u_dot], by the model's kernel code.
 
@@ -305,7 +305,7 @@ def rhs(code, phase, sigma, x, accel, gravity, params, out, slip=0.0):
         raise ValueError(UNKNOWN_CODE)
 
 
-@njit(cache=True)
+@kernel
 def derivatives(system, t, x, out):
     """f(t, x) of ``system`` into out: the one place where the ground motion enters the right-hand side.
 
@@ -316,7 +316,7 @@ def derivatives(system, t, x, out):
         system.params, out, system.slip)
 
 
-@njit(cache=True)
+@kernel
 def dopri_step(system, t, x, h, work):
     """One Dormand-Prince step of length h from (t, x), with ``work.f0`` = f(t, x).
 
@@ -352,7 +352,7 @@ def dopri_step(system, t, x, h, work):
         error[i] = h * (E1 * f0[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
 
 
-@njit(cache=True)
+@kernel
 def error_norm(x, x_new, error, scale, rtol, atol, count):
     """RMS of the local error over the mixed absolute/relative tolerance (accept when <= 1).
 
@@ -365,7 +365,7 @@ def error_norm(x, x_new, error, scale, rtol, atol, count):
     return math.sqrt(total / count)
 
 
-@njit(cache=True)
+@kernel
 def integrated_size(system):
     """State components the error norm is over: all while the base slides; else the slip is constant, not counted.
 
@@ -375,7 +375,7 @@ def integrated_size(system):
     return STATE_SIZE if system.slip != 0.0 else TIED_STATE_SIZE
 
 
-@njit(cache=True)
+@kernel
 def next_step(h, norm):
     """Step-size proposal after an accepted step."""
     if norm > 0.0:
@@ -383,7 +383,7 @@ def next_step(h, norm):
     return h * MAX_FACTOR
 
 
-@njit(cache=True)
+@kernel
 def adaptive_step(system, t, x, h, work, zeno_guard):
     """Take one accepted step of at most h from (t, x) into ``work``; returns (h_taken, error norm).
 
@@ -410,7 +410,7 @@ def adaptive_step(system, t, x, h, work, zeno_guard):
 # dense output and event location
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def hermite(step, s, i):
     """Cubic Hermite interpolant of state component i at fraction s in [0, 1] of ``step``."""
     h00 = 2 * s**3 - 3 * s**2 + 1
@@ -421,7 +421,7 @@ def hermite(step, s, i):
     return h00 * step.x0[i] + h10 * h * step.f0[i] + h01 * step.x1[i] + h11 * h * step.f1[i]
 
 
-@njit(cache=True)
+@kernel
 def hermite_derivative(step, s, i):
     """Time derivative of ``hermite`` at fraction s."""
     h = step.h
@@ -432,7 +432,7 @@ def hermite_derivative(step, s, i):
     return d00 * step.x0[i] + d10 * step.f0[i] + d01 * step.x1[i] + d11 * step.f1[i]
 
 
-@njit(cache=True)
+@kernel
 def support(code, params, x, gravity):
     """Vertical support force per unit mass [m/s^2] of a pivot model at rest, by its kernel code.
 
@@ -445,7 +445,7 @@ def support(code, params, x, gravity):
     raise ValueError(UNKNOWN_CODE)
 
 
-@njit(cache=True)
+@kernel
 def event_value(kind, index, system, step, s, interpolated):
     """The event function of ``kind`` (and contact indicator ``index``) on the step's interpolant at fraction s.
 
@@ -474,7 +474,7 @@ def event_value(kind, index, system, step, s, interpolated):
     return abs(accel) - math.tan(params["alpha"]) * support(system.code, params, interpolated, gravity)
 
 
-@njit(cache=True)
+@kernel
 def locate(kind, index, system, step, interpolated):
     """Fraction s in (0, 1] of the step where the event function changes sign (Illinois method)."""
     s_low, s_high = 0.0, 1.0
@@ -503,7 +503,7 @@ def locate(kind, index, system, step, interpolated):
     return s_high
 
 
-@njit(cache=True)
+@kernel
 def refine_event(kind, index, system, step, s_guess, work):
     """Take the step to the event found on the interpolant, then sharpen the event time on the real solution.
 
@@ -548,7 +548,7 @@ def refine_event(kind, index, system, step, s_guess, work):
     return h_high
 
 
-@njit(cache=True)
+@kernel
 def track_peak(step, summary, overturn):
     """Update the peak |theta| with the extremum inside the step (theta' changes sign) and its end."""
     x0, x1 = step.x0, step.x1
@@ -575,7 +575,7 @@ def track_peak(step, summary, overturn):
 # shared bookkeeping
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def static_settlement(code, params):
     """Settlement of the foundation under the block's weight [m], by the model's kernel code."""
     if code == HOUSNER:
@@ -586,7 +586,7 @@ def static_settlement(code, params):
     raise ValueError(UNKNOWN_CODE)
 
 
-@njit(cache=True)
+@kernel
 def state_scales(params, y_static, scale):
     """Absolute-error scales of [theta, theta_dot, y, y_dot] into ``scale``; returns p^2 [1/s^2].
 
@@ -603,13 +603,13 @@ def state_scales(params, y_static, scale):
     return p_squared
 
 
-@njit(cache=True)
+@kernel
 def interval_of(t, dt):
     """Index of the sample interval that starts at or just before t (t within 1e-9 dt of a sample: that one)."""
     return int(math.floor(t / dt + 1e-9))
 
 
-@njit(cache=True)
+@kernel
 def write_rows(history, next_row, dt, step):
     """History rows at the sample times in (t, t + h] of ``step``, from its interpolant; returns the next row."""
     if history.shape[0] == 0:
@@ -624,7 +624,7 @@ def write_rows(history, next_row, dt, step):
     return next_row
 
 
-@njit(cache=True)
+@kernel
 def hold_rows(history, next_row, dt, t1, x):
     """History rows up to time t1 while the state is constant (rest)."""
     if history.shape[0] == 0:
@@ -636,7 +636,7 @@ def hold_rows(history, next_row, dt, t1, x):
     return next_row
 
 
-@njit(cache=True)
+@kernel
 def finish(history, next_row, summary, status, t):
     """Blank the history after overturning, failure or free flight and write the outcome."""
     if history.shape[0] > 0 and (status == OVERTURNED or status == FAILED or status == FREE_FLIGHT):
@@ -647,7 +647,7 @@ def finish(history, next_row, summary, status, t):
     summary["t_end"] = t
 
 
-@njit(cache=True)
+@kernel
 def book_overturn(summary, params, t):
     """The block reached the overturning angle at time t."""
     summary["time_of_overturn"] = t
@@ -655,7 +655,7 @@ def book_overturn(summary, params, t):
     summary["time_of_peak"] = t
 
 
-@njit(cache=True)
+@kernel
 def book_impact(summary, impact_times, t):
     """Count an impact at time t and keep its time while there is room."""
     summary["n_impacts"] += 1.0
@@ -664,7 +664,7 @@ def book_impact(summary, impact_times, t):
         impact_times[count - 1] = t
 
 
-@njit(cache=True)
+@kernel
 def start_summary(summary, x, min_support, t_free_flight):
     """Initial values of every summary field for a run starting at state x.
 
@@ -698,7 +698,7 @@ def start_summary(summary, x, min_support, t_free_flight):
 # friction at the base (housner, winkler): stick-slip, mode selection, bookkeeping
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def stick_margin(system, x, t):
     """(mu_s N - |H|, H) per unit mass [m/s^2] of the base held stuck at state x, time t.
 
@@ -718,13 +718,13 @@ def stick_margin(system, x, t):
     return params["mu_s"] * normal - abs(horizontal), horizontal
 
 
-@njit(cache=True)
+@kernel
 def slip_direction(horizontal):
     """Direction of the slip that starts where a stuck base would need the force ``horizontal`` (opposite)."""
     return -1.0 if horizontal > 0.0 else 1.0
 
 
-@njit(cache=True)
+@kernel
 def slip_event(system, step, min_fraction, interpolated):
     """The friction event inside the step: (kind, fraction s); (EVENT_NONE, 2) if none.
 
@@ -742,7 +742,7 @@ def slip_event(system, step, min_fraction, interpolated):
     return EVENT_NONE, 2.0
 
 
-@njit(cache=True)
+@kernel
 def stopped_at_end(system, x, scale):
     """True when a sliding base ends a step with its slip rate at zero (or past it): the stop is there.
 
@@ -751,7 +751,7 @@ def stopped_at_end(system, x, scale):
     return system.slip != 0.0 and system.slip * x[SLIP_RATE] <= SLIP_STOP_FRACTION * scale[SLIP_RATE]
 
 
-@njit(cache=True)
+@kernel
 def book_mode_time(summary, mode, duration):
     """Add ``duration`` [s] to the time spent in contact ``mode`` (fields.MODE_*)."""
     if mode == MODE_REST:
@@ -766,7 +766,7 @@ def book_mode_time(summary, mode, duration):
         summary["time_in_flight"] += duration
 
 
-@njit(cache=True)
+@kernel
 def pivot_mode(system):
     """Contact mode (fields.MODE_*) of a pivot model's system: flat or rocking, stuck or sliding."""
     if system.phase == REST:
@@ -774,7 +774,7 @@ def pivot_mode(system):
     return MODE_ROCK if system.slip == 0.0 else MODE_SLIDE_ROCK
 
 
-@njit(cache=True)
+@kernel
 def bed_mode(system, indicators):
     """Contact mode of a bed model from its corners' penetrations (indicators 0, 1) and its slip."""
     lifted = int(indicators[0] < 0.0) + int(indicators[1] < 0.0)
@@ -785,7 +785,7 @@ def bed_mode(system, indicators):
     return MODE_REST if system.slip == 0.0 else MODE_SLIDE
 
 
-@njit(cache=True)
+@kernel
 def book_slip(summary, x):
     """Peak and current absolute slip [m] after a step (the slip's extrema are at its stops: step ends)."""
     slip = abs(x[SLIP])
@@ -794,7 +794,7 @@ def book_slip(summary, x):
     summary["residual_slip"] = slip
 
 
-@njit(cache=True)
+@kernel
 def flat_slide_mode(params, slip):
     """(phase, sigma, slip) of a rigid base sliding flat in direction ``slip``.
 
@@ -806,7 +806,7 @@ def flat_slide_mode(params, slip):
     return REST, 0.0, slip
 
 
-@njit(cache=True)
+@kernel
 def rest_mode(system, x, t, crossed):
     """(phase, sigma, slip) of a rigid base with friction, flat and not sliding (u' = 0) at time t.
 
@@ -837,7 +837,7 @@ def rest_mode(system, x, t, crossed):
     return REST, 0.0, 0.0
 
 
-@njit(cache=True)
+@kernel
 def stuck_slip(system, x, t):
     """Slip direction of a base whose slip rate is zero at time t: 0 if it can stay stuck."""
     stuck = System(system.code, system.phase, system.sigma, 0.0, system.params, system.motion)
@@ -845,7 +845,7 @@ def stuck_slip(system, x, t):
     return 0.0 if margin >= 0.0 else slip_direction(horizontal)
 
 
-@njit(cache=True)
+@kernel
 def friction_pivot_impact(system, x, zeno_speed, t, impact_times, summary):
     """Impact at theta = 0 of a rigid base with friction (``housner.friction_impact``); (phase, sigma, slip) after.
 
@@ -871,7 +871,7 @@ def friction_pivot_impact(system, x, zeno_speed, t, impact_times, summary):
 # pivot models: housner, ssi, ssi-paper
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def start_threshold(params):
     """The coefficient c [-] with which a pivot model at rest starts to move when |ag| > c * support.
 
@@ -883,7 +883,7 @@ def start_threshold(params):
     return tan_alpha
 
 
-@njit(cache=True)
+@kernel
 def rest_until_uplift(system, x, t, t_sample_end):
     """Closed-form rest phase inside one sample interval; returns (t_new, start_now).
 
@@ -917,7 +917,7 @@ def rest_until_uplift(system, x, t, t_sample_end):
     return min(max(t_cross, t), t_sample_end), True
 
 
-@njit(cache=True)
+@kernel
 def vertical_at_rest(code, x, y_static, scale, quiet):
     """True when a pivot model at rest has no vertical vibration left.
 
@@ -933,7 +933,7 @@ def vertical_at_rest(code, x, y_static, scale, quiet):
     raise ValueError(UNKNOWN_CODE)
 
 
-@njit(cache=True)
+@kernel
 def pivot_event(system, step, interpolated):
     """The earliest event inside an accepted step of a pivot model: (kind, fraction s)."""
     params = system.params
@@ -960,7 +960,7 @@ def pivot_event(system, step, interpolated):
     return kind, s_event
 
 
-@njit(cache=True)
+@kernel
 def pivot_impact(system, x, zeno_speed, t, impact_times, summary):
     """Impact at theta = 0: restitution and pivot switch by the model's rule; returns (phase, sigma) after it.
 
@@ -979,7 +979,7 @@ def pivot_impact(system, x, zeno_speed, t, impact_times, summary):
     return ROCKING, -system.sigma
 
 
-@njit(cache=True)
+@kernel
 def ssi_bookkeeping(system, x, y_static, t, summary):
     """After a step of the ssi model: book the support force, tension and settlement.
 
@@ -1187,7 +1187,7 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
 # bed models: winkler (the bed's contact law: pipeline.models.contact)
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@kernel
 def bed_event(system, step, before, after, min_fraction, interpolated):
     """Earliest contact change or overturning inside the step: (kind, indicator index, fraction s).
 
@@ -1209,7 +1209,7 @@ def bed_event(system, step, before, after, min_fraction, interpolated):
     return kind, index, s_event
 
 
-@njit(cache=True)
+@kernel
 def bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_times):
     """Uplift, flights, touch-downs, corner uplift, support and friction demand after ``step``.
 

@@ -46,7 +46,7 @@ import math
 
 from pipeline.models.base import RockingModel
 from pipeline.models.fields import SSI
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 PAPER_TITLE = "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations"
 PAPER_CITATION = (f"{PAPER_TITLE}. Article; preprint at Preprints.org, 2026, doi:10.20944/preprints202603.1401.v1. "
@@ -57,7 +57,7 @@ names it (the report, cube.nc's ``references``)."""
 
 
 
-@njit(cache=True)
+@kernel
 def ssi_rest_rhs(x, gravity, params, out):
     """Both corners down: only the vertical spring-dashpot moves (gravity: g + a_v [m/s^2])."""
     omega = params["omega"]
@@ -67,7 +67,7 @@ def ssi_rest_rhs(x, gravity, params, out):
     out[3] = gravity - omega * omega * x[2] - 2.0 * params["xi"] * omega * x[3]
 
 
-@njit(cache=True)
+@kernel
 def ssi_rhs(sigma, x, accel, gravity, params, out):
     """dx/dt while rocking on pivot sigma (the equations in the module docstring).
 
@@ -89,7 +89,7 @@ def ssi_rhs(sigma, x, accel, gravity, params, out):
     out[3] = y_acc
 
 
-@njit(cache=True)
+@kernel
 def ssi_support(x, params):
     """Force of the spring-dashpot on the block per unit mass [m/s^2] (negative: it pulls).
 
@@ -99,7 +99,7 @@ def ssi_support(x, params):
     return omega * omega * x[2] + 2.0 * params["xi"] * omega * x[3]
 
 
-@njit(cache=True)
+@kernel
 def ssi_pivot_switch(x, params):
     """``consistent`` switch: theta' and the centre-of-mass velocity stay continuous, so y' jumps."""
     x[3] = x[3] + 2.0 * params["R"] * math.sin(params["alpha"]) * abs(x[1])

@@ -58,10 +58,10 @@ import math
 from pipeline.models.base import RockingModel
 from pipeline.models.contact import bed_force_at, bed_full_contact
 from pipeline.models.fields import WINKLER
-from pipeline.models.jit import njit
+from pipeline.models.jit import kernel
 
 
-@njit(cache=True)
+@kernel
 def bed_force(x, params):
     """Vertical force F and its moment M about the base centre, both per unit mass, for state x.
 
@@ -71,13 +71,13 @@ def bed_force(x, params):
     return bed_force_at(x, params, math.sin(x[0]), math.cos(x[0]))
 
 
-@njit(cache=True)
+@kernel
 def accelerations(theta, theta_dot, y, y_dot, ag, force, moment, h, j, g):
     """(theta'', y'') from the two equations of motion (module docstring); force, moment per mass."""
     return accelerations_at(math.sin(theta), math.cos(theta), theta_dot, ag, force, moment, h, j, g)
 
 
-@njit(cache=True)
+@kernel
 def accelerations_at(sin_t, cos_t, theta_dot, ag, force, moment, h, j, g):
     """``accelerations`` with sin(theta) and cos(theta) already known."""
     vertical = g - force - h * cos_t * theta_dot * theta_dot
@@ -88,7 +88,7 @@ def accelerations_at(sin_t, cos_t, theta_dot, ag, force, moment, h, j, g):
     return theta_acc, y_acc
 
 
-@njit(cache=True)
+@kernel
 def winkler_rhs(x, accel, gravity, params, out):
     """dx/dt for x = [theta, theta', y, y']; accel: horizontal ground acceleration, gravity: g + a_v [m/s^2]."""
     h = params["h"]
@@ -104,7 +104,7 @@ def winkler_rhs(x, accel, gravity, params, out):
     out[3] = y_acc
 
 
-@njit(cache=True)
+@kernel
 def winkler_slip_rhs(slip, x, accel, gravity, params, out):
     """dx/dt while the base slides in direction ``slip`` (+1, -1): the friction is -mu_k slip F (docstring)."""
     h = params["h"]
@@ -123,7 +123,7 @@ def winkler_slip_rhs(slip, x, accel, gravity, params, out):
     out[5] = horizontal - accel - h * cos_t * theta_acc + h * sin_t * rate2
 
 
-@njit(cache=True)
+@kernel
 def stick_forces(x, accel, gravity, params):
     """(H, F) per unit mass [m/s^2]: the horizontal force a stuck base needs and the bed's normal force."""
     h = params["h"]
@@ -136,7 +136,7 @@ def stick_forces(x, accel, gravity, params):
     return accel + h * cos_t * theta_acc - h * sin_t * x[1] * x[1], force
 
 
-@njit(cache=True)
+@kernel
 def settled_beyond_reach(x, params, peak_angle):
     """True when the settled block can no longer reach its recorded peak angle nor lift a corner.
 
@@ -165,7 +165,7 @@ def settled_beyond_reach(x, params, peak_angle):
     return excess < reach
 
 
-@njit(cache=True)
+@kernel
 def friction_demand(x, dx, accel, force, params):
     """|H| / N: friction coefficient needed to hold the base centre against sliding.
 
