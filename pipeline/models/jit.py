@@ -4,16 +4,16 @@ Input : the environment variable PIPELINE_NO_NUMBA. Output: two decorators, or n
 call forms when PIPELINE_NO_NUMBA=1 (debugging, coverage, and the property test that the compiled
 kernels equal the plain-Python ones):
 
-- ``njit``: numba's decorator, for the few functions that allocate arrays (the time loops' work arrays,
-  the batch entry points);
-- ``kernel``: every other compiled helper (right-hand sides, steps, events, bookkeeping). It is cached and
-  compiled without numba's reference counting (``_nrt=False``): a helper only borrows the arrays it is
-  handed, and its caller keeps them alive.
+- ``njit``: numba's decorator, for the few functions that allocate arrays (the entry points, which allocate
+  each response's work arrays);
+- ``kernel``: every other compiled function (the time loops, right-hand sides, steps, events, bookkeeping).
+  It is cached and compiled without numba's reference counting (``_nrt=False``): a kernel only borrows the
+  arrays it is handed, and its caller keeps them alive.
 
 Why ``kernel`` exists: the helpers pass arrays inside small records (a step, the system, the work arrays)
 through a dozen compiled calls per integration step, and numba counts every such borrow with two atomic
 instructions (NRT_incref/NRT_decref). Measured on the 2026-11-26 machine, those took 33-42% of a run's
-time; without them a Housner run is 4.3x and a winkler run 3.3x faster, with bit-identical results. The
+time; without them a Housner run is 4-5x and a winkler run 3-4x faster, with bit-identical results. The
 rules that make this safe are checked by numba and by tests/physics/test_kernel_rules.py: a ``kernel`` cannot
 allocate (numba refuses to compile an allocation without reference counting) and must not return an
 array (the test inspects every compiled signature).

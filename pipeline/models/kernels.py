@@ -20,7 +20,8 @@ Four small records travel between the functions, as scipy's rk.py passes one sta
   f(t, x), evaluated by ``derivatives``.
 - ``Step`` (t, h, x0, f0, x1, f1): one step and its dense output, read by event location, peak
   tracking and the history rows.
-- ``Workspace``: the work arrays of one response (Runge-Kutta stages, error, scales), allocated once.
+- ``Workspace``: the work arrays of one response (Runge-Kutta stages, error, scales, contact indicators), allocated
+  once per response by the entry point (``simulate_kernel``): the loops and their helpers are ``jit.kernel``s.
 
 Two time loops:
 - ``pivot_loop`` (housner, ssi, ssi-paper): the block rests until the uplift condition, rocks on one
@@ -188,13 +189,16 @@ class Workspace(NamedTuple):
     error: np.ndarray         # (STATE_SIZE,) local error estimate of the step
     scale: np.ndarray         # (STATE_SIZE,) absolute-error scale of each state component
     interpolated: np.ndarray  # (STATE_SIZE,) interpolated state of the event functions
+    before: np.ndarray        # (N_CONTACT_INDICATORS,) a bed's contact indicators at the step's start
+    after: np.ndarray         # (N_CONTACT_INDICATORS,) ... and at its end
 
 
 @njit(cache=True)
 def workspace():
-    """The work arrays of one response."""
+    """The work arrays of one response (allocated by the entry point: the loops are kernels, which cannot)."""
     return Workspace(np.empty((N_STAGES, STATE_SIZE)), np.empty(STATE_SIZE), np.empty(STATE_SIZE),
-                     np.empty(STATE_SIZE), np.empty(STATE_SIZE), np.empty(STATE_SIZE))
+                     np.empty(STATE_SIZE), np.empty(STATE_SIZE), np.empty(STATE_SIZE),
+                     np.empty(N_CONTACT_INDICATORS), np.empty(N_CONTACT_INDICATORS))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1006,9 +1010,9 @@ def ssi_bookkeeping(system, x, y_static, t, summary):
     return snapped
 
 
-@njit(cache=True)
-def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
-    """Integrate one response of a pivot model from state x (see the module docstring).
+@kernel
+def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary, work):
+    """Integrate one response of a pivot model from state x, in the work arrays ``work`` (see the module docstring).
 
     At rest the state is constant (closed form) or only the SSI vertical vibration moves; steps never
     cross a sample of the ground motion. The run stops where g + a_v first falls below zero (free flight).
@@ -1024,7 +1028,6 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
     threshold = start_threshold(params)
     friction = params["mu_s"] > 0.0
     y_static = static_settlement(code, params)
-    work = workspace()
     p_squared = state_scales(params, y_static, work.scale)
     zeno_speed = math.sqrt(2.0 * p_squared * math.sin(alpha) * params["zeno"])
     f0, x_new, f1 = work.f0, work.x_new, work.stages[END_STAGE]
@@ -1252,9 +1255,9 @@ def bed_bookkeeping(system, step, before, after, event_at_end, summary, impact_t
             summary["peak_friction_demand"] = demand
 
 
-@njit(cache=True)
-def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary):
-    """Integrate one response of a bed model from state x.
+@kernel
+def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summary, work):
+    """Integrate one response of a bed model from state x, in the work arrays ``work`` (``workspace()``).
 
     No rest phase, no impact rule (the block flies where g + a_v < 0 as anywhere else: its bed lets go).
     With friction (``params["mu_s"] > 0``) the base centre sticks or slides, with stick-slip events
@@ -1266,11 +1269,9 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
     if friction:
         system = System(code, ROCKING, 0.0, stuck_slip(system, x, 0.0), params, motion)
     t_final = (samples.shape[1] + n_tail - 1) * dt
-    work = workspace()
     state_scales(params, static_settlement(code, params), work.scale)
     f0, x_new, f1 = work.f0, work.x_new, work.stages[END_STAGE]
-    before = np.empty(N_CONTACT_INDICATORS)
-    after = np.empty(N_CONTACT_INDICATORS)
+    before, after = work.before, work.after
     force, _ = bed_force(x, params)
     start_summary(summary, x, force, free_flight_time(motion, params["g"]))
     contact_indicators(x, params, before)
@@ -1384,10 +1385,11 @@ def simulate_kernel(code, samples, dt, n_tail, params, x0, history, impact_times
         Filled with the first ``capacity`` impact times [s].
     summary : SUMMARY_DTYPE record, filled.
     """
+    work = workspace()
     if code == WINKLER:
-        bed_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary)
+        bed_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary, work)
     elif code == HOUSNER or code == SSI:
-        pivot_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary)
+        pivot_loop(code, samples, dt, n_tail, params, x0, history, impact_times, summary, work)
     else:
         raise ValueError(UNKNOWN_CODE)
 
