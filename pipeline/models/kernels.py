@@ -729,21 +729,24 @@ def slip_direction(horizontal):
 
 
 @kernel
-def slip_event(system, step, min_fraction, interpolated):
-    """The friction event inside the step: (kind, fraction s); (EVENT_NONE, 2) if none.
+def slip_event(system, step, min_fraction, interpolated, known_start):
+    """The friction event inside the step: (kind, fraction s, event function at the step's end).
 
-    A stuck base whose margin (``stick_margin``) turns negative starts to slide (EVENT_SLIP_START); a sliding
-    one whose slip rate reaches zero stops (EVENT_SLIP_STOP). Events below min_fraction are ignored.
+    kind is EVENT_NONE and s = 2 if there is none. A stuck base whose margin (``stick_margin``) turns negative
+    starts to slide (EVENT_SLIP_START); a sliding one whose slip rate reaches zero stops (EVENT_SLIP_STOP). Events
+    below min_fraction are ignored. known_start: the event function at the step's start when the caller has it
+    (the previous step's end value, same system and state: the interpolant is exact at both ends), else NaN. A
+    stuck base's margin costs a contact-force evaluation, so this saves one of the two per step.
     """
     kind = EVENT_SLIP_START if system.slip == 0.0 else EVENT_SLIP_STOP
-    v_start = event_value(kind, 0, system, step, 0.0, interpolated)
+    v_start = known_start if known_start == known_start else event_value(kind, 0, system, step, 0.0, interpolated)
     v_end = event_value(kind, 0, system, step, 1.0, interpolated)
     crossed = v_end < 0.0 if kind == EVENT_SLIP_START else v_end <= 0.0
     if crossed and v_start >= 0.0:
         s_hit = locate(kind, 0, system, step, interpolated)
         if s_hit > min_fraction:
-            return kind, s_hit
-    return EVENT_NONE, 2.0
+            return kind, s_hit, v_end
+    return EVENT_NONE, 2.0, v_end
 
 
 @kernel
@@ -1106,7 +1109,7 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
             kind, s_event = EVENT_NONE, 2.0
             if system.phase == ROCKING:  # (sliding flat, only the slip can change: the friction ratio is fixed)
                 kind, s_event = pivot_event(system, step, work.interpolated)
-            slip_kind, s_slip = slip_event(system, step, 0.0, work.interpolated)
+            slip_kind, s_slip, _ = slip_event(system, step, 0.0, work.interpolated, math.nan)
             if slip_kind != EVENT_NONE and s_slip < s_event:
                 kind, s_event = slip_kind, s_slip
         else:
@@ -1284,6 +1287,7 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
     failed = False
     overturned = False
     n_events = 0
+    margin_at_start = math.nan  # a stuck base's stick margin at (t, x), when the step before computed it
     derivatives(system, t, x, f0)
     while t < t_final - SEGMENT_END_FRACTION * dt:
         h = min(h, (interval_of(t, dt) + 1) * dt - t)  # steps end on every sample (see pivot_loop)
@@ -1296,12 +1300,15 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
         step = Step(t, h, x, f0, x_new, f1)
         # an event at the very start of the step is the one just located: ignore it
         kind, index, s_event = bed_event(system, step, before, after, EVENT_TIME_RESOLUTION / h, work.interpolated)
+        margin_at_end = math.nan
         if friction:
-            slip_kind, s_slip = slip_event(system, step, EVENT_TIME_RESOLUTION / h, work.interpolated)
+            slip_kind, s_slip, margin_at_end = slip_event(system, step, EVENT_TIME_RESOLUTION / h, work.interpolated,
+                                                          margin_at_start)
             if slip_kind != EVENT_NONE and s_slip < s_event:
                 kind, index, s_event = slip_kind, 0, s_slip
         event_at_end = False
-        if kind != EVENT_NONE and s_event < 1.0:
+        refined = kind != EVENT_NONE and s_event < 1.0
+        if refined:
             step = Step(t, refine_event(kind, index, system, step, s_event, work), x, f0, x_new, f1)
             far_side = after[index]
             contact_indicators(x_new, params, after)
@@ -1340,6 +1347,10 @@ def bed_loop(code, samples, dt, n_tail, params, x, history, impact_times, summar
                 if n_events > params["max_events"]:
                     failed = True
                     break
+            # the next step starts where this one ended, stuck as it was: its margin there is known (unless the
+            # step was cut at an event, whose far side was not where the margin was evaluated)
+            stuck_on = system.slip == 0.0 and not refined and kind != EVENT_SLIP_START and kind != EVENT_SLIP_STOP
+            margin_at_start = margin_at_end if stuck_on else math.nan
         if (history.shape[0] == 0 and t > samples.shape[1] * dt and after[0] > 0.0 and after[1] > 0.0
                 and system.slip == 0.0 and settled_beyond_reach(x, params, summary["peak_angle"])):
             # the ground is at rest and the block can no longer reach its peak, lift or slide (no history kept)
