@@ -19,6 +19,11 @@ from .motions import BLOCK, TAIL, case_motion
 from .winkler_reference import reference_winkler
 
 
+# every case's reference is computed once (``both`` caches it) when one worker runs the module: split over two
+# workers, each computed the cases both need (30 s of CPU instead of 22 s)
+pytestmark = pytest.mark.xdist_group("winkler-vs-reference")
+
+
 def stiffness(omega_over_p):
     return BLOCK.mass * (omega_over_p * BLOCK.p()) ** 2
 
