@@ -18,7 +18,6 @@ from pipeline.models import simulate
 from .motions import BLOCK, TAIL, case_motion
 from .winkler_reference import reference_winkler
 
-
 # every case's reference is computed once (``both`` caches it) when one worker runs the module: split over two
 # workers, each computed the cases both need (30 s of CPU instead of 22 s)
 pytestmark = pytest.mark.xdist_group("winkler-vs-reference")
