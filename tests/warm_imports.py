@@ -1,26 +1,29 @@
-"""Import every module of the package and of the test suite once, so that Python writes their bytecode (and
-that of the libraries they import) before the test processes start (``make test``: beside the kernel compile,
-on the core it leaves idle). Without it, pytest and each of its workers compile the same few thousand library
-modules side by side at start-up (``--no-compile`` installs; the Makefile explains why). Checks nothing."""
+"""Write the bytecode of the package, of the test suite and of the libraries they import once, before the test
+processes start (``make test``: beside the kernel compile, on the core it leaves idle). Without it, pytest and each
+of its workers compile the same few thousand library modules side by side at start-up (``--no-compile`` installs;
+the Makefile explains why) and each rewrites the test modules' asserts. Imports every ``pipeline`` module, then
+collects the tests as pytest does (its assert-rewritten bytecode is cached too). Runs no test, checks nothing."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib
+import io
 import pkgutil
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def warm() -> int:
-    """Import pipeline.* and tests.*; returns the number of modules imported."""
-    count = 0
-    for package in ("pipeline", "tests"):
-        for module in pkgutil.walk_packages([str(ROOT / package)], f"{package}."):
-            if module.name.rsplit(".", 1)[-1] != "__main__":  # (it would run the command line)
-                importlib.import_module(module.name)
-                count += 1
-    return count
+    """Import pipeline.* and collect the tests; returns pytest's exit status (0: collected)."""
+    for module in pkgutil.walk_packages([str(ROOT / "pipeline")], "pipeline."):
+        if module.name.rsplit(".", 1)[-1] != "__main__":  # (it would run the command line)
+            importlib.import_module(module.name)
+    with contextlib.redirect_stdout(io.StringIO()):  # (the list of tests; a collection error shows in the run itself)
+        return int(pytest.main(["--collect-only", "-q", "-p", "no:cacheprovider", str(ROOT / "tests")]))
 
 
 if __name__ == "__main__":

@@ -16,7 +16,7 @@ instructions (NRT_incref/NRT_decref). Measured on the 2026-11-26 machine, those 
 time; without them a Housner run is 4-5x and a winkler run 3-4x faster, with bit-identical results. The
 rules that make this safe are checked by numba and by tests/physics/test_kernel_rules.py: a ``kernel`` cannot
 allocate (numba refuses to compile an allocation without reference counting) and must not return an
-array (the test inspects every compiled signature).
+array (the test inspects every compiled signature), and a run frees every array it allocates.
 """
 
 from __future__ import annotations
@@ -35,9 +35,15 @@ if os.environ.get("PIPELINE_NO_NUMBA", "") not in ("", "0"):
         return function
 else:
     from numba import njit
+    from numba.core.cpu import CPUTargetOptions
+
+    # ``_nrt`` is numba's own (private) switch, there since numba 0.49; a release without it would reject it at
+    # the first call, so it is looked up here and, if gone, the kernels count references as before (slower, the
+    # same numbers; tests/physics/test_kernel_rules.py then fails, to say so).
+    KERNEL_OPTIONS = {"cache": True, "_nrt": False} if hasattr(CPUTargetOptions, "_nrt") else {"cache": True}
 
     def kernel(function):
-        """Compile a helper of the time loops: cached, without reference counting (see the module docstring)."""
-        return njit(cache=True, _nrt=False)(function)
+        """Compile a function of the time loops: cached, without reference counting (see the module docstring)."""
+        return njit(**KERNEL_OPTIONS)(function)
 
 __all__ = ["kernel", "njit"]
