@@ -739,7 +739,7 @@ def slip_event(system, step, min_fraction, interpolated, known_start):
     stuck base's margin costs a contact-force evaluation, so this saves one of the two per step.
     """
     kind = EVENT_SLIP_START if system.slip == 0.0 else EVENT_SLIP_STOP
-    v_start = known_start if known_start == known_start else event_value(kind, 0, system, step, 0.0, interpolated)
+    v_start = event_value(kind, 0, system, step, 0.0, interpolated) if math.isnan(known_start) else known_start
     v_end = event_value(kind, 0, system, step, 1.0, interpolated)
     crossed = v_end < 0.0 if kind == EVENT_SLIP_START else v_end <= 0.0
     if crossed and v_start >= 0.0:
