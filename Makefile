@@ -29,9 +29,12 @@ unexport PYTHONDONTWRITEBYTECODE
 
 # uv (from PyPI) installs into the venv in seconds where pip takes about a minute; it resolves the same
 # versions from the same index and, like --no-compile, leaves bytecode to the first import.
+# The venv is made without pip (installing pip into it took 7 s of a fresh clone's set-up); the system's pip
+# (22.3 or later: --python) puts uv into it. Without such a pip, the venv gets its own pip, which installs uv.
 $(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --no-compile 'uv>=0.5'
+	$(PYTHON) -m venv --without-pip $(VENV)
+	$(PYTHON) -m pip --python $(BIN)/python install --quiet --no-compile 'uv>=0.5' \
+	  || { $(PYTHON) -m venv $(VENV) && $(BIN)/python -m pip install --quiet --no-compile 'uv>=0.5'; }
 	$(UV) pip install --quiet --python $(BIN)/python -e '.[test]'
 	touch $(STAMP)
 
@@ -42,7 +45,7 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 .SECONDEXPANSION:
 .venv-%/.installed: tests/consumers/%.txt $$(wildcard tests/consumers/$$*.no-deps.txt) $(STAMP)
 	@rm -rf .venv-$* && echo "building the $* consumer environment .venv-$* (log: .venv-$*.log)"
-	@if { $(PYTHON) -m venv .venv-$* \
+	@if { $(UV) venv --quiet --python $(BIN)/python .venv-$* \
 	      && if [ -f tests/consumers/$*.no-deps.txt ]; then \
 	           $(UV) pip install --python .venv-$*/bin/python --no-deps -r tests/consumers/$*.no-deps.txt; fi \
 	      && $(UV) pip install --python .venv-$*/bin/python -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
