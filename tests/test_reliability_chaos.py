@@ -1,9 +1,14 @@
 """Chaos (issue 13): ``kill -9`` of the study process or of one of its pool workers at random points
 of a small study, ten times, then one undisturbed run. The cube must be identical to a clean run's,
-no worker may outlive its killed parent, and no ``.part`` file may be left behind."""
+no worker may outlive its killed parent, and no ``.part`` file may be left behind.
+
+The ten interrupted runs are forked from one process that has imported everything (tests/chaos_zygote.py):
+started as ``python -m pipeline``, each spent about 3 of its 4 s importing, and a kill "at a random point"
+mostly fell in the imports. The last run is a fresh ``python -m pipeline`` process."""
 
 from __future__ import annotations
 
+import json
 import os
 import random
 import signal
@@ -15,8 +20,6 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
-from pipeline.config import load_study
-from pipeline.study import run_study
 from tests.reliability_helpers import small_study_text, write_at2
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -54,68 +57,100 @@ def wait_until(predicate, timeout, step=0.02) -> bool:
     return predicate()
 
 
+class Zygote:
+    """The forking process of tests/chaos_zygote.py: starts ``rockfrag`` runs as its children, reaps them."""
+
+    def __init__(self, folder: Path):
+        environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
+        self.process = subprocess.Popen([sys.executable, "-m", "tests.chaos_zygote"], cwd=ROOT, env=environment,
+                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.folder = folder
+
+    def ask(self, **command) -> dict:
+        self.process.stdin.write(json.dumps(command) + "\n")
+        self.process.stdin.flush()
+        answer = self.process.stdout.readline()
+        assert answer, f"the chaos zygote died (exit {self.process.wait()})"
+        return json.loads(answer)
+
+    def start(self, arguments: list[str], attempt: int) -> tuple[int, Path]:
+        stderr = self.folder / f"attempt-{attempt}.stderr"
+        return self.ask(run=arguments, stderr=str(stderr))["pid"], stderr
+
+    def close(self) -> None:
+        self.process.stdin.close()
+        self.process.wait(timeout=30)
+
+
 @pytest.mark.slow
 def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
+    """Ten runs forked from one warm process (tests/chaos_zygote.py), so that the kills fall in the runs and not
+    in Python's imports, then a last undisturbed run as a fresh ``python -m pipeline`` process."""
     rng = random.Random(13)
-    write_at2(tmp_path / "records" / "pulse-a.AT2", amplitude_g=0.3, npts=1000)
-    write_at2(tmp_path / "records" / "pulse-b.AT2", amplitude_g=0.5, dt=0.005, npts=1600)
+    write_at2(tmp_path / "records" / "pulse-a.AT2", amplitude_g=0.3, npts=2500)
+    write_at2(tmp_path / "records" / "pulse-b.AT2", amplitude_g=0.5, dt=0.005, npts=4000)
     study = tmp_path / "chaos.toml"
     study.write_text(small_study_text(tmp_path / "records", levels=[0.3, 1.0]))
-    reference, _ = run_study(load_study(study), output=tmp_path / "reference", workers=1, progress=False,
-                             log=lambda message: None, warn=lambda message: None)
-
     output = tmp_path / "out"
-    command = [sys.executable, "-m", "pipeline", "run", str(study), "--output", str(output), "--no-progress"]
-    environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
-    outcomes = []
-    for attempt in range(KILLS):
-        # forget some finished cells so that every attempt has work left to interrupt
-        for checkpoint in (output / ".checkpoints").glob("*.ckpt"):
-            if rng.random() < 0.6:
-                checkpoint.unlink()
-        process = subprocess.Popen(command, cwd=ROOT, env=environment, stdout=subprocess.DEVNULL,
-                                   stderr=subprocess.PIPE, text=True)
-        target = "worker" if attempt % 2 else "parent"
-        during_work = target == "worker" or rng.random() < 0.6  # else: at a random point of start-up
-        seen_children: set[int] = set()
-        if during_work:
-            # the workers seen when they appear count too: a short run's pool may be gone after the random pause
-            wait_until(lambda: bool(seen_children.update(children(process.pid)) or seen_children)
-                       or process.poll() is not None, timeout=90)
-            time.sleep(rng.uniform(0.0, 0.2))
-        else:
-            deadline = time.monotonic() + rng.uniform(0.2, 3.0)
-            while time.monotonic() < deadline and process.poll() is None:
-                time.sleep(0.02)
-        seen_children |= children(process.pid)
-        if target == "worker":
-            running = children(process.pid)  # a worker seen earlier may have finished
-            if running and process.poll() is None:
-                os.kill(rng.choice(sorted(running)), signal.SIGKILL)
-                outcomes.append("worker killed")
-            try:
-                _, stderr = process.communicate(timeout=120)
-            except subprocess.TimeoutExpired:  # a hang: dump every thread's stack (faulthandler) for the report
-                process.send_signal(signal.SIGABRT)
-                _, stderr = process.communicate(timeout=30)
-                pytest.fail(f"run hung after a worker was killed; threads:\n{stderr[-8000:]}")
-            assert process.returncode == 0, stderr  # the lost cells were retried in a fresh pool
-            assert "Traceback" not in stderr
-        else:
-            if process.poll() is None:
-                process.kill()
-                outcomes.append(f"parent killed with {len(seen_children)} workers")
-            process.wait()
-            process.stderr.close()
-            assert wait_until(lambda: not any(alive(pid) for pid in seen_children), timeout=10), \
-                f"orphan workers after kill -9 of the parent: {[p for p in seen_children if alive(p)]}"
+    arguments = ["run", str(study), "--output", str(output), "--no-progress"]
+    zygote = Zygote(tmp_path)
+    try:
+        assert zygote.ask(reference=str(study), output=str(tmp_path / "reference")) == {"ready": True}
+        outcomes = [_attempt(zygote, arguments, output, attempt, rng) for attempt in range(KILLS)]
+    finally:
+        zygote.close()
 
-    final = subprocess.run(command, cwd=ROOT, env=environment, capture_output=True, text=True, timeout=180)
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
+    final = subprocess.run([sys.executable, "-m", "pipeline", *arguments], cwd=ROOT, env=environment,
+                           capture_output=True, text=True, timeout=180)
     assert final.returncode == 0, final.stderr
     assert "Traceback" not in final.stderr
-    with xr.open_dataset(output / "cube.nc") as cube:
+    with xr.open_dataset(output / "cube.nc") as cube, xr.open_dataset(tmp_path / "reference" / "cube.nc") as reference:
         assert cube.identical(reference)
     assert not list(output.rglob("*.part"))
     assert sum("killed" in outcome for outcome in outcomes) >= KILLS // 2, outcomes
     assert sum(outcome.startswith("parent killed with") and not outcome.endswith(" 0 workers")
                for outcome in outcomes) >= 1, outcomes  # at least one orphan check had workers to check
+
+
+def _attempt(zygote: Zygote, arguments: list[str], output: Path, attempt: int, rng: random.Random) -> str:
+    """One run of the study, its parent or one of its workers killed at a random point; what happened."""
+    # forget some finished cells so that every attempt has work left to interrupt
+    for checkpoint in (output / ".checkpoints").glob("*.ckpt"):
+        if rng.random() < 0.6:
+            checkpoint.unlink()
+    pid, stderr_path = zygote.start(arguments, attempt)
+    target = "worker" if attempt % 2 else "parent"
+    during_work = target == "worker" or rng.random() < 0.6  # else: at a random point of start-up
+    seen_children: set[int] = set()
+    if during_work:
+        # the workers seen when they appear count too: a short run's pool may be gone after the random pause
+        wait_until(lambda: bool(seen_children.update(children(pid)) or seen_children) or not alive(pid),
+                   timeout=90)
+        time.sleep(rng.uniform(0.0, 0.1))
+    else:  # reading the study and the records, before the pool starts (about 0.3 s)
+        deadline = time.monotonic() + rng.uniform(0.0, 0.3)
+        while time.monotonic() < deadline and alive(pid):
+            time.sleep(0.005)
+    seen_children |= children(pid)
+    outcome = "finished before the kill"
+    if target == "worker":
+        running = children(pid)  # a worker seen earlier may have finished
+        if running and alive(pid):
+            os.kill(rng.choice(sorted(running)), signal.SIGKILL)
+            outcome = "worker killed"
+        if not wait_until(lambda: not alive(pid), timeout=120):  # a hang: every thread's stack (faulthandler)
+            os.kill(pid, signal.SIGABRT)
+            zygote.ask(wait=pid)
+            pytest.fail(f"run hung after a worker was killed; threads:\n{stderr_path.read_text()[-8000:]}")
+        status, stderr = zygote.ask(wait=pid)["status"], stderr_path.read_text()
+        assert status == 0, stderr  # the lost cells were retried in a fresh pool
+        assert "Traceback" not in stderr
+    else:
+        if alive(pid):
+            os.kill(pid, signal.SIGKILL)
+            outcome = f"parent killed with {len(seen_children)} workers"
+        zygote.ask(wait=pid)
+        assert wait_until(lambda: not any(alive(child) for child in seen_children), timeout=10), \
+            f"orphan workers after kill -9 of the parent: {[p for p in seen_children if alive(p)]}"
+    return outcome
