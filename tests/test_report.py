@@ -85,45 +85,6 @@ def test_no_figure_warning_and_no_open_figures(small_pipeline):
     assert plt.get_fignums() == []
 
 
-@pytest.mark.slow
-def test_report_reads_results_and_never_simulates(small_pipeline, monkeypatch, tmp_path):
-    """Drawn again from the result files alone, every solver forbidden, the report is byte for byte the one the
-    fragility run drew from its datasets in memory: no creation dates, nothing but the files (the run time and
-    the run's statistics, which the title and provenance pages state, are passed back)."""
-    import shutil
-
-    import pipeline.models as models
-    from pipeline.config import load_study
-    from pipeline.report import report_stage
-
-    output, study, _ = small_pipeline
-
-    def forbidden(*args, **kwargs):
-        raise AssertionError("the report ran a solver")
-
-    for name in ("simulate", "simulate_batch", "simulate_histories"):
-        monkeypatch.setattr(models, name, forbidden)
-    copy = tmp_path / "copy"
-    shutil.copytree(output, copy)
-    for name in ("report.pdf", "report.html"):
-        (copy / name).unlink()
-    shutil.rmtree(copy / "figures")
-    html = (output / "report.html").read_text()
-    runtime = re.search(r"<td>run time</td><td>(\d+) s up to this report", html)  # the provenance page
-    computed = re.search(r"([\d,]+) of them were computed for this report, the results of (\d+) of its (\d+) ", html)
-    run = {"runs_computed": int(computed.group(1).replace(",", "")), "cells_reused": int(computed.group(2)),
-           "cells": int(computed.group(3))} if computed else \
-        {"runs_computed": 1, "cells_reused": 0, "cells": 1} if "all computed for this report" in html else \
-        {"runs_computed": 0, "cells_reused": 1, "cells": 1} if "computed in an earlier run" in html else None
-    opened = _datasets(copy)
-    pdf, pngs = report_stage(load_study(study), opened["cube"], opened["ida"], opened["fragility"], None, copy,
-                             runtime_s=float(runtime.group(1)) if runtime else float("nan"), progress=False, run=run)
-    assert pdf.read_bytes() == (output / "report.pdf").read_bytes()
-    assert (copy / "report.html").read_text() == html
-    assert [png.read_bytes() for png in pngs] == [(output / "figures" / png.name).read_bytes() for png in pngs]
-    assert plt.get_fignums() == []
-
-
 def _results(output, study, **changes):
     from pipeline.config import load_study
     from pipeline.report import Results

@@ -91,29 +91,80 @@ def test_the_overprint_check_catches_overprinted_texts():
 
 
 @pytest.mark.slow
-def test_no_page_of_the_report_overprints_or_leaves_the_page(small_pipeline):
-    """FINDINGS 24-28, 12: panel titles, return-period labels, y labels, subtitles, legend entries and table
-    cells never overlap, and no text is cut at the page edge, on one page of each kind of the small study's
-    report (the first block's; every text page) as the report draws it, footer included. About 8 s."""
-    from pipeline.report import build_plan
+def test_each_kind_of_page_drawn_again_from_the_files_is_legible_and_the_same(small_pipeline, monkeypatch, tmp_path):
+    """One page of each kind (the first block's; every text page) of the small study's report, drawn again as the
+    report draws it (footer included) from the result files alone, every solver forbidden. One drawing serves
+    two checks:
 
-    results = pipeline_results(small_pipeline.output, small_pipeline.study)
-    planned = build_plan(results)
+    - FINDINGS 24-28, 12: panel titles, return-period labels, y labels, subtitles, legend entries and table
+      cells never overlap, and no text is cut at the page edge;
+    - the report is made from its files: each figure page drawn here is, byte for byte, the PNG the fragility
+      run drew from its datasets in memory, and report.html (every text page, caption and heading, the PNGs
+      embedded) is, character for character, the one planned from the files. The run time and the run's
+      statistics, which the title and provenance pages state, are read back from the run's HTML.
+    """
+    import shutil
+    from dataclasses import replace
+
+    import pipeline.models as models
+    from pipeline.config import load_study
+    from pipeline.report import build_plan, figure_png, html_document, report_footer, report_results
+
+    output, study, _ = small_pipeline
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("the report ran a solver")
+
+    for name in ("simulate", "simulate_batch", "simulate_histories"):
+        monkeypatch.setattr(models, name, forbidden)
+    copy = tmp_path / "copy"  # the result files without the report the run wrote
+    shutil.copytree(output, copy, ignore=shutil.ignore_patterns("report.pdf", "report.html", "figures"))
+    written = (output / "report.html").read_text()
+    opened = {name: xr.load_dataset(copy / f"{name}.nc") for name in ("cube", "ida", "fragility")}
+    config = load_study(study)
+    runtime, run = _run_statement(written)
+    results = report_results(config, opened["cube"], opened["ida"], opened["fragility"], None, copy, runtime_s=runtime,
+                             run=run)
+    planned, footer = build_plan(results), report_footer(results)
     assert {"ida-paper", "showcase-response", "applicability", "efficiency"} <= {page.name for page in planned}
-    kinds = set()
+    figure_files = [f"{number:02d}-{page.name}.png" for number, page in enumerate(planned, start=1)
+                    if page.html is None]
+    assert sorted(path.name for path in (output / "figures").glob("*.png")) == figure_files
+    blocks = [block.name for block in config.blocks]
+    kinds, rendered = set(), []
     for number, page in enumerate(planned, start=1):
-        kind = (page.section, page.name.split("-")[1] if page.section == "Fragility" else "")
-        if page.html is None and kind in kinds:
-            continue  # the same figure for another block or model
-        kinds.add(kind)
-        figure = page.draw()
-        try:
-            add_footer(figure, "a report title", number, len(planned))
-            shown = _shown_texts(figure)
-            assert overprinted(figure, shown) == [], page.name
-            assert off_page(figure, shown) == [], page.name
-        finally:
-            plt.close(figure)
+        png = b"" if page.html is not None else (output / "figures" / f"{number:02d}-{page.name}.png").read_bytes()
+        kind = page.name
+        for block in blocks:
+            kind = kind.replace(block, "")
+        if page.html is not None or kind not in kinds:
+            kinds.add(kind)
+            figure = page.draw()
+            try:
+                add_footer(figure, footer, number, len(planned))
+                if page.html is None:
+                    assert figure_png(figure) == png, f"page {number} ({page.name}) drawn from the files differs"
+                shown = _shown_texts(figure)
+                assert overprinted(figure, shown) == [], page.name
+                assert off_page(figure, shown) == [], page.name
+            finally:
+                plt.close(figure)
+        rendered.append(replace(page, png=png))
+    assert html_document(results.title, rendered) == written
+    assert b"/CreationDate" not in (output / "report.pdf").read_bytes()  # the same files, the same PDF
+    assert plt.get_fignums() == []
+
+
+def _run_statement(html: str) -> tuple[float, dict | None]:
+    """The run time [s] and the run's statistics (``runs_computed``, ``cells_reused``, ``cells``) that a report's
+    title and provenance pages state, read back from its HTML (NaN and None where it states none)."""
+    runtime = re.search(r"<td>run time</td><td>(\d+) s up to this report", html)  # the provenance page
+    computed = re.search(r"([\d,]+) of them were computed for this report, the results of (\d+) of its (\d+) ", html)
+    run = {"runs_computed": int(computed.group(1).replace(",", "")), "cells_reused": int(computed.group(2)),
+           "cells": int(computed.group(3))} if computed else \
+        {"runs_computed": 1, "cells_reused": 0, "cells": 1} if "all computed for this report" in html else \
+        {"runs_computed": 0, "cells_reused": 1, "cells": 1} if "computed in an earlier run" in html else None
+    return float(runtime.group(1)) if runtime else float("nan"), run
 
 
 # ---------------------------------------------------------------- IDA pages (FINDINGS 24)

@@ -347,7 +347,8 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
     return Page("contents", "Contents", "Contents", draw, "", "<ul class='contents'>" + "".join(items) + "</ul>")
 
 
-def _png(figure) -> bytes:
+def figure_png(figure) -> bytes:
+    """The figure as the report's PNG (``PNG_DPI``), as bytes."""
     buffer = io.BytesIO()
     figure.savefig(buffer, dpi=PNG_DPI, format="png")
     return buffer.getvalue()
@@ -406,7 +407,7 @@ def _page_png(task) -> bytes:
     figure = _PLANNED[index].draw()
     try:
         add_footer(figure, footer, index + 1, total)
-        return _png(figure)
+        return figure_png(figure)
     finally:
         plt.close(figure)
 
@@ -534,6 +535,24 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
     pngs : list of pathlib.Path
         ``output/figures/NN-name.png``, one per figure page (NN its page number), in page order.
     """
+    results = report_results(config, cube, ida, fragility, risk, output, runtime_s, applicability, run)
+    return write_report(build_plan(results), output, results.title, report_footer(results), progress, workers)
+
+
+def report_results(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragility: xr.Dataset,
+                   risk: xr.Dataset | None, output: str | os.PathLike, runtime_s: float = float("nan"),
+                   applicability: xr.Dataset | None = None, run: dict | None = None) -> Results:
+    """What the report is drawn from: the given datasets and what ``report_stage`` reads from ``output``.
+
+    The arguments are those of ``report_stage`` (which see); nothing is drawn or written, no solver runs.
+
+    Returns
+    -------
+    Results
+        The study's datasets (risk merged into ``fragility``), ``showcase.nc``, ``efficiency.nc``,
+        ``applicability.nc`` (unless given) and the vertical component's effect when ``cube_without_vertical.nc``
+        is there.
+    """
     output = Path(output)
     if risk is not None and risk is not fragility and "probability_in_life" not in fragility:
         fragility = fragility.merge(risk, combine_attrs="override")
@@ -543,14 +562,17 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
         applicability = _open_optional(output / "applicability.nc")
     comparison = open_comparison(cube, output)
     vertical = None if comparison is None else vertical_effect(cube, comparison, damage_states_from_config(config.raw))
-    results = Results(config, cube, ida, fragility, output, showcase=_open_optional(output / "showcase.nc"),
-                      applicability=applicability, efficiency=efficiency, runtime_s=runtime_s, vertical=vertical,
-                      run=None if run is None else {key: run[key] for key in ("runs_computed", "cells_reused", "cells")
-                                                    if key in run})
-    settings = results.settings
-    footer = " · ".join(str(part) for part in (settings.get("project"), results.title, f"study '{config.name}'")
-                        if part)
-    return write_report(build_plan(results), output, results.title, footer, progress, workers)
+    return Results(config, cube, ida, fragility, output, showcase=_open_optional(output / "showcase.nc"),
+                   applicability=applicability, efficiency=efficiency, runtime_s=runtime_s, vertical=vertical,
+                   run=None if run is None else {key: run[key] for key in ("runs_computed", "cells_reused", "cells")
+                                                 if key in run})
 
 
-__all__ = ["Page", "Results", "build_plan", "plan", "report_stage", "write_report"]
+def report_footer(results: Results) -> str:
+    """The left footer of every page: project, report title and study name, joined by middle dots."""
+    parts = (results.settings.get("project"), results.title, f"study '{results.config.name}'")
+    return " · ".join(str(part) for part in parts if part)
+
+
+__all__ = ["Page", "Results", "build_plan", "figure_png", "plan", "report_footer", "report_results", "report_stage",
+           "write_report"]
