@@ -37,6 +37,7 @@ from pipeline.report.layout import (
     GRID,
     chars_across,
     log_axis,
+    log_minor_ticks,
     log_y_axis,
     new_page,
     outside_legend,
@@ -148,6 +149,8 @@ def spectra_page(showcase, caption):
         axis.loglog(periods, np.quantile(spectra, q, axis=0), label=f"{q:.0%} fractile", **style)
     axis.set_xlabel("period T [s]")
     axis.set_ylabel("spectral acceleration Sa(T, 5%) [g]")
+    log_minor_ticks(axis.xaxis)
+    log_minor_ticks(axis.yaxis)
     axis.grid(alpha=0.3, which="both")
     outside_legend(figure, [axis])
     return figure

@@ -22,7 +22,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.font_manager import FontProperties  # noqa: E402
-from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+from matplotlib.ticker import FixedLocator, FuncFormatter, Locator, LogLocator, NullFormatter  # noqa: E402
 
 PAGE_SIZE = (11.69, 8.27)  # A4 landscape [in]
 GRID = dict(left=0.07, right=0.835, bottom=0.145, top=0.885, wspace=0.2, hspace=0.32)  # axes area
@@ -150,6 +150,39 @@ def log_ticks(low: float, high: float, most: int = 8) -> list[float]:
     return values
 
 
+class InView(Locator):
+    """Another locator's tick values inside the axis's view only.
+
+    matplotlib makes a tick (two lines, a grid line and two labels) for every value a locator returns, drawn or
+    not, and a log axis's minor locator returns a decade beyond each end: those undrawn ticks were a sixth of
+    the report's drawing time. The page looks the same, pixel for pixel.
+    """
+
+    def __init__(self, locator: Locator):
+        self.locator = locator
+
+    def set_axis(self, axis) -> None:
+        """Attach both locators to the matplotlib Axis."""
+        super().set_axis(axis)
+        self.locator.set_axis(axis)
+
+    def __call__(self):
+        """The tick values inside the current view."""
+        low, high = sorted(self.axis.get_view_interval())
+        return [value for value in self.locator() if low <= value <= high]
+
+    def tick_values(self, vmin, vmax):
+        """The wrapped locator's values from ``vmin`` to ``vmax``."""
+        low, high = sorted((vmin, vmax))
+        return [value for value in self.locator.tick_values(vmin, vmax) if low <= value <= high]
+
+
+def log_minor_ticks(axis) -> None:
+    """Minor ticks at 2-9 x 10^n (LogLocator ``subs="auto"``), unlabelled, on one matplotlib Axis (x or y)."""
+    axis.set_minor_locator(InView(LogLocator(subs="auto")))
+    axis.set_minor_formatter(NullFormatter())
+
+
 def _log_ticks_on(axis, limits) -> None:
     """Fixed tick values of ``log_ticks`` on one matplotlib Axis (x or y), labelled as plain numbers.
 
@@ -164,8 +197,7 @@ def _log_ticks_on(axis, limits) -> None:
     most = max(3, int(length / ((2.2 if vertical else 3.5) * float(size))))
     axis.set_major_locator(FixedLocator(log_ticks(*limits, most=most)))
     axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-    axis.set_minor_locator(LogLocator(subs="auto"))
-    axis.set_minor_formatter(NullFormatter())
+    log_minor_ticks(axis)
 
 
 def log_axis(axis, limits: tuple[float, float] | None = None) -> None:
