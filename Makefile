@@ -42,13 +42,17 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 
 # A consumer environment never stops make: a failed build leaves no stamp, and the test that needs it fails
 # under `make test` (ROCKFRAG_CONSUMERS=required) with the log's name, after every other test has run.
+# Its scripts run once with --help, which imports the consumer: that writes the bytecode of what the round trip
+# imports (4-8 s of CPU per environment, here on the core the kernel compile leaves idle, not in the tests).
 .SECONDEXPANSION:
 .venv-%/.installed: tests/consumers/%.txt $$(wildcard tests/consumers/$$*.no-deps.txt) $(STAMP)
 	@rm -rf .venv-$* && echo "building the $* consumer environment .venv-$* (log: .venv-$*.log)"
 	@if { $(UV) venv --quiet --python $(BIN)/python .venv-$* \
 	      && if [ -f tests/consumers/$*.no-deps.txt ]; then \
 	           $(UV) pip install --python .venv-$*/bin/python --no-deps -r tests/consumers/$*.no-deps.txt; fi \
-	      && $(UV) pip install --python .venv-$*/bin/python -r tests/consumers/$*.txt; } > .venv-$*.log 2>&1; \
+	      && $(UV) pip install --python .venv-$*/bin/python -r tests/consumers/$*.txt \
+	      && for script in tests/consumers/$*_*.py; do NUMBA_DISABLE_JIT=1 .venv-$*/bin/python $$script --help; done; \
+	    } > .venv-$*.log 2>&1; \
 	then touch $@; else echo "the $* consumer environment failed to build: see .venv-$*.log" >&2; exit 1; fi
 
 consumers: $(CONSUMER_STAMPS)  ## build the consumer environments (.venv-pelicun, .venv-openquake) of the round-trip tests

@@ -15,6 +15,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+LAZY = ("dask.distributed",)
+"""Libraries the package imports only when it needs them and the tests then start: the dask executor (about 300
+modules with tornado and msgpack, imported by the dask tests in-process and in `rockfrag --scheduler` runs)."""
 
 
 def warm() -> int:
@@ -22,6 +25,8 @@ def warm() -> int:
     for module in pkgutil.walk_packages([str(ROOT / "pipeline")], "pipeline."):
         if module.name.rsplit(".", 1)[-1] != "__main__":  # (it would run the command line)
             importlib.import_module(module.name)
+    for name in LAZY:
+        importlib.import_module(name)
     with contextlib.redirect_stdout(io.StringIO()):  # (the list of tests; a collection error shows in the run itself)
         return int(pytest.main(["--collect-only", "-q", "-p", "no:cacheprovider", str(ROOT / "tests")]))
 
