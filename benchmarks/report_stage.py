@@ -12,12 +12,7 @@ import sys
 import time
 from pathlib import Path
 
-import xarray as xr
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # this checkout's pipeline, not an installed one
-
-from pipeline.config import load_study  # noqa: E402
-from pipeline.report import report_stage  # noqa: E402
 
 
 def main(output, study=None, workers=None):
@@ -26,6 +21,12 @@ def main(output, study=None, workers=None):
     if missing:
         raise SystemExit(f"report_stage: {output} has no {', '.join(missing)}; run `make fragility` first (or "
                          "`rockfrag fragility STUDY --output DIR` and give DIR)")
+    # imported after the check: a missing study is one line at once, not after 3 s of importing matplotlib
+    import xarray as xr
+
+    from pipeline.config import load_study
+    from pipeline.report import report_stage
+
     config = load_study(study or None)
     datasets = {}
     for name in ("cube", "ida", "fragility"):
