@@ -42,7 +42,7 @@ def _child(arguments: list[str], stderr_path: str) -> None:
 
         status = main(arguments)
     except SystemExit as stop:
-        status = stop.code if isinstance(stop.code, int) else 1
+        status = 0 if stop.code is None else stop.code if isinstance(stop.code, int) else 1
     except BaseException:  # noqa: BLE001 - what `python -m pipeline` would print before dying
         import traceback
 
