@@ -31,3 +31,34 @@ def test_the_sweep_page_draws_one_panel_per_model_and_block_from_the_sweep_file(
     drawn = first.get_lines()[0].get_ydata()
     np.testing.assert_array_equal(drawn, dataset.peak_angle_ratio_to_housner.sel(model="winkler",
                                                                                   block="cabinet").values[0, 0])
+
+
+def test_log_minor_ticks_only_inside_the_view_and_the_drawing_unchanged():
+    """layout.InView: a log axis's minor ticks are made only where they are drawn, and the page is the same PNG."""
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import LogLocator, NullFormatter
+
+    from pipeline.report import figure_png
+    from pipeline.report.layout import log_minor_ticks
+
+    def drawn(in_view):
+        figure = plt.figure(figsize=(4, 3))
+        axis = figure.add_subplot()
+        axis.loglog([0.03, 40.0], [0.2, 7.0])
+        axis.set_xlim(0.03, 40.0)
+        axis.grid(which="both")
+        if in_view:
+            log_minor_ticks(axis.xaxis)
+        else:
+            axis.xaxis.set_minor_locator(LogLocator(subs="auto"))
+            axis.xaxis.set_minor_formatter(NullFormatter())
+        try:
+            png = figure_png(figure)
+            return png, len(axis.xaxis.get_minor_ticks()), list(axis.xaxis.get_minorticklocs())
+        finally:
+            plt.close(figure)
+
+    png, made, shown = drawn(in_view=True)
+    png_all, made_all, shown_all = drawn(in_view=False)
+    assert png == png_all and np.allclose(shown, [v for v in shown_all if 0.03 <= v <= 40.0])
+    assert made == len(shown) < made_all  # the undrawn decades beyond each end are not made
