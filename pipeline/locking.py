@@ -11,8 +11,9 @@ by the process that has just taken the lock belong to runs that died: they are r
 never while another run holds the folder.
 
 A command that fails (any exception out of the locked block) leaves the folder as it found it: the
-lock file goes if this run created it, and so does the folder (and any parent it created) if
-nothing else is left in it. A run that waited on a lock file removed this way takes the lock again
+lock file goes if this run created it, so do the empty folders it made inside (``.checkpoints`` of a run
+that failed before its first cell), and so does the folder (and any parent it created) if nothing else is
+left in it. A run that waited on a lock file removed this way takes the lock again
 on the file now at its path, so two runs never hold the same folder.
 """
 
@@ -120,11 +121,27 @@ def _acquire(folder: Path, wait: bool, notify) -> tuple[int, bool]:
         os.close(descriptor)  # the run we waited for failed and removed this lock file: lock the new one
 
 
-def _leave_as_found(lock_path: Path, created_lock: bool, created_folders: list[Path]) -> None:
-    """After a failure: remove the lock file this run created, then the folders it created if empty."""
+def _subfolders(folder: Path) -> set[str]:
+    """Every folder under ``folder``, as paths relative to it."""
+    return {os.path.relpath(os.path.join(parent, name), folder)
+            for parent, names, _ in os.walk(folder) for name in names}
+
+
+def _leave_as_found(lock_path: Path, created_lock: bool, created_folders: list[Path],
+                    found: set[str] | None = None) -> None:
+    """After a failure: remove what this run made that holds nothing.
+
+    The lock file this run created, the empty folders it made inside the output folder (those not among ``found``,
+    e.g. ``.checkpoints`` of a run that failed before its first cell), then the folders it created if empty.
+    """
     if created_lock:
         with contextlib.suppress(OSError):
             lock_path.unlink()
+    if found is not None:
+        folder = lock_path.parent
+        for name in sorted(_subfolders(folder) - found, key=lambda name: name.count(os.sep), reverse=True):
+            with contextlib.suppress(OSError):  # rmdir refuses a folder that holds anything
+                (folder / name).rmdir()
     for folder in created_folders:  # deepest first; rmdir refuses a folder that holds anything
         try:
             folder.rmdir()
@@ -160,6 +177,7 @@ def output_lock(folder, wait=False, notify=None):
         raise
     _held[key] = [descriptor, 1]
     failed = True
+    found = _subfolders(folder)
     try:
         os.ftruncate(descriptor, 0)
         os.pwrite(descriptor, f"{os.getpid()}\n".encode(), 0)
@@ -170,5 +188,5 @@ def output_lock(folder, wait=False, notify=None):
     finally:
         del _held[key]
         if failed:  # still holding the lock, so no other run can be using the file or the folder
-            _leave_as_found(folder / LOCK_NAME, created_lock, created_folders)
+            _leave_as_found(folder / LOCK_NAME, created_lock, created_folders, found)
         os.close(descriptor)

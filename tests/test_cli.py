@@ -68,6 +68,7 @@ def test_unreachable_scheduler_is_one_line(tmp_path):
                             env={**os.environ, "ROCKFRAG_DASK_CONNECT_TIMEOUT": "1"})  # 10 s by default
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "cannot connect to the dask scheduler" in result.stderr
+    assert not (tmp_path / "out").exists()  # nor its empty .checkpoints folder
 
 
 # ---------------------------------------------------------------- a failed command leaves no trace (issue 21)

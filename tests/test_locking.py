@@ -72,3 +72,22 @@ def test_lock_is_reentrant_in_one_process_and_released(tmp_path):
                 fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     with open(tmp_path / LOCK_NAME) as handle:
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)  # free again
+
+
+def test_a_failed_block_removes_the_empty_folders_it_made_and_keeps_the_rest(tmp_path):
+    """A run that fails before its first cell leaves no empty ``.checkpoints`` (nor its new output folder)
+    behind; in a folder that was there, what was there stays, and so does a new folder that holds a file."""
+    new = tmp_path / "new" / "reports"
+    with pytest.raises(RuntimeError), output_lock(new):
+        (new / ".checkpoints").mkdir()
+        raise RuntimeError("the scheduler did not answer")
+    assert not (tmp_path / "new").exists()
+
+    used = tmp_path / "used"
+    (used / "figures").mkdir(parents=True)  # an earlier run's, empty
+    with pytest.raises(RuntimeError), output_lock(used):
+        (used / ".checkpoints" / "deeper").mkdir(parents=True)
+        (used / "kept").mkdir()
+        (used / "kept" / "cell.ckpt").write_text("a finished cell")
+        raise RuntimeError("failed later")
+    assert sorted(p.name for p in used.iterdir()) == ["figures", "kept"]
