@@ -24,9 +24,9 @@ from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Number
 
 MAX_KINETIC_FRICTION = 4.0 / 3.0
-"""Largest kinetic coefficient a soil may state: a rigid base's limit (Painleve's paradox), which is
-pipeline.models.options.RIGID_BASE_MAX_KINETIC_FRICTION (importing it here would be circular: the models import
-this module; tests/test_soils.py checks that the two agree)."""
+"""Largest kinetic coefficient a soil may state: a rigid base's limit. Above it a block rocking on a sliding corner
+can meet Painleve's paradox (no solution of its equations; pipeline/models/housner.py). The models read it from here
+(pipeline.models.options.RIGID_BASE_MAX_KINETIC_FRICTION)."""
 
 SOIL_RANGES = {
     "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),

@@ -24,6 +24,7 @@ from pipeline.models import fields
 from pipeline.models.base import RockingModel
 from pipeline.models.bed_hunt_crossley import NAME as HUNT_CROSSLEY
 from pipeline.models.contact import BED_LAWS
+from pipeline.soils import MAX_KINETIC_FRICTION
 from pipeline.units import STANDARD_GRAVITY
 from pipeline.validation import Checked, Nullable, Number, Table, Text, shown
 
@@ -37,9 +38,9 @@ DEFAULT_ZENO_FRACTION = 1e-6  # excursions below this fraction of alpha end the 
 MAX_EVENTS = 200_000
 
 HOUSNER = "housner"  # restitution = "housner": Housner's r = 1 - 1.5 sin^2(alpha) of the block
-RIGID_BASE_MAX_KINETIC_FRICTION = 4.0 / 3.0
-"""Largest kinetic friction coefficient of a rigid base: above it a block rocking on a sliding corner can meet
-Painleve's paradox (no solution of its equations; pipeline/models/housner.py). A bed has no such limit."""
+RIGID_BASE_MAX_KINETIC_FRICTION = MAX_KINETIC_FRICTION
+"""Largest kinetic friction coefficient of a rigid base (pipeline.soils.MAX_KINETIC_FRICTION, 4/3). A bed has no
+such limit."""
 FRICTION_RANGE = "a number mu > 0 or a pair [mu_s, mu_k] with mu_s >= mu_k > 0 (static, kinetic)"
 MAX_XI = {HUNT_CROSSLEY: 10.0}
 """Largest damping ratio xi of a bed law whose xi may reach 1 or more (default: xi < 1). Hunt-Crossley's
