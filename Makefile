@@ -63,7 +63,7 @@ warm: $(STAMP)
 	$(BIN)/python -m tests.warm_kernels
 
 # Writes the bytecode of the package, the tests (assert-rewritten, as pytest collects them) and the libraries they
-# import once (about 14 s of CPU in a fresh clone), beside the kernel compile, instead of in pytest and each of its
+# import once (14-18 s of CPU in a fresh clone), beside the kernel compile, instead of in pytest and each of its
 # workers side by side.
 warm-imports: $(STAMP)
 	$(BIN)/python -m tests.warm_imports

@@ -31,15 +31,14 @@ def _answer(message: dict) -> None:
     sys.stdout.flush()
 
 
-def _child(arguments: list[str], stderr_path: str) -> None:
-    """In the forked child: ``rockfrag ARGS`` with stdout to /dev/null and stderr to ``stderr_path``; never returns."""
+def _child(main, arguments: list[str], stderr_path: str) -> None:
+    """In the forked child: ``main(ARGS)`` (rockfrag's) with stdout to /dev/null and stderr to ``stderr_path``; never
+    returns."""
     status = 70
     try:
         os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
         os.dup2(os.open(stderr_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644), 2)
         os.dup2(os.open(os.devnull, os.O_RDONLY), 0)  # the commands are the parent's, not the run's
-        from pipeline.cli import main
-
         status = main(arguments)
     except SystemExit as stop:
         status = 0 if stop.code is None else stop.code if isinstance(stop.code, int) else 1
@@ -56,6 +55,8 @@ def _child(arguments: list[str], stderr_path: str) -> None:
 def serve() -> None:
     """Answer the commands on stdin until it ends."""
     import tqdm
+
+    from pipeline.cli import main  # once, here: every child starts with it imported
 
     tqdm.tqdm.monitor_interval = 0  # no monitor thread: this process forks
     for line in sys.stdin:
@@ -75,7 +76,7 @@ def serve() -> None:
             sys.stderr.flush()
             pid = os.fork()
             if pid == 0:
-                _child(command["run"], command["stderr"])
+                _child(main, command["run"], command["stderr"])
             _answer({"pid": pid})
         elif "wait" in command:
             _, status = os.waitpid(command["wait"], 0)

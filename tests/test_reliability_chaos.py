@@ -26,6 +26,11 @@ ROOT = Path(__file__).resolve().parents[1]
 KILLS = 10
 
 
+def run_environment() -> dict:
+    """The environment of the processes that run the study: this checkout's pipeline, stacks dumped on SIGABRT."""
+    return {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
+
+
 def children(pid) -> set[int]:
     """Live child processes of ``pid`` (from /proc)."""
     found = set()
@@ -61,8 +66,7 @@ class Zygote:
     """The forking process of tests/chaos_zygote.py: starts ``rockfrag`` runs as its children, reaps them."""
 
     def __init__(self, folder: Path):
-        environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
-        self.process = subprocess.Popen([sys.executable, "-m", "tests.chaos_zygote"], cwd=ROOT, env=environment,
+        self.process = subprocess.Popen([sys.executable, "-m", "tests.chaos_zygote"], cwd=ROOT, env=run_environment(),
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         self.folder = folder
 
@@ -100,8 +104,7 @@ def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
     finally:
         zygote.close()
 
-    environment = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONFAULTHANDLER": "1"}
-    final = subprocess.run([sys.executable, "-m", "pipeline", *arguments], cwd=ROOT, env=environment,
+    final = subprocess.run([sys.executable, "-m", "pipeline", *arguments], cwd=ROOT, env=run_environment(),
                            capture_output=True, text=True, timeout=180)
     assert final.returncode == 0, final.stderr
     assert "Traceback" not in final.stderr

@@ -108,7 +108,7 @@ def test_each_kind_of_page_drawn_again_from_the_files_is_legible_and_the_same(sm
 
     import pipeline.models as models
     from pipeline.config import load_study
-    from pipeline.report import build_plan, figure_png, html_document, report_footer, report_results
+    from pipeline.report import build_plan, figure_file, figure_png, html_document, report_footer, report_results
 
     output, study, _ = small_pipeline
 
@@ -127,13 +127,12 @@ def test_each_kind_of_page_drawn_again_from_the_files_is_legible_and_the_same(sm
                              run=run)
     planned, footer = build_plan(results), report_footer(results)
     assert {"ida-paper", "showcase-response", "applicability", "efficiency"} <= {page.name for page in planned}
-    figure_files = [f"{number:02d}-{page.name}.png" for number, page in enumerate(planned, start=1)
-                    if page.html is None]
+    figure_files = [figure_file(number, page) for number, page in enumerate(planned, start=1) if page.html is None]
     assert sorted(path.name for path in (output / "figures").glob("*.png")) == figure_files
     blocks = [block.name for block in config.blocks]
     kinds, rendered = set(), []
     for number, page in enumerate(planned, start=1):
-        png = b"" if page.html is not None else (output / "figures" / f"{number:02d}-{page.name}.png").read_bytes()
+        png = b"" if page.html is not None else (output / "figures" / figure_file(number, page)).read_bytes()
         kind = page.name
         for block in blocks:
             kind = kind.replace(block, "")

@@ -347,6 +347,11 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
     return Page("contents", "Contents", "Contents", draw, "", "<ul class='contents'>" + "".join(items) + "</ul>")
 
 
+def figure_file(number: int, page: Page) -> str:
+    """The file name of a figure page's PNG in ``figures/``: its page number, then its name (``14-spectra.png``)."""
+    return f"{number:02d}-{page.name}.png"
+
+
 def figure_png(figure) -> bytes:
     """The figure as the report's PNG (``PNG_DPI``), as bytes."""
     buffer = io.BytesIO()
@@ -454,7 +459,7 @@ def render(planned: list[Page], footer: str, output_dir, progress=True, workers=
                         plt.close(figure)
                     png = next(pngs) if page.html is None else None
                     if png is not None:
-                        with atomic_path(figure_dir / f"{number:02d}-{page.name}.png") as path:
+                        with atomic_path(figure_dir / figure_file(number, page)) as path:
                             path.write_bytes(png)
                     rendered.append(replace(page, png=png))
     finally:
@@ -475,7 +480,7 @@ def write_report(planned: list[Page], output_dir, title="rockfrag report", foote
     rendered = render(planned, footer or title, output_dir, progress, workers)
     with atomic_path(output_dir / "report.html") as temporary:
         temporary.write_text(html_document(title, rendered), encoding="utf-8")
-    pngs = [output_dir / "figures" / f"{n:02d}-{p.name}.png" for n, p in enumerate(rendered, start=1)
+    pngs = [output_dir / "figures" / figure_file(n, p) for n, p in enumerate(rendered, start=1)
             if p.png is not None]
     return output_dir / "report.pdf", pngs
 
@@ -574,5 +579,5 @@ def report_footer(results: Results) -> str:
     return " · ".join(str(part) for part in parts if part)
 
 
-__all__ = ["Page", "Results", "build_plan", "figure_png", "plan", "report_footer", "report_results", "report_stage",
-           "write_report"]
+__all__ = ["Page", "Results", "build_plan", "figure_file", "figure_png", "plan", "report_footer", "report_results",
+           "report_stage", "write_report"]
