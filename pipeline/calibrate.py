@@ -357,6 +357,7 @@ class _Objective:
         if smoothing_hz and smoothing_hz < 0.8 * nyquist:
             self.sos = butter(4, smoothing_hz, fs=1.0 / step, output="sos")
         self.smoothed_reference = self.smooth(reference)
+        self._centred_windows = {}  # n -> (the smoothed, centred reference over [0, n), its RMS)
         # white-noise variance left inside the pass band, estimated from what the low-pass removed
         self.noise_variance = 0.0
         if self.sos is not None:
@@ -377,11 +378,20 @@ class _Objective:
             return values
         return sosfiltfilt(self.sos, values, axis=-1)
 
+    def _centred_window(self, n):
+        """The reference over the first n samples, smoothed as the models are and centred, with its RMS.
+
+        Each window's once: a search evaluates thousands of points on a handful of windows.
+        """
+        if n not in self._centred_windows:
+            reference = self.smooth(self.reference[:n])
+            reference = reference - reference.mean()
+            self._centred_windows[n] = reference, math.sqrt(float(np.mean(reference**2)))
+        return self._centred_windows[n]
+
     def __call__(self, model_on_times, n):
         """Objective per row of ``model_on_times`` (already on ``times``) over the first n samples."""
-        reference = self.smooth(self.reference[:n])
-        reference = reference - reference.mean()
-        sigma_reference = math.sqrt(float(np.mean(reference**2)))
+        reference, sigma_reference = self._centred_window(n)
         model = self.smooth(model_on_times[:, :n])
         model = model - model.mean(axis=1, keepdims=True)
         sigma_model = np.sqrt(np.mean(model**2, axis=1))
