@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -49,27 +50,39 @@ def _number(text, kind):
     return kind(text) if text else None
 
 
+_PARSED: dict[tuple[str, bytes], tuple[CatalogueEntry, ...]] = {}
+"""Catalogues parsed in this process, by path and content: a command reads the catalogue two or three times
+(record sets, ids, entries), and the tests run commands by the thousand in one process. Reading the file is
+cheap; parsing its rows is what this saves."""
+
+
 def load_catalogue(manifest_path) -> list[CatalogueEntry]:
-    """Parse the catalogue; paths are resolved relative to the manifest's folder."""
+    """Parse the catalogue; paths are resolved relative to the manifest's folder.
+
+    A file whose path and bytes were parsed before in this process is not parsed again.
+    """
     manifest_path = Path(manifest_path)
     if not manifest_path.is_file():
         raise ManifestError(f"{manifest_path}: record catalogue not found")
-    with open(manifest_path, newline="", encoding="utf-8") as handle:
-        reader = csv.DictReader(handle)
-        missing = [c for c in REQUIRED_COLUMNS if c not in (reader.fieldnames or [])]
-        if missing:
-            raise ManifestError(f"{manifest_path}: missing column(s) {', '.join(missing)}; "
-                                f"expected {', '.join(REQUIRED_COLUMNS)}")
-        entries = []
-        for row in reader:
-            entries.append(CatalogueEntry(
-                id=row["id"], path=manifest_path.parent / row["file"], event=row["event"],
-                year=_number(row["year"], int), magnitude=_number(row["magnitude"], float),
-                station=row["station"], component=row["component"],
-                sets=tuple(s for s in row["sets"].split(";") if s), source=row["source"],
-                units=row["units"], sha256=row["sha256"],
-                extra={k: v for k, v in row.items() if k not in REQUIRED_COLUMNS}))
-    return entries
+    key = (str(manifest_path), manifest_path.read_bytes())
+    if key not in _PARSED:
+        _PARSED[key] = tuple(_parse_catalogue(manifest_path, key[1].decode("utf-8")))
+    return list(_PARSED[key])
+
+
+def _parse_catalogue(manifest_path: Path, text: str) -> list[CatalogueEntry]:
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    missing = [c for c in REQUIRED_COLUMNS if c not in (reader.fieldnames or [])]
+    if missing:
+        raise ManifestError(f"{manifest_path}: missing column(s) {', '.join(missing)}; "
+                            f"expected {', '.join(REQUIRED_COLUMNS)}")
+    return [CatalogueEntry(id=row["id"], path=manifest_path.parent / row["file"], event=row["event"],
+                           year=_number(row["year"], int), magnitude=_number(row["magnitude"], float),
+                           station=row["station"], component=row["component"],
+                           sets=tuple(s for s in row["sets"].split(";") if s), source=row["source"],
+                           units=row["units"], sha256=row["sha256"],
+                           extra={k: v for k, v in row.items() if k not in REQUIRED_COLUMNS})
+            for row in reader]
 
 
 def sha256_of(path) -> str:
