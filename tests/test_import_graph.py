@@ -11,6 +11,7 @@ each other do not count their shared ``__init__``).
 from __future__ import annotations
 
 import ast
+import functools
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent / "pipeline"
@@ -92,7 +93,9 @@ def imports_of(name: str, path: Path, source: str, known: dict[str, Path]) -> se
     return set().union(*(imported(name, path, node, known) for node in ast.walk(tree)))
 
 
+@functools.cache
 def import_graph() -> dict[str, set[str]]:
+    """{module: the pipeline modules it imports}, parsed once per process (the tests below only read it)."""
     known = modules()
     return {name: imports_of(name, path, path.read_text(encoding="utf-8"), known) for name, path in known.items()}
 
