@@ -418,18 +418,20 @@ def _page_png(task) -> bytes:
 
 
 def _png_pages(planned, footer, workers):
-    """PNG bytes of every figure page, in order, and the pool drawing them (None: drawn here).
+    """The pool drawing every figure page's PNG and the PNG bytes in page order, or (None, None).
+
+    (None, None): there is no pool, and the PNGs are saved from the PDF's figures.
 
     A text page (``Page.html`` set) is HTML text in report.html and a page of report.pdf: it has no PNG (its
     image was used nowhere, and drawing text pages at 100 dpi was a third of the report's drawing time).
 
-    The pages are drawn in one forked worker process while this process writes the PDF (both cores
-    busy; about 40% less wall time), or here, page by page, when ``workers`` is 1 or the platform
-    cannot fork.
+    The pages are drawn again in one forked worker process while this process writes the PDF (both cores
+    busy; about 40% less wall time). When ``workers`` is 1 or the platform cannot fork, there is no pool: each
+    figure is drawn once, for its PDF page and its PNG.
     """
-    tasks = [(index, footer, len(planned)) for index, page in enumerate(planned) if page.html is None]
     if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():
-        return None, (_page_png(task) for task in tasks)
+        return None, None
+    tasks = [(index, footer, len(planned)) for index, page in enumerate(planned) if page.html is None]
     pool = multiprocessing.get_context("fork").Pool(1)
     return pool, pool.imap(_page_png, tasks)
 
@@ -451,13 +453,16 @@ def render(planned: list[Page], footer: str, output_dir, progress=True, workers=
                                                "CreationDate": None}) as document:
                 for number, page in enumerate(tqdm(planned, desc="report", unit="page", disable=not progress),
                                               start=1):
-                    figure = page.draw()
+                    figure, png = page.draw(), None
                     try:
                         add_footer(figure, footer, number, len(planned))
                         document.savefig(figure)
+                        if page.html is None and pool is None:
+                            png = figure_png(figure)
                     finally:
                         plt.close(figure)
-                    png = next(pngs) if page.html is None else None
+                    if page.html is None and pool is not None:
+                        png = next(pngs)
                     if png is not None:
                         with atomic_path(figure_dir / figure_file(number, page)) as path:
                             path.write_bytes(png)
