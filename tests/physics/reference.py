@@ -38,6 +38,14 @@ def free_flight_time(ag_vertical, dt, g=G):
                   (i - 1) * dt, i * dt, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
 
+def carried_step(piece) -> float | None:
+    """The first step [s] for the interval after ``piece`` (a solve_ivp result): the longest step it took, if it
+    ran to its end. solve_ivp would otherwise estimate one at every interval (two more right-hand sides and often
+    a smaller step; the step controller still rejects a step that is too long). None after a terminal event:
+    there the right-hand side or the state jumps, and solve_ivp estimates the step afresh."""
+    return float(np.max(np.diff(piece.t))) if piece.status == 0 and piece.t.size > 1 else None
+
+
 def solve_by_interval(fun, t_start, t_stop, state, dt, events, args=(), first_step=None, **tolerances):
     """solve_ivp(DOP853) from ``t_start`` to ``t_stop``, one sample interval of the ground motion at a time.
 
@@ -53,15 +61,17 @@ def solve_by_interval(fun, t_start, t_stop, state, dt, events, args=(), first_st
     t_events = [[] for _ in events]
     y_events = [[] for _ in events]
     t, y = t_start, np.asarray(state, dtype=float)
+    step = first_step
     while t < t_stop:
         knot = (math.floor(t / dt + 1e-9) + 1) * dt
         t_next = min(knot, t_stop)
         if t_next - t <= 1e-12 * max(1.0, t):
             t = t_next
             continue
-        first = None if first_step is None or t > t_start else min(first_step, t_next - t)
+        first = None if step is None else min(step, t_next - t)
         piece = solve_ivp(fun, (t, t_next), y, method="DOP853", events=events, args=args, first_step=first,
                           **tolerances)
+        step = carried_step(piece)
         ts.append(piece.t[1:])
         ys.append(piece.y[:, 1:])
         for k in range(len(events)):

@@ -44,6 +44,8 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .reference import carried_step
+
 G = 9.80665
 ZENO_FRACTION = 1e-6  # of alpha: a smaller excursion after an impact lays the block flat
 
@@ -173,6 +175,7 @@ def reference_sliding(ag, dt, b, h, mu_s, mu_k, t_end, g=G):
     t = 0.0
     mode = select_flat(0.0, state, 0)
     guard = 0
+    step = None  # solve_ivp's first step in the next interval (reference.carried_step)
     while t < t_end - 1e-12 and not overturned:
         guard += 1
         if guard > 500_000:
@@ -181,11 +184,13 @@ def reference_sliding(ag, dt, b, h, mu_s, mu_k, t_end, g=G):
         if mode == ("flat", 0, 0):
             a0, a1 = abs(ground(t)), abs(ground(t_next - 1e-15))
             if max(a0, a1) <= min(mu_s, b / h) * g:
-                t = t_next
+                t, step = t_next, None
                 continue
         named = events_for()
         solution = solve_ivp(rhs, (t, t_next), state, method="DOP853", rtol=1e-10, atol=1e-13,
-                             events=[e for _, e in named], dense_output=True)
+                             events=[e for _, e in named], dense_output=True,
+                             first_step=None if step is None else min(step, t_next - t))
+        step = carried_step(solution)
         kind, sigma, d = mode
         for (name, _), times in zip(named, solution.t_events):
             if name == "peak":

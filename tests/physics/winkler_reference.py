@@ -29,6 +29,8 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .reference import carried_step
+
 G = 9.80665
 
 
@@ -206,6 +208,7 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
         peak_angle = max(peak_angle, float(np.max(np.abs(states[0]))))
         peak_uplift = max(peak_uplift, float(np.max(-states[2] + b * np.abs(np.sin(states[0])))))
 
+    step = None  # solve_ivp's first step in the next interval (reference.carried_step)
     for i in range(n - 1):
         t, t_next = i * dt, (i + 1) * dt
         rhs = rhs_factory(i)
@@ -216,7 +219,9 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
                 wrapped.terminal, wrapped.direction = True, direction
                 events.append(wrapped)
             solution = solve_ivp(rhs, (t, t_next), state, method="DOP853", rtol=rtol, atol=atol,
-                                 events=events + [overturn] + watch_events)
+                                 events=events + [overturn] + watch_events,
+                                 first_step=None if step is None else min(step, t_next - t))
+            step = carried_step(solution)
             if solution.status < 0:
                 raise RuntimeError(f"solve_ivp failed at t = {t}: {solution.message}")
             track(solution.y)

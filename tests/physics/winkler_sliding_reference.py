@@ -41,6 +41,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from .reference import carried_step
 from .winkler_reference import bed_force
 
 G = 9.80665
@@ -142,6 +143,7 @@ def reference_winkler_sliding(ag, dt, b, h, mass, K, xi, mu_s, mu_k, bed="two-sp
     n_impacts = n_flights = n_events = 0
     overturned = False
 
+    step = None  # solve_ivp's first step in the next interval (reference.carried_step)
     for i in range(n - 1):
         t, t_next = i * dt, (i + 1) * dt
         a0, slope = ground[i], (ground[i + 1] - ground[i]) / dt
@@ -172,7 +174,9 @@ def reference_winkler_sliding(ag, dt, b, h, mass, K, xi, mu_s, mu_k, bed="two-sp
                 wrapped.terminal, wrapped.direction = True, crossing
                 events.append(wrapped)
             solution = solve_ivp(rhs, (t, t_next), state, method="DOP853", rtol=rtol, atol=atol,
-                                 events=events + [friction_event, overturn, turning])
+                                 events=events + [friction_event, overturn, turning],
+                                 first_step=None if step is None else min(step, t_next - t))
+            step = carried_step(solution)
             if solution.status < 0:
                 raise RuntimeError(f"solve_ivp failed at t = {t}: {solution.message}")
             t_stop = float(solution.t[-1])
