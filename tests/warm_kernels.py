@@ -1,7 +1,8 @@
 """Compile the numba kernels into their on-disk cache (cache=True) in one process, before the test workers
 start (``make test``, ``make test-fast``): otherwise each pytest-xdist worker compiles them at once in a fresh
-clone, about 25 s of CPU each. A second when the cache is already there. Calls every compiled entry point
-(one sample case per registered model) and the response-spectrum oscillator; checks nothing."""
+clone, about 25 s of CPU each. A second when the cache is already there. Runs simulate, simulate_batch and
+simulate_histories (one compiled entry point, kernels.run_kernel, whose array arguments have the same types in all
+three) on one sample case per registered model, and the response-spectrum oscillator; checks nothing."""
 
 from __future__ import annotations
 

@@ -247,11 +247,12 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
     table, states = parameter_table(spec, [(block, k, xi)], settings)
     state = states[0]
     state[0], state[1] = float(theta0), float(thetadot0)
-    history = np.empty((samples.shape[1] + n_tail, fields.STATE_SIZE))
-    impacts = np.empty(IMPACT_CAPACITY)
-    summaries = new_summaries(1)
-    kernels.single_kernel(spec.kernel_code, samples, float(dt), n_tail, table, state, history, impacts, summaries)
-    return _result(spec, block, dt, summaries[0], history, impacts, table[0])
+    history = np.empty((1, samples.shape[1] + n_tail, fields.STATE_SIZE))
+    impacts = np.empty((1, IMPACT_CAPACITY))
+    summaries = new_summaries((1, 1))
+    kernels.run_kernel(spec.kernel_code, samples, float(dt), n_tail, np.ones(1), table, states, history, impacts,
+                       summaries)
+    return _result(spec, block, dt, summaries[0, 0], history[0], impacts[0], table[0])
 
 
 def _result(spec, block, dt, summary, history, impacts, params):
@@ -347,7 +348,8 @@ def simulate_batch(model: str, ag: ArrayLike, dt: float, scales: ArrayLike,
     table, states = parameter_table(spec, blocks_and_foundations, SolverOptions(**options))
     scales = np.ascontiguousarray(scales, dtype=np.float64)
     summaries = new_summaries((len(table), scales.size))
-    kernels.batch_kernel(spec.kernel_code, samples, float(dt), n_tail, scales, table, states, summaries)
+    kernels.run_kernel(spec.kernel_code, samples, float(dt), n_tail, scales, table, states,
+                       np.empty((len(table), 0, fields.STATE_SIZE)), np.empty((len(table), 0)), summaries)
     return summaries
 
 
@@ -400,9 +402,10 @@ def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tup
     table, states = parameter_table(spec, cases, SolverOptions(**options))
     n_total = samples.shape[1] + n_tail
     histories = np.empty((len(table), n_total, fields.STATE_SIZE))
-    summaries = new_summaries(len(table))
-    kernels.history_batch_kernel(spec.kernel_code, samples, float(dt), n_tail, table, states, histories, summaries)
-    return np.arange(n_total) * dt, histories[:, :, 0], histories[:, :, 2], summaries
+    summaries = new_summaries((len(table), 1))
+    kernels.run_kernel(spec.kernel_code, samples, float(dt), n_tail, np.ones(1), table, states, histories,
+                       np.empty((len(table), 0)), summaries)
+    return np.arange(n_total) * dt, histories[:, :, 0], histories[:, :, 2], summaries[:, 0]
 
 
 from pipeline.models import housner as _housner  # noqa: E402  (registration at import)

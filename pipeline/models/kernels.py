@@ -1406,22 +1406,20 @@ def simulate_kernel(code, samples, dt, n_tail, params, x0, history, impact_times
 
 
 @njit(cache=True)
-def single_kernel(code, samples, dt, n_tail, params_table, x0, history, impact_times, summaries):
-    """``simulate_kernel`` for params_table[0] into summaries[0] (records cross from Python as arrays)."""
-    simulate_kernel(code, samples, dt, n_tail, params_table[0], x0, history, impact_times, summaries[0])
+def run_kernel(code, samples, dt, n_tail, scales, params_table, initial_states, histories, impact_times, summaries):
+    """Run each parameter row at each factor in ``scales``.
 
+    The one compiled entry point: ``simulate``, ``simulate_batch`` and ``simulate_histories`` all call it (an
+    entry point is compiled with the whole integrator inside it, about 1.5 s each in a fresh clone).
+    Every component (the vertical too) is scaled by the same factor.
 
-@njit(cache=True)
-def batch_kernel(code, samples, dt, n_tail, scales, params_table, initial_states, summaries):
-    """One record at each factor in ``scales`` for each parameter row (no histories).
-
-    Every component (the vertical too) is scaled by the same factors.
-
-    scales (n_scale,); params_table (n_case,) records; initial_states (n_case, STATE_SIZE);
-    summaries (n_case, n_scale) records, filled.
+    scales (n_scale,); params_table (n_case,) records; initial_states (n_case, STATE_SIZE), left unchanged;
+    histories (n_case, n + n_tail, STATE_SIZE) filled with each row's states, or (n_case, 0, STATE_SIZE) to keep
+    none (with histories, one factor only: a second would write over the first); impact_times (n_case, capacity)
+    filled, or (n_case, 0); summaries (n_case, n_scale) records, filled.
     """
-    empty = np.empty((0, STATE_SIZE))
-    impacts = np.empty(0)
+    if histories.shape[1] > 0 and scales.size > 1:
+        raise ValueError("run_kernel: histories are kept for one scale factor only")
     scaled = np.empty(samples.shape)
     x = np.empty(STATE_SIZE)
     for j in range(scales.size):
@@ -1431,15 +1429,5 @@ def batch_kernel(code, samples, dt, n_tail, scales, params_table, initial_states
         for row in range(params_table.shape[0]):
             for i in range(STATE_SIZE):
                 x[i] = initial_states[row, i]
-            simulate_kernel(code, scaled, dt, n_tail, params_table[row], x, empty, impacts, summaries[row, j])
-
-
-@njit(cache=True)
-def history_batch_kernel(code, samples, dt, n_tail, params_table, initial_states, histories, summaries):
-    """One ground motion for each parameter row, keeping the histories (n_case, n + n_tail, STATE_SIZE)."""
-    impacts = np.empty(0)
-    x = np.empty(STATE_SIZE)
-    for row in range(params_table.shape[0]):
-        for i in range(STATE_SIZE):
-            x[i] = initial_states[row, i]
-        simulate_kernel(code, samples, dt, n_tail, params_table[row], x, histories[row], impacts, summaries[row])
+            simulate_kernel(code, scaled, dt, n_tail, params_table[row], x, histories[row], impact_times[row],
+                            summaries[row, j])

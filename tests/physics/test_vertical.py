@@ -74,11 +74,11 @@ def settled_run(model, ag, dt, *, bed=None, ag_vertical=None, gravity=G, block=B
     if spec.needs_foundation:
         states[0, 2] = gravity * block.mass / k
     samples = np.array([ag] if ag_vertical is None else [ag, ag_vertical], dtype=float)  # kernels.GroundMotion
-    history = np.empty((samples.shape[1], STATE_SIZE))
-    summaries = new_summaries(1)
-    kernels.single_kernel(spec.kernel_code, samples, float(dt), 0, table, states[0], history,
-                          np.empty(IMPACT_CAPACITY), summaries)
-    return summaries[0], history
+    history = np.empty((1, samples.shape[1], STATE_SIZE))
+    summaries = new_summaries((1, 1))
+    kernels.run_kernel(spec.kernel_code, samples, float(dt), 0, np.ones(1), table, states, history,
+                       np.empty((1, IMPACT_CAPACITY)), summaries)
+    return summaries[0, 0], history[0]
 
 
 def sine_pulse(amplitude, period, dt=0.005, duration=6.0):
