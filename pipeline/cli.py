@@ -303,7 +303,7 @@ def command_fragility(args) -> int:
              "[applicability] run = true runs it")
     results_s = time.perf_counter() - started  # the run time the report states: one number, here and there
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, results_s, applicability,
-                             progress=not args.no_progress, run=stats)
+                             progress=not args.no_progress, workers=args.workers, run=stats)
     print(f"wrote {pdf}, {output / 'report.html'} and {len(pngs)} figure page images in {output / 'figures'}/")
     print(f"done in {time.perf_counter() - started:.0f} s (results in {results_s:.0f} s, as the report states; "
           f"the report in {time.perf_counter() - started - results_s:.0f} s)")

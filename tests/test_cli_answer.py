@@ -165,16 +165,18 @@ def _run(study, output, capsys, monkeypatch, *flags):
     return captured, calls
 
 
-def _planned_not_rendered(planned: list):
+def _planned_not_rendered(planned: list, workers_seen: list):
     """Stands in for ``report_stage``: plans the report from what the run hands it (every text page's HTML) and
     builds every figure page's figure, without rendering report.pdf and the PNGs (the small pipeline's run and the
-    README's example render theirs, about 10 s of CPU here). The planned pages are appended to ``planned``."""
+    README's example render theirs, about 10 s of CPU here). The planned pages are appended to ``planned``, the
+    ``workers`` it was given to ``workers_seen``."""
     import matplotlib.pyplot as plt
 
     from pipeline.report import build_plan, report_results
 
     def stage(config, cube, ida, fragility, risk, output, runtime_s=float("nan"), applicability=None,
               progress=True, workers=None, run=None):
+        workers_seen.append(workers)
         pages = build_plan(report_results(config, cube, ida, fragility, risk, output, runtime_s, applicability, run))
         for page in pages:
             plt.close(page.draw())
@@ -187,10 +189,11 @@ def _planned_not_rendered(planned: list):
 def test_fragility_ends_with_the_answer_and_skips_the_sweep_of_a_study_file(tiny_run, capsys, monkeypatch):
     """On a study with one soil, whose by-model page is laid out on a grid (drawing it once crashed)."""
     study, output = tiny_run
-    planned = []
-    monkeypatch.setattr("pipeline.report.report_stage", _planned_not_rendered(planned))
+    planned, workers = [], []
+    monkeypatch.setattr("pipeline.report.report_stage", _planned_not_rendered(planned, workers))
     captured, calls = _run(study, output, capsys, monkeypatch)
     assert not calls and "applicability sweep not run" in captured.err and "--applicability" in captured.err
+    assert workers == [1]  # --serial: the report's figures are drawn in this process too, no forked worker
     answer = captured.out[captured.out.index("Overturning, model recommended"):].splitlines()
     table = pd.read_csv(output / "fragility.csv")
     row = table[(table.model == "recommended") & (table.damage_state == "overturning") & (table.soil == "sand")]
