@@ -23,29 +23,29 @@ def test_records_writes_table_and_plots(tmp_path, capsys):
     assert "PGA [g]" in capsys.readouterr().out
 
 
-def test_bad_file_is_one_line_and_nonzero(tmp_path, bolu_path):
+def test_bad_file_is_one_line_and_nonzero(tmp_path, bolu_path, capsys):
+    """In this process; the same case in a real process: test_cli_reliability's exit-1 test."""
     folder = tmp_path / "mine"
     folder.mkdir()
     shutil.copy(bolu_path, folder / "good.AT2")
     (folder / "bad.AT2").write_text("PEER\nx\nUNITS OF G\nNPTS= 10, DT= .01 SEC\n .1 abc\n")
-    result = subprocess.run([sys.executable, "-m", "pipeline", "records", "--set", str(folder),
-                             "--output", str(tmp_path / "out"), "--no-progress"],
-                            capture_output=True, text=True)
-    assert result.returncode == 1
-    assert "Traceback" not in result.stderr
-    assert "bad.AT2, line 5" in result.stderr and "'abc'" in result.stderr
+    status = main(["records", "--set", str(folder), "--output", str(tmp_path / "out"), "--no-progress"])
+    stderr = capsys.readouterr().err
+    assert status == 1
+    assert "Traceback" not in stderr
+    assert "bad.AT2, line 5" in stderr and "'abc'" in stderr
     assert len(pd.read_csv(tmp_path / "out" / "records.csv")) == 1  # the good file went on
 
 
-def test_bad_recipe_exits_2_without_traceback(tmp_path):
+def test_bad_recipe_exits_2_without_traceback(tmp_path, capsys):
+    """In this process; exit 2 in a real process: the bad study and the unreachable scheduler below."""
     recipe = tmp_path / "recipe.toml"
     recipe.write_text('[[steps]]\nname = "taper"\nmax_percentage = 3\n')
-    result = subprocess.run([sys.executable, "-m", "pipeline", "records", "--set", "bolu",
-                             "--processing", str(recipe), "--output", str(tmp_path)],
-                            capture_output=True, text=True)
-    assert result.returncode == 2
-    assert "Traceback" not in result.stderr
-    assert "steps[0].max_percentage" in result.stderr and "0.0 to 0.5" in result.stderr
+    status = main(["records", "--set", "bolu", "--processing", str(recipe), "--output", str(tmp_path)])
+    stderr = capsys.readouterr().err
+    assert status == 2
+    assert "Traceback" not in stderr
+    assert "steps[0].max_percentage" in stderr and "0.0 to 0.5" in stderr
     assert not (tmp_path / "records.csv").exists()
 
 
