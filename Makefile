@@ -5,7 +5,6 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
-UV_STAMP := $(VENV)/.uv
 ROCKFRAG := $(BIN)/rockfrag
 UV     := $(BIN)/uv
 REPORTS := reports
@@ -32,13 +31,10 @@ unexport PYTHONDONTWRITEBYTECODE
 # versions from the same index and, like --no-compile, leaves bytecode to the first import.
 # The venv is made without pip (installing pip into it took 7 s of a fresh clone's set-up); the system's pip
 # (22.3 or later: --python) puts uv into it. Without such a pip, the venv gets its own pip, which installs uv.
-$(UV_STAMP):
+$(STAMP): pyproject.toml
 	$(PYTHON) -m venv --without-pip $(VENV)
 	$(PYTHON) -m pip --python $(BIN)/python install --quiet --no-compile 'uv>=0.5' \
 	  || { $(PYTHON) -m venv $(VENV) && $(BIN)/python -m pip install --quiet --no-compile 'uv>=0.5'; }
-	touch $(UV_STAMP)
-
-$(STAMP): pyproject.toml $(UV_STAMP)
 	$(UV) pip install --quiet --python $(BIN)/python -e '.[test]'
 	touch $(STAMP)
 
@@ -48,9 +44,8 @@ install: $(STAMP)  ## create .venv and install rockfrag with its test tools
 # under `make test` (ROCKFRAG_CONSUMERS=required) with the log's name, after every other test has run.
 # Its scripts run once with --help, which imports the consumer: that writes the bytecode of what the round trip
 # imports (4-8 s of CPU per environment, here on the core the kernel compile leaves idle, not in the tests).
-# It needs only the main environment's Python and uv, so under make -j2 it starts while the package installs.
 .SECONDEXPANSION:
-.venv-%/.installed: tests/consumers/%.txt $$(wildcard tests/consumers/$$*.no-deps.txt) $(UV_STAMP)
+.venv-%/.installed: tests/consumers/%.txt $$(wildcard tests/consumers/$$*.no-deps.txt) $(STAMP)
 	@rm -rf .venv-$* && echo "building the $* consumer environment .venv-$* (log: .venv-$*.log)"
 	@if { $(UV) venv --quiet --python $(BIN)/python .venv-$* \
 	      && if [ -f tests/consumers/$*.no-deps.txt ]; then \
