@@ -1,6 +1,7 @@
 """Chaos (issue 13): ``kill -9`` of the study process or of one of its pool workers at random points
 of a small study, ten times, then one undisturbed run. The cube must be identical to a clean run's,
-no worker may outlive its killed parent, and no ``.part`` file may be left behind.
+no worker may outlive its killed parent, nothing may hold the output lock 10 s after a run ended, and no
+``.part`` file may be left behind.
 
 The ten interrupted runs are forked from one process that has imported everything (tests/chaos_zygote.py):
 started as ``python -m pipeline``, each spent about 3 of its 4 s importing, and a kill "at a random point"
@@ -8,6 +9,7 @@ mostly fell in the imports. The last run is a fresh ``python -m pipeline`` proce
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import random
@@ -20,6 +22,7 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
+from pipeline.locking import LOCK_NAME
 from tests.reliability_helpers import small_study_text, write_at2
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,6 +54,24 @@ def alive(pid) -> bool:
         return (Path(f"/proc/{pid}") / "stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
     except (OSError, IndexError):
         return False
+
+
+def lock_is_free(folder: Path) -> bool:
+    """Whether no process holds ``folder``'s output lock. Pool workers inherit the run's locked descriptor (fork
+    copies it): a worker of a killed run that was not seen yet (forked just before the kill) holds the lock until
+    it notices its parent is gone and exits, milliseconds later; a run started before then finds the folder in
+    use."""
+    try:
+        descriptor = os.open(folder / LOCK_NAME, os.O_RDWR)
+    except FileNotFoundError:
+        return True
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    finally:
+        os.close(descriptor)  # (releases the lock taken just now)
+    return True
 
 
 def wait_until(predicate, timeout, step=0.02) -> bool:
@@ -156,4 +177,6 @@ def _attempt(zygote: Zygote, arguments: list[str], output: Path, attempt: int, r
         zygote.ask(wait=pid)
         assert wait_until(lambda: not any(alive(child) for child in seen_children), timeout=10), \
             f"orphan workers after kill -9 of the parent: {[p for p in seen_children if alive(p)]}"
+    # every process of the run is gone, those never seen too: nothing holds the output folder
+    assert wait_until(lambda: lock_is_free(output), timeout=10), f"{outcome}: the output lock is held 10 s later"
     return outcome
