@@ -21,12 +21,15 @@ from tests.helpers import pipeline_results
 # ---------------------------------------------------------------- what the drawn page shows
 
 
-def _shown_texts(figure):
+def _shown_texts(figure, drawn=False):
     """Every text a reader sees on the drawn figure, with its extent in pixels.
 
     Tick labels count only for the ticks inside the axis's view (matplotlib keeps the others, undrawn).
+    ``drawn``: the figure was just drawn on its canvas at its own dpi (saved as the report's PNG), so the extents
+    are measured on that drawing, without drawing it again.
     """
-    figure.canvas.draw()
+    if not drawn:
+        figure.canvas.draw()
     renderer = figure.canvas.get_renderer()
     all_ticks, drawn_ticks = set(), set()
     for axis in [a for parent in figure.axes for a in (parent, *parent.child_axes)]:
@@ -108,7 +111,15 @@ def test_each_kind_of_page_drawn_again_from_the_files_is_legible_and_the_same(sm
 
     import pipeline.models as models
     from pipeline.config import load_study
-    from pipeline.report import build_plan, figure_file, figure_png, html_document, report_footer, report_results
+    from pipeline.report import (
+        PNG_DPI,
+        build_plan,
+        figure_file,
+        figure_png,
+        html_document,
+        report_footer,
+        report_results,
+    )
 
     output, study, _ = small_pipeline
 
@@ -142,8 +153,9 @@ def test_each_kind_of_page_drawn_again_from_the_files_is_legible_and_the_same(sm
             try:
                 add_footer(figure, footer, number, len(planned))
                 if page.html is None:
+                    assert figure.dpi == PNG_DPI  # the PNG's drawing is the figure's own: its texts are measured on it
                     assert figure_png(figure) == png, f"page {number} ({page.name}) drawn from the files differs"
-                shown = _shown_texts(figure)
+                shown = _shown_texts(figure, drawn=page.html is None)
                 assert overprinted(figure, shown) == [], page.name
                 assert off_page(figure, shown) == [], page.name
             finally:
