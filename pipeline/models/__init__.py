@@ -28,7 +28,7 @@ from pipeline.errors import SolverError
 from pipeline.models import fields, kernels
 from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
 from pipeline.models.contact import LAWS
-from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS, new_summaries
+from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS
 from pipeline.models.options import (  # noqa: F401  (the API)
     BED_TYPES,
     DEFAULT_ATOL,
@@ -249,9 +249,8 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
     state[0], state[1] = float(theta0), float(thetadot0)
     history = np.empty((1, samples.shape[1] + n_tail, fields.STATE_SIZE))
     impacts = np.empty((1, IMPACT_CAPACITY))
-    summaries = new_summaries((1, 1))
-    kernels.run_kernel(spec.kernel_code, samples, float(dt), n_tail, np.ones(1), table, states, history, impacts,
-                       summaries)
+    summaries = kernels.run_cases(spec.kernel_code, samples, dt, n_tail, table, states, histories=history,
+                                  impact_times=impacts)
     return _result(spec, block, dt, summaries[0, 0], history[0], impacts[0], table[0])
 
 
@@ -347,10 +346,7 @@ def simulate_batch(model: str, ag: ArrayLike, dt: float, scales: ArrayLike,
     samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
     table, states = parameter_table(spec, blocks_and_foundations, SolverOptions(**options))
     scales = np.ascontiguousarray(scales, dtype=np.float64)
-    summaries = new_summaries((len(table), scales.size))
-    kernels.run_kernel(spec.kernel_code, samples, float(dt), n_tail, scales, table, states,
-                       np.empty((len(table), 0, fields.STATE_SIZE)), np.empty((len(table), 0)), summaries)
-    return summaries
+    return kernels.run_cases(spec.kernel_code, samples, dt, n_tail, table, states, scales=scales)
 
 
 def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tuple[Block, float | None, float | None]],
@@ -402,9 +398,7 @@ def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tup
     table, states = parameter_table(spec, cases, SolverOptions(**options))
     n_total = samples.shape[1] + n_tail
     histories = np.empty((len(table), n_total, fields.STATE_SIZE))
-    summaries = new_summaries((len(table), 1))
-    kernels.run_kernel(spec.kernel_code, samples, float(dt), n_tail, np.ones(1), table, states, histories,
-                       np.empty((len(table), 0)), summaries)
+    summaries = kernels.run_cases(spec.kernel_code, samples, dt, n_tail, table, states, histories=histories)
     return np.arange(n_total) * dt, histories[:, :, 0], histories[:, :, 2], summaries[:, 0]
 
 

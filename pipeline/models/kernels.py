@@ -67,6 +67,7 @@ from pipeline.models.fields import (
     SWITCH_CONSISTENT,
     TIED_STATE_SIZE,
     WINKLER,
+    new_summaries,
 )
 from pipeline.models.housner import (
     friction_impact,
@@ -1431,3 +1432,20 @@ def run_kernel(code, samples, dt, n_tail, scales, params_table, initial_states, 
                 x[i] = initial_states[row, i]
             simulate_kernel(code, scaled, dt, n_tail, params_table[row], x, histories[row], impact_times[row],
                             summaries[row, j])
+
+
+def run_cases(code, samples, dt, n_tail, params_table, initial_states, scales=None, histories=None,
+              impact_times=None) -> np.ndarray:
+    """``run_kernel`` from Python: the summaries, (n_case, n_scale) records.
+
+    ``scales`` None runs the ground motion as given (one factor, 1). ``histories`` and ``impact_times`` None keep
+    none: the kernel is handed empty arrays of the same types, so that one compiled signature serves every call.
+    """
+    n_case = params_table.shape[0]
+    scales = np.ones(1) if scales is None else scales
+    histories = np.empty((n_case, 0, STATE_SIZE)) if histories is None else histories
+    impact_times = np.empty((n_case, 0)) if impact_times is None else impact_times
+    summaries = new_summaries((n_case, scales.size))
+    run_kernel(code, samples, float(dt), n_tail, scales, params_table, initial_states, histories, impact_times,
+               summaries)
+    return summaries

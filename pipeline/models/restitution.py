@@ -138,8 +138,8 @@ def free_rocking_restitution(block: Block, k: float, bed: str, xi: float, g: flo
     dt = SAMPLE_STEP / p
     n_samples = int(round(DURATION / SAMPLE_STEP)) + 1
     history = np.empty((1, n_samples, fields.STATE_SIZE))
-    kernels.run_kernel(WINKLER.kernel_code, np.zeros((1, 2)), dt, n_samples - 2, np.ones(1), table,
-                       state.reshape(1, -1), history, np.empty((1, 0)), fields.new_summaries((1, 1)))
+    kernels.run_cases(WINKLER.kernel_code, np.zeros((1, 2)), dt, n_samples - 2, table, state.reshape(1, -1),
+                      histories=history)
     history = history[0]
     if not np.all(np.isfinite(history[:, 0])):
         return math.nan  # overturned or failed

@@ -457,11 +457,11 @@ def render(planned: list[Page], footer: str, output_dir, progress=True, workers=
                     try:
                         add_footer(figure, footer, number, len(planned))
                         document.savefig(figure)
-                        if page.html is None and pool is None:
+                        if page.html is None and pngs is None:  # no PNG worker: this drawing makes the PNG
                             png = figure_png(figure)
                     finally:
                         plt.close(figure)
-                    if page.html is None and pool is not None:
+                    if page.html is None and png is None:
                         png = next(pngs)
                     if png is not None:
                         with atomic_path(figure_dir / figure_file(number, page)) as path:

@@ -34,7 +34,7 @@ from pipeline.models import (
     simulate,
     simulate_batch,
 )
-from pipeline.models.fields import STATE_SIZE, new_summaries
+from pipeline.models.fields import STATE_SIZE
 from pipeline.models.winkler import bed_force
 from pipeline.processing import process_record
 from pipeline.records import load_records
@@ -75,9 +75,8 @@ def settled_run(model, ag, dt, *, bed=None, ag_vertical=None, gravity=G, block=B
         states[0, 2] = gravity * block.mass / k
     samples = np.array([ag] if ag_vertical is None else [ag, ag_vertical], dtype=float)  # kernels.GroundMotion
     history = np.empty((1, samples.shape[1], STATE_SIZE))
-    summaries = new_summaries((1, 1))
-    kernels.run_kernel(spec.kernel_code, samples, float(dt), 0, np.ones(1), table, states, history,
-                       np.empty((1, IMPACT_CAPACITY)), summaries)
+    summaries = kernels.run_cases(spec.kernel_code, samples, dt, 0, table, states, histories=history,
+                                  impact_times=np.empty((1, IMPACT_CAPACITY)))
     return summaries[0, 0], history[0]
 
 
