@@ -46,6 +46,12 @@ def carried_step(piece) -> float | None:
     return float(np.max(np.diff(piece.t))) if piece.status == 0 and piece.t.size > 1 else None
 
 
+def bounded_first_step(carried: float | None, room: float) -> float | None:
+    """solve_ivp's ``first_step`` for an interval of length ``room`` [s]: the carried step (``carried_step``) if it
+    fits, else ``room``; None (solve_ivp estimates one) when nothing was carried."""
+    return None if carried is None else min(carried, room)
+
+
 def solve_by_interval(fun, t_start, t_stop, state, dt, events, args=(), first_step=None, **tolerances):
     """solve_ivp(DOP853) from ``t_start`` to ``t_stop``, one sample interval of the ground motion at a time.
 
@@ -68,8 +74,8 @@ def solve_by_interval(fun, t_start, t_stop, state, dt, events, args=(), first_st
         if t_next - t <= 1e-12 * max(1.0, t):
             t = t_next
             continue
-        first = None if step is None else min(step, t_next - t)
-        piece = solve_ivp(fun, (t, t_next), y, method="DOP853", events=events, args=args, first_step=first,
+        piece = solve_ivp(fun, (t, t_next), y, method="DOP853", events=events, args=args,
+                          first_step=bounded_first_step(step, t_next - t),
                           **tolerances)
         step = carried_step(piece)
         ts.append(piece.t[1:])

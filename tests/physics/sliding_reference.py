@@ -44,7 +44,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .reference import carried_step
+from .reference import bounded_first_step, carried_step
 
 G = 9.80665
 ZENO_FRACTION = 1e-6  # of alpha: a smaller excursion after an impact lays the block flat
@@ -189,7 +189,7 @@ def reference_sliding(ag, dt, b, h, mu_s, mu_k, t_end, g=G):
         named = events_for()
         solution = solve_ivp(rhs, (t, t_next), state, method="DOP853", rtol=1e-10, atol=1e-13,
                              events=[e for _, e in named], dense_output=True,
-                             first_step=None if step is None else min(step, t_next - t))
+                             first_step=bounded_first_step(step, t_next - t))
         step = carried_step(solution)
         kind, sigma, d = mode
         for (name, _), times in zip(named, solution.t_events):

@@ -31,7 +31,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .reference import carried_step
+from .reference import bounded_first_step, carried_step
 
 G = 9.80665
 # The longest step [samples]: a longer one that ran past a landing would try a deep penetration of a stiff bed
@@ -244,10 +244,9 @@ def reference_winkler(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g
                 wrapped = (lambda e: lambda tt, x: e(tt, x))(event)
                 wrapped.terminal, wrapped.direction = True, direction
                 events.append(wrapped)
-            first = None if step is None else min(step, t_next - t)
             solution = solve_ivp(rhs, (t, t_next), state, method="DOP853", rtol=rtol, atol=atol,
                                  events=events + [overturn] + watch_events, dense_output=inside,
-                                 max_step=MAX_STEP_SAMPLES * dt, first_step=first)
+                                 max_step=MAX_STEP_SAMPLES * dt, first_step=bounded_first_step(step, t_next - t))
             step = carried_step(solution)
             if solution.status < 0:
                 raise RuntimeError(f"solve_ivp failed at t = {t}: {solution.message}")

@@ -41,7 +41,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .reference import carried_step
+from .reference import bounded_first_step, carried_step
 from .winkler_reference import bed_force
 
 G = 9.80665
@@ -175,7 +175,7 @@ def reference_winkler_sliding(ag, dt, b, h, mass, K, xi, mu_s, mu_k, bed="two-sp
                 events.append(wrapped)
             solution = solve_ivp(rhs, (t, t_next), state, method="DOP853", rtol=rtol, atol=atol,
                                  events=events + [friction_event, overturn, turning],
-                                 first_step=None if step is None else min(step, t_next - t))
+                                 first_step=bounded_first_step(step, t_next - t))
             step = carried_step(solution)
             if solution.status < 0:
                 raise RuntimeError(f"solve_ivp failed at t = {t}: {solution.message}")
