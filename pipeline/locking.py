@@ -4,7 +4,9 @@ Input : an output folder.
 Output: an advisory lock (``fcntl.flock`` on ``<folder>/.rockfrag.lock``, holding the owner's pid)
         kept while a command writes there. A second run on the same folder stops with one line
         naming the folder and the owner's pid (or waits: ``wait=True``, the CLI's ``--wait``). The
-        kernel drops the lock when its owner dies, even by ``kill -9``, so a lock is never stale.
+        kernel drops the lock when its owner dies, even by ``kill -9``, so a lock is never stale; the pool
+        workers the owner forked share its lock until they exit, so a lock whose owner is dead is waited
+        for (``ORPHAN_GRACE_SECONDS``) rather than reported in use.
 
 Every rockfrag writer in a folder holds its lock, so the temporary ``.*.part`` files found there
 by the process that has just taken the lock belong to runs that died: they are removed then, and
@@ -23,6 +25,7 @@ import contextlib
 import errno
 import fcntl
 import os
+import time
 from pathlib import Path
 
 from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
@@ -57,10 +60,59 @@ def prepare_output_folder(folder) -> Path:
     return folder
 
 
+def _owner_pid(path) -> int | None:
+    """The pid written in the lock file ``path``, or None."""
+    with contextlib.suppress(OSError, ValueError, IndexError):
+        return int(Path(path).read_text().split()[0])
+    return None
+
+
 def _owner(path) -> str:
-    with contextlib.suppress(OSError, ValueError):
-        return f" (pid {int(Path(path).read_text().split()[0])})"
-    return ""
+    pid = _owner_pid(path)
+    return "" if pid is None else f" (pid {pid})"
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, dead but not yet reaped by its parent, does not)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+    except (OSError, IndexError):  # no /proc (macOS): ask the kernel
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return False
+        except PermissionError:
+            return True
+        return True
+
+
+# How long [s] a run waits for a lock whose owner is dead. The owner's pool workers share its locked descriptor
+# (fork copies it), so a worker forked just before the owner was killed holds the lock until it sees its parent
+# gone and exits, milliseconds later: a run started at once would otherwise find the folder "in use".
+ORPHAN_GRACE_SECONDS = 5.0
+
+
+def _take_from_dead_owner(descriptor: int, lock_path: Path) -> bool:
+    """Take the lock held on behalf of a dead owner (see ORPHAN_GRACE_SECONDS).
+
+    True once taken; False at once when the owner is alive or unknown, or after the grace period.
+    """
+    pid = _owner_pid(lock_path)
+    if pid is None or _alive(pid):
+        return False
+    deadline = time.monotonic() + ORPHAN_GRACE_SECONDS
+    while time.monotonic() < deadline:
+        time.sleep(0.02)
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as error:
+            if error.errno not in BUSY:
+                raise
+            continue
+        return True
+    return False
 
 
 def stale_part_files(folder) -> list[Path]:
@@ -100,13 +152,16 @@ def _acquire(folder: Path, wait: bool, notify) -> tuple[int, bool]:
             try:
                 fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as error:
-                if error.errno not in BUSY or not wait:
+                if error.errno not in BUSY:
                     raise
-                if notify is not None and not told:
-                    notify(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
-                           "waiting for it to finish (Ctrl-C stops waiting)")
-                    told = True
-                fcntl.flock(descriptor, fcntl.LOCK_EX)
+                if not _take_from_dead_owner(descriptor, lock_path):
+                    if not wait:
+                        raise
+                    if notify is not None and not told:
+                        notify(f"output folder {folder} is in use by another rockfrag run{_owner(lock_path)}; "
+                               "waiting for it to finish (Ctrl-C stops waiting)")
+                        told = True
+                    fcntl.flock(descriptor, fcntl.LOCK_EX)
         except OSError as error:
             os.close(descriptor)
             if error.errno in BUSY:

@@ -5,12 +5,15 @@ removed, and the lock is reentrant within one process."""
 from __future__ import annotations
 
 import fcntl
+import os
+import subprocess
+import sys
 import threading
 import time
 
 import pytest
 
-from pipeline import cli
+from pipeline import cli, locking
 from pipeline.locking import LOCK_NAME, output_lock
 from tests.reliability_helpers import assert_one_line_error, tiny_run_argv
 
@@ -18,15 +21,15 @@ from tests.reliability_helpers import assert_one_line_error, tiny_run_argv
 def test_second_run_on_a_locked_folder_stops_with_one_line(tmp_path, capsys):
     output = tmp_path / "out"
     output.mkdir()
-    with open(output / LOCK_NAME, "w") as handle:  # another run holds the folder
+    with open(output / LOCK_NAME, "w") as handle:  # another run, alive (this process's pid), holds the folder
         fcntl.flock(handle, fcntl.LOCK_EX)
-        handle.write("4242\n")
+        handle.write(f"{os.getpid()}\n")
         handle.flush()
         (output / ".cube.nc.abc.part").write_text("being written by the other run")
         status = cli.main(tiny_run_argv(tmp_path, "--output", str(output)))
         captured = capsys.readouterr()
         assert status == cli.EXIT_USER_ERROR
-        assert_one_line_error(captured.err, str(output), "in use by another rockfrag run", "pid 4242")
+        assert_one_line_error(captured.err, str(output), "in use by another rockfrag run", f"pid {os.getpid()}")
         assert (output / ".cube.nc.abc.part").exists()  # the other run's temporary file is untouched
     assert not (output / "cube.nc").exists()
 
@@ -34,9 +37,9 @@ def test_second_run_on_a_locked_folder_stops_with_one_line(tmp_path, capsys):
 def test_wait_lets_a_second_run_start_when_the_first_one_ends(tmp_path, capsys):
     output = tmp_path / "out"
     output.mkdir()
-    handle = open(output / LOCK_NAME, "w")  # another run holds the folder, and ends 1 s later
+    handle = open(output / LOCK_NAME, "w")  # another run (alive: this process's pid) holds the folder, ends 1 s later
     fcntl.flock(handle, fcntl.LOCK_EX)
-    handle.write("4242\n")
+    handle.write(f"{os.getpid()}\n")
     handle.flush()
     released = threading.Timer(1.0, handle.close)
     released.start()
@@ -49,8 +52,54 @@ def test_wait_lets_a_second_run_start_when_the_first_one_ends(tmp_path, capsys):
     assert status == 0, captured.err
     assert time.monotonic() - started >= 1.0
     waiting = [line for line in captured.err.splitlines() if "waiting for it to finish" in line]
-    assert len(waiting) == 1 and "pid 4242" in waiting[0] and str(output) in waiting[0]
+    assert len(waiting) == 1 and f"pid {os.getpid()}" in waiting[0] and str(output) in waiting[0]
     assert (output / "cube.nc").is_file()
+
+
+def held_for_a_dead_owner(output):
+    """The folder's lock held by an open file of this process (as a pool worker of a killed run holds its
+    parent's), the lock file naming a process that has ended (the killed run)."""
+    ended = subprocess.Popen([sys.executable, "-c", ""])
+    ended.wait()
+    output.mkdir()
+    handle = open(output / LOCK_NAME, "w")
+    fcntl.flock(handle, fcntl.LOCK_EX)
+    handle.write(f"{ended.pid}\n")
+    handle.flush()
+    return handle
+
+
+def test_a_lock_a_dead_runs_worker_still_holds_is_waited_for(tmp_path, capsys):
+    """A run started just after another was killed in the same folder: the killed run's pool worker holds the lock
+    for a moment (here 0.5 s), and the new run takes it then instead of stopping with "in use"."""
+    output = tmp_path / "out"
+    handle = held_for_a_dead_owner(output)
+    released = threading.Timer(0.5, handle.close)
+    released.start()
+    started = time.monotonic()
+    try:
+        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output)))
+    finally:
+        released.join()
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    assert time.monotonic() - started >= 0.5 and "in use" not in captured.err
+    assert (output / "cube.nc").is_file()
+
+
+def test_the_wait_for_a_dead_runs_worker_is_bounded(tmp_path, capsys, monkeypatch):
+    """A lock of a dead owner that stays held past the grace period is "in use", with the usual one line."""
+    monkeypatch.setattr(locking, "ORPHAN_GRACE_SECONDS", 0.3)
+    output = tmp_path / "out"
+    handle = held_for_a_dead_owner(output)
+    started = time.monotonic()
+    try:
+        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output)))
+    finally:
+        handle.close()
+    captured = capsys.readouterr()
+    assert status == cli.EXIT_USER_ERROR and time.monotonic() - started >= 0.3
+    assert_one_line_error(captured.err, str(output), "in use by another rockfrag run")
 
 
 def test_stale_part_files_are_removed_when_the_folder_is_free(tmp_path, capsys):
