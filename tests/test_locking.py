@@ -34,6 +34,17 @@ def test_second_run_on_a_locked_folder_stops_with_one_line(tmp_path, capsys):
     assert not (output / "cube.nc").exists()
 
 
+def run_while_held(tmp_path, output, release, *options) -> tuple[int, float]:
+    """``rockfrag run`` of the tiny study into ``output`` while another holder has its lock; ``release`` (called
+    when the run ends, however) lets go of it. Returns the exit status and the run's wall time [s]."""
+    started = time.monotonic()
+    try:
+        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output), *options))
+    finally:
+        release()
+    return status, time.monotonic() - started
+
+
 def test_wait_lets_a_second_run_start_when_the_first_one_ends(tmp_path, capsys):
     output = tmp_path / "out"
     output.mkdir()
@@ -43,14 +54,10 @@ def test_wait_lets_a_second_run_start_when_the_first_one_ends(tmp_path, capsys):
     handle.flush()
     released = threading.Timer(1.0, handle.close)
     released.start()
-    started = time.monotonic()
-    try:
-        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output), "--wait"))
-    finally:
-        released.join()
+    status, seconds = run_while_held(tmp_path, output, released.join, "--wait")
     captured = capsys.readouterr()
     assert status == 0, captured.err
-    assert time.monotonic() - started >= 1.0
+    assert seconds >= 1.0
     waiting = [line for line in captured.err.splitlines() if "waiting for it to finish" in line]
     assert len(waiting) == 1 and f"pid {os.getpid()}" in waiting[0] and str(output) in waiting[0]
     assert (output / "cube.nc").is_file()
@@ -76,14 +83,10 @@ def test_a_lock_a_dead_runs_worker_still_holds_is_waited_for(tmp_path, capsys):
     handle = held_for_a_dead_owner(output)
     released = threading.Timer(0.5, handle.close)
     released.start()
-    started = time.monotonic()
-    try:
-        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output)))
-    finally:
-        released.join()
+    status, seconds = run_while_held(tmp_path, output, released.join)
     captured = capsys.readouterr()
     assert status == 0, captured.err
-    assert time.monotonic() - started >= 0.5 and "in use" not in captured.err
+    assert seconds >= 0.5 and "in use" not in captured.err
     assert (output / "cube.nc").is_file()
 
 
@@ -92,13 +95,9 @@ def test_the_wait_for_a_dead_runs_worker_is_bounded(tmp_path, capsys, monkeypatc
     monkeypatch.setattr(locking, "ORPHAN_GRACE_SECONDS", 0.3)
     output = tmp_path / "out"
     handle = held_for_a_dead_owner(output)
-    started = time.monotonic()
-    try:
-        status = cli.main(tiny_run_argv(tmp_path, "--output", str(output)))
-    finally:
-        handle.close()
+    status, seconds = run_while_held(tmp_path, output, handle.close)
     captured = capsys.readouterr()
-    assert status == cli.EXIT_USER_ERROR and time.monotonic() - started >= 0.3
+    assert status == cli.EXIT_USER_ERROR and seconds >= 0.3
     assert_one_line_error(captured.err, str(output), "in use by another rockfrag run")
 
 
