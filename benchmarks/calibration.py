@@ -14,11 +14,11 @@ import warnings
 
 import numpy as np
 
-from pipeline.blocks import PAPER_BLOCK
-from pipeline.calibrate import calibrate
-from pipeline.models import simulate
-from pipeline.processing import process_record
-from pipeline.records import load_records
+from rockfrag.blocks import PAPER_BLOCK
+from rockfrag.calibrate import calibrate
+from rockfrag.models import simulate
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
 
 RECORD = "PEER/RSN68_SFERN_PEL090"  # San Fernando 1971, 79 s at dt = 0.01 s
 DURATION = 70.0  # s

@@ -14,8 +14,8 @@ import xarray as xr
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # this checkout's pipeline, not an installed one
 
-from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING  # noqa: E402
-from pipeline.fragility import fragility_dataset  # noqa: E402
+from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING  # noqa: E402
+from rockfrag.fragility import fragility_dataset  # noqa: E402
 
 SHAPE = {"record": 44, "im_level": 40, "soil": 5, "block": 3, "model": 3}
 

@@ -60,11 +60,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.opensees_winkler import gravity_then_excitation, rigid_block_frame  # noqa: E402
-from pipeline.blocks import Block  # noqa: E402
-from pipeline.models import simulate  # noqa: E402
-from pipeline.processing import load_recipe, process_record  # noqa: E402
-from pipeline.records import load_records  # noqa: E402
-from pipeline.units import STANDARD_GRAVITY as G  # noqa: E402
+from rockfrag.blocks import Block  # noqa: E402
+from rockfrag.models import simulate  # noqa: E402
+from rockfrag.processing import load_recipe, process_record  # noqa: E402
+from rockfrag.records import load_records  # noqa: E402
+from rockfrag.units import STANDARD_GRAVITY as G  # noqa: E402
 from tests.physics.winkler_reference import reference_winkler  # noqa: E402
 
 SQUAT = Block(name="squat", R=math.hypot(1.0, 0.5), alpha=math.atan2(1.0, 0.5), mass=5000.0)  # b/h = 2

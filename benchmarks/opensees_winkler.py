@@ -34,11 +34,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pipeline.blocks import Block  # noqa: E402
-from pipeline.models import simulate  # noqa: E402
-from pipeline.processing import load_recipe, process_record  # noqa: E402
-from pipeline.records import load_records  # noqa: E402
-from pipeline.units import STANDARD_GRAVITY as G  # noqa: E402
+from rockfrag.blocks import Block  # noqa: E402
+from rockfrag.models import simulate  # noqa: E402
+from rockfrag.processing import load_recipe, process_record  # noqa: E402
+from rockfrag.records import load_records  # noqa: E402
+from rockfrag.units import STANDARD_GRAVITY as G  # noqa: E402
 from tests.physics.winkler_reference import dashpot_always_force, reference_winkler  # noqa: E402
 
 BLOCK = Block(name="bench", R=2.0, alpha=0.25, mass=5000.0)

@@ -24,8 +24,8 @@ def main(output, study=None, workers=None):
     # imported after the check: a missing study is one line at once, not after 3 s of importing matplotlib
     import xarray as xr
 
-    from pipeline.config import load_study
-    from pipeline.report import report_stage
+    from rockfrag.config import load_study
+    from rockfrag.report import report_stage
 
     config = load_study(study or None)
     datasets = {}

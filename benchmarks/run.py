@@ -26,15 +26,15 @@ import sliding as sliding_benchmark  # noqa: E402  (benchmarks/sliding.py)
 from opensees_sliding import run as sliding_against_opensees  # noqa: E402  (benchmarks/opensees_sliding.py)
 from opensees_winkler import run as winkler_against_opensees  # noqa: E402  (benchmarks/opensees_winkler.py)
 
-from pipeline.blocks import Block  # noqa: E402
-from pipeline.config import load_study  # noqa: E402
-from pipeline.ida import hunt_and_fill  # noqa: E402
-from pipeline.models import Outcome, get_model, simulate, simulate_batch  # noqa: E402
-from pipeline.processing import process_record  # noqa: E402
-from pipeline.records import load_records  # noqa: E402
-from pipeline.soils import soil_block_stiffness  # noqa: E402
-from pipeline.study import bed_calibration, solver_options  # noqa: E402
-from pipeline.units import STANDARD_GRAVITY  # noqa: E402
+from rockfrag.blocks import Block  # noqa: E402
+from rockfrag.config import load_study  # noqa: E402
+from rockfrag.ida import hunt_and_fill  # noqa: E402
+from rockfrag.models import Outcome, get_model, simulate, simulate_batch  # noqa: E402
+from rockfrag.processing import process_record  # noqa: E402
+from rockfrag.records import load_records  # noqa: E402
+from rockfrag.soils import soil_block_stiffness  # noqa: E402
+from rockfrag.study import bed_calibration, solver_options  # noqa: E402
+from rockfrag.units import STANDARD_GRAVITY  # noqa: E402
 from tests.physics.reference import reference_response  # noqa: E402  (the independent scipy reference)
 
 BLOCK = Block(name="bench", R=2.0, alpha=0.25, mass=5000.0)
@@ -195,7 +195,7 @@ def accuracy_and_chaos(records, anchored=False):
 
 
 def run_study_subprocess(args, output):
-    command = [sys.executable, "-m", "pipeline", "run", *args, "--output", str(output), "--no-progress"]
+    command = [sys.executable, "-m", "rockfrag", "run", *args, "--output", str(output), "--no-progress"]
     start = time.perf_counter()
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
     subprocess.run(command, check=True, capture_output=True, text=True)

@@ -18,11 +18,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 warnings.simplefilter("ignore")
 
-from pipeline.config import load_study  # noqa: E402
-from pipeline.models import get_model, simulate_batch  # noqa: E402
-from pipeline.processing import process_record  # noqa: E402
-from pipeline.records import load_records  # noqa: E402
-from pipeline.soils import soil_block_stiffness  # noqa: E402
+from rockfrag.config import load_study  # noqa: E402
+from rockfrag.models import get_model, simulate_batch  # noqa: E402
+from rockfrag.processing import process_record  # noqa: E402
+from rockfrag.records import load_records  # noqa: E402
+from rockfrag.soils import soil_block_stiffness  # noqa: E402
 
 FRICTION = 0.5
 CASES = [("housner", {}), ("winkler", {"bed": "continuous"}), ("winkler", {"bed": "two-spring"})]

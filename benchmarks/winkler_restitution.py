@@ -3,7 +3,7 @@
 Input : nothing (a block of R = 2 m, mass 5 t, at several alpha; beds at omega_v/p = 30-1000).
 Output: tables on stdout and reports/winkler_restitution.png (r against xi, one panel per bed).
 
-The measure is the project's definition (pipeline.models.restitution.free_rocking_restitution): the block
+The measure is the project's definition (rockfrag.models.restitution.free_rocking_restitution): the block
 is launched from the settled bed with the angular velocity that takes a rigid block to 0.6 alpha, then
 rocks freely; successive peaks theta_k give r_k = sqrt(drop_{k+1} / drop_k), drop = cos(alpha - theta) -
 cos(alpha) (the rigid block's impact speed squared), the quantity Housner's r = 1 - 1.5 sin^2(alpha)
@@ -25,9 +25,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from pipeline.blocks import Block  # noqa: E402
-from pipeline.errors import SolverError  # noqa: E402
-from pipeline.models import restitution  # noqa: E402
+from rockfrag.blocks import Block  # noqa: E402
+from rockfrag.errors import SolverError  # noqa: E402
+from rockfrag.models import restitution  # noqa: E402
 
 ALPHAS = (0.1, 0.15, 0.25, 0.4)
 XIS = {"two-spring": (0.0, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.7, 0.9),

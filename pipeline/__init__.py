@@ -22,7 +22,7 @@ Beside the flow: ``calibrate`` (fit k and xi to a reference, paper eq. 17) and `
 (where is the rigid base good enough). Shared by the stages: ``validation`` (schemas of user values),
 ``errors``, ``units`` (SI constants), ``outputs`` (atomic writes, the one netCDF writer),
 ``checkpoints`` and ``locking``. ``cli`` ties the stages to the ``rockfrag`` command (``__main__``:
-``python -m pipeline``).
+``python -m rockfrag``).
 """
 
 __version__ = "0.1.0"

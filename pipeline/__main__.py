@@ -1,7 +1,7 @@
-"""``python -m pipeline`` runs the ``rockfrag`` command."""
+"""``python -m rockfrag`` runs the ``rockfrag`` command."""
 
 import sys
 
-from pipeline.cli import main
+from rockfrag.cli import main
 
 sys.exit(main())

@@ -1,8 +1,8 @@
-"""pipeline.answer - the answer of a study: in the terminal, and on the report's answer pages.
+"""rockfrag.answer - the answer of a study: in the terminal, and on the report's answer pages.
 
-Input : the fragility dataset (``fragility.nc``, with the risk variables of pipeline.risk merged in, as
+Input : the fragility dataset (``fragility.nc``, with the risk variables of rockfrag.risk merged in, as
         ``fragility_stage`` returns and writes it) and the paths of the main outputs; for the answer pages
-        also the site's hazard curve (pipeline.hazard), the return periods and the verdict limits of the
+        also the site's hazard curve (rockfrag.hazard), the return periods and the verdict limits of the
         study (``[hazard] return_periods``, ``[decision]``), the largest recorded intensity of each block
         and the share of runs that would slide.
 Output: ``answer_table``, a short text table, one row per block and soil, that ``rockfrag fragility``
@@ -11,7 +11,7 @@ Output: ``answer_table``, a short text table, one row per block and soil, that `
         was used, and where the full results are. ``block_answers``: per block and soil, the intensity at
         each return period, P(each damage state) there with its band, the annual frequency and the
         probability in the design life of each state, and the verdict ("anchor", "check sliding",
-        "no action"); ``verdict_sentence`` says it in words (pipeline.report draws it).
+        "no action"); ``verdict_sentence`` says it in words (rockfrag.report draws it).
 
 The answer model is the first of ``ANSWER_MODELS`` the study ran: the ``recommended`` rows (the
 tensionless bed over the experimental restitution band, its model spread in beta) when the fragility
@@ -30,13 +30,13 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.damage_states import families_of
-from pipeline.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
-from pipeline.lognormal_fit import lognormal_cdf
-from pipeline.models.variants import RECOMMENDED
-from pipeline.risk import annual_frequency as risk_annual_frequency
-from pipeline.risk import probability_in_life as risk_probability_in_life
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.damage_states import families_of
+from rockfrag.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
+from rockfrag.lognormal_fit import lognormal_cdf
+from rockfrag.models.variants import RECOMMENDED
+from rockfrag.risk import annual_frequency as risk_annual_frequency
+from rockfrag.risk import probability_in_life as risk_probability_in_life
+from rockfrag.units import STANDARD_GRAVITY
 
 ANSWER_MODELS = (RECOMMENDED, "winkler-centre", "winkler", "ssi", "ssi-paper", "housner")
 """Models the answer is given for, in order of preference: the first one the study ran is used."""
@@ -54,7 +54,7 @@ ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT = "anchor", "check sliding", "no ac
 """The verdicts of the answer pages (NO_VERDICT: no hazard curve for the study's measure)."""
 
 ANSWER_STATE = "overturning"
-"""The damage state of the answer (pipeline.fragility's overturning state)."""
+"""The damage state of the answer (rockfrag.fragility's overturning state)."""
 
 _IN_M_S2 = {"g": STANDARD_GRAVITY, "m s-2": 1.0, "m/s^2": 1.0, "m/s2": 1.0, "m/s**2": 1.0}
 """Acceleration units a result file may state, as m/s^2 per unit (UDUNITS spelling or rockfrag's)."""
@@ -116,7 +116,7 @@ def answer_rows(fragility: xr.Dataset) -> list[dict]:
     Parameters
     ----------
     fragility : xarray.Dataset
-        ``fragility.nc`` as written by ``pipeline.fragility.fragility_stage`` (risk variables optional).
+        ``fragility.nc`` as written by ``rockfrag.fragility.fragility_stage`` (risk variables optional).
 
     Returns
     -------
@@ -154,7 +154,7 @@ def answer_table(fragility: xr.Dataset, outputs: Sequence[Path | str] = ()) -> s
     Parameters
     ----------
     fragility : xarray.Dataset
-        ``fragility.nc`` as written by ``pipeline.fragility.fragility_stage``.
+        ``fragility.nc`` as written by ``rockfrag.fragility.fragility_stage``.
     outputs : sequence of path
         Files to name at the end (e.g. the report, fragility.csv, fragility.nc).
 
@@ -204,7 +204,7 @@ def answer_table(fragility: xr.Dataset, outputs: Sequence[Path | str] = ()) -> s
 def intensity_at_frequency(hazard: HazardCurve, frequency: float) -> float:
     """The intensity whose annual frequency of exceedance is ``frequency`` [1/yr].
 
-    The inverse of ``pipeline.hazard.hazard_frequency``: log-log interpolation, power laws beyond both ends.
+    The inverse of ``rockfrag.hazard.hazard_frequency``: log-log interpolation, power laws beyond both ends.
 
     Parameters
     ----------
@@ -433,7 +433,7 @@ def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnsw
     A block that overturns has also rocked past every angle and uplifted, and one that slid 30 cm has slid 5 cm,
     so exceeding a state implies exceeding the milder ones. Curves fitted one by one may cross in a tail below
     the data (where the fit keeps them apart only from the first level a severe state is reached,
-    ``pipeline.fragility``); the answer reads each state as "this state or worse", the largest of its own and
+    ``rockfrag.fragility``); the answer reads each state as "this state or worse", the largest of its own and
     the more severe states' values, as pelicun reads the limit states of one component.
     """
     rows = list(rows)
@@ -466,7 +466,7 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     fragility : xarray.Dataset
         ``fragility.nc`` (risk variables optional: computed here from ``hazard`` where missing).
     hazard : HazardCurve or None
-        The site's hazard curve for the study's measure (``pipeline.hazard.study_hazard``); None: no
+        The site's hazard curve for the study's measure (``rockfrag.hazard.study_hazard``); None: no
         return-period intensities, no risk, verdict ``NO_VERDICT``.
     return_periods : sequence of float
         Return periods [years].
@@ -480,7 +480,7 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     sliding : mapping, optional
         (block, soil) -> share of the records of a tied base that need more base friction than the soil's
         coefficient, at the level run at or below the largest return-period intensity (the decision's;
-        ``pipeline.report.adapters.sliding_share``); NaN or absent: unknown, or the cell runs with friction
+        ``rockfrag.report.adapters.sliding_share``); NaN or absent: unknown, or the cell runs with friction
         and its slip states answer.
     max_sliding_share : float, optional
         Above this share the verdict is ``CHECK_SLIDING``.

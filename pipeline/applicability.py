@@ -1,4 +1,4 @@
-"""pipeline.applicability - when Housner's rigid base is good enough (paper section 2).
+"""rockfrag.applicability - when Housner's rigid base is good enough (paper section 2).
 
 Input : blocks, a record set, a few intensity levels (multiples of each block's uplift PGA) and a
         sweep of soil shear modulus G_s (default 10 MPa - 100 GPa) and block modulus E_b.
@@ -22,14 +22,14 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
-from pipeline import __version__
-from pipeline.calibrate import correlation
-from pipeline.executors import shutdown_pool, worker_pool
-from pipeline.models import get_model, simulate_histories
-from pipeline.models.base import Outcome
-from pipeline.outputs import atomic_path, write_dataset
-from pipeline.soils import interface_stiffness
-from pipeline.study import StudyRecords, study_records
+from rockfrag import __version__
+from rockfrag.calibrate import correlation
+from rockfrag.executors import shutdown_pool, worker_pool
+from rockfrag.models import get_model, simulate_histories
+from rockfrag.models.base import Outcome
+from rockfrag.outputs import atomic_path, write_dataset
+from rockfrag.soils import interface_stiffness
+from rockfrag.study import StudyRecords, study_records
 
 DEFAULT_SHEAR_MODULI = np.geomspace(10e6, 100e9, 13)
 DEFAULT_LEVEL_FACTORS = (1.5, 2.5, 4.0)

@@ -1,4 +1,4 @@
-"""pipeline.blocks - rigid rocking blocks: geometry, mass, stiffness and named presets.
+"""rockfrag.blocks - rigid rocking blocks: geometry, mass, stiffness and named presets.
 
 Input : either half-width b and half-height h [m], or the semi-diagonal R [m] and slenderness
         alpha [rad]; mass [kg]; block Young's modulus E_b [Pa]; footprint area A [m^2] and
@@ -11,9 +11,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from pipeline.errors import ConfigError
-from pipeline.units import STANDARD_GRAVITY
-from pipeline.validation import Number
+from rockfrag.errors import ConfigError
+from rockfrag.units import STANDARD_GRAVITY
+from rockfrag.validation import Number
 
 BLOCK_RANGES: dict[str, Number] = {
     "b": Number(0, 1e4, low_open=True, unit="m"),
@@ -26,7 +26,7 @@ BLOCK_RANGES: dict[str, Number] = {
     "soil_depth": Number(0, 1e4, low_open=True, unit="m"),
 }
 """What each number of a block must be (SI units; b, h: half-width and half-height): checked by ``Block`` and
-by the study schema (pipeline.config), and listed by ``rockfrag study --keys``."""
+by the study schema (rockfrag.config), and listed by ``rockfrag study --keys``."""
 
 
 def _check(name: str, value: object, key: str) -> float:

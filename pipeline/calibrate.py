@@ -1,4 +1,4 @@
-"""pipeline.calibrate - fit a foundation model's interface stiffness k and damping ratio xi to a reference.
+"""rockfrag.calibrate - fit a foundation model's interface stiffness k and damping ratio xi to a reference.
 
 Input : a reference rotation history (a table of time and rotation, e.g. from LS-DYNA or a shake-table
         test; units from the header or flags), the ground motion that produced it [m/s^2] sampled at
@@ -51,12 +51,12 @@ from numpy.typing import ArrayLike
 from scipy.optimize import minimize
 from scipy.signal import butter, find_peaks, sosfiltfilt
 
-from pipeline.blocks import Block
-from pipeline.errors import ConfigError, PipelineError, RecordError
-from pipeline.models import SolverOptions, get_model, simulate_histories
-from pipeline.outputs import atomic_path
-from pipeline.records.text import bracketed_units, read_columns
-from pipeline.validation import Interval, Number, Table
+from rockfrag.blocks import Block
+from rockfrag.errors import ConfigError, PipelineError, RecordError
+from rockfrag.models import SolverOptions, get_model, simulate_histories
+from rockfrag.outputs import atomic_path
+from rockfrag.records.text import bracketed_units, read_columns
+from rockfrag.validation import Interval, Number, Table
 
 _MICRO = ("us", "\u00b5s", "\u03bcs", "microsecond", "microseconds", "usec")
 TIME_UNITS = {**{name: 1.0 for name in ("s", "sec", "secs", "second", "seconds")},
@@ -268,7 +268,7 @@ MIN_REFERENCE_ROWS = 10
 def load_reference(path, time_unit=None, angle_unit=None) -> Reference:
     """Reference (time [s], rotation [rad]) from a text table: column 1 time, column 2 rotation.
 
-    The table is read by ``pipeline.records.text.read_columns`` (comma, semicolon, tab or space separated,
+    The table is read by ``rockfrag.records.text.read_columns`` (comma, semicolon, tab or space separated,
     ``#`` comments, header lines above the numbers; further columns are left out). Units come from the
     flags, else from the headers ('time [ms]', 'theta (deg)', 'rotation_rad'; see ``TIME_UNITS``/
     ``ANGLE_UNITS``), else s and rad are assumed (``Reference.describe_units`` says which). A text cell
@@ -874,7 +874,7 @@ CALIBRATION_OPTIONS = Table({
     "xi_range": Interval(Number(0.0, 1.0, high_open=True), names=("xi_min", "xi_max"), strict=False),
     "confidence": Number(0.0, 1.0, low_open=True, high_open=True),
 })
-"""The search settings of ``calibrate`` (pipeline.validation): grid sizes, the search box, the confidence."""
+"""The search settings of ``calibrate`` (rockfrag.validation): grid sizes, the search box, the confidence."""
 
 
 def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_xi, confidence=None):

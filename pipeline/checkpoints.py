@@ -1,4 +1,4 @@
-"""pipeline.checkpoints - one self-verifying file per finished study cell.
+"""rockfrag.checkpoints - one self-verifying file per finished study cell.
 
 Input : a folder (``<output>/.checkpoints``), cell keys (hashes of everything a cell depends on)
         and the NumPy arrays computed for them (any dtype NumPy saves without pickling, structured
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.outputs import atomic_path
+from rockfrag.outputs import atomic_path
 
 MAGIC = b"rockfrag-checkpoint 1\n"
 """First bytes of every checkpoint file; a different format version is quarantined and recomputed."""

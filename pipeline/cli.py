@@ -1,10 +1,10 @@
-"""pipeline.cli - the ``rockfrag`` command; subcommands are named after pipeline stages.
+"""rockfrag.cli - the ``rockfrag`` command; subcommands are named after pipeline stages.
 
 Input : command-line arguments. Output: files in the output folder (``reports/`` by default) and a
 short summary on stdout. A user error (bad record, bad parameter) prints one line on stderr and
 exits with status 2, without a traceback; files already written stay valid. Skipped records give
 status 1; anything else (a bug) one line, a traceback log file in the output folder and status 3
-(``EXIT_CODES``). A command holds the lock of its output folder (pipeline.locking) while it runs.
+(``EXIT_CODES``). A command holds the lock of its output folder (rockfrag.locking) while it runs.
 """
 
 from __future__ import annotations
@@ -21,10 +21,10 @@ import traceback
 import warnings
 from pathlib import Path
 
-from pipeline import __version__
-from pipeline.errors import PipelineError
-from pipeline.locking import output_lock
-from pipeline.validation import did_you_mean
+from rockfrag import __version__
+from rockfrag.errors import PipelineError
+from rockfrag.locking import output_lock
+from rockfrag.validation import did_you_mean
 
 EXIT_USER_ERROR = 2
 EXIT_PARTIAL = 1
@@ -150,8 +150,8 @@ def _study_config(args, applicability=None):
 
 def _load_study_once(args, applicability):
     """``_study_config`` without its cache; repeats no plausibility warning an earlier load of ``args`` gave."""
-    from pipeline.config import load_study
-    from pipeline.plausibility import PlausibilityWarning
+    from rockfrag.config import load_study
+    from rockfrag.plausibility import PlausibilityWarning
 
     study = {}
     if getattr(args, "record_set", None):
@@ -203,9 +203,9 @@ def command_records(args) -> int:
     """``rockfrag records``: the records table (records.csv) and, with ``--plot``, a figure per record."""
     import pandas as pd
 
-    from pipeline.processing import load_recipe
-    from pipeline.records import load_records
-    from pipeline.records_report import TABLE_COLUMNS, records_stage
+    from rockfrag.processing import load_recipe
+    from rockfrag.records import load_records
+    from rockfrag.records_report import TABLE_COLUMNS, records_stage
 
     config, output = _study_config(args)
     recipe = load_recipe(config.processing or None)
@@ -238,8 +238,8 @@ def command_records(args) -> int:
 
 def command_run(args) -> int:
     """``rockfrag run``: the study cube (cube.nc) and the showcase (showcase.nc); resumes from checkpoints."""
-    from pipeline.showcase import showcase_stage
-    from pipeline.study import run_study, study_records
+    from rockfrag.showcase import showcase_stage
+    from rockfrag.study import run_study, study_records
 
     config, output = _study_config(args)
     loaded = study_records(config, log=_log)
@@ -257,21 +257,21 @@ def command_fragility(args) -> int:
     """``rockfrag fragility``: the whole pipeline.
 
     Study cube, IDA, fragility and risk, applicability (``run_applicability``), report, and the answer table
-    (``pipeline.answer``; not with ``--quiet``).
+    (``rockfrag.answer``; not with ``--quiet``).
     """
     import time
 
     import xarray as xr
 
-    from pipeline.fragility import fragility_stage
-    from pipeline.ida import ida_stage
-    from pipeline.report import report_stage
-    from pipeline.showcase import showcase_stage
-    from pipeline.study import run_study, study_records
+    from rockfrag.fragility import fragility_stage
+    from rockfrag.ida import ida_stage
+    from rockfrag.report import report_stage
+    from rockfrag.showcase import showcase_stage
+    from rockfrag.study import run_study, study_records
 
     started = time.perf_counter()
     config, output = _study_config(args)
-    from pipeline.risk import study_hazard
+    from rockfrag.risk import study_hazard
 
     hazard = study_hazard(config)  # a hazard curve for another intensity measure fails here, before any run
     if hazard is not None and hazard.site is not None:
@@ -284,7 +284,7 @@ def command_fragility(args) -> int:
     ida = ida_stage(cube, output)
     print(f"wrote {output / 'ida.nc'}")
     if "capacity_scale_factor" in cube:  # measure ranking from the adaptive capacities (no solver runs)
-        from pipeline.efficiency import efficiency_stage
+        from rockfrag.efficiency import efficiency_stage
 
         efficiency_stage(cube, loaded.records, config, output)
         print(f"wrote {output / 'efficiency.nc'} and {output / 'efficiency.csv'}")
@@ -293,7 +293,7 @@ def command_fragility(args) -> int:
         if (output / name).is_file():  # no OpenQuake file for a measure OpenQuake does not have
             print(f"wrote {output / name}")
     if run_applicability(args, config):
-        from pipeline.applicability import applicability_stage
+        from rockfrag.applicability import applicability_stage
 
         applicability = applicability_stage(config, output, workers=args.workers, progress=not args.no_progress,
                                             loaded=loaded)
@@ -308,7 +308,7 @@ def command_fragility(args) -> int:
     print(f"done in {time.perf_counter() - started:.0f} s (results in {results_s:.0f} s, as the report states; "
           f"the report in {time.perf_counter() - started - results_s:.0f} s)")
     if not args.quiet:
-        from pipeline.answer import answer_table
+        from rockfrag.answer import answer_table
 
         print()
         print(answer_table(fragility, outputs=(pdf, output / "fragility.csv", output / "fragility.nc")))
@@ -325,7 +325,7 @@ def run_applicability(args, config) -> bool:
     ----------
     args : argparse.Namespace
         The parsed ``fragility`` command line (``applicability``: True, False or None; ``study``).
-    config : pipeline.config.StudyConfig
+    config : rockfrag.config.StudyConfig
         The loaded study.
 
     Returns
@@ -342,8 +342,8 @@ def run_applicability(args, config) -> bool:
 
 
 def _ground_motion(args, config):
-    from pipeline.processing import load_recipe, process_record
-    from pipeline.records import load_records
+    from rockfrag.processing import load_recipe, process_record
+    from rockfrag.records import load_records
 
     records, failures = load_records(args.record, units=config.record_units or None, dt=config.record_dt)
     if failures:
@@ -356,7 +356,7 @@ def _ground_motion(args, config):
 
 def _calibration_bed(args, config) -> dict:
     """``{"bed": ...}`` for a model with a bed (``--bed``, else the study's ``[solver] bed``), else ``{}``."""
-    from pipeline.models import BED_TYPES, get_model
+    from rockfrag.models import BED_TYPES, get_model
 
     if args.bed is not None and args.bed not in BED_TYPES:
         raise PipelineError(f"--bed {args.bed!r} unknown{did_you_mean(args.bed, BED_TYPES)}; valid: "
@@ -370,7 +370,7 @@ def _calibration_bed(args, config) -> dict:
 
 def command_calibrate(args) -> int:
     """``rockfrag calibrate``: k and xi of the SSI model fitted to a reference history (eq. 17)."""
-    from pipeline.calibrate import calibrate, check_reference, load_reference, write_outputs
+    from rockfrag.calibrate import calibrate, check_reference, load_reference, write_outputs
 
     config, output = _study_config(args)
     blocks = {b.name: b for b in config.blocks}
@@ -424,8 +424,8 @@ APPLICABILITY_OPTIONS = ("g_range", "n_g", "levels", "block_moduli", "tolerance"
 
 def command_applicability(args) -> int:
     """``rockfrag applicability``: the rigid-base applicability sweep (applicability.nc and its figure)."""
-    from pipeline.applicability import applicability_stage
-    from pipeline.study import study_records
+    from rockfrag.applicability import applicability_stage
+    from rockfrag.study import study_records
 
     overrides = {key: getattr(args, key) for key in APPLICABILITY_OPTIONS if getattr(args, key) is not None}
     config, output = _study_config(args, overrides)
@@ -441,7 +441,7 @@ def command_applicability(args) -> int:
 
 def command_study(args) -> int:
     """``rockfrag study``: check a study file; with ``--keys``, every key with its value, range and unit."""
-    from pipeline.config import study_keys
+    from rockfrag.config import study_keys
 
     config, output = _study_config(args)
     if args.keys:
@@ -477,8 +477,8 @@ def check_record_selection(selection, field: str = "study.record_sets", source: 
         The first name that is no set, id, folder or file ("not found", with a did-you-mean), or a catalogue
         record whose file is missing.
     """
-    from pipeline.errors import ConfigError
-    from pipeline.records import catalogue, record_sets
+    from rockfrag.errors import ConfigError
+    from rockfrag.records import catalogue, record_sets
 
     sets, entries = record_sets(), {entry.id: entry for entry in catalogue()}
     for text in selection:

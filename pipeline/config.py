@@ -1,4 +1,4 @@
-"""pipeline.config - study definition: shipped defaults plus a user TOML file, validated once.
+"""rockfrag.config - study definition: shipped defaults plus a user TOML file, validated once.
 
 Input : ``pipeline/defaults.toml`` and optionally a user study file with the same layout (a table or
         key in the user file replaces the default one; ``[soils_custom.NAME]``, ``[blocks_custom.NAME]``
@@ -29,17 +29,17 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.blocks import BLOCK_RANGES, Block
-from pipeline.damage_states import EDPS, DamageState, damage_states_from_config
-from pipeline.errors import ConfigError, PipelineError
-from pipeline.hazard import check_site, hazard_for
-from pipeline.measures import MEASURES, scaling_measures
-from pipeline.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
-from pipeline.models.options import HOUSNER
-from pipeline.models.variants import DEFAULT_BAND, band_variants
-from pipeline.plausibility import ON_IMPLAUSIBLE, check_study
-from pipeline.soils import DEFAULT_FRICTION, SOIL_RANGES, SOILS, SoilClass
-from pipeline.validation import (
+from rockfrag.blocks import BLOCK_RANGES, Block
+from rockfrag.damage_states import EDPS, DamageState, damage_states_from_config
+from rockfrag.errors import ConfigError, PipelineError
+from rockfrag.hazard import check_site, hazard_for
+from rockfrag.measures import MEASURES, scaling_measures
+from rockfrag.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
+from rockfrag.models.options import HOUSNER
+from rockfrag.models.variants import DEFAULT_BAND, band_variants
+from rockfrag.plausibility import ON_IMPLAUSIBLE, check_study
+from rockfrag.soils import DEFAULT_FRICTION, SOIL_RANGES, SOILS, SoilClass
+from rockfrag.validation import (
     Checked,
     Either,
     Flag,
@@ -53,14 +53,14 @@ from pipeline.validation import (
     did_you_mean,
     schema_keys,
 )
-from pipeline.validation import shown as _shown
+from rockfrag.validation import shown as _shown
 
 BAND = "band"
 """``[solver] restitution = "band"``: each bed model runs at the edges and centre of ``restitution_band``
-(pipeline.models.variants)."""
+(rockfrag.models.variants)."""
 
 FRICTION_MODES = ("where-it-matters", "all", "none")
-"""``[solver] friction``: which housner and winkler cells slide (pipeline.study.cell_friction)."""
+"""``[solver] friction``: which housner and winkler cells slide (rockfrag.study.cell_friction)."""
 
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
@@ -68,7 +68,7 @@ uplift intensity."""
 
 
 # ---------------------------------------------------------------- the schema
-# The schema classes are pipeline.validation's; a study table adds one hint for a top-level key written
+# The schema classes are rockfrag.validation's; a study table adds one hint for a top-level key written
 # below a [table] header (TOML puts it into that table).
 
 def _misplaced(key: str) -> str:
@@ -108,7 +108,7 @@ SCHEMA = Table({
     "study": _table({"name": Text(nonempty=True), "record_sets": Names('["far-field"]'), "processing": TEXT,
                      "output": Text(nonempty=True),
                      "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"), "vertical": Flag(),
-                     # report metadata, read by pipeline.report
+                     # report metadata, read by rockfrag.report
                      "title": TEXT, "project": TEXT, "author": TEXT}),
     "intensity": _table({"measure": Text(scaling_measures()), "period": Number(0.01, 20.0, unit="s"),
                          "damping": Number(0.0, 0.5),
@@ -129,7 +129,7 @@ SCHEMA = Table({
     "decision": _table({"max_probability_in_life": Checked(lambda value, field, source: _named(
                             value, field, source, Number(0.0, 1.0, low_open=True)),
                             "a table of damage state = probability, each > 0 and <= 1"),
-                        "max_sliding_share": Number(0.0, 1.0)}),  # read by pipeline.answer (verdicts)
+                        "max_sliding_share": Number(0.0, 1.0)}),  # read by rockfrag.answer (verdicts)
     "fragility": _table({"bootstrap": Number(0, 100000, integer=True), "seed": Number(0, 2**32, integer=True),
                          "confidence": Number(0.0, 1.0, low_open=True, high_open=True)}),
     "checks": _table({"plausibility": Text(ON_IMPLAUSIBLE)}),
@@ -143,7 +143,7 @@ SCHEMA = Table({
         "levels": Numbers(Number(0, 100, low_open=True)),
         "block_moduli": Numbers(Number(0, 1e13, low_open=True, unit="Pa")),
         "tolerance": Number(0, 10, low_open=True),
-        "run": Flag(),  # read by pipeline.cli (rockfrag fragility); absent: only the default study
+        "run": Flag(),  # read by rockfrag.cli (rockfrag fragility); absent: only the default study
     }),
 })
 """Every key a study file may hold, with its type and range."""
@@ -213,7 +213,7 @@ class StudyConfig:
     name : str
         The study's name (``[study] name``).
     record_sets : tuple of str
-        Record sets, record ids, folders or files (``pipeline.records.load_records``).
+        Record sets, record ids, folders or files (``rockfrag.records.load_records``).
     processing : str
         The processing recipe file; "" for the shipped ``pipeline/processing.toml``.
     output : Path
@@ -238,7 +238,7 @@ class StudyConfig:
     friction : str
         ``[solver] friction``, which housner and winkler cells run with Coulomb friction at the base (each
         soil's ``friction_static``/``friction_kinetic``): "where-it-matters" (where the soil's mu_s is below the
-        block's b/h), "all" or "none" (every base tied). ssi is always tied (pipeline.study.cell_friction).
+        block's b/h), "all" or "none" (every base tied). ssi is always tied (rockfrag.study.cell_friction).
     tail : float
         Free vibration simulated after the record [s].
     overturn_angle : float
@@ -269,7 +269,7 @@ class StudyConfig:
         The soil-stiffness sweep (``[applicability]``).
     vertical : bool
         ``[study] vertical``: each horizontal component runs with its station's vertical component (g + a_v(t)
-        in every model) and, for comparison, without it (pipeline.study). False: horizontal components only.
+        in every model) and, for comparison, without it (rockfrag.study). False: horizontal components only.
     """
 
     name: str
@@ -318,7 +318,7 @@ class StudyConfig:
 
     @property
     def measure_options(self) -> dict:
-        """Options every ``pipeline.measures.Measure`` call of the study takes."""
+        """Options every ``rockfrag.measures.Measure`` call of the study takes."""
         return {"period": self.period, "damping": self.damping, "period_range": self.period_range}
 
     @property
@@ -326,7 +326,7 @@ class StudyConfig:
         """Absolute intensity levels in SI (m/s^2 for PGA and Sa, m/s for PGV).
 
         With relative levels, the dimensionless multiples themselves (per-block intensities:
-        pipeline.study.level_intensities).
+        rockfrag.study.level_intensities).
         """
         if self.relative_levels:
             return np.asarray(self.levels, dtype=float)
@@ -464,7 +464,7 @@ def _check_hazard(path, source, measure="pga", period=None, site=None):
     """Check that the hazard curve loads and is for the study's intensity measure (and Sa period).
 
     Loads means: the file exists, is numeric, and its frequencies decrease. No file and a measure other than
-    the shipped example's: no risk, nothing to check (pipeline.hazard.hazard_for).
+    the shipped example's: no risk, nothing to check (rockfrag.hazard.hazard_for).
     """
     if path and Path(path).is_dir():
         raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
@@ -587,7 +587,7 @@ def load_study(path: str | Path | None = None, overrides: dict | None = None) ->
         The file cannot be read or is not TOML, or a key is unknown, of the wrong type or out of
         range; the message names the file and the field as written.
     """
-    default = tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text())
+    default = tomllib.loads(files("rockfrag").joinpath("defaults.toml").read_text())
     source = "pipeline/defaults.toml"
     merged = _blocks_as_selector(default)
     if path is not None:
@@ -638,7 +638,7 @@ def _default_notes() -> dict[str, str]:
     A comment continued on the next lines (indented lines holding only a comment) is joined to it.
     """
     notes, table, last = {}, "", None
-    for line in files("pipeline").joinpath("defaults.toml").read_text().splitlines():
+    for line in files("rockfrag").joinpath("defaults.toml").read_text().splitlines():
         if last and line[:1].isspace() and line.lstrip().startswith("#"):
             notes[last] = f"{notes[last]} {line.strip().lstrip('#').strip()}".strip()
             continue

@@ -1,4 +1,4 @@
-"""pipeline.cube - the result schema of a study: a labelled xarray cube and its netCDF file.
+"""rockfrag.cube - the result schema of a study: a labelled xarray cube and its netCDF file.
 
 Input : per-run summary vectors from the solvers, arranged (record, im_level, soil, block, model),
         plus record, soil, block metadata and the study configuration.
@@ -9,9 +9,9 @@ Output: an ``xarray.Dataset`` following CF-1.12 (every variable with ``units`` a
 Vertical component: every cube says per record whether the record's vertical component was applied
 (``vertical_applied``, with the vertical's id and PGA), and in its ``vertical`` attribute whether the study
 applied verticals. A study with ``[study] vertical = true`` writes two cubes of the same records, levels and
-scale factors: ``cube.nc`` with the verticals and ``COMPARISON_CUBE`` without them (pipeline.study).
+scale factors: ``cube.nc`` with the verticals and ``COMPARISON_CUBE`` without them (rockfrag.study).
 
-Units: one per quantity in the file, as UDUNITS parses it (``pipeline.measures.file_units``). Every
+Units: one per quantity in the file, as UDUNITS parses it (``rockfrag.measures.file_units``). Every
 acceleration (levels, ``intensity``, ``record_pga``, ``block_uplift_acceleration``, ``record_im`` of an
 acceleration measure) is in multiples of g, written "9.80665 m s-2" (UDUNITS reads "g" as grams);
 velocities in "m s-1"; the rest SI.
@@ -24,14 +24,14 @@ import json
 import numpy as np
 import xarray as xr
 
-from pipeline import __version__
-from pipeline.measures import MEASURES, file_units, parse_units
-from pipeline.models import get_model, model_label
-from pipeline.models.base import Outcome
-from pipeline.models.fields import FIELDS_BY_NAME, MODE_TIME_FIELDS
-from pipeline.models.ssi import PAPER_CITATION
+from rockfrag import __version__
+from rockfrag.measures import MEASURES, file_units, parse_units
+from rockfrag.models import get_model, model_label
+from rockfrag.models.base import Outcome
+from rockfrag.models.fields import FIELDS_BY_NAME, MODE_TIME_FIELDS
+from rockfrag.models.ssi import PAPER_CITATION
 
-# Kept for the stages that read outcomes (ida, fragility): the one enum is pipeline.models.base.Outcome.
+# Kept for the stages that read outcomes (ida, fragility): the one enum is rockfrag.models.base.Outcome.
 OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = (
     int(Outcome.NO_UPLIFT), int(Outcome.ROCKING), int(Outcome.OVERTURNED), int(Outcome.FAILED),
     int(Outcome.FREE_FLIGHT))
@@ -62,7 +62,7 @@ def _bed(model):
     return model.uses_bed
 
 
-# Cube variable: (summary field of pipeline.models.fields, which models it applies to; NaN elsewhere).
+# Cube variable: (summary field of rockfrag.models.fields, which models it applies to; NaN elsewhere).
 # Units and long names come from the field; derived variables (outcome, peak_angle_ratio,
 # support_tension) are added below.
 VARIABLES = {
@@ -82,7 +82,7 @@ VARIABLES = {
 
 SLIP_VARIABLES = ("peak_slip", "residual_slip", *MODE_TIME_FIELDS)
 """Cube variables of the base's slip and the time in each contact mode [m, s]: finite only in the cells that
-run with friction (``friction_static`` finite), NaN where the base is tied (pipeline.study.cell_friction)."""
+run with friction (``friction_static`` finite), NaN where the base is tied (rockfrag.study.cell_friction)."""
 FRICTION_VARIABLES = {
     "friction_static": "static friction coefficient mu_s of the base in the cell's runs (NaN: the base is tied, "
                        "no sliding)",
@@ -137,11 +137,11 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     interface stiffness [N/m]; provenance : dict of JSON-able facts; intensity : (n_block, n_level)
     physical intensity of every level [SI] (default: the absolute levels); capacities : (4, n_record,
     n_soil, n_block, n_model) adaptive overturning capacity, bracket and extra runs as scale factors
-    (pipeline.study.gather_capacities) or None; capacity_stats : its run accounting; verticals : the
+    (rockfrag.study.gather_capacities) or None; capacity_stats : its run accounting; verticals : the
     processed vertical component of each record (a Record, or None where it has none), or None when the
     study takes no verticals; vertical_applied : whether the runs applied those verticals (the cube's
     ``vertical_applied`` flag per record, and its ``vertical`` attribute); friction : (2, n_soil, n_block,
-    n_model) each cell's base friction (mu_s, mu_k) [-], NaN where tied (pipeline.study.friction_grid; None:
+    n_model) each cell's base friction (mu_s, mu_k) [-], NaN where tied (rockfrag.study.friction_grid; None:
     every base tied): the cube's ``friction_static``/``friction_kinetic`` and where ``SLIP_VARIABLES`` apply.
 
     Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
@@ -318,7 +318,7 @@ def _level_coordinates(config, measure_name, intensity) -> dict:
                   "units": "1"})
         uplift = intensity[:, 0] / float(config.levels[0])
         extra = {"block_uplift_intensity": ("block", uplift / measure.display_factor, {
-            "long_name": f"{measure_name} at which the block starts to rock (pipeline.study.uplift_intensity)",
+            "long_name": f"{measure_name} at which the block starts to rock (rockfrag.study.uplift_intensity)",
             "units": units})}
     else:
         level = ("im_level", np.asarray(config.levels, float),

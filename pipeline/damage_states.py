@@ -1,15 +1,15 @@
-"""pipeline.damage_states - the limit states a fragility is fitted for.
+"""rockfrag.damage_states - the limit states a fragility is fitted for.
 
 Input : the shipped registry below, plus ``[damage_states.NAME]`` tables of a study file (``edp``,
         ``threshold``, ``description``).
 Output: ``DamageState`` objects in order of increasing severity, read by the study file's schema
-        (pipeline.config), the fits (pipeline.fragility) and the report's labels.
+        (rockfrag.config), the fits (rockfrag.fragility) and the report's labels.
 
 A state is reached when its engineering demand parameter ``edp`` (a cube variable, or the outcome
 ``uplifted`` / ``overturned``) is at least ``threshold``; overturning exceeds every rocking threshold.
 
 Slip states (``edp = "peak_slip"``, threshold in metres) are a family of their own beside the rocking ones:
-they apply only to the cells that run with friction at the base (pipeline.study.cell_friction; elsewhere the
+they apply only to the cells that run with friction at the base (rockfrag.study.cell_friction; elsewhere the
 fits mark them ``not-applicable``), do not nest with the rocking states, and sort after uplift and before the
 rocking states (so the two most severe states stay the rocking ones and overturning).
 A new shipped state is one ``register_damage_state`` call.
@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from pipeline.errors import ConfigError
+from rockfrag.errors import ConfigError
 
 SLIP_EDPS = ("peak_slip",)
 NOT_APPLICABLE = "not-applicable"

@@ -1,4 +1,4 @@
-"""pipeline.efficiency - which intensity measure predicts a block's overturning best.
+"""rockfrag.efficiency - which intensity measure predicts a block's overturning best.
 
 Input : the study cube (``capacity_scale_factor``: each record's adaptive overturning capacity as a
         scale factor, per soil, block and model), the study's processed records and configuration,
@@ -9,7 +9,7 @@ Output: ``reports/efficiency.nc`` and ``efficiency.csv``: per soil, block, model
         median capacity, its dispersion, the efficiency rank and the sufficiency p-values; and
         ``plot_efficiency(dataset)``, a one-page figure. The measures have different units, so
         ``efficiency.nc`` holds one median variable per measure, ``median_capacity_<measure>``, in
-        the units result files use for that quantity (``pipeline.measures.file_units``: multiples of
+        the units result files use for that quantity (``rockfrag.measures.file_units``: multiples of
         g for accelerations); ``efficiency.csv`` gives the median in those units and names them.
 
 No new solver run: scaling a record by lambda scales every measure with scaling exponent 1 by
@@ -35,9 +35,9 @@ import pandas as pd
 import xarray as xr
 from scipy import stats
 
-from pipeline.measures import MEASURES, convert_units, file_units, scaling_measures, udunits, unit_label
-from pipeline.outputs import atomic_path, write_dataset
-from pipeline.records import RECORDS_DIR
+from rockfrag.measures import MEASURES, convert_units, file_units, scaling_measures, udunits, unit_label
+from rockfrag.outputs import atomic_path, write_dataset
+from rockfrag.records import RECORDS_DIR
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -183,7 +183,7 @@ def median_capacity_units(name: str) -> str:
     Returns
     -------
     str
-        The units result files give the measure's SI quantity (``pipeline.measures.file_units``):
+        The units result files give the measure's SI quantity (``rockfrag.measures.file_units``):
         "9.80665 m s-2" (g) for accelerations, "m s-1" for velocities, "1" for ratios.
     """
     return file_units(MEASURES[name].si_unit)

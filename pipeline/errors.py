@@ -1,4 +1,4 @@
-"""pipeline.errors - the exceptions a user of rockfrag can see.
+"""rockfrag.errors - the exceptions a user of rockfrag can see.
 
 Every error names what was wrong (file, line, field), the value found and what is allowed, so
 that the CLI can print it as one line and exit non-zero without a traceback.

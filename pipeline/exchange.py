@@ -1,6 +1,6 @@
-"""pipeline.exchange - stage 8b: fragility dataset -> files for downstream tools.
+"""rockfrag.exchange - stage 8b: fragility dataset -> files for downstream tools.
 
-Input : the fragility dataset (``pipeline.fragility.fragility_dataset``: ``median`` and ``beta`` per
+Input : the fragility dataset (``rockfrag.fragility.fragility_dataset``: ``median`` and ``beta`` per
         soil x block x model x damage state, the row's ``status``, the block's studied range, the intensity
         measure and unit in its attributes; optional ``beta_model``) and the study's Sa period [s].
 Output: ``fragility_pelicun.csv``, pelicun 3.x damage-model parameters (``pelicun_table``), and
@@ -30,7 +30,7 @@ a second component, ``ID.SLIP``, and its functions go to ``fragility_openquake_s
 OpenQuake clamps the intensity to [minIML, maxIML]: a function is held at its value at minIML below it and
 at maxIML above it. So minIML and maxIML are not the studied range (which the comment before each function
 gives) but ``TAIL_SIGMAS`` beta beyond every curve of the function and the studied range: OpenQuake then
-evaluates our lognormals wherever they differ from 0 and 1, as pelicun and ``pipeline.risk`` do.
+evaluates our lognormals wherever they differ from 0 and 1, as pelicun and ``rockfrag.risk`` do.
 """
 
 from __future__ import annotations
@@ -44,11 +44,11 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pipeline.damage_states import NOT_APPLICABLE, families_of
-from pipeline.errors import ConfigError
-from pipeline.measures import MEASURES, Measure, convert_units, unit_label
-from pipeline.models.variants import RECOMMENDED
-from pipeline.outputs import atomic_path
+from rockfrag.damage_states import NOT_APPLICABLE, families_of
+from rockfrag.errors import ConfigError
+from rockfrag.measures import MEASURES, Measure, convert_units, unit_label
+from rockfrag.models.variants import RECOMMENDED
+from rockfrag.outputs import atomic_path
 
 PELICUN_FILE = "fragility_pelicun.csv"
 OPENQUAKE_FILE = "fragility_openquake.xml"
@@ -107,7 +107,7 @@ def written_state(median: float, beta: float, status: str, lowest: float) -> Wri
     beta : float
         The row's total dispersion [-]; 0 for a step.
     status : str
-        The row's status (``pipeline.fragility.STATUS``).
+        The row's status (``rockfrag.fragility.STATUS``).
     lowest : float
         The lowest intensity level studied for the block [intensity unit].
 
@@ -182,7 +182,7 @@ def state_families(dataset: xr.Dataset) -> dict[str, list[str]]:
 
     A component's limit states must nest (each more severe one reached later), which the rocking and the slip
     states do not; so each family is a component (pelicun) or a file (OpenQuake) of its own. The family of a
-    state is that of its EDP (``damage_state_edp``; pipeline.damage_states.families_of).
+    state is that of its EDP (``damage_state_edp``; rockfrag.damage_states.families_of).
     """
     states = [str(s) for s in dataset.damage_state.values]
     edps = dataset["damage_state_edp"].values if "damage_state_edp" in dataset.coords else ["uplifted"] * len(states)
@@ -326,7 +326,7 @@ def openquake_imt(measure: str, period: float | None = None) -> str | None:
     Parameters
     ----------
     measure : str
-        The study's intensity measure (a ``pipeline.measures.MEASURES`` name).
+        The study's intensity measure (a ``rockfrag.measures.MEASURES`` name).
     period : float, optional
         The Sa period [s], for measures that have one.
 

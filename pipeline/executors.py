@@ -1,4 +1,4 @@
-"""pipeline.executors - where a stage's independent tasks run: in process, on local worker processes or on dask.
+"""rockfrag.executors - where a stage's independent tasks run: in process, on local worker processes or on dask.
 
 In : a pure task function (picklable, module level), one tuple of arguments per task, and the choice of
      executor: ``workers`` (1: in this process; n: a local process pool of n workers; None: one per
@@ -11,7 +11,7 @@ Worker hygiene: local pool workers die with the process that started them, even 
 ``kill -9`` (``worker_pool``); a pool is shut down within a bounded time even if a worker hangs
 (``shutdown_pool``); a task whose worker died is retried once in a fresh executor and then, alone, in
 a one-worker pool, so that only the task that kills its own worker is lost, not its neighbours.
-The study (pipeline.study) and the applicability sweep (pipeline.applicability) run their tasks here;
+The study (rockfrag.study) and the applicability sweep (rockfrag.applicability) run their tasks here;
 every executor runs the same pure function, so results do not depend on the executor.
 """
 
@@ -27,7 +27,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, NamedTuple
 
-from pipeline.errors import PipelineError
+from rockfrag.errors import PipelineError
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 

@@ -1,14 +1,14 @@
-"""pipeline.fragility - stage 8: the cube -> lognormal fragility functions per soil and damage state.
+"""rockfrag.fragility - stage 8: the cube -> lognormal fragility functions per soil and damage state.
 
 Input : the study cube (outcome, peak_angle_ratio over record x im_level x soil x block x model; the
         intensity of each level per block, see ``intensity_levels``), the damage states
-        (``pipeline.damage_states``: the registry plus ``[damage_states.NAME]`` tables of the study file).
+        (``rockfrag.damage_states``: the registry plus ``[damage_states.NAME]`` tables of the study file).
 Output: ``reports/fragility.nc`` (median, beta, bootstrap bounds, fit method, ``status``, the
         ``extrapolated`` flag, goodness of fit, the non-crossing rule's deviance cost and the studied
         range per soil x block x model x damage state; empirical fractions per level; the three-outcome
-        probabilities), ``fragility.csv``, and through ``pipeline.exchange`` the files for pelicun and OpenQuake.
+        probabilities), ``fragility.csv``, and through ``rockfrag.exchange`` the files for pelicun and OpenQuake.
 
-Fits (Baker 2015, Earthquake Spectra 31(1); the numerics on arrays are in ``pipeline.lognormal_fit``):
+Fits (Baker 2015, Earthquake Spectra 31(1); the numerics on arrays are in ``rockfrag.lognormal_fit``):
 binomial maximum likelihood on the counts per level, a probit regression solved by vectorised Fisher
 scoring. Overturning follows the IDA capacity convention of Vamvatsikos & Cornell (2002): a record
 counts as overturned at every level from its first overturning level on (``OVERTURNING_CONVENTION``);
@@ -44,15 +44,15 @@ import pandas as pd
 import xarray as xr
 from tqdm.auto import tqdm
 
-from pipeline.config import StudyConfig
-from pipeline.cube import (
+from rockfrag.config import StudyConfig
+from rockfrag.cube import (
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
     OUTCOME_NO_UPLIFT,
     OUTCOME_OVERTURNED,
     OUTCOME_ROCKING,
 )
-from pipeline.damage_states import (
+from rockfrag.damage_states import (
     DAMAGE_STATES,
     NOT_APPLICABLE,
     DamageState,
@@ -60,17 +60,17 @@ from pipeline.damage_states import (
     is_slip_state,
     state_family,
 )
-from pipeline.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
+from rockfrag.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
     OPENQUAKE_FILE,
     pelicun_id,
     pelicun_table,
     write_csv,
     write_exchange_files,
 )
-from pipeline.exchange import intensity_unit_label as _unit_label
-from pipeline.hazard import study_hazard
-from pipeline.ida import resurrected
-from pipeline.lognormal_fit import (  # noqa: F401
+from rockfrag.exchange import intensity_unit_label as _unit_label
+from rockfrag.hazard import study_hazard
+from rockfrag.ida import resurrected
+from rockfrag.lognormal_fit import (  # noqa: F401
     CROSSING_TOLERANCE,
     curves_cross,
     deviance,
@@ -82,12 +82,12 @@ from pipeline.lognormal_fit import (  # noqa: F401
     lognormal_cdf,
     separation,
 )
-from pipeline.measures import MEASURES, convert_units, parse_units, udunits, unit_label
-from pipeline.models import MODELS
-from pipeline.models.variants import BAND_ROLES, RECOMMENDED, split_variant
-from pipeline.outputs import write_dataset
-from pipeline.risk import risk_dataset
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.measures import MEASURES, convert_units, parse_units, udunits, unit_label
+from rockfrag.models import MODELS
+from rockfrag.models.variants import BAND_ROLES, RECOMMENDED, split_variant
+from rockfrag.outputs import write_dataset
+from rockfrag.risk import risk_dataset
+from rockfrag.units import STANDARD_GRAVITY
 
 STATUS = {
     "fitted": "lognormal fitted by maximum likelihood; median inside the studied range",
@@ -171,10 +171,10 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
 def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     """The physical intensity of every (block, im_level) in the study's display unit, and its ``units``.
 
-    The ``units`` are as UDUNITS parses them ("9.80665 m s-2" for g; ``pipeline.measures.Measure.cf_units``).
+    The ``units`` are as UDUNITS parses them ("9.80665 m s-2" for g; ``rockfrag.measures.Measure.cf_units``).
     Works for both cube layouts: one physical ``im_level`` coordinate shared by all blocks, or a
     dimensionless ``im_level`` with the physical intensity as a (block, im_level) coordinate (``intensity``,
-    or any other found by its dims and units, in any unit ``pipeline.measures.parse_units`` reads: g
+    or any other found by its dims and units, in any unit ``rockfrag.measures.parse_units`` reads: g
     multiples, SI, or an older file's "g"). Returns (n_block, n_level).
     """
     n_block, n_level = cube.sizes["block"], cube.sizes["im_level"]
@@ -462,7 +462,7 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         The study cube (``cube.nc``): outcome and peak angle ratio over record x im_level x soil x block x model,
         intensities in the units the cube states (multiples of g for accelerations).
     states : list of DamageState, optional
-        Damage states in order of severity; default: the registry (``pipeline.damage_states.DAMAGE_STATES``).
+        Damage states in order of severity; default: the registry (``rockfrag.damage_states.DAMAGE_STATES``).
     ida : xarray.Dataset, optional
         ``ida.nc``: its refined overturning capacities are fitted as the check ``capacity_median``/``capacity_beta``.
     n_bootstrap : int
@@ -598,7 +598,7 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
 # ---------------------------------------------------------------- the recommended curve
 
 BAND_COMBINATION = (
-    "recommended = the admissible tensionless-bed model over the restitution band (pipeline.models.variants): "
+    "recommended = the admissible tensionless-bed model over the restitution band (rockfrag.models.variants): "
     "median and beta_record_to_record are the band centre's fit; beta_model is the spread of the median over "
     "the band, taken as uniform in ln(median) between the edges' medians: |ln(m_high / m_low)| / (2 sqrt(3)); "
     "beta = sqrt(beta_record_to_record^2 + beta_model^2) (FEMA P-58's combination of record-to-record and "
@@ -761,7 +761,7 @@ def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:
 def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, output: str | Path,
                     progress: bool | None = None,
                     log: Callable[[str], object] | None = None) -> tuple[xr.Dataset, xr.Dataset]:
-    """Fit, add the risk, and write fragility.nc, fragility.csv and the exchange files (``pipeline.exchange``).
+    """Fit, add the risk, and write fragility.nc, fragility.csv and the exchange files (``rockfrag.exchange``).
 
     The hazard curve is read (and checked against the study's intensity measure) before any fit.
     Fit warnings are printed to ``log`` (stderr by default) and kept in the dataset.

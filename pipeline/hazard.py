@@ -1,4 +1,4 @@
-"""pipeline.hazard - a site's hazard curve: read, checked against the study's measure, interpolated.
+"""rockfrag.hazard - a site's hazard curve: read, checked against the study's measure, interpolated.
 
 Input : a hazard curve file that states its intensity measure (and period for Sa), in one of three
         formats (``load_hazard``): rockfrag's CSV (``# measure = pga`` header lines, columns intensity
@@ -11,8 +11,8 @@ Output: a ``HazardCurve`` (intensity in the measure's display unit, annual frequ
         by log-log interpolation (``hazard_frequency``).
 
 A hazard curve for another measure (or another Sa period) than the study's is a ConfigError; the study
-file's check (pipeline.config) and the risk stage (pipeline.risk) both read curves here. Measures,
-their units, labels and OpenQuake IMT names come from the registry in pipeline.measures. Beyond the
+file's check (rockfrag.config) and the risk stage (rockfrag.risk) both read curves here. Measures,
+their units, labels and OpenQuake IMT names come from the registry in rockfrag.measures. Beyond the
 last tabulated intensity the curve is extended with the slope of its last segment (a power law), and
 below the first point with the slope of its first.
 
@@ -36,9 +36,9 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike
 
-from pipeline.errors import ConfigError
-from pipeline.measures import MEASURES, display_units, scaling_measures
-from pipeline.validation import Number, shown
+from rockfrag.errors import ConfigError
+from rockfrag.measures import MEASURES, display_units, scaling_measures
+from rockfrag.validation import Number, shown
 
 EXAMPLE_HAZARD = "hazard_example.csv"
 """Shipped example, PGA only: H(s) = 1e-4 s^-2.5 [1/yr], s = PGA [g] (Cornell et al. 2002 power-law form)."""
@@ -117,7 +117,7 @@ class HazardSite:
 class HazardCurve:
     """Mean annual frequency of exceedance [1/yr] of an intensity measure at one site."""
 
-    intensity: np.ndarray  # in the measure's display unit (pipeline.measures.display_units)
+    intensity: np.ndarray  # in the measure's display unit (rockfrag.measures.display_units)
     annual_frequency: np.ndarray  # 1/yr
     measure: str  # pga | sa | pgv
     period: float | None  # Sa period [s]; None for pga, pgv
@@ -332,7 +332,7 @@ def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
         A rockfrag CSV, an OpenQuake hazard-curve CSV or a USGS hazard JSON (module docstring); empty
         or None reads the shipped example (PGA only).
     measure : str, optional
-        The study's intensity measure, a name of the registry (``pipeline.measures.MEASURES``).
+        The study's intensity measure, a name of the registry (``rockfrag.measures.MEASURES``).
     period : float, optional
         The study's Sa period [s]; checked only for a measure defined at a period.
     site : (float, float), optional
@@ -354,7 +354,7 @@ def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
         ``site`` is given; or ``site`` is given and the file states no coordinates.
     """
     if path is None or str(path) == "":
-        source_file = files("pipeline").joinpath(EXAMPLE_HAZARD)
+        source_file = files("rockfrag").joinpath(EXAMPLE_HAZARD)
         source = f"pipeline/{EXAMPLE_HAZARD} (example, not site-specific)"
     else:
         source_file, source = Path(path), str(path)
@@ -397,7 +397,7 @@ def hazard_for(path: str | os.PathLike | None, measure: str, period: float | Non
 
 
 class HazardSettings(Protocol):
-    """What ``study_hazard`` reads of a study; ``pipeline.config.StudyConfig`` has it."""
+    """What ``study_hazard`` reads of a study; ``rockfrag.config.StudyConfig`` has it."""
 
     @property
     def hazard_file(self) -> str:
@@ -405,7 +405,7 @@ class HazardSettings(Protocol):
 
     @property
     def measure(self) -> str:
-        """The study's intensity measure (a name of ``pipeline.measures.MEASURES``)."""
+        """The study's intensity measure (a name of ``rockfrag.measures.MEASURES``)."""
 
     @property
     def period(self) -> float:
@@ -422,7 +422,7 @@ def study_hazard(config: HazardSettings) -> HazardCurve | None:
     Parameters
     ----------
     config : HazardSettings
-        The study (``pipeline.config.StudyConfig``): ``hazard_file``, ``measure``, ``period`` [s] and,
+        The study (``rockfrag.config.StudyConfig``): ``hazard_file``, ``measure``, ``period`` [s] and,
         if it has one, ``hazard_site`` ([lon, lat] in degrees, or None).
 
     Returns

@@ -1,4 +1,4 @@
-"""pipeline.ida - stage 7: the cube -> incremental dynamic analysis (IDA) curves and capacities.
+"""rockfrag.ida - stage 7: the cube -> incremental dynamic analysis (IDA) curves and capacities.
 
 Input : the study cube (``cube.nc``): peak_angle_ratio and outcome over (record, im_level, soil,
         block, model).
@@ -17,7 +17,7 @@ Output: ``reports/ida.nc`` with, per soil, block and model:
           lowest seen to overturn), the runs it took and, as attributes, the runs saved against
           uniform stripes of the same resolution.
 Intensities are per block: the cube's (block, im_level) coordinate ``intensity``, in the measure's display
-unit, written as UDUNITS parses it ("9.80665 m s-2" for g; ``pipeline.measures.parse_units``).
+unit, written as UDUNITS parses it ("9.80665 m s-2" for g; ``rockfrag.measures.parse_units``).
 
 Capacity convention (Vamvatsikos & Cornell 2002): a record's overturning capacity is its FIRST
 overturning intensity; a record that survives a higher level (resurrection) is still taken to have
@@ -34,9 +34,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED
-from pipeline.measures import convert_units, parse_units, udunits
-from pipeline.outputs import write_dataset
+from rockfrag.cube import OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED
+from rockfrag.measures import convert_units, parse_units, udunits
+from rockfrag.outputs import write_dataset
 
 FRACTILES = (0.16, 0.50, 0.84)
 FRACTILE_ATTRS = {"long_name": "fractile (non-exceedance probability) over the records", "units": "1"}
@@ -109,7 +109,7 @@ def resurrected(outcome) -> np.ndarray:
 def block_intensities(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     """(n_block, n_level) intensity of every level for every block [display unit], and its ``units``.
 
-    Reads the (block, im_level) coordinate ``intensity`` (pipeline.cube); a cube without it (absolute
+    Reads the (block, im_level) coordinate ``intensity`` (rockfrag.cube); a cube without it (absolute
     levels from an older layout) has the same levels ``im_level`` for every block. The units come back as
     UDUNITS parses them (an older file's "g" becomes "9.80665 m s-2").
     """
@@ -121,7 +121,7 @@ def block_intensities(cube: xr.Dataset) -> tuple[np.ndarray, str]:
 
 
 def _canonical(units: str) -> str:
-    """``units`` as UDUNITS writes it (``pipeline.measures.udunits``), unchanged when not an intensity unit."""
+    """``units`` as UDUNITS writes it (``rockfrag.measures.udunits``), unchanged when not an intensity unit."""
     parsed = parse_units(units)
     return units if parsed is None else udunits(parsed[1], parsed[0])
 

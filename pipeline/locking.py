@@ -1,4 +1,4 @@
-"""pipeline.locking - one rockfrag run per output folder, and cleaning what killed runs left.
+"""rockfrag.locking - one rockfrag run per output folder, and cleaning what killed runs left.
 
 Input : an output folder.
 Output: an advisory lock (``fcntl.flock`` on ``<folder>/.rockfrag.lock``, holding the owner's pid)
@@ -28,8 +28,8 @@ import os
 import time
 from pathlib import Path
 
-from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
-from pipeline.errors import PipelineError
+from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
+from rockfrag.errors import PipelineError
 
 LOCK_NAME = ".rockfrag.lock"
 

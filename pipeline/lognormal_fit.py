@@ -1,4 +1,4 @@
-"""pipeline.lognormal_fit - lognormal fragility fits on arrays (no cube, no xarray).
+"""rockfrag.lognormal_fit - lognormal fragility fits on arrays (no cube, no xarray).
 
 Input : counts per intensity level (exceed, total : (..., n_level)) and the levels [IM units], or
         per-record capacities [IM units] with right-censoring.

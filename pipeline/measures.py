@@ -1,4 +1,4 @@
-"""pipeline.measures - stage 3: ground acceleration -> intensity measures.
+"""rockfrag.measures - stage 3: ground acceleration -> intensity measures.
 
 Input : acceleration samples [m/s^2] (ndarray, shape (n,)) at a constant time step dt [s].
 Output: scalar intensity measures in SI units (PGA [m/s^2], PGV [m/s], PGD [m], Arias intensity
@@ -7,7 +7,7 @@ Output: scalar intensity measures in SI units (PGA [m/s^2], PGV [m/s], PGD [m], 
         p PGV/(g tan alpha) per block, average spectral acceleration over a period range, the
         period and amplitude of the dominant velocity pulse).
 
-``MEASURES`` registers every measure a study can scale records to or rank (pipeline.efficiency) as
+``MEASURES`` registers every measure a study can scale records to or rank (rockfrag.efficiency) as
 one ``Measure``: name, function, SI and display unit, long name, short label, pelicun demand type and
 OpenQuake IMT. Every stage reads these (the study file's choices and units, the cube's metadata, the
 report's axes, the hazard readers, the pelicun export): a new measure is one ``@define_measure``
@@ -35,11 +35,11 @@ import numpy as np
 from numba import njit
 from scipy.linalg import expm
 
-from pipeline.processing import integrate
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.processing import integrate
+from rockfrag.units import STANDARD_GRAVITY
 
 if TYPE_CHECKING:
-    from pipeline.blocks import Block
+    from rockfrag.blocks import Block
 
 DEFAULT_PERIODS = np.round(np.geomspace(0.02, 10.0, 60), 4)
 """Periods of the default response spectrum [s]."""
@@ -268,7 +268,7 @@ class Measure:
     """One intensity measure: the one place every stage reads it from.
 
     ``function(acceleration [m/s^2], dt [s], block, options) -> value [si_unit]``; ``block`` is a
-    ``pipeline.blocks.Block`` for per-block measures (ignored otherwise); ``options`` holds the
+    ``rockfrag.blocks.Block`` for per-block measures (ignored otherwise); ``options`` holds the
     study's ``period`` [s], ``damping`` [-] and ``period_range`` ((low, high) [s] or None).
     ``long_name`` and ``label`` are templates filled with the options by ``describe`` and
     ``short_label`` (fields ``period``, ``damping``, ``low``, ``high``): the long name for netCDF
@@ -314,7 +314,7 @@ class Measure:
             Ground acceleration [m/s^2].
         dt : float
             Time step [s].
-        block : pipeline.blocks.Block, optional
+        block : rockfrag.blocks.Block, optional
             The block, required for a per-block measure (ignored otherwise).
         **options
             The study's ``period`` [s], ``damping`` [-] and ``period_range`` ((low, high) [s]).

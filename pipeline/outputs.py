@@ -1,4 +1,4 @@
-"""pipeline.outputs - writing result files safely, netCDF files in one way.
+"""rockfrag.outputs - writing result files safely, netCDF files in one way.
 
 Input : a destination path (and for ``write_dataset`` an xarray dataset). Output: ``atomic_path``, a
 temporary path in the same folder that is renamed onto the destination only when writing succeeded, so a

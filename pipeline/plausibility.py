@@ -1,8 +1,8 @@
-"""pipeline.plausibility - physical plausibility of a study's blocks, soils and their foundations.
+"""rockfrag.plausibility - physical plausibility of a study's blocks, soils and their foundations.
 
-Input : the study's blocks (``pipeline.blocks.Block``: b, h, R [m], mass [kg], E_b [Pa], footprint
-        area [m^2], soil depth [m]) and soils (``pipeline.soils.SoilClass``: G_s [Pa]), and for each
-        pair its ``pipeline.soils.Foundation`` (k [N/m], static settlement m g / k [m], omega_v / p).
+Input : the study's blocks (``rockfrag.blocks.Block``: b, h, R [m], mass [kg], E_b [Pa], footprint
+        area [m^2], soil depth [m]) and soils (``rockfrag.soils.SoilClass``: G_s [Pa]), and for each
+        pair its ``rockfrag.soils.Foundation`` (k [N/m], static settlement m g / k [m], omega_v / p).
 Output: one line per implausible value, naming the value with its unit, its consequence and the
         likely unit slip, e.g. ``block 'cabinet': E_b = 200 Pa is below 1 MPa (static settlement
         204 m on clay): did you mean 200 GPa?``. ``check_study`` raises the first as a ``ConfigError``
@@ -12,7 +12,7 @@ A check is one function ``(block, soil, foundation) -> str | None`` registered w
 ``@plausibility_check(name, field)`` in ``CHECKS``, in the order the checks are tried: the moduli and
 sizes whose unit slips they name come before the density, settlement and frequency they cause (b and h
 in mm are a size slip, not a mass one: the density check stays silent then). A block given
-both ways (R and b/h) is refused when it is built (``pipeline.blocks.geometry_conflict``): after that
+both ways (R and b/h) is refused when it is built (``rockfrag.blocks.geometry_conflict``): after that
 the keys given are no longer known.
 """
 
@@ -23,9 +23,9 @@ import warnings
 from dataclasses import dataclass
 from typing import Callable, Iterable
 
-from pipeline.blocks import Block
-from pipeline.errors import ConfigError
-from pipeline.soils import Foundation, SoilClass, foundation
+from rockfrag.blocks import Block
+from rockfrag.errors import ConfigError
+from rockfrag.soils import Foundation, SoilClass, foundation
 
 MIN_MODULUS = 1.0e6
 """Smallest plausible E_b and soil shear modulus G_s [Pa] (1 MPa; soft clay has G_s of ~5 MPa)."""

@@ -1,4 +1,4 @@
-"""pipeline.processing - stage 2: raw acceleration trace -> corrected trace ready for analysis.
+"""rockfrag.processing - stage 2: raw acceleration trace -> corrected trace ready for analysis.
 
 Input : a ``Record`` (obspy Trace of acceleration [m/s^2]) and a ``ProcessingRecipe`` (ordered list
         of named steps with parameters; the shipped one is ``pipeline/processing.toml``).
@@ -8,7 +8,7 @@ Output: a new ``Record`` whose trace is demeaned, detrended, tapered, zero-phase
         a record. Inputs are not modified.
 
 A step is one function registered with ``@processing_step``, which declares the schema of each keyword
-parameter (pipeline.validation): what a recipe may set. A parameter without a default must be set by
+parameter (rockfrag.validation): what a recipe may set. A parameter without a default must be set by
 the recipe (the band-pass corners: the recipe file is their one authority). Steps talk through the
 trace: ``pad`` records the samples it added in ``stats.padding`` and ``unpad`` removes them; a step
 that depends on another step's settings names it in ``reads`` and receives that step's parameters
@@ -32,10 +32,10 @@ from typing import Any
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-from pipeline import __version__
-from pipeline.errors import ConfigError, RecordError
-from pipeline.records import Record
-from pipeline.validation import Checked, Flag, Number, Table, Text, shown
+from rockfrag import __version__
+from rockfrag.errors import ConfigError, RecordError
+from rockfrag.records import Record
+from rockfrag.validation import Checked, Flag, Number, Table, Text, shown
 
 
 @dataclass(frozen=True)
@@ -342,7 +342,7 @@ def recipe_from_dict(data: dict, source="<dict>") -> ProcessingRecipe:
 def load_recipe(path=None) -> ProcessingRecipe:
     """The shipped default recipe, or a user TOML file with the same layout (validated)."""
     if path is None:
-        text = files("pipeline").joinpath("processing.toml").read_text()
+        text = files("rockfrag").joinpath("processing.toml").read_text()
         source = "pipeline/processing.toml"
     else:
         try:
@@ -390,7 +390,7 @@ def process_record(record: Record, recipe: ProcessingRecipe | None = None) -> Re
     Parameters
     ----------
     record : Record
-        A record as read (``pipeline.records``): ground acceleration [m/s^2] in ``record.trace``.
+        A record as read (``rockfrag.records``): ground acceleration [m/s^2] in ``record.trace``.
         It is not modified.
     recipe : ProcessingRecipe, optional
         The steps to run (``load_recipe``); the shipped ``pipeline/processing.toml`` if omitted. The

@@ -1,4 +1,4 @@
-"""pipeline.records_report - the ``rockfrag records`` stage: record table and per-record figures.
+"""rockfrag.records_report - the ``rockfrag records`` stage: record table and per-record figures.
 
 Input : loaded ``Record`` objects and the processing recipe.
 Output: a pandas table of catalogue metadata and intensity measures of the processed records
@@ -6,7 +6,7 @@ Output: a pandas table of catalogue metadata and intensity measures of the proce
         velocity and displacement, and the 5%-damped response spectrum, all labelled with units.
 
 Each record is one component: the table's ``group`` numbers the records of one station and event
-(``pipeline.records.group_components``, counted from 1 in order of appearance) and ``axis`` says which
+(``rockfrag.records.group_components``, counted from 1 in order of appearance) and ``axis`` says which
 component a row is (``H1``, ``H2``, ``Z`` for the vertical), so the PGA of each component of a
 three-component record reads off its rows.
 """
@@ -20,12 +20,12 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from pipeline.errors import RecordError
-from pipeline.measures import intensity_measures, response_spectrum
-from pipeline.outputs import atomic_path
-from pipeline.processing import integrate, process_record
-from pipeline.records import component_labels
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.errors import RecordError
+from rockfrag.measures import intensity_measures, response_spectrum
+from rockfrag.outputs import atomic_path
+from rockfrag.processing import integrate, process_record
+from rockfrag.records import component_labels
+from rockfrag.units import STANDARD_GRAVITY
 
 TABLE_COLUMNS = {
     "group": "group", "axis": "axis",

@@ -1,10 +1,10 @@
-"""pipeline.risk - fragility x site hazard -> mean annual frequency and probability in a design life.
+"""rockfrag.risk - fragility x site hazard -> mean annual frequency and probability in a design life.
 
 Input : lognormal fragility parameters (median [IM units], beta [-], beta = 0 a step) and the site's
-        hazard curve for the study's intensity measure (read and checked by ``pipeline.hazard``).
+        hazard curve for the study's intensity measure (read and checked by ``rockfrag.hazard``).
 Output: lambda_DS = integral P(DS | im) |d lambda(im)| [1/yr] and P(DS in T years) = 1 - exp(-lambda_DS T).
 
-The hazard is interpolated log-log (``pipeline.hazard.hazard_frequency``) and integrated on a fine
+The hazard is interpolated log-log (``rockfrag.hazard.hazard_frequency``) and integrated on a fine
 logarithmic grid.
 """
 
@@ -15,8 +15,8 @@ import xarray as xr
 from numpy.typing import ArrayLike
 from scipy.special import ndtr
 
-from pipeline.hazard import HazardCurve, hazard_frequency
-from pipeline.hazard import study_hazard as study_hazard  # re-exported: cli.py imports it from here
+from rockfrag.hazard import HazardCurve, hazard_frequency
+from rockfrag.hazard import study_hazard as study_hazard  # re-exported: cli.py imports it from here
 
 
 def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, points: int = 4000,
@@ -25,7 +25,7 @@ def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, poi
 
     beta = 0 is a step at the median: lambda_DS = lambda(median). ``lower`` (IM units) keeps only the
     intensities from it on: the part of lambda_DS above the lowest level at which a record reached the
-    state (pipeline.answer), the rest being the fitted curve's tail alone.
+    state (rockfrag.answer), the rest being the fitted curve's tail alone.
     """
     if hazard is None or not (np.isfinite(median) and np.isfinite(beta)):
         return np.nan
@@ -56,7 +56,7 @@ def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life:
     Parameters
     ----------
     fragility : xarray.Dataset
-        The fitted fragility (``pipeline.fragility``): ``median`` [the measure's display unit, as the
+        The fitted fragility (``rockfrag.fragility``): ``median`` [the measure's display unit, as the
         hazard curve] and ``beta`` [-] over (soil, block, model, damage_state); beta = 0 is a step.
     hazard : HazardCurve or None
         The site's hazard curve for the study's measure (``study_hazard``); None: no risk computed,

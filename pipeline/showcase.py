@@ -1,4 +1,4 @@
-"""pipeline.showcase - study-time data for the report: record-set measures and spectra, showcase histories.
+"""rockfrag.showcase - study-time data for the report: record-set measures and spectra, showcase histories.
 
 Input : the study configuration and its processed records (``study.StudyRecords``).
 Output: ``reports/showcase.nc`` holding
@@ -24,16 +24,16 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline import __version__
-from pipeline.errors import ConfigError, PipelineError
-from pipeline.measures import intensity_measures, response_spectrum, significant_window
-from pipeline.models import get_model, simulate
-from pipeline.models.variants import calibrate_models
-from pipeline.outputs import write_dataset
-from pipeline.processing import integrate, process_record
-from pipeline.records import load_records
-from pipeline.soils import soil_block_stiffness
-from pipeline.study import StudyRecords, cell_friction, study_records
+from rockfrag import __version__
+from rockfrag.errors import ConfigError, PipelineError
+from rockfrag.measures import intensity_measures, response_spectrum, significant_window
+from rockfrag.models import get_model, simulate
+from rockfrag.models.variants import calibrate_models
+from rockfrag.outputs import write_dataset
+from rockfrag.processing import integrate, process_record
+from rockfrag.records import load_records
+from rockfrag.soils import soil_block_stiffness
+from rockfrag.study import StudyRecords, cell_friction, study_records
 
 PAPER_RECORD = "DUZCE/BOL090"
 SPECTRUM_PERIODS = np.geomspace(0.02, 10.0, 60)

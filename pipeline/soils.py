@@ -1,14 +1,14 @@
-"""pipeline.soils - soil classes and the interface stiffness of the SSI-rocking model.
+"""rockfrag.soils - soil classes and the interface stiffness of the SSI-rocking model.
 
 Input : a soil class (shear modulus G_s [Pa], Poisson's ratio, density, damping ratio) and a
         ``Block`` (E_b [Pa], footprint area A [m^2], effective soil depth H [m]).
 Output: the interface stiffness k [N/m] of paper eq. 19, k = (A/H) / (1/G_s + 1/E_b), the vertical
         circular frequency w = sqrt(k/m) [rad/s] and dashpot c = 2 xi w m [N s/m] (eq. 10); with
-        ``foundation`` also the static settlement m g / k [m] and w / p, which pipeline.plausibility checks.
+        ``foundation`` also the static settlement m g / k [m] and w / p, which rockfrag.plausibility checks.
 
 Base friction: each soil class also carries the Coulomb friction coefficients of a block's base on it,
 static ``friction_static`` and kinetic ``friction_kinetic`` [-] (``FRICTION_SOURCES``), which the study uses
-for the runs that slide (pipeline.study.cell_friction).
+for the runs that slide (rockfrag.study.cell_friction).
 
 The paper's "dynamic elastic modulus" E_d of eq. 7 / Table 1, E_d = 2G(1-nu)/(1-2nu), is the
 constrained (oedometric, P-wave) modulus, not Young's modulus; it is labelled so here.
@@ -19,14 +19,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from pipeline.errors import ConfigError
-from pipeline.units import STANDARD_GRAVITY
-from pipeline.validation import Number
+from rockfrag.errors import ConfigError
+from rockfrag.units import STANDARD_GRAVITY
+from rockfrag.validation import Number
 
 MAX_KINETIC_FRICTION = 4.0 / 3.0
 """Largest kinetic coefficient a soil may state: a rigid base's limit. Above it a block rocking on a sliding corner
 can meet Painleve's paradox (no solution of its equations; pipeline/models/housner.py). The models read it from here
-(pipeline.models.options.RIGID_BASE_MAX_KINETIC_FRICTION)."""
+(rockfrag.models.options.RIGID_BASE_MAX_KINETIC_FRICTION)."""
 
 SOIL_RANGES = {
     "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),
@@ -137,7 +137,7 @@ def foundation(soil: SoilClass, block, g: float = STANDARD_GRAVITY) -> Foundatio
     ----------
     soil : SoilClass
         The foundation material (shear modulus G_s [Pa]).
-    block : pipeline.blocks.Block
+    block : rockfrag.blocks.Block
         The block (mass [kg], E_b [Pa], footprint area [m^2], soil depth [m], R [m]).
     g : float
         Gravity [m/s^2].

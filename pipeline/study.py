@@ -1,7 +1,7 @@
-"""pipeline.study - stage 6: every record x intensity level x soil x block x model -> the cube.
+"""rockfrag.study - stage 6: every record x intensity level x soil x block x model -> the cube.
 
-Input : a ``StudyConfig`` (pipeline.config).
-Output: ``reports/cube.nc`` (see pipeline.cube) and the ``xarray.Dataset``.
+Input : a ``StudyConfig`` (rockfrag.config).
+Output: ``reports/cube.nc`` (see rockfrag.cube) and the ``xarray.Dataset``.
 
 Levels: absolute (the same intensities for every block) or, with ``[intensity] levels.relative_to =
 "uplift"``, multiples of each block's uplift intensity (``level_intensities``); scale factors are then
@@ -9,7 +9,7 @@ per (record, level, block).
 
 Work unit: one record and one block at all its scale factors for all the cells (soil, model) it
 still needs, run by the compiled batch solver. The same task then refines each cell's overturning
-capacity adaptively (pipeline.ida.capacity_from_stripes, to ``capacity_resolution``) and returns it
+capacity adaptively (rockfrag.ida.capacity_from_stripes, to ``capacity_resolution``) and returns it
 as a second checkpoint entry, so capacities come from runs, not from the grid. A cell's result is
 checkpointed as one small file named by a hash of everything it depends on (record checksum,
 processing recipe, intensity settings, levels, block, soil, model, solver settings, package version),
@@ -21,15 +21,15 @@ Sliding (``[solver] friction``, ``cell_friction``): a housner or winkler cell ru
 the base, the soil's (mu_s, mu_k), where the study says it slides; its friction is part of its job and of its
 checkpoint key (a tied cell's key is the same as before friction existed). A sliding housner cell is per soil.
 
-Executors (pipeline.executors): in-process (workers=1), all local cores (default, process pool), or
+Executors (rockfrag.executors): in-process (workers=1), all local cores (default, process pool), or
 dask.distributed (``scheduler`` address of a running cluster, or ``dask_workers`` to start a
 LocalCluster). Every executor runs the same pure task function, so the cube is identical whatever the
 executor.
 
-Reliability: checkpoints verify themselves (pipeline.checkpoints; a damaged one is quarantined and
-recomputed), the output folder is locked for the run (pipeline.locking), pool workers die with the
+Reliability: checkpoints verify themselves (rockfrag.checkpoints; a damaged one is quarantined and
+recomputed), the output folder is locked for the run (rockfrag.locking), pool workers die with the
 study process (parent-death signal), cells of a worker that was killed are retried once in a fresh
-pool and then reported (pipeline.executors), and a record that cannot be processed or scaled is
+pool and then reported (rockfrag.executors), and a record that cannot be processed or scaled is
 skipped with its reason. The records are read and processed once per command (``study_records``,
 a ``StudyRecords``) and shared with the showcase, efficiency and applicability stages.
 """
@@ -46,24 +46,24 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from pipeline import __version__
-from pipeline.blocks import Block
-from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
-from pipeline.checkpoints import CheckpointStore
-from pipeline.cube import COMPARISON_CUBE, build_cube
-from pipeline.errors import PipelineError, RecordError
-from pipeline.executors import check_workers, make_executor, pool_executor, run_tasks
-from pipeline.ida import capacity_from_stripes, uniform_stripe_runs
-from pipeline.locking import output_lock
-from pipeline.measures import MEASURES, pga
-from pipeline.models import DEFAULT_ATOL, DEFAULT_RTOL, calibrated_law, get_model, simulate_batch
-from pipeline.models.base import Outcome
-from pipeline.models.fields import SUMMARY_DTYPE, new_summaries
-from pipeline.models.variants import BAND_XI_FLOOR, BandCalibration, calibrate_models, split_variant
-from pipeline.outputs import write_dataset
-from pipeline.processing import ProcessingRecipe, load_recipe, process_records
-from pipeline.records import Record, group_components, load_records, split_vertical
-from pipeline.soils import soil_block_stiffness
+from rockfrag import __version__
+from rockfrag.blocks import Block
+from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
+from rockfrag.checkpoints import CheckpointStore
+from rockfrag.cube import COMPARISON_CUBE, build_cube
+from rockfrag.errors import PipelineError, RecordError
+from rockfrag.executors import check_workers, make_executor, pool_executor, run_tasks
+from rockfrag.ida import capacity_from_stripes, uniform_stripe_runs
+from rockfrag.locking import output_lock
+from rockfrag.measures import MEASURES, pga
+from rockfrag.models import DEFAULT_ATOL, DEFAULT_RTOL, calibrated_law, get_model, simulate_batch
+from rockfrag.models.base import Outcome
+from rockfrag.models.fields import SUMMARY_DTYPE, new_summaries
+from rockfrag.models.variants import BAND_XI_FLOOR, BandCalibration, calibrate_models, split_variant
+from rockfrag.outputs import write_dataset
+from rockfrag.processing import ProcessingRecipe, load_recipe, process_records
+from rockfrag.records import Record, group_components, load_records, split_vertical
+from rockfrag.soils import soil_block_stiffness
 
 
 @dataclass(frozen=True)
@@ -86,9 +86,9 @@ def cell_friction(block, soil, model: str, mode: str) -> tuple[float, float] | N
 
     Parameters
     ----------
-    block : pipeline.blocks.Block
+    block : rockfrag.blocks.Block
         The block (half-width b and half-height h [m]).
-    soil : pipeline.soils.SoilClass or None
+    soil : rockfrag.soils.SoilClass or None
         The soil (``friction_static``, ``friction_kinetic``); None: no soil, a tied base.
     model : str
         The model's name; only models that slide (housner, winkler) take friction: ssi is always tied.
@@ -285,7 +285,7 @@ def friction_grid(config) -> np.ndarray:
 
     Parameters
     ----------
-    config : pipeline.config.StudyConfig
+    config : rockfrag.config.StudyConfig
         The study (soils, blocks, models and ``[solver] friction``).
 
     Returns
@@ -324,7 +324,7 @@ def restitution_key(config, model) -> dict:
 
 
 def solver_options(config) -> dict:
-    """The study's solver settings as ``simulate_batch`` keywords (pipeline.models.SolverOptions).
+    """The study's solver settings as ``simulate_batch`` keywords (rockfrag.models.SolverOptions).
 
     With a restitution target the bed runs the law its damping was calibrated with
     (``restitution.calibrated_law``: the continuous bed takes Hunt-Crossley damping).
@@ -337,7 +337,7 @@ def bed_calibration(config, stiffness) -> BandCalibration | None:
     """The calibrated damping of every bed model on every (soil, block), or None without a restitution target.
 
     A band variant whose target the bed cannot reach runs at the nearest reachable one; the study lists
-    those (``calibration_lines``) and the cube keeps both (pipeline.models.variants).
+    those (``calibration_lines``) and the cube keeps both (rockfrag.models.variants).
     """
     models = [name for name in config.models if get_model(name).uses_bed]
     if not (config.calibrates_bed and models):
@@ -416,14 +416,14 @@ class StudyRecords:
 
     Attributes
     ----------
-    records : list of pipeline.records.Record
+    records : list of rockfrag.records.Record
         The processed records, in the study's order: acceleration [m/s^2] sampled every ``dt`` [s],
         with the processing provenance in ``trace.stats.processing``.
-    failures : list of pipeline.errors.RecordError
+    failures : list of rockfrag.errors.RecordError
         The records that could not be read or processed, each with its one-line reason.
-    recipe : pipeline.processing.ProcessingRecipe
+    recipe : rockfrag.processing.ProcessingRecipe
         The processing recipe applied (part of every cell's checkpoint key and of the outputs' hashes).
-    verticals : list of pipeline.records.Record, or None
+    verticals : list of rockfrag.records.Record, or None
         ``[study] vertical = true``: the processed vertical component of each record's station (up
         positive), in the order of ``records``; each record and its vertical are cut to the window they
         share (``ComponentGroup.aligned``) before processing, so they have one start, time step and
@@ -448,7 +448,7 @@ def study_records(config, log=print) -> StudyRecords:
 
     Parameters
     ----------
-    config : pipeline.config.StudyConfig
+    config : rockfrag.config.StudyConfig
         The study (record sets, record units and dt, processing recipe, ``vertical``).
     log : callable
         Receives one line per skipped record.
@@ -491,7 +491,7 @@ def pair_verticals(records) -> tuple[list[tuple[Record, Record]], list[RecordErr
 
     Parameters
     ----------
-    records : list of pipeline.records.Record
+    records : list of rockfrag.records.Record
         Read (unprocessed) records; components of one station and event are grouped by
         ``group_components``.
 
@@ -500,7 +500,7 @@ def pair_verticals(records) -> tuple[list[tuple[Record, Record]], list[RecordErr
     pairs : list of (Record, Record)
         (horizontal, vertical) in the order of the horizontals, each cut by ``ComponentGroup.aligned``
         (same start, time step and length); horizontals of one station share one vertical object.
-    failures : list of pipeline.errors.RecordError
+    failures : list of rockfrag.errors.RecordError
         One per horizontal without a vertical among ``records``, or whose components share no window or
         time step.
     """
@@ -600,7 +600,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     verticals = loaded.verticals
     if config.vertical and verticals is None:
         raise PipelineError("[study] vertical = true, but the records were read without their verticals "
-                            "(pipeline.study.study_records of a horizontal-only study)")
+                            "(rockfrag.study.study_records of a horizontal-only study)")
     record_im = record_intensities(records, config)
     keep, unscalable = _scalable(records, record_im, warn)
     failures += unscalable

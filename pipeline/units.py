@@ -1,4 +1,4 @@
-"""pipeline.units - SI constants and converters used at the edges of the pipeline.
+"""rockfrag.units - SI constants and converters used at the edges of the pipeline.
 
 Everything inside the package is SI (m, s, rad, kg, N/m, Pa, m/s^2). Converters turn the units
 found in record files or given by users into SI, and back for display.

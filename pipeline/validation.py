@@ -1,4 +1,4 @@
-"""pipeline.validation - the one validation layer: schemas of user values, checked once where they enter.
+"""rockfrag.validation - the one validation layer: schemas of user values, checked once where they enter.
 
 Input : a value as the user gave it (TOML or Python), the field's name and the file it came from.
 Output: the value (numbers as float/int), or one ``ConfigError`` naming the file and the field, saying
@@ -8,8 +8,8 @@ Output: the value (numbers as float/int), or one ``ConfigError`` naming the file
 A schema is built from small classes that all have ``check(value, field, source)``: ``Number``,
 ``Text``, ``Flag``, ``Names``, ``Numbers``, ``Interval``, ``Nullable``, ``Table`` (fixed keys),
 ``NamedTables`` (``[PREFIX.NAME]`` tables), ``Either`` and ``Checked`` (a function of its own). Study
-files (pipeline.config), processing recipes (pipeline.processing), calibration options
-(pipeline.calibrate) and solver options (pipeline.models) declare theirs with them.
+files (rockfrag.config), processing recipes (rockfrag.processing), calibration options
+(rockfrag.calibrate) and solver options (rockfrag.models) declare theirs with them.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from pipeline.errors import ConfigError
+from rockfrag.errors import ConfigError
 
 
 @dataclass(frozen=True)

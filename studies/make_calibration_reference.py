@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.config import load_study
-from pipeline.models import simulate
-from pipeline.processing import load_recipe, process_record
-from pipeline.records import load_records
+from rockfrag.config import load_study
+from rockfrag.models import simulate
+from rockfrag.processing import load_recipe, process_record
+from rockfrag.records import load_records
 
 RECORD, SCALE, BLOCK = "DUZCE/BOL090", 1.5, "paper"
 STIFFNESS, DAMPING = 3.7e8, 0.042  # N/m, -

@@ -1,6 +1,6 @@
 """A process that forks ``rockfrag`` runs for the chaos test (tests/test_reliability_chaos.py).
 
-Each ``python -m pipeline run`` of the chaos study spent about 3 of its 4 s importing (numpy, scipy, obspy's
+Each ``python -m rockfrag run`` of the chaos study spent about 3 of its 4 s importing (numpy, scipy, obspy's
 filters, xarray) and loading the compiled kernels: eleven of them were most of the test's minute. This process
 pays that once. It computes the reference cube in-process (which imports and loads everything a run needs),
 then forks each run on request: the child is a real ``rockfrag run`` process (its own pool of workers, its own
@@ -42,7 +42,7 @@ def _child(main, arguments: list[str], stderr_path: str) -> None:
         status = main(arguments)
     except SystemExit as stop:
         status = 0 if stop.code is None else stop.code if isinstance(stop.code, int) else 1
-    except BaseException:  # noqa: BLE001 - what `python -m pipeline` would print before dying
+    except BaseException:  # noqa: BLE001 - what `python -m rockfrag` would print before dying
         import traceback
 
         traceback.print_exc()
@@ -56,14 +56,14 @@ def serve() -> None:
     """Answer the commands on stdin until it ends."""
     import tqdm
 
-    from pipeline.cli import main  # once, here: every child starts with it imported
+    from rockfrag.cli import main  # once, here: every child starts with it imported
 
     tqdm.tqdm.monitor_interval = 0  # no monitor thread: this process forks
     for line in sys.stdin:
         command = json.loads(line)
         if "reference" in command:
-            from pipeline.config import load_study
-            from pipeline.study import run_study
+            from rockfrag.config import load_study
+            from rockfrag.study import run_study
 
             run_study(load_study(command["reference"]), output=command["output"], workers=1, progress=False,
                       log=lambda message: None, warn=lambda message: None)

@@ -57,7 +57,7 @@ def bolu_path() -> Path:
 
 @pytest.fixture(scope="session")
 def all_records():
-    from pipeline.records import load_records
+    from rockfrag.records import load_records
 
     records, failures = load_records("all")
     assert not failures, failures
@@ -66,7 +66,7 @@ def all_records():
 
 @pytest.fixture(scope="session")
 def bolu_records():
-    from pipeline.records import load_records
+    from rockfrag.records import load_records
 
     records, failures = load_records("bolu")
     assert not failures
@@ -77,7 +77,7 @@ def bolu_records():
 def small_pipeline(tmp_path_factory: pytest.TempPathFactory) -> PipelineRun:
     """``rockfrag fragility`` on the small study (tests/helpers.py PIPELINE_STUDY), run once per session: the
     report, outputs-table and README tests read its folder. Read only: copy the folder before changing it."""
-    from pipeline.cli import main
+    from rockfrag.cli import main
 
     folder = tmp_path_factory.mktemp("pipeline")
     study = folder / "study.toml"

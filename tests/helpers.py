@@ -116,16 +116,16 @@ def pipeline_results(folder: Path, study: Path, **changes):
     study : Path
         The study file the run read.
     **changes
-        Fields of ``pipeline.report.Results`` to replace (e.g. ``fragility=``, ``runtime_s=``).
+        Fields of ``rockfrag.report.Results`` to replace (e.g. ``fragility=``, ``runtime_s=``).
 
     Returns
     -------
-    pipeline.report.Results
+    rockfrag.report.Results
     """
     import xarray as xr
 
-    from pipeline.config import load_study
-    from pipeline.report import Results
+    from rockfrag.config import load_study
+    from rockfrag.report import Results
 
     opened = {}
     for name in ("cube", "ida", "fragility", "showcase", "efficiency"):

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.applicability import run_applicability, threshold_modulus
-from pipeline.blocks import PAPER_BLOCK
-from pipeline.processing import process_record
-from pipeline.records import load_records
+from rockfrag.applicability import run_applicability, threshold_modulus
+from rockfrag.blocks import PAPER_BLOCK
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
 
 
 def test_threshold_interpolates_the_last_crossing():

@@ -12,13 +12,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pipeline.blocks import PAPER_BLOCK, Block
-from pipeline.calibrate import calibrate, check_reference, correlation, load_reference
-from pipeline.cli import main
-from pipeline.errors import ConfigError, PipelineError, RecordError
-from pipeline.models import simulate
-from pipeline.processing import process_record
-from pipeline.records import load_records
+from rockfrag.blocks import PAPER_BLOCK, Block
+from rockfrag.calibrate import calibrate, check_reference, correlation, load_reference
+from rockfrag.cli import main
+from rockfrag.errors import ConfigError, PipelineError, RecordError
+from rockfrag.models import simulate
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
 
 SEGMENT = slice(800, 2000)  # Bolu 090, 8-20 s: the strong motion, where the paper block rocks many cycles
 SCALE = 2.0  # peak angle ~7 % of alpha, 30-90 impacts, no overturning for k in 1e8-9e8 N/m

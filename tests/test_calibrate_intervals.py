@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from scipy.stats import binom, chi2
 
-from pipeline.blocks import PAPER_BLOCK
-from pipeline.calibrate import autocorrelation_time, calibrate, fit_intervals, write_outputs
-from pipeline.models import simulate
-from pipeline.processing import process_record
-from pipeline.records import load_records
+from rockfrag.blocks import PAPER_BLOCK
+from rockfrag.calibrate import autocorrelation_time, calibrate, fit_intervals, write_outputs
+from rockfrag.models import simulate
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
 
 pytestmark = pytest.mark.xdist_group("calibration-intervals")  # one worker computes the 40 seeds' intervals once
 
@@ -196,7 +196,7 @@ def test_autocorrelation_time_of_white_and_ar1_noise():
 
 
 def test_a_confidence_outside_zero_one_is_refused(segment, clean):
-    from pipeline.errors import ConfigError
+    from rockfrag.errors import ConfigError
 
     ag, dt = segment
     for confidence in (0.0, 1.0, 1.5):
@@ -207,9 +207,9 @@ def test_a_confidence_outside_zero_one_is_refused(segment, clean):
 def test_cli_prints_the_intervals_and_passes_the_confidence(tmp_path, capsys, monkeypatch):
     """rockfrag calibrate --confidence reaches calibrate(), and its printout and calibration.json carry the intervals
     (the search itself replaced: its intervals are the tests above)."""
-    import pipeline.calibrate as calibration
-    from pipeline.calibrate import CalibrationResult
-    from pipeline.cli import main
+    import rockfrag.calibrate as calibration
+    from rockfrag.calibrate import CalibrationResult
+    from rockfrag.cli import main
 
     asked = {}
 

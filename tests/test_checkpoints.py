@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.checkpoints import CheckpointStore, DamagedCheckpoint, decode, encode
-from pipeline.config import load_study
-from pipeline.study import run_study
+from rockfrag.checkpoints import CheckpointStore, DamagedCheckpoint, decode, encode
+from rockfrag.config import load_study
+from rockfrag.study import run_study
 from tests.reliability_helpers import QUIET, write_tiny_study
 
 

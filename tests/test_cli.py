@@ -10,7 +10,7 @@ import sys
 import pandas as pd
 import pytest
 
-from pipeline.cli import main
+from rockfrag.cli import main
 
 
 def test_records_writes_table_and_plots(tmp_path, capsys):
@@ -52,7 +52,7 @@ def test_bad_recipe_exits_2_without_traceback(tmp_path, capsys):
 def test_bad_study_exits_2_with_the_field(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text('[intensity]\nlevels = { start = 0.5, stop = 0.1, count = 5 }\n')
-    result = subprocess.run([sys.executable, "-m", "pipeline", "run", str(study), "--output", str(tmp_path / "out")],
+    result = subprocess.run([sys.executable, "-m", "rockfrag", "run", str(study), "--output", str(tmp_path / "out")],
                             capture_output=True, text=True)
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "intensity.levels" in result.stderr and str(study) in result.stderr
@@ -63,7 +63,7 @@ def test_bad_study_exits_2_with_the_field(tmp_path):
 def test_unreachable_scheduler_is_one_line(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text('soils = ["rock"]\n[study]\nrecord_sets = ["bolu"]\n[intensity]\nlevels = [0.5]\n')
-    result = subprocess.run([sys.executable, "-m", "pipeline", "run", str(study), "--output", str(tmp_path / "out"),
+    result = subprocess.run([sys.executable, "-m", "rockfrag", "run", str(study), "--output", str(tmp_path / "out"),
                              "--scheduler", "tcp://127.0.0.1:9", "--no-progress"], capture_output=True, text=True,
                             env={**os.environ, "ROCKFRAG_DASK_CONNECT_TIMEOUT": "1"})  # 10 s by default
     assert result.returncode == 2 and "Traceback" not in result.stderr
@@ -81,7 +81,7 @@ def test_a_failed_command_leaves_no_empty_folder_or_lock_behind(tmp_path, capsys
 
 
 def test_a_failed_command_leaves_an_existing_folder_as_it_found_it(tmp_path, capsys):
-    from pipeline.locking import LOCK_NAME
+    from rockfrag.locking import LOCK_NAME
 
     empty, used = tmp_path / "empty", tmp_path / "used"
     empty.mkdir()
@@ -99,7 +99,7 @@ def test_a_failed_command_leaves_an_existing_folder_as_it_found_it(tmp_path, cap
 def test_output_lock_cleans_up_only_after_a_failure(tmp_path):
     import pytest
 
-    from pipeline.locking import LOCK_NAME, output_lock
+    from rockfrag.locking import LOCK_NAME, output_lock
 
     with pytest.raises(RuntimeError):
         with output_lock(tmp_path / "a" / "b"):
@@ -123,12 +123,12 @@ def test_a_run_waiting_on_a_failed_run_locks_the_new_lock_file(tmp_path):
 
     import pytest
 
-    from pipeline.locking import LOCK_NAME, output_lock
+    from rockfrag.locking import LOCK_NAME, output_lock
 
     output = tmp_path / "out"
     script = textwrap.dedent(f"""
         import time
-        from pipeline.locking import output_lock
+        from rockfrag.locking import output_lock
         try:
             with output_lock({str(output)!r}):
                 print("locked", flush=True)

@@ -10,14 +10,14 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from pipeline import applicability as applicability_module
-from pipeline.answer import answer_model, answer_rows, answer_table, display_scale
-from pipeline.calibrate import check_reference, load_reference
-from pipeline.cli import _study_config, build_parser, main, run_applicability
-from pipeline.config import load_study
-from pipeline.errors import ConfigError
-from pipeline.records import load_records
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag import applicability as applicability_module
+from rockfrag.answer import answer_model, answer_rows, answer_table, display_scale
+from rockfrag.calibrate import check_reference, load_reference
+from rockfrag.cli import _study_config, build_parser, main, run_applicability
+from rockfrag.config import load_study
+from rockfrag.errors import ConfigError
+from rockfrag.records import load_records
+from rockfrag.units import STANDARD_GRAVITY
 
 ROOT = Path(__file__).resolve().parents[1]
 TINY = """
@@ -172,7 +172,7 @@ def _planned_not_rendered(planned: list, workers_seen: list):
     ``workers`` it was given to ``workers_seen``."""
     import matplotlib.pyplot as plt
 
-    from pipeline.report import build_plan, report_results
+    from rockfrag.report import build_plan, report_results
 
     def stage(config, cube, ida, fragility, risk, output, runtime_s=float("nan"), applicability=None,
               progress=True, workers=None, run=None):
@@ -190,7 +190,7 @@ def test_fragility_ends_with_the_answer_and_skips_the_sweep_of_a_study_file(tiny
     """On a study with one soil, whose by-model page is laid out on a grid (drawing it once crashed)."""
     study, output = tiny_run
     planned, workers = [], []
-    monkeypatch.setattr("pipeline.report.report_stage", _planned_not_rendered(planned, workers))
+    monkeypatch.setattr("rockfrag.report.report_stage", _planned_not_rendered(planned, workers))
     captured, calls = _run(study, output, capsys, monkeypatch)
     assert not calls and "applicability sweep not run" in captured.err and "--applicability" in captured.err
     assert workers == [1]  # --serial: the report's figures are drawn in this process too, no forked worker
@@ -211,7 +211,7 @@ def test_fragility_ends_with_the_answer_and_skips_the_sweep_of_a_study_file(tiny
 def test_quiet_hides_the_answer_and_the_flag_runs_the_sweep(tiny_run, capsys, monkeypatch):
     study, output = tiny_run
     # the flags are what is tested here: the report (planned by the test above) is not made again
-    monkeypatch.setattr("pipeline.report.report_stage", lambda *args, **kwargs: (output / "report.pdf", []))
+    monkeypatch.setattr("rockfrag.report.report_stage", lambda *args, **kwargs: (output / "report.pdf", []))
     captured, calls = _run(study, output, capsys, monkeypatch, "--quiet", "--applicability")
     assert len(calls) == 1 and "Overturning" not in captured.out and "sweep not run" not in captured.err
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from pipeline.cli import main
+from rockfrag.cli import main
 
 BLOCK = '[blocks.cab]\nb = 0.3\nh = 1.0\nmass = 300\nE_b = 200\n'
 STUDY = 'soils = ["clay"]\n' + BLOCK

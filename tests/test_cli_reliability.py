@@ -16,10 +16,10 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from pipeline import cli
-from pipeline.config import load_study
-from pipeline.records import load_records
-from pipeline.study import run_study
+from rockfrag import cli
+from rockfrag.config import load_study
+from rockfrag.records import load_records
+from rockfrag.study import run_study
 from tests.reliability_helpers import (
     QUIET,
     assert_one_line_error,
@@ -192,7 +192,7 @@ def test_internal_error_is_one_line_with_a_log_and_exit_3(tmp_path, capsys, monk
     def broken_stage(*args, **kwargs):
         raise ZeroDivisionError("a bug")
 
-    monkeypatch.setattr("pipeline.records_report.records_stage", broken_stage)
+    monkeypatch.setattr("rockfrag.records_report.records_stage", broken_stage)
     output = tmp_path / "out"
     status = cli.main(["records", "--set", "bolu", "--output", str(output), "--no-progress"])
     captured = capsys.readouterr()
@@ -229,11 +229,11 @@ def test_internal_error_in_a_real_process(tmp_path):
     """A real process: one stderr line, rc 3, no traceback on the terminal."""
     code = textwrap.dedent(f"""
         import sys
-        import pipeline.records_report as stage
+        import rockfrag.records_report as stage
         def broken(*a, **k):
             raise KeyError("surprise")
         stage.records_stage = broken
-        from pipeline.cli import main
+        from rockfrag.cli import main
         sys.exit(main(["records", "--set", "bolu", "--output", {str(tmp_path)!r}, "--no-progress"]))
     """)
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
@@ -243,7 +243,7 @@ def test_internal_error_in_a_real_process(tmp_path):
 
 def test_bad_records_in_a_real_process_exit_1(tmp_path):
     folder = _bad_folder(tmp_path, {"dt": 1e-300})
-    result = subprocess.run([sys.executable, "-m", "pipeline", "records", "--set", str(folder), "--output",
+    result = subprocess.run([sys.executable, "-m", "rockfrag", "records", "--set", str(folder), "--output",
                              str(tmp_path / "out"), "--no-progress"], capture_output=True, text=True, cwd=ROOT)
     assert result.returncode == 1
     assert_one_line_error(result.stderr, "bad.AT2", "DT = 1e-300")
@@ -253,7 +253,7 @@ def test_internal_error_in_a_cell_names_the_record(tiny_study, tmp_path, capsys,
     def broken_cells(*args, **kwargs):
         raise IndexError("kernel bug")
 
-    monkeypatch.setattr("pipeline.study.compute_cells", broken_cells)
+    monkeypatch.setattr("rockfrag.study.compute_cells", broken_cells)
     status = cli.main(["run", str(tiny_study), "--output", str(tmp_path / "out"), "--serial", "--no-progress"])
     assert status == cli.EXIT_INTERNAL_ERROR
     assert_one_line_error(capsys.readouterr().err, "stage 'run'", str(tiny_study), "(record pulse, block ",

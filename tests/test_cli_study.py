@@ -6,10 +6,10 @@ from importlib.resources import files
 
 import pytest
 
-from pipeline.cli import main
-from pipeline.config import SCHEMA, load_study, study_keys
-from pipeline.errors import ConfigError
-from pipeline.validation import schema_keys
+from rockfrag.cli import main
+from rockfrag.config import SCHEMA, load_study, study_keys
+from rockfrag.errors import ConfigError
+from rockfrag.validation import schema_keys
 
 
 def _leaf_keys(table: dict, prefix: str = "") -> set[str]:
@@ -30,7 +30,7 @@ def test_keys_lists_every_key_of_the_shipped_study_with_what_it_must_be(capsys):
     assert main(["study", "--keys"]) == 0
     printed = capsys.readouterr().out
     listed = {line.split()[0] for line in printed.splitlines()[1:-1]}
-    shipped = _leaf_keys(tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text()))
+    shipped = _leaf_keys(tomllib.loads(files("rockfrag").joinpath("defaults.toml").read_text()))
     assert shipped <= listed, f"keys of defaults.toml missing from --keys: {sorted(shipped - listed)}"
     assert listed == {key for key, _ in schema_keys(SCHEMA)}
     line = next(line for line in printed.splitlines() if line.startswith("hazard.design_life "))

@@ -8,8 +8,8 @@ import argparse
 import pytest
 import xarray as xr
 
-from pipeline.cli import _executor_options, _study_config, build_parser, main
-from pipeline.errors import PipelineError
+from rockfrag.cli import _executor_options, _study_config, build_parser, main
+from rockfrag.errors import PipelineError
 
 RECORD_COMMANDS = ("records", "run", "fragility", "applicability")
 SHARED = ("--set", "--units", "--dt", "--processing", "--output", "--no-progress")
@@ -119,8 +119,8 @@ mass = 2000.0
 
 
 def test_applicability_command_and_fragility_stage_share_one_definition(tmp_path, capsys):
-    from pipeline.applicability import applicability_stage
-    from pipeline.config import load_study
+    from rockfrag.applicability import applicability_stage
+    from rockfrag.config import load_study
 
     study = tmp_path / "study.toml"
     study.write_text(SWEEP_STUDY)

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from pipeline.cli import main
-from pipeline.config import load_study
-from pipeline.errors import ConfigError
+from rockfrag.cli import main
+from rockfrag.config import load_study
+from rockfrag.errors import ConfigError
 
 BLOCK = "b = 0.5\nh = 2.0\nmass = 1000.0\n"
 

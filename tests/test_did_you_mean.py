@@ -3,11 +3,11 @@ files), ``rockfrag calibrate --block/--soil/--model``, ``get_model``, one helper
 
 import pytest
 
-from pipeline.cli import main
-from pipeline.config import load_study
-from pipeline.errors import ConfigError, SolverError
-from pipeline.models import get_model
-from pipeline.validation import did_you_mean
+from rockfrag.cli import main
+from rockfrag.config import load_study
+from rockfrag.errors import ConfigError, SolverError
+from rockfrag.models import get_model
+from rockfrag.validation import did_you_mean
 
 
 def test_did_you_mean_suggests_the_closest_name_or_nothing():

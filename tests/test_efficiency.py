@@ -8,7 +8,7 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
-from pipeline.efficiency import (
+from rockfrag.efficiency import (
     capacities_in_measures,
     efficiency_from_capacities,
     efficiency_table,
@@ -16,7 +16,7 @@ from pipeline.efficiency import (
     rank_ascending,
     write_efficiency,
 )
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.units import STANDARD_GRAVITY
 
 N = 40
 rng = np.random.default_rng(7)

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pipeline.config import load_study
-from pipeline.efficiency import efficiency_dataset, efficiency_table
-from pipeline.ida import ida_dataset
-from pipeline.study import run_study, study_records
+from rockfrag.config import load_study
+from rockfrag.efficiency import efficiency_dataset, efficiency_table
+from rockfrag.ida import ida_dataset
+from rockfrag.study import run_study, study_records
 
 STUDY = Path(__file__).resolve().parents[1] / "studies" / "near-field-pulse.toml"
 SUBSET = ["NORTHR/RRS_032", "IMPVALL/H-E06_233", "LANDERS/LCN_239"]

@@ -1,4 +1,4 @@
-"""Process hygiene (issue 13, pipeline.executors): a task whose worker is killed is retried once in a
+"""Process hygiene (issue 13, rockfrag.executors): a task whose worker is killed is retried once in a
 fresh pool, then reported alone while its neighbours finish; pool workers die with their parent; a pool
 shuts down in bounded time; and the study keeps the records whose workers survived."""
 
@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from pipeline.config import load_study
-from pipeline.errors import PipelineError
-from pipeline.executors import Executor, check_workers, make_executor, run_tasks, shutdown_pool, worker_pool
-from pipeline.study import compute_cells, run_study
+from rockfrag.config import load_study
+from rockfrag.errors import PipelineError
+from rockfrag.executors import Executor, check_workers, make_executor, run_tasks, shutdown_pool, worker_pool
+from rockfrag.study import compute_cells, run_study
 from tests.reliability_helpers import QUIET, small_study_text, write_at2, write_tiny_study
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,7 +68,7 @@ def test_workers_die_with_their_parent(tmp_path):
     script.write_text(textwrap.dedent("""
         import os, sys, time
         from concurrent.futures import ProcessPoolExecutor
-        from pipeline.executors import die_with_parent
+        from rockfrag.executors import die_with_parent
 
         def pid(_):
             time.sleep(0.2)
@@ -120,7 +120,7 @@ def test_record_whose_worker_dies_twice_is_reported_and_the_rest_kept(tmp_path, 
     write_at2(tmp_path / "records" / "fine.AT2", amplitude_g=0.3, dt=0.005, npts=800)
     study = tmp_path / "study.toml"
     study.write_text(small_study_text(tmp_path / "records", levels=[0.5], soils=["rock"]))
-    monkeypatch.setattr("pipeline.study.compute_cells", _oom_on_fine_sampling)
+    monkeypatch.setattr("rockfrag.study.compute_cells", _oom_on_fine_sampling)
     warnings = []
     dataset, stats = run_study(load_study(study), output=tmp_path / "out", workers=2, progress=False,
                                log=lambda message: None, warn=warnings.append)

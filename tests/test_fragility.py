@@ -14,9 +14,9 @@ from scipy.optimize import minimize
 from scipy.special import log_ndtr
 from scipy.stats import norm
 
-from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.damage_states import DAMAGE_STATES, damage_states_from_config, families_of, state_family
-from pipeline.fragility import (
+from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from rockfrag.damage_states import DAMAGE_STATES, damage_states_from_config, families_of, state_family
+from rockfrag.fragility import (
     STATUS,
     curves_cross,
     fit_binomial,
@@ -31,9 +31,9 @@ from pipeline.fragility import (
     pelicun_table,
     separation,
 )
-from pipeline.ida import ida_dataset
-from pipeline.outputs import write_dataset
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.ida import ida_dataset
+from rockfrag.outputs import write_dataset
+from rockfrag.units import STANDARD_GRAVITY
 
 UPLIFT_G = 0.2  # g tan(alpha) of the synthetic block [g]
 

@@ -13,18 +13,18 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline import errors
-from pipeline.cli import main
-from pipeline.config import load_study
-from pipeline.errors import ConfigError
-from pipeline.hazard import (
+from rockfrag import errors
+from rockfrag.cli import main
+from rockfrag.config import load_study
+from rockfrag.errors import ConfigError
+from rockfrag.hazard import (
     EARTH_RADIUS_KM,
     HazardSiteWarning,
     great_circle_km,
     load_hazard,
     study_hazard,
 )
-from pipeline.risk import risk_dataset
+from rockfrag.risk import risk_dataset
 
 DATA = Path(__file__).parent / "data"
 REGIONAL = DATA / "openquake_hazard_curve-rlz-000-PGA_6sites.csv"
@@ -167,12 +167,12 @@ def test_the_study_key_reaches_the_risk_and_its_attributes(tmp_path):
 
 
 def test_rockfrag_fragility_prints_the_site_and_warns_when_far(tmp_path, capsys, monkeypatch):
-    import pipeline.study
+    import rockfrag.study
 
     def stop(*args, **kwargs):
         raise errors.PipelineError("stopped after the hazard (test)")
 
-    monkeypatch.setattr(pipeline.study, "study_records", stop)  # the run itself is not this test's business
+    monkeypatch.setattr(rockfrag.study, "study_records", stop)  # the run itself is not this test's business
     path = tmp_path / "study.toml"
     path.write_text(f'[hazard]\nfile = "{REGIONAL}"\nsite = [-121.0, 38.2]\n')
     with warnings.catch_warnings():

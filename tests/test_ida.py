@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.ida import first_crossing_im, hunt_and_fill, ida_dataset, overturning_capacities
+from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from rockfrag.ida import first_crossing_im, hunt_and_fill, ida_dataset, overturning_capacities
 
 
 def constructed_cube(ratios, outcomes, levels):

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.blocks import Block
-from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.ida import capacity_from_stripes, ida_dataset, uniform_stripe_runs
-from pipeline.models import simulate_batch
+from rockfrag.blocks import Block
+from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from rockfrag.ida import capacity_from_stripes, ida_dataset, uniform_stripe_runs
+from rockfrag.models import simulate_batch
 
 SLENDER = Block(name="slender", b=0.3, h=1.5, mass=2000.0)
 

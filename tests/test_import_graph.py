@@ -2,9 +2,9 @@
 
 Every ``import`` and ``from ... import`` of every module under ``pipeline/`` counts, those inside
 functions and ``if TYPE_CHECKING:`` blocks included: a lazy import hides a circle from Python, not
-from a reader. ``from pipeline.a import b`` is an edge to ``pipeline.a.b`` when that is a module, else
-to ``pipeline.a``; importing ``pipeline.a.b`` from outside the package ``pipeline.a`` also runs
-``pipeline/a/__init__.py``, so it is an edge to ``pipeline.a`` too (a package's own modules importing
+from a reader. ``from rockfrag.a import b`` is an edge to ``rockfrag.a.b`` when that is a module, else
+to ``rockfrag.a``; importing ``rockfrag.a.b`` from outside the package ``rockfrag.a`` also runs
+``pipeline/a/__init__.py``, so it is an edge to ``rockfrag.a`` too (a package's own modules importing
 each other do not count their shared ``__init__``).
 """
 
@@ -18,29 +18,29 @@ PACKAGE = Path(__file__).resolve().parent.parent / "pipeline"
 
 LAYERS: list[tuple[str, ...]] = [
     # 0 foundations: the version, exceptions, SI constants, atomic writes, fit numerics on arrays
-    ("pipeline", "pipeline.errors", "pipeline.units", "pipeline.outputs", "pipeline.lognormal_fit"),
+    ("rockfrag", "rockfrag.errors", "rockfrag.units", "rockfrag.outputs", "rockfrag.lognormal_fit"),
     # 1 plumbing shared by stages: value checks, file locks, checkpoints, worker pools
-    ("pipeline.validation", "pipeline.locking", "pipeline.checkpoints", "pipeline.executors"),
+    ("rockfrag.validation", "rockfrag.locking", "rockfrag.checkpoints", "rockfrag.executors"),
     # 2 inputs: record readers and signal processing
-    ("pipeline.records", "pipeline.records.*", "pipeline.processing"),
+    ("rockfrag.records", "rockfrag.records.*", "rockfrag.processing"),
     # 3 facts every stage reads: measures, blocks, soils, damage states, hazard curves
-    ("pipeline.measures", "pipeline.blocks", "pipeline.soils", "pipeline.damage_states", "pipeline.hazard",
-     "pipeline.plausibility"),  # plausibility: issue 21's checks of a study's blocks and soils
+    ("rockfrag.measures", "rockfrag.blocks", "rockfrag.soils", "rockfrag.damage_states", "rockfrag.hazard",
+     "rockfrag.plausibility"),  # plausibility: issue 21's checks of a study's blocks and soils
     # 4 the solvers
-    ("pipeline.models", "pipeline.models.*"),
+    ("rockfrag.models", "rockfrag.models.*"),
     # 5 the study definition
-    ("pipeline.config",),
+    ("rockfrag.config",),
     # 6 results of one kind: the cube, IDA, risk, calibration, the records table, the exchange files (8b)
-    ("pipeline.cube", "pipeline.ida", "pipeline.risk", "pipeline.calibrate", "pipeline.records_report",
-     "pipeline.exchange"),
+    ("rockfrag.cube", "rockfrag.ida", "rockfrag.risk", "rockfrag.calibrate", "rockfrag.records_report",
+     "rockfrag.exchange"),
     # 7 stages that combine them: the sweep, the fits (which add the risk), the measure ranking
-    ("pipeline.study", "pipeline.fragility", "pipeline.efficiency"),
+    ("rockfrag.study", "rockfrag.fragility", "rockfrag.efficiency"),
     # 8 stages built on the sweep
-    ("pipeline.showcase", "pipeline.applicability"),
+    ("rockfrag.showcase", "rockfrag.applicability"),
     # 9 what the reader gets: the report and the terminal's answer table
-    ("pipeline.report", "pipeline.report.*", "pipeline.answer"),
+    ("rockfrag.report", "rockfrag.report.*", "rockfrag.answer"),
     # 10 the command
-    ("pipeline.cli", "pipeline.__main__"),
+    ("rockfrag.cli", "rockfrag.__main__"),
 ]
 """Layer order, bottom first: a module may import its own layer and those below it, never above."""
 
@@ -50,7 +50,8 @@ branches; each entry says why. Empty: the graph is clean."""
 
 
 def module_name(path: Path) -> str:
-    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    """The import name of a module file: the folder ``pipeline/`` is installed as the package ``rockfrag``."""
+    parts = ("rockfrag", *path.relative_to(PACKAGE).with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
@@ -73,7 +74,7 @@ def imported(name: str, path: Path, node: ast.AST, known: dict[str, Path]) -> se
         return set()
     found = set()
     for target in targets:
-        if not (target == "pipeline" or target.startswith("pipeline.")):
+        if not (target == "rockfrag" or target.startswith("rockfrag.")):
             continue
         while target not in known:  # an attribute of a module: the module
             target = target.rsplit(".", 1)[0]
@@ -134,26 +135,26 @@ def test_the_graph_is_read_from_every_import_lazy_ones_included():
     known = modules()
     source = """
 import numpy
-from pipeline.errors import ConfigError
-from pipeline import measures
+from rockfrag.errors import ConfigError
+from rockfrag import measures
 
 if TYPE_CHECKING:
-    from pipeline.blocks import Block
+    from rockfrag.blocks import Block
 
 def stage():
-    import pipeline.cube
-    from pipeline.models.base import Outcome
-    from pipeline.models import fields
+    import rockfrag.cube
+    from rockfrag.models.base import Outcome
+    from rockfrag.models import fields
 """
-    found = imports_of("pipeline.hazard", PACKAGE / "hazard.py", source, known)
-    assert found == {"pipeline.errors", "pipeline.measures", "pipeline.blocks", "pipeline.cube", "pipeline.models.base",
-                     "pipeline.models", "pipeline.models.fields"}  # models/__init__ runs for models.base and .fields
-    inside = imports_of("pipeline.models.ssi", PACKAGE / "models" / "ssi.py", "from pipeline.models.base import X",
+    found = imports_of("rockfrag.hazard", PACKAGE / "hazard.py", source, known)
+    assert found == {"rockfrag.errors", "rockfrag.measures", "rockfrag.blocks", "rockfrag.cube", "rockfrag.models.base",
+                     "rockfrag.models", "rockfrag.models.fields"}  # models/__init__ runs for models.base and .fields
+    inside = imports_of("rockfrag.models.ssi", PACKAGE / "models" / "ssi.py", "from rockfrag.models.base import X",
                         known)
-    assert inside == {"pipeline.models.base"}  # within its package, a module does not count the package __init__
+    assert inside == {"rockfrag.models.base"}  # within its package, a module does not count the package __init__
     graph = import_graph()
-    assert "pipeline.config" in graph and "pipeline.models.kernels" in graph and "pipeline.report.adapters" in graph
-    assert "pipeline.damage_states" in graph["pipeline.config"]
+    assert "rockfrag.config" in graph and "rockfrag.models.kernels" in graph and "rockfrag.report.adapters" in graph
+    assert "rockfrag.damage_states" in graph["rockfrag.config"]
 
 
 def test_the_cycle_finder_finds_a_cycle():

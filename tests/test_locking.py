@@ -13,8 +13,8 @@ import time
 
 import pytest
 
-from pipeline import cli, locking
-from pipeline.locking import LOCK_NAME, output_lock
+from rockfrag import cli, locking
+from rockfrag.locking import LOCK_NAME, output_lock
 from tests.reliability_helpers import assert_one_line_error, tiny_run_argv
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.measures import (
+from rockfrag.measures import (
     arias_intensity,
     cav,
     pga,
@@ -14,7 +14,7 @@ from pipeline.measures import (
     significant_duration,
     significant_window,
 )
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.units import STANDARD_GRAVITY
 
 
 def test_sdof_step_response_matches_closed_form():

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.efficiency import ranked_measures
-from pipeline.hazard import _measure_from_imt, load_hazard
-from pipeline.measures import (
+from rockfrag.blocks import Block
+from rockfrag.efficiency import ranked_measures
+from rockfrag.hazard import _measure_from_imt, load_hazard
+from rockfrag.measures import (
     MEASURES,
     average_spectral_acceleration,
     cav,
@@ -20,7 +20,7 @@ from pipeline.measures import (
     short_label,
     velocity_pulse,
 )
-from pipeline.units import STANDARD_GRAVITY as G
+from rockfrag.units import STANDARD_GRAVITY as G
 
 BLOCK = Block(name="cabinet", b=0.3, h=1.5, mass=2000.0)  # tan(alpha) = 0.2, R = sqrt(0.09 + 2.25)
 

@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.errors import ConfigError
-from pipeline.exchange import (
+from rockfrag.errors import ConfigError
+from rockfrag.exchange import (
     OPENQUAKE_FILE,
     openquake_imt,
     openquake_limit_state,
@@ -31,9 +31,9 @@ from pipeline.exchange import (
     state_families,
     write_exchange_files,
 )
-from pipeline.hazard import HazardCurve
-from pipeline.models.variants import RECOMMENDED
-from pipeline.risk import annual_frequency, probability_in_life
+from rockfrag.hazard import HazardCurve
+from rockfrag.models.variants import RECOMMENDED
+from rockfrag.risk import annual_frequency, probability_in_life
 from tests.helpers import CONSUMERS, consumer_python
 from tests.test_pelicun import exchange_dataset, our_curves, readme_example
 

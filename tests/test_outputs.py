@@ -1,4 +1,4 @@
-"""Result files: one netCDF writer (pipeline.outputs.write_dataset) that every stage calls; it compresses
+"""Result files: one netCDF writer (rockfrag.outputs.write_dataset) that every stage calls; it compresses
 every numeric data variable, reads back identical, gives coordinates no fill value, and never leaves a
 half-written file."""
 
@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 import xarray as xr
 
-import pipeline
-from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.ida import ida_stage
-from pipeline.outputs import write_dataset
+import rockfrag
+from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from rockfrag.ida import ida_stage
+from rockfrag.outputs import write_dataset
 
-PACKAGE = Path(pipeline.__file__).parent
+PACKAGE = Path(rockfrag.__file__).parent
 
 
 def uncompressed(path: Path) -> list[str]:
@@ -111,4 +111,4 @@ def test_no_module_but_outputs_writes_netcdf():
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
             if isinstance(node, ast.Attribute) and node.attr == "to_netcdf":
                 writers.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno}")
-    assert writers == [], f"write netCDF files with pipeline.outputs.write_dataset, not to_netcdf: {writers}"
+    assert writers == [], f"write netCDF files with rockfrag.outputs.write_dataset, not to_netcdf: {writers}"

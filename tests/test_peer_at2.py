@@ -12,9 +12,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pipeline.errors import RecordError
-from pipeline.records.peer_at2 import is_peer_at2, parse_peer_at2
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.errors import RecordError
+from rockfrag.records.peer_at2 import is_peer_at2, parse_peer_at2
+from rockfrag.units import STANDARD_GRAVITY
 
 VARIANT_FILES = {
     "nga-west2": "peer_original/NHERI-SimCenter__EE-UQ/RSN125_FRIULI.A_A-TMZ000.AT2",

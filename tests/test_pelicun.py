@@ -26,8 +26,8 @@ import pytest
 import xarray as xr
 from scipy.stats import norm
 
-from pipeline.exchange import pelicun_id, pelicun_table, state_families, write_exchange_files
-from pipeline.models.variants import RECOMMENDED
+from rockfrag.exchange import pelicun_id, pelicun_table, state_families, write_exchange_files
+from rockfrag.models.variants import RECOMMENDED
 from tests.helpers import CONSUMERS, ROOT, consumer_python
 
 DEMAND_LEVELS = np.geomspace(0.03, 8.0, 10)

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.config import load_study
-from pipeline.errors import ConfigError
-from pipeline.plausibility import (
+from rockfrag.blocks import Block
+from rockfrag.config import load_study
+from rockfrag.errors import ConfigError
+from rockfrag.plausibility import (
     CHECKS,
     MIN_FREQUENCY_RATIO,
     OVERRIDE_HINT,
@@ -22,8 +22,8 @@ from pipeline.plausibility import (
     implausibilities,
     settlement,
 )
-from pipeline.soils import SOILS, Foundation, SoilClass, foundation
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.soils import SOILS, Foundation, SoilClass, foundation
+from rockfrag.units import STANDARD_GRAVITY
 
 ROOT = Path(__file__).resolve().parents[1]
 CABINET = {"b": 0.3, "h": 1.5, "mass": 2000.0, "E_b": 200e9, "footprint_area": 0.48, "soil_depth": 1.0}

@@ -7,8 +7,8 @@ import inspect
 import numpy as np
 import pytest
 
-from pipeline.errors import ConfigError
-from pipeline.processing import (
+from rockfrag.errors import ConfigError
+from rockfrag.processing import (
     PROCESSING_STEPS,
     header_corners,
     integrate,
@@ -17,7 +17,7 @@ from pipeline.processing import (
     recipe_from_dict,
     tail_checks,
 )
-from pipeline.records import read_record
+from rockfrag.records import read_record
 
 
 def test_every_real_record_ends_at_rest(all_records):
@@ -118,7 +118,7 @@ def test_the_shipped_recipe_is_the_authority_for_the_band_pass_corners():
 
 def test_per_record_override_changes_only_that_record(bolu_records, tmp_path):
     path = tmp_path / "recipe.toml"
-    default = (__import__("pipeline").__path__[0] + "/processing.toml")
+    default = (__import__("rockfrag").__path__[0] + "/processing.toml")
     path.write_text(open(default).read() + '\n[overrides."DUZCE/BOL090".bandpass]\nfreqmin = 0.5\n')
     recipe = load_recipe(path)
     record = bolu_records["DUZCE/BOL090"]

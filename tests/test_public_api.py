@@ -12,7 +12,7 @@ import re
 
 import pytest
 
-from pipeline import calibrate, config, fragility, hazard, models, outputs, processing, records, risk
+from rockfrag import calibrate, config, fragility, hazard, models, outputs, processing, records, risk
 
 PUBLIC_API = [
     models.simulate,

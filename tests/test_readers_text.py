@@ -9,11 +9,11 @@ import obspy
 import pandas as pd
 import pytest
 
-from pipeline.cli import main
-from pipeline.errors import RecordError
-from pipeline.records import detect_format, load_records, read_record
-from pipeline.records.text import read_columns
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.cli import main
+from rockfrag.errors import RecordError
+from rockfrag.records import detect_format, load_records, read_record
+from rockfrag.records.text import read_columns
+from rockfrag.units import STANDARD_GRAVITY
 
 KNET_FILE = Path(obspy.__file__).parent / "io" / "nied" / "tests" / "data" / "test.knet"
 SAMPLES = [0.0, 0.1, -0.25, 0.05, 0.0]

@@ -46,7 +46,7 @@ def test_python_example_runs_as_printed(number, tmp_path, monkeypatch, capsys):
 
 
 def test_every_rockfrag_line_parses():
-    from pipeline.cli import build_parser
+    from rockfrag.cli import build_parser
 
     parser = build_parser()
     checked = 0
@@ -129,7 +129,7 @@ def runnable_commands() -> list[str]:
 @pytest.mark.xdist_group("readme-commands")
 def test_readme_commands_on_shipped_inputs_run_as_printed(tmp_path, capsys):
     """Each such line runs with the real `rockfrag` and exits 0 (outputs go to a temporary folder)."""
-    from pipeline.cli import main
+    from rockfrag.cli import main
 
     commands = runnable_commands()
     assert any(c.startswith("fragility studies/example.toml") for c in commands)

@@ -1,6 +1,6 @@
 """The recommended fragility: the restitution band's variants, their calibration in a study, and the
-combination of their fits into one curve with its model dispersion (pipeline.models.variants,
-pipeline.study, pipeline.fragility.with_recommended).
+combination of their fits into one curve with its model dispersion (rockfrag.models.variants,
+rockfrag.study, rockfrag.fragility.with_recommended).
 
 The combination is checked against a Monte Carlo of what it claims to be (a median uniform in log between
 the edges' medians, times record-to-record scatter), not against its own formula."""
@@ -13,14 +13,14 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.blocks import Block
-from pipeline.config import load_study
-from pipeline.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.errors import ConfigError, SolverError
-from pipeline.fragility import RECOMMENDED, fragility_dataset, fragility_table
-from pipeline.models import get_model, model_label
-from pipeline.models.restitution import free_rocking_restitution
-from pipeline.models.variants import (
+from rockfrag.blocks import Block
+from rockfrag.config import load_study
+from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from rockfrag.errors import ConfigError, SolverError
+from rockfrag.fragility import RECOMMENDED, fragility_dataset, fragility_table
+from rockfrag.models import get_model, model_label
+from rockfrag.models.restitution import free_rocking_restitution
+from rockfrag.models.variants import (
     BAND_XI_FLOOR,
     RESTITUTION_CAP,
     band_target,
@@ -28,8 +28,8 @@ from pipeline.models.variants import (
     calibrate_models,
     split_variant,
 )
-from pipeline.soils import SOILS, soil_block_stiffness
-from pipeline.study import cells_for_record, restitution_key
+from rockfrag.soils import SOILS, soil_block_stiffness
+from rockfrag.study import cells_for_record, restitution_key
 
 CABINET = Block(name="cabinet", b=0.3, h=1.5, mass=2000.0, E_b=200e9, footprint_area=0.48, soil_depth=1.0)
 PAPER = Block(name="paper", R=9.39, alpha=0.44, mass=326197.0, E_b=210e9, footprint_area=8.0, soil_depth=2.0)

@@ -10,9 +10,9 @@ import numpy as np
 import obspy
 import pytest
 
-from pipeline.errors import ManifestError, RecordError
-from pipeline.records import list_formats, load_records, read_record, record_sets, same_samples
-from pipeline.records.manifest import load_catalogue, verify
+from rockfrag.errors import ManifestError, RecordError
+from rockfrag.records import list_formats, load_records, read_record, record_sets, same_samples
+from rockfrag.records.manifest import load_catalogue, verify
 
 
 def test_catalogue_sets_have_the_published_sizes():

@@ -4,8 +4,8 @@ no worker may outlive its killed parent, nothing may hold the output lock 10 s a
 ``.part`` file may be left behind.
 
 The ten interrupted runs are forked from one process that has imported everything (tests/chaos_zygote.py):
-started as ``python -m pipeline``, each spent about 3 of its 4 s importing, and a kill "at a random point"
-mostly fell in the imports. The last run is a fresh ``python -m pipeline`` process."""
+started as ``python -m rockfrag``, each spent about 3 of its 4 s importing, and a kill "at a random point"
+mostly fell in the imports. The last run is a fresh ``python -m rockfrag`` process."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from pathlib import Path
 import pytest
 import xarray as xr
 
-from pipeline.locking import LOCK_NAME
+from rockfrag.locking import LOCK_NAME
 from tests.reliability_helpers import small_study_text, write_at2
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -110,7 +110,7 @@ class Zygote:
 @pytest.mark.slow
 def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
     """Ten runs forked from one warm process (tests/chaos_zygote.py), so that the kills fall in the runs and not
-    in Python's imports, then a last undisturbed run as a fresh ``python -m pipeline`` process."""
+    in Python's imports, then a last undisturbed run as a fresh ``python -m rockfrag`` process."""
     rng = random.Random(13)
     write_at2(tmp_path / "records" / "pulse-a.AT2", amplitude_g=0.3, npts=2500)
     write_at2(tmp_path / "records" / "pulse-b.AT2", amplitude_g=0.5, dt=0.005, npts=4000)
@@ -125,7 +125,7 @@ def test_random_kills_of_parent_and_workers_leave_an_identical_cube(tmp_path):
     finally:
         zygote.close()
 
-    final = subprocess.run([sys.executable, "-m", "pipeline", *arguments], cwd=ROOT, env=run_environment(),
+    final = subprocess.run([sys.executable, "-m", "rockfrag", *arguments], cwd=ROOT, env=run_environment(),
                            capture_output=True, text=True, timeout=180)
     assert final.returncode == 0, final.stderr
     assert "Traceback" not in final.stderr

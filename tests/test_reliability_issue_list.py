@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from pipeline import cli
-from pipeline.checkpoints import SUFFIX
+from rockfrag import cli
+from rockfrag.checkpoints import SUFFIX
 from tests.reliability_helpers import error_lines, small_study_text, write_at2
 
 

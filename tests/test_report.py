@@ -12,7 +12,7 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from pipeline.report.adapters import differs_by_soil
+from rockfrag.report.adapters import differs_by_soil
 
 A4_LANDSCAPE_POINTS = (842, 595)  # 297 x 210 mm
 
@@ -86,8 +86,8 @@ def test_no_figure_warning_and_no_open_figures(small_pipeline):
 
 
 def _results(output, study, **changes):
-    from pipeline.config import load_study
-    from pipeline.report import Results
+    from rockfrag.config import load_study
+    from rockfrag.report import Results
 
     opened = _datasets(output)
     values = dict(config=load_study(study), cube=opened["cube"], ida=opened["ida"], fragility=opened["fragility"],
@@ -98,7 +98,7 @@ def _results(output, study, **changes):
 
 @pytest.mark.slow
 def test_pages_cover_only_the_study(small_pipeline):
-    from pipeline.report import plan
+    from rockfrag.report import plan
 
     output, study, _ = small_pipeline
     results = _results(output, study)
@@ -115,9 +115,9 @@ def test_pages_cover_only_the_study(small_pipeline):
 
 @pytest.mark.slow
 def test_figure_pages_rigid_base_once_legend_outside_shared_scales(small_pipeline):
-    from pipeline.report import figures
-    from pipeline.report.adapters import models_of
-    from pipeline.report.layout import PAGE_SIZE
+    from rockfrag.report import figures
+    from rockfrag.report.adapters import models_of
+    from rockfrag.report.layout import PAGE_SIZE
 
     output, study, _ = small_pipeline
     results = _results(output, study)
@@ -186,7 +186,7 @@ def _fake_cube(tension, friction=None):
 
 
 def test_limitations_state_the_tension_fraction_per_soil_and_block():
-    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+    from rockfrag.report.adapters import model_info, run_fraction, tension_flag
 
     tension = np.full((10, 2, 2, 1, 2), np.nan)
     tension[..., 1] = 0.0
@@ -200,7 +200,7 @@ def test_limitations_state_the_tension_fraction_per_soil_and_block():
 
 
 def test_tension_flag_not_applicable_is_not_counted():
-    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+    from rockfrag.report.adapters import model_info, run_fraction, tension_flag
 
     flags = np.full((10, 2, 2, 1, 2), -1, dtype=np.int8)  # -1: the model cannot pull (tensionless, rigid)
     flags[..., 1] = 0
@@ -213,7 +213,7 @@ def test_tension_flag_not_applicable_is_not_counted():
 
 
 def test_tension_falls_back_to_negative_support_force():
-    from pipeline.report.adapters import model_info, run_fraction, tension_flag
+    from rockfrag.report.adapters import model_info, run_fraction, tension_flag
 
     force = np.full((10, 2, 2, 1, 2), 1000.0)
     force[:5, :, 1, 0, 1] = -1.0
@@ -225,7 +225,7 @@ def test_tension_falls_back_to_negative_support_force():
 
 
 def test_sliding_fraction_above_the_friction_coefficient():
-    from pipeline.report.adapters import friction_flag, model_info, run_fraction
+    from rockfrag.report.adapters import friction_flag, model_info, run_fraction
 
     demand = np.full((10, 2, 2, 1, 2), 0.2)
     demand[:4, 1, 0, 0, 1] = 0.7  # 4 of 20 runs on clay need more than mu = 0.5
@@ -244,7 +244,7 @@ def _fake_fragility(medians, levels=(0.1, 1.0)):
 
 
 def test_extrapolated_medians_from_the_studied_range(tmp_path):
-    from pipeline.report.adapters import extrapolation
+    from rockfrag.report.adapters import extrapolation
 
     table = extrapolation(_fake_fragility([0.5, 2.0, np.nan]), tmp_path)
     assert list(table.status) == ["within", "above-range", "no fit"]
@@ -254,7 +254,7 @@ def test_extrapolated_medians_from_the_studied_range(tmp_path):
 
 
 def test_extrapolated_medians_from_the_fragility_csv_status_column(tmp_path):
-    from pipeline.report.adapters import extrapolation
+    from rockfrag.report.adapters import extrapolation
 
     pd.DataFrame({"soil": ["clay"] * 3, "block": ["b"] * 3, "model": ["ssi"] * 3, "damage_state": ["a", "b", "c"],
                   "status": ["ok", "extrapolated-above", "ok"]}).to_csv(tmp_path / "fragility.csv", index=False)
@@ -263,7 +263,7 @@ def test_extrapolated_medians_from_the_fragility_csv_status_column(tmp_path):
 
 
 def test_text_pages_split_long_tables_with_their_header():
-    from pipeline.report.text import heading, paginate, paragraph, table
+    from rockfrag.report.text import heading, paginate, paragraph, table
 
     items = [heading("h"), paragraph("p"), table(["a", "b"], [[str(i), str(i)] for i in range(100)])]
     pages = paginate(items, capacity=30)
@@ -275,7 +275,7 @@ def test_text_pages_split_long_tables_with_their_header():
 def test_a_wrapped_cell_is_not_split_across_two_pages():
     """Issue 20: a limitations row's wrapped model name ended at the top of the next page ("low edge"), away
     from its row."""
-    from pipeline.report.text import paginate, table
+    from rockfrag.report.text import paginate, table
 
     rows = [[f"row {i}", "x"] for i in range(26)] + [["row 26", "first line"], ["", "second line"],
                                                        ["", "third line"]] + [["row 27", "y"]] * 30
@@ -290,10 +290,10 @@ def test_showcase_record_is_bolu_or_the_named_one():
     import tomllib
     from importlib.resources import files
 
-    from pipeline.config import study_from_dict
-    from pipeline.showcase import showcase_record_id
+    from rockfrag.config import study_from_dict
+    from rockfrag.showcase import showcase_record_id
 
-    defaults = tomllib.loads(files("pipeline").joinpath("defaults.toml").read_text())
+    defaults = tomllib.loads(files("rockfrag").joinpath("defaults.toml").read_text())
     config = study_from_dict(defaults)
     assert showcase_record_id(config, ["DUZCE/BOL090", "X/Y"]) == "DUZCE/BOL090"
     assert showcase_record_id(config, ["X/Y"]) is None
@@ -319,8 +319,8 @@ def test_showcase_file_has_units_and_the_studys_cases(small_pipeline):
 
 
 def test_efficiency_page_is_drawn_on_the_page_size_from_efficiency_nc():
-    from pipeline.report import figures
-    from pipeline.report.layout import PAGE_SIZE
+    from rockfrag.report import figures
+    from rockfrag.report.layout import PAGE_SIZE
 
     dims = ("soil", "block", "model", "measure")
     dataset = xr.Dataset({name: (dims, np.full((1, 2, 1, 2), value)) for name, value in
@@ -356,9 +356,9 @@ def _housner_slides_on_rock(fragility):
 
 def test_a_rigid_base_that_slides_on_some_soils_is_drawn_from_each_soils_own_cell(small_pipeline):
     """The fragility-by-soil reference and the outcomes page took Housner from the first soil's cell."""
-    from pipeline.lognormal_fit import lognormal_cdf
-    from pipeline.report import figures
-    from pipeline.report.adapters import model_info
+    from rockfrag.lognormal_fit import lognormal_cdf
+    from rockfrag.report import figures
+    from rockfrag.report.adapters import model_info
 
     output, study, _ = small_pipeline
     # the small study's Housner slides on sand and is tied on rock: start from it tied everywhere, then let rock's
@@ -394,7 +394,7 @@ def test_a_rigid_base_that_slides_on_some_soils_is_drawn_from_each_soils_own_cel
 
 def test_the_run_count_is_the_studys_cells_a_sliding_rigid_base_once_per_friction_pair():
     """The title page counted a rigid base once per block, where the study runs it per friction pair."""
-    from pipeline.report.sections import Results, n_runs, runs_words
+    from rockfrag.report.sections import Results, n_runs, runs_words
 
     dims = ("soil", "block", "model")
     friction = np.full((2, 3, 2), np.nan)  # soils sand, rock; blocks a (tied), b (slides on sand), c (both)
@@ -419,7 +419,7 @@ def test_the_title_page_says_in_words_that_results_came_from_an_earlier_run_and_
     run" meant nothing to a client, and the report gave no date."""
     import os
 
-    from pipeline.report.sections import Results, results_date, runs_words
+    from rockfrag.report.sections import Results, results_date, runs_words
 
     cube = xr.Dataset(coords={"soil": ["sand"], "block": ["a"], "model": ["ssi"], "record": range(2),
                               "im_level": range(3)})

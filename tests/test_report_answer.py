@@ -10,7 +10,7 @@ import pytest
 import xarray as xr
 from scipy.stats import lognorm
 
-from pipeline.answer import (
+from rockfrag.answer import (
     ANCHOR,
     CHECK_SLIDING,
     NO_ACTION,
@@ -21,7 +21,7 @@ from pipeline.answer import (
     percent,
     verdict_sentence,
 )
-from pipeline.hazard import HazardCurve, load_hazard
+from rockfrag.hazard import HazardCurve, load_hazard
 
 K0, K = 1e-4, 2.5  # the shipped example: lambda(s) = K0 s^-K [1/yr], s = PGA [g]
 
@@ -138,8 +138,8 @@ def test_probabilities_are_rounded_to_what_they_support(value, shown):
 
 
 def test_the_study_states_the_limits_and_return_periods(tmp_path):
-    from pipeline.config import load_study
-    from pipeline.errors import ConfigError
+    from rockfrag.config import load_study
+    from rockfrag.errors import ConfigError
 
     study = tmp_path / "s.toml"
     study.write_text('[hazard]\nreturn_periods = [100.0, 2475.0]\n[decision]\nmax_probability_in_life = '
@@ -165,9 +165,9 @@ def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_lev
     the one at or below the intensity, as the probability table reads it (issue 20, finding 4)."""
     import xarray as xr
 
-    from pipeline.models.fields import MODE_TIME_FIELDS
-    from pipeline.models.variants import RECOMMENDED
-    from pipeline.report.answer_page import governing_modes
+    from rockfrag.models.fields import MODE_TIME_FIELDS
+    from rockfrag.models.variants import RECOMMENDED
+    from rockfrag.report.answer_page import governing_modes
 
     levels = np.array([0.1, 0.3, 1.0])  # g
     times = np.zeros((4, 3, 1, 1, 2, len(MODE_TIME_FIELDS)))  # record, level, soil, block, model, mode
@@ -207,7 +207,7 @@ def _tied_cube(outcome):
 def test_the_governing_motion_counts_as_the_fits_do_and_a_milder_motion_is_never_below_100_percent():
     """The client read "at rest (98%)" (at rest or worse is always 100%), "rocks (50%)" where 22 of 44 rocked
     and 22 overturned, and a record that overturned at a lower level counted as rocking (resurrection)."""
-    from pipeline.report.answer_page import governing_modes
+    from rockfrag.report.answer_page import governing_modes
 
     outcome = np.zeros((44, 3), int)
     outcome[0, 0] = 1                     # one record of 44 lifts off at 0.1 g: the rest stay at rest
@@ -222,10 +222,10 @@ def test_the_governing_motion_counts_as_the_fits_do_and_a_milder_motion_is_never
 def test_the_motion_table_and_the_probability_table_agree_on_one_cell():
     """One definition, level and counting rule: the share of records that overturn in the motion table is the
     count of records in the probability table's cell, at the same level (issue 20, finding 4)."""
-    from pipeline.answer import _records_at
-    from pipeline.damage_states import DAMAGE_STATES
-    from pipeline.fragility import exceedance
-    from pipeline.report.answer_page import governing_modes
+    from rockfrag.answer import _records_at
+    from rockfrag.damage_states import DAMAGE_STATES
+    from rockfrag.fragility import exceedance
+    from rockfrag.report.answer_page import governing_modes
 
     outcome = np.zeros((10, 3), int)
     outcome[:, 1:] = 1
@@ -266,7 +266,7 @@ def test_curves_that_cross_below_the_data_are_read_as_this_state_or_worse():
 def test_the_answer_says_where_the_bed_could_not_reach_the_band():
     """The example study's log warned that the bed runs the band's centre and upper edge at a lower r than asked;
     the answer page must say it too (beta_model there leaves out the less dissipative side)."""
-    from pipeline.report.answer_page import _band_reach
+    from rockfrag.report.answer_page import _band_reach
 
     dims = ("soil", "block", "model")
     requested = np.array([[[np.nan, 0.825, 0.845, 0.866]], [[np.nan, 0.825, 0.845, 0.866]]])
@@ -302,7 +302,7 @@ def _supported(lower, median=1.0, beta=0.6):
 def test_a_verdict_from_the_fits_tail_below_every_record_is_said_so():
     """The client read 2.2% at 0.3 g where no record overturned: each cell says what the records did at the level
     at or below the intensity, and the verdict says when it rests on the fitted curve's tail alone."""
-    from pipeline.report.answer_page import _at_cell, _period_header
+    from rockfrag.report.answer_page import _at_cell, _period_header
 
     levels, answer = _tail_case(5)  # first overturning at 1.39 g, far above the 2,475-year 0.57 g
     overturning = answer.soils[0].states[1]
@@ -333,7 +333,7 @@ def test_a_verdict_from_the_fits_tail_below_every_record_is_said_so():
 
 
 def test_the_data_supported_part_of_the_annual_frequency_is_the_integral_above_the_lower_limit():
-    from pipeline.risk import annual_frequency
+    from rockfrag.risk import annual_frequency
 
     hazard = _power_law()
     whole = annual_frequency(1.0, 0.6, hazard)
@@ -345,8 +345,8 @@ def test_the_data_supported_part_of_the_annual_frequency_is_the_integral_above_t
 
 def test_each_answer_page_states_the_planar_model_and_where_the_friction_comes_from(small_pipeline):
     """A client took the soil's friction for the plinth's, and the planar model's limits were on another page."""
-    from pipeline.report.answer_page import answer_items
-    from pipeline.report.sections import limitations_items, sources_items
+    from rockfrag.report.answer_page import answer_items
+    from rockfrag.report.sections import limitations_items, sources_items
     from tests.helpers import pipeline_results
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
@@ -365,8 +365,8 @@ def test_each_answer_page_states_the_planar_model_and_where_the_friction_comes_f
 
 
 def test_the_seed_paper_is_cited_from_its_copy_and_named_in_full_on_the_methods_page(small_pipeline):
-    from pipeline.report.sections import methods_items
-    from pipeline.report.words import PAPER_CITATION, PAPER_TITLE, REFERENCES
+    from rockfrag.report.sections import methods_items
+    from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, REFERENCES
     from tests.helpers import ROOT, pipeline_results
 
     assert REFERENCES["paper"].startswith(PAPER_CITATION) and "doi:10.20944/" in PAPER_CITATION
@@ -380,7 +380,7 @@ def test_the_seed_paper_is_cited_from_its_copy_and_named_in_full_on_the_methods_
 def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from_the_fits_tail():
     """The client read "uplift 98%, once in 13 years" from a median of 0.069 g, below the lowest level run (0.1 g),
     where every record had already lifted off: the page gives the records' fraction there as a lower bound."""
-    from pipeline.report.answer_page import _at_cell, _below_lowest
+    from rockfrag.report.answer_page import _at_cell, _below_lowest
 
     levels = np.geomspace(0.1, 4.0, 8)
     empirical = np.ones((levels.size, 2, 1, 2, 2))
@@ -406,7 +406,7 @@ def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run(
     page did not say that its band's three runs were one run (beta_model 0 by construction)."""
     from types import SimpleNamespace
 
-    from pipeline.report.answer_page import curve_reason
+    from rockfrag.report.answer_page import curve_reason
 
     models = ["recommended", "winkler-low", "winkler-centre", "winkler-high"]
     dims = ("soil", "block", "model")
@@ -458,7 +458,7 @@ def _friction_cube():
 def test_the_sliding_share_is_the_records_at_the_level_at_or_below_the_intensity_not_a_grid_average():
     """The client read 11-12% (an unweighted average over the levels up to the 2,475-year PGA) where 41-45% of the
     records at the 0.54 g level needed more friction; and a cell that slides was judged by another model's ties."""
-    from pipeline.report.adapters import sliding_at, sliding_share
+    from rockfrag.report.adapters import sliding_at, sliding_share
 
     cube = _friction_cube()
     models = ["recommended", "winkler-centre", "winkler-low"]
@@ -491,7 +491,7 @@ def test_answer_page_says_when_the_measure_is_not_sufficient():
     one sentence naming it; sufficient (or no test for the block) is none."""
     import xarray as xr
 
-    from pipeline.report.answer_page import sufficiency_words
+    from rockfrag.report.answer_page import sufficiency_words
 
     dims = ("soil", "block", "model", "measure")
     p = np.full((1, 2, 1, 2), 0.5)
@@ -510,7 +510,7 @@ def test_answer_page_says_when_the_measure_is_not_sufficient():
 def test_an_anchor_verdict_says_how_the_anchorage_is_designed(small_pipeline):
     """'Anchor it' came without a design basis (client read): the page points to the code procedure, exactly where a
     soil's verdict is 'anchor'."""
-    from pipeline.report.answer_page import ANCHOR_DESIGN, answer_items
+    from rockfrag.report.answer_page import ANCHOR_DESIGN, answer_items
     from tests.helpers import pipeline_results
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
@@ -526,6 +526,6 @@ def test_an_anchor_verdict_says_how_the_anchorage_is_designed(small_pipeline):
 
 def test_a_lower_bound_of_every_record_is_printed_as_a_certainty():
     """'\u2265100%' read oddly on the default report (every record uplifted at that level): it is 100%."""
-    from pipeline.report.answer_page import _at_least
+    from rockfrag.report.answer_page import _at_least
 
     assert _at_least(1.0) == "100%" and _at_least(0.61) == "\u226561%" and _at_least(0.996) == ">99%"

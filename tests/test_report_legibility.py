@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.report import figures
-from pipeline.report.layout import add_footer, log_ticks, new_page
-from pipeline.report.text import draw_text_page, heading, paragraph, table
+from rockfrag.report import figures
+from rockfrag.report.layout import add_footer, log_ticks, new_page
+from rockfrag.report.text import draw_text_page, heading, paragraph, table
 from tests.helpers import pipeline_results
 
 # ---------------------------------------------------------------- what the drawn page shows
@@ -109,9 +109,9 @@ def test_each_kind_of_page_drawn_again_from_the_files_is_legible_and_the_same(sm
     import shutil
     from dataclasses import replace
 
-    import pipeline.models as models
-    from pipeline.config import load_study
-    from pipeline.report import (
+    import rockfrag.models as models
+    from rockfrag.config import load_study
+    from rockfrag.report import (
         PNG_DPI,
         build_plan,
         figure_file,
@@ -221,7 +221,7 @@ def test_drawn_log_axes_label_their_ticks_on_a_short_range():
     figure = new_page("short range")
     axis = figure.add_axes([0.1, 0.2, 0.2, 0.15])
     axis.plot([1, 2], [0.3, 0.9])
-    from pipeline.report.layout import log_y_axis
+    from rockfrag.report.layout import log_y_axis
 
     log_y_axis(axis, (0.3, 0.9))
     try:
@@ -235,7 +235,7 @@ def test_drawn_log_axes_label_their_ticks_on_a_short_range():
 def test_long_captions_are_wrapped_whole_inside_the_page():
     """FINDINGS 24: captions were cut at the page edge (and at two lines): every word is drawn, inside the page,
     clear of the footer."""
-    from pipeline.report import CAPTIONS
+    from rockfrag.report import CAPTIONS
 
     caption = CAPTIONS["ida"] + " " + CAPTIONS["fragility-soils"][:220]  # longer than any caption of the report
     figure = new_page("A page", caption)
@@ -273,7 +273,7 @@ def test_the_ground_motion_shares_the_time_axis_of_the_response_and_has_one(smal
 # ---------------------------------------------------------------- fragility pages (FINDINGS 26)
 
 def test_the_recommended_curve_has_a_style_of_its_own():
-    from pipeline.report.adapters import model_styles, models_of
+    from rockfrag.report.adapters import model_styles, models_of
 
     names = ["housner", "recommended", "ssi", "winkler-low", "winkler-centre", "winkler-high"]
     models = models_of(xr.Dataset(coords={"model": names}))
@@ -305,7 +305,7 @@ def test_every_fragility_panel_has_x_tick_values(small_pipeline):
 # ---------------------------------------------------------------- applicability and efficiency (FINDINGS 27, 28)
 
 def test_the_applicability_legend_names_each_model_each_block_and_each_band(small_pipeline):
-    from pipeline.report.adapters import models_of, short_label
+    from rockfrag.report.adapters import models_of, short_label
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     figure = figures.applicability_page(results.cube, "")
@@ -335,7 +335,7 @@ def _efficiency(measures=("pga", "pgv", "pga_ratio")):
 
 
 def test_efficiency_leaves_out_a_measure_identical_by_construction_and_says_why():
-    from pipeline.report import _twins_words
+    from rockfrag.report import _twins_words
 
     dataset = _efficiency()
     assert figures.efficiency_twins(dataset) == {"pga_ratio": "pga"}
@@ -377,7 +377,7 @@ def test_table_headers_wrap_and_are_never_cut():
 
 def test_a_short_section_shares_the_page_of_the_one_before():
     """FINDINGS 32: pages holding a few rows or one line. The next section starts where the last one ends."""
-    from pipeline.report import _packed_pages, contents_page, html_document
+    from rockfrag.report import _packed_pages, contents_page, html_document
 
     long_rows = [[f"row {n}", "x"] for n in range(45)]
     parts = [("limitations", "Limitations", "Limitations", [heading("Tension"), table(["a", "b"], long_rows),
@@ -397,7 +397,7 @@ def test_a_short_section_shares_the_page_of_the_one_before():
 def test_what_is_left_of_a_run_goes_on_its_last_page_when_it_overflows_a_little():
     """FINDINGS 32 (a page with 2 records of a table): a few rows more than a page hold go on it, set closer,
     inside the page; many more start a page of their own."""
-    from pipeline.report.text import BOTTOM, LINE, STRETCH, TOP, paginate
+    from rockfrag.report.text import BOTTOM, LINE, STRETCH, TOP, paginate
 
     capacity = int((TOP - BOTTOM) / LINE)
     rows = [[f"record {n}", "0.41"] for n in range(capacity - 4 + STRETCH)]  # heading 2, header 1, gap 1
@@ -416,7 +416,7 @@ def test_what_is_left_of_a_run_goes_on_its_last_page_when_it_overflows_a_little(
 
 
 def test_a_table_too_wide_for_the_page_is_set_smaller_not_cut():
-    from pipeline.report.text import TABLE_SIZE, table_layout
+    from rockfrag.report.text import TABLE_SIZE, table_layout
 
     wide = table(["block", "model", "why no median"], [["squat machinery skid", "Winkler bed, tensionless, band high "
                                                         "edge (restitution band)", "reached only at the highest "
@@ -434,7 +434,7 @@ def test_a_table_too_wide_for_the_page_is_set_smaller_not_cut():
 
 @pytest.mark.slow
 def test_the_title_page_has_no_code_identifiers_and_the_provenance_keeps_them(small_pipeline):
-    from pipeline.report.sections import provenance_items, run_time_words, title_items
+    from rockfrag.report.sections import provenance_items, run_time_words, title_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study, runtime_s=0.0)
     title = " ".join(item.text for item in title_items(results))
@@ -459,7 +459,7 @@ CITATION = re.compile(r"\b((?:[A-Z][\w-]*(?: et al\.| & [A-Z][\w-]*)?) (?:19|20)
 def test_every_reference_is_cited_and_every_citation_listed(small_pipeline):
     """FINDINGS 30: works listed but never cited (ElGawady, ASCE 7-22, Chopra & Yim, Shenton, Makris &
     Vassiliou) and a citation never listed (Luco & Cornell 2007). Read from the report's HTML."""
-    from pipeline.report.words import REFERENCES
+    from rockfrag.report.words import REFERENCES
 
     html = (small_pipeline.output / "report.html").read_text()
     text = html_module.unescape(re.sub(r"<[^>]+>", " ", re.sub(r"<img[^>]*>", " ", html)))
@@ -475,7 +475,7 @@ def test_every_reference_is_cited_and_every_citation_listed(small_pipeline):
 def test_the_stated_limits_and_values_carry_their_source(small_pipeline):
     """FINDINGS 30, 18: the 1% and 10% limits, the 50-year life, μ per soil, the moduli: a source or the study's
     choice in plain words."""
-    from pipeline.report.sections import sources_items
+    from rockfrag.report.sections import sources_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     bullets = [item.text for item in sources_items(results)]
@@ -493,7 +493,7 @@ def test_the_stated_limits_and_values_carry_their_source(small_pipeline):
 SMALLEST_TABLE_TYPE = 7.5  # pt: the client could not read the 6 pt answer tables in print
 
 def test_a_table_too_wide_at_the_smallest_type_is_split_by_columns_and_nothing_is_cut():
-    from pipeline.report.text import fit_table, table_layout
+    from rockfrag.report.text import fit_table, table_layout
 
     header = ["damage state"] + [f"on soil number {n}: P in 50 years" for n in range(7)]
     rows = [[f"state {r}"] + [f"<0.01%, not reached below 0.82 g ({r}{n})" for n in range(7)] for r in range(4)]
@@ -520,7 +520,7 @@ def test_a_table_too_wide_at_the_smallest_type_is_split_by_columns_and_nothing_i
 @pytest.mark.slow
 def test_no_table_of_the_report_is_set_below_the_smallest_type(small_pipeline):
     """The small study's answer pages were set in 7.4 pt and its limitations in 6.8 pt."""
-    from pipeline.report import build_plan
+    from rockfrag.report import build_plan
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     for page in build_plan(results):

@@ -4,13 +4,13 @@ import matplotlib
 import numpy as np
 import xarray as xr
 
-from pipeline.report import figures
+from rockfrag.report import figures
 
 matplotlib.use("Agg")
 
 
 def _sweep(models=("ssi", "winkler"), blocks=("paper", "cabinet")):
-    """An applicability.nc as pipeline.applicability writes it (only what the sweep page reads)."""
+    """An applicability.nc as rockfrag.applicability writes it (only what the sweep page reads)."""
     shape = (len(models), len(blocks), 2, 3, 5)
     ratio = 1.0 + np.arange(np.prod(shape)).reshape(shape) / 1000.0
     return xr.Dataset(
@@ -38,8 +38,8 @@ def test_log_minor_ticks_only_inside_the_view_and_the_drawing_unchanged():
     import matplotlib.pyplot as plt
     from matplotlib.ticker import LogLocator, NullFormatter
 
-    from pipeline.report import figure_png
-    from pipeline.report.layout import log_minor_ticks
+    from rockfrag.report import figure_png
+    from rockfrag.report.layout import log_minor_ticks
 
     def drawn(in_view):
         figure = plt.figure(figsize=(4, 3))

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.report.words import CODE_IDENTIFIERS
+from rockfrag.report.words import CODE_IDENTIFIERS
 from tests.helpers import pipeline_results
 
 K0, K = 1e-4, 2.5  # the shipped example hazard: lambda(s) = K0 s^-K
@@ -64,7 +64,7 @@ def test_references_and_glossary_pages_cite_the_sources(small_pipeline):
 
 
 def test_every_figure_has_a_caption_that_says_what_to_read(small_pipeline):
-    from pipeline.report import plan
+    from rockfrag.report import plan
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     figures = [page for page in plan(results) if page.html is None and page.name != "title"]
@@ -76,7 +76,7 @@ def test_every_figure_has_a_caption_that_says_what_to_read(small_pipeline):
 
 def test_no_orphan_footnote_mark(small_pipeline, tmp_path):
     """A footnote is printed only when a row carries its mark, and every mark has its footnote."""
-    from pipeline.report.sections import summary_items
+    from rockfrag.report.sections import summary_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
 
@@ -96,7 +96,7 @@ def test_no_orphan_footnote_mark(small_pipeline, tmp_path):
 
 
 def test_curves_without_a_median_carry_the_counts_that_justify_it(small_pipeline):
-    from pipeline.report.sections import limitations_items
+    from rockfrag.report.sections import limitations_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     items = limitations_items(results)
@@ -124,10 +124,10 @@ def test_limitations_tables_are_one_table_each_with_the_reason_and_one_row_per_s
         small_pipeline, tmp_path):
     """Issue 20, finding 8: the extrapolated and no-median tables were split in two by width, and a state no record
     reached took one row per model and soil."""
-    from pipeline.report.adapters import block_name
-    from pipeline.report.sections import limitations_items
-    from pipeline.report.text import fit_table
-    from pipeline.report.words import state_short_label
+    from rockfrag.report.adapters import block_name
+    from rockfrag.report.sections import limitations_items
+    from rockfrag.report.text import fit_table
+    from rockfrag.report.words import state_short_label
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     fragility = results.fragility.copy(deep=True)
@@ -156,7 +156,7 @@ def test_limitations_tables_are_one_table_each_with_the_reason_and_one_row_per_s
 
 
 def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline):
-    from pipeline.report import figures
+    from rockfrag.report import figures
 
     showcase = pipeline_results(small_pipeline.output, small_pipeline.study).showcase
     assert "y - y_static" in showcase.settlement.attrs["long_name"]  # positive up, as the file defines it
@@ -173,7 +173,7 @@ def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline
 
 
 def test_contents_and_station_names_are_not_cut(small_pipeline):
-    from pipeline.report import build_plan, records_items
+    from rockfrag.report import build_plan, records_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     planned = build_plan(results)
@@ -193,8 +193,8 @@ def test_contents_and_station_names_are_not_cut(small_pipeline):
 
 def test_a_panel_with_points_but_no_curve_says_why():
     """The uplift panel had dots and no curve: a state without a median is named in its panel."""
-    from pipeline.report import figures
-    from pipeline.report.adapters import model_info
+    from rockfrag.report import figures
+    from rockfrag.report.adapters import model_info
 
     levels = np.array([0.2, 0.4, 0.8])
     dims = ("soil", "block", "model", "damage_state")
@@ -217,7 +217,7 @@ def test_a_panel_with_points_but_no_curve_says_why():
 
 
 def test_p_values_are_not_shown_beyond_what_they_support():
-    from pipeline.report import figures
+    from rockfrag.report import figures
 
     dims = ("soil", "block", "model", "measure")
     shape = (1, 1, 1, 3)
@@ -239,7 +239,7 @@ def test_p_values_are_not_shown_beyond_what_they_support():
 
 
 def test_a_steel_base_is_not_counted_as_a_soil():
-    from pipeline.report.sections import grounds
+    from rockfrag.report.sections import grounds
 
     cube = xr.Dataset(coords={"soil": ["clay", "rock", "steel"],
                               "soil_shear_modulus": ("soil", [3.7e7, 1e9, 8e10])})
@@ -249,8 +249,8 @@ def test_a_steel_base_is_not_counted_as_a_soil():
 # ---------------------------------------------------------------- credible intensities
 
 def test_intensity_axes_are_log_and_mark_the_hazard_and_the_extrapolation(small_pipeline):
-    from pipeline.report import figures
-    from pipeline.report.adapters import models_of
+    from rockfrag.report import figures
+    from rockfrag.report.adapters import models_of
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     block = str(results.cube.block.values[1])
@@ -282,7 +282,7 @@ def test_intensity_axes_are_log_and_mark_the_hazard_and_the_extrapolation(small_
 
 
 def test_the_methods_page_states_the_scale_factors(small_pipeline):
-    from pipeline.report.sections import methods_items
+    from rockfrag.report.sections import methods_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     with xr.open_dataset(small_pipeline.output / "cube.nc") as cube:
@@ -293,12 +293,12 @@ def test_the_methods_page_states_the_scale_factors(small_pipeline):
 
 def test_the_kinetic_friction_ratio_is_read_from_the_soils_not_written_twice():
     """Issue 20: the sources said "Kinetic friction 0.8 × static" while the shipped soils are 0.85 × (steel 0.8 ×)."""
-    import pipeline.soils
-    from pipeline.report.sections import _kinetic_words
-    from pipeline.soils import SOILS
+    import rockfrag.soils
+    from rockfrag.report.sections import _kinetic_words
+    from rockfrag.soils import SOILS
 
     words = _kinetic_words(list(SOILS.values()))
-    ratio = pipeline.soils.KINETIC_OVER_STATIC
+    ratio = rockfrag.soils.KINETIC_OVER_STATIC
     usual = [s.name for s in SOILS.values() if round(ratio * s.friction_static, 2) == s.friction_kinetic]
     assert usual and f"{ratio:g} × static (rounded to 0.01) on {', '.join(usual)}" in words
     for soil in SOILS.values():
@@ -307,7 +307,7 @@ def test_the_kinetic_friction_ratio_is_read_from_the_soils_not_written_twice():
 
 
 def test_the_glossary_explains_flight_and_the_pulse_measures():
-    from pipeline.report.words import GLOSSARY
+    from rockfrag.report.words import GLOSSARY
 
     terms = " ".join(term for term, _ in GLOSSARY)
     for word in ("flies", "free flight", "pulse period", "pulse acceleration"):
@@ -316,8 +316,8 @@ def test_the_glossary_explains_flight_and_the_pulse_measures():
 
 def test_slip_states_carry_their_unit_in_table_headers():
     """Issue 20: the answer tables headed the slip states "slip 0.05" and "slip 0.30", with no unit."""
-    from pipeline.damage_states import DAMAGE_STATES, is_slip_state
-    from pipeline.report.words import state_short_label
+    from rockfrag.damage_states import DAMAGE_STATES, is_slip_state
+    from rockfrag.report.words import state_short_label
 
     slips = [state for state in DAMAGE_STATES.values() if is_slip_state(state)]
     assert slips
@@ -332,7 +332,7 @@ def test_the_records_table_says_station_names_are_the_sources_own(small_pipeline
     manifest's, shown whole), and the table says so."""
     import csv
 
-    from pipeline.report import STATION_NAMES, records_items
+    from rockfrag.report import STATION_NAMES, records_items
     from tests.helpers import pipeline_results
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)

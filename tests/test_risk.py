@@ -9,10 +9,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from pipeline.config import load_study
-from pipeline.errors import ConfigError
-from pipeline.hazard import _measure_from_imt, hazard_frequency, load_hazard, study_hazard
-from pipeline.risk import annual_frequency, probability_in_life
+from rockfrag.config import load_study
+from rockfrag.errors import ConfigError
+from rockfrag.hazard import _measure_from_imt, hazard_frequency, load_hazard, study_hazard
+from rockfrag.risk import annual_frequency, probability_in_life
 
 DATA = Path(__file__).parent / "data"
 

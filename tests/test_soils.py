@@ -7,9 +7,9 @@ from dataclasses import replace
 
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.errors import ConfigError
-from pipeline.soils import SOILS, SoilClass, interface_stiffness, soil_block_stiffness
+from rockfrag.blocks import Block
+from rockfrag.errors import ConfigError
+from rockfrag.soils import SOILS, SoilClass, interface_stiffness, soil_block_stiffness
 
 
 @pytest.mark.parametrize("name, table_e_d", [("sand", 280e6), ("gravel", 1050e6), ("rock", 3500e6)])

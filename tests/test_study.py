@@ -14,14 +14,14 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.config import load_study, study_from_dict
-from pipeline.errors import ConfigError
-from pipeline.measures import spectral_acceleration
-from pipeline.models import simulate
-from pipeline.processing import process_record
-from pipeline.records import load_records
-from pipeline.soils import SOILS, soil_block_stiffness
-from pipeline.study import run_study
+from rockfrag.config import load_study, study_from_dict
+from rockfrag.errors import ConfigError
+from rockfrag.measures import spectral_acceleration
+from rockfrag.models import simulate
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
+from rockfrag.soils import SOILS, soil_block_stiffness
+from rockfrag.study import run_study
 from tests.helpers import SMALL_STUDY
 
 SMALL = SMALL_STUDY  # tests/helpers.py: the same study runs the session pipeline (conftest small_pipeline)
@@ -161,7 +161,7 @@ def test_killed_run_resumes_without_recomputing(small_study, tmp_path):
                      .replace("levels = [0.1, 0.3, 0.6, 1.0]",  # one checkpoint file per cell
                               "levels = [0.6]\ncapacity_resolution = 0.0"))
     output = tmp_path / "out"
-    command = [sys.executable, "-m", "pipeline", "run", str(study), "--output", str(output), "--no-progress",
+    command = [sys.executable, "-m", "rockfrag", "run", str(study), "--output", str(output), "--no-progress",
                "--serial"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     checkpoints = output / ".checkpoints"

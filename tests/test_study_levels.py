@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.config import load_study
-from pipeline.cube import OUTCOME_NO_UPLIFT
-from pipeline.errors import ConfigError
-from pipeline.models import simulate
-from pipeline.processing import process_record
-from pipeline.records import load_records
-from pipeline.study import run_study, uplift_intensity
-from pipeline.units import STANDARD_GRAVITY as G
+from rockfrag.config import load_study
+from rockfrag.cube import OUTCOME_NO_UPLIFT
+from rockfrag.errors import ConfigError
+from rockfrag.models import simulate
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
+from rockfrag.study import run_study, uplift_intensity
+from rockfrag.units import STANDARD_GRAVITY as G
 
 RELATIVE = """
 soils = ["rock"]

@@ -1,4 +1,4 @@
-"""Sliding in the study: which cells run with friction (``[solver] friction``, pipeline.study.cell_friction),
+"""Sliding in the study: which cells run with friction (``[solver] friction``, rockfrag.study.cell_friction),
 their checkpoint keys, the cube's slip variables and the slip damage states' rows.
 
 The small study: the squat skid (b/h = 0.75) on a slick soil (mu_s 0.3: it slides) and on a grippy one (mu_s 1.0
@@ -10,16 +10,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.config import load_study
-from pipeline.damage_states import DAMAGE_STATES
-from pipeline.errors import ConfigError
-from pipeline.fragility import fragility_dataset
-from pipeline.models import simulate_batch
-from pipeline.models.options import RIGID_BASE_MAX_KINETIC_FRICTION
-from pipeline.processing import load_recipe
-from pipeline.soils import MAX_KINETIC_FRICTION, SOILS
-from pipeline.study import cell_friction, cells_for_record, run_study, solver_options, study_records
+from rockfrag.blocks import Block
+from rockfrag.config import load_study
+from rockfrag.damage_states import DAMAGE_STATES
+from rockfrag.errors import ConfigError
+from rockfrag.fragility import fragility_dataset
+from rockfrag.models import simulate_batch
+from rockfrag.models.options import RIGID_BASE_MAX_KINETIC_FRICTION
+from rockfrag.processing import load_recipe
+from rockfrag.soils import MAX_KINETIC_FRICTION, SOILS
+from rockfrag.study import cell_friction, cells_for_record, run_study, solver_options, study_records
 
 STUDY = """
 soils = ["slick", "grippy"]
@@ -187,7 +187,7 @@ def test_slip_damage_states_are_fitted_where_cells_slide_and_not_applicable_wher
 def test_showcase_runs_each_case_as_the_study_runs_its_cell():
     """The showcase's histories take the study's base friction: a rigid base that slides on some soil is drawn per
     soil (not once, tied), and a bed model slides where its cell does."""
-    from pipeline.showcase import response_cases
+    from rockfrag.showcase import response_cases
 
     config = load_study()
     paper = next(b for b in config.blocks if b.name == "paper")  # tan(alpha) = 0.47: slides on clay and sand

@@ -17,18 +17,18 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from pipeline.config import load_study
-from pipeline.cube import COMPARISON_CUBE, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-from pipeline.damage_states import DamageState
-from pipeline.errors import ConfigError
-from pipeline.fragility import exceedance, fragility_dataset
-from pipeline.measures import MEASURES
-from pipeline.models import simulate_batch
-from pipeline.models.base import Outcome
-from pipeline.models.fields import SUMMARY_FIELDS
-from pipeline.processing import load_recipe
-from pipeline.soils import soil_block_stiffness
-from pipeline.study import cell_capacity, cells_for_record, run_study, solver_options, study_records, vertical_key
+from rockfrag.config import load_study
+from rockfrag.cube import COMPARISON_CUBE, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+from rockfrag.damage_states import DamageState
+from rockfrag.errors import ConfigError
+from rockfrag.fragility import exceedance, fragility_dataset
+from rockfrag.measures import MEASURES
+from rockfrag.models import simulate_batch
+from rockfrag.models.base import Outcome
+from rockfrag.models.fields import SUMMARY_FIELDS
+from rockfrag.processing import load_recipe
+from rockfrag.soils import soil_block_stiffness
+from rockfrag.study import cell_capacity, cells_for_record, run_study, solver_options, study_records, vertical_key
 
 from .physics.reference import free_flight_time
 
@@ -213,11 +213,11 @@ def test_checkpoint_keys_say_whether_and_which_vertical_was_applied(vertical_run
 
 
 def test_the_report_plans_the_vertical_pages(vertical_run):
-    from pipeline.damage_states import damage_states_from_config
-    from pipeline.ida import ida_dataset
-    from pipeline.report import plan
-    from pipeline.report.sections import Results, limitations_items
-    from pipeline.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page
+    from rockfrag.damage_states import damage_states_from_config
+    from rockfrag.ida import ida_dataset
+    from rockfrag.report import plan
+    from rockfrag.report.sections import Results, limitations_items
+    from rockfrag.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page
 
     config, output, cube, _, _ = vertical_run
     comparison = open_comparison(cube, output)
@@ -342,7 +342,7 @@ def _fake_solver(rule):
 
 def _capacity(monkeypatch, stripes, statuses, rule, resolution=0.02):
     fake, calls = _fake_solver(rule)
-    monkeypatch.setattr("pipeline.study.simulate_batch", fake)
+    monkeypatch.setattr("rockfrag.study.simulate_batch", fake)
     summary = np.zeros(len(stripes), dtype=[("status", "f8")])
     summary["status"] = [float(s) for s in statuses]
     job = ("key", "housner", None, None, None, None)  # (key, model, block, k, xi, friction): tied
@@ -384,8 +384,8 @@ def test_a_refining_run_in_free_flight_stops_with_the_bracket_so_far(monkeypatch
 
 
 def test_a_free_flight_is_neither_a_resurrection_nor_counted_in_the_outcome_classes():
-    from pipeline.cube import OUTCOME_FREE_FLIGHT, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
-    from pipeline.ida import resurrected
+    from rockfrag.cube import OUTCOME_FREE_FLIGHT, OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+    from rockfrag.ida import resurrected
 
     flown = np.array([[OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FREE_FLIGHT]])
     survived = np.array([[OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_ROCKING]])

@@ -17,9 +17,9 @@ import obspy
 import pandas as pd
 import pytest
 
-from pipeline.errors import RecordError
-from pipeline.processing import load_recipe
-from pipeline.records import (
+from rockfrag.errors import RecordError
+from rockfrag.processing import load_recipe
+from rockfrag.records import (
     group_components,
     load_records,
     read_record,
@@ -27,11 +27,11 @@ from pipeline.records import (
     record_sets,
     split_vertical,
 )
-from pipeline.records.asdf import is_asdf, pre_filter, read_asdf
-from pipeline.records.csmip import is_csmip, read_csmip
-from pipeline.records.manifest import sha256_of
-from pipeline.records_report import records_stage
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.records.asdf import is_asdf, pre_filter, read_asdf
+from rockfrag.records.csmip import is_csmip, read_csmip
+from rockfrag.records.manifest import sha256_of
+from rockfrag.records_report import records_stage
+from rockfrag.units import STANDARD_GRAVITY
 
 ROOT = Path(__file__).resolve().parents[1]
 RIDGECREST = ROOT / "records" / "ridgecrest-2019"
@@ -157,7 +157,7 @@ def test_obspy_reads_v1_through_the_declared_entry_points(tmp_path):
     as a throw-away distribution, as `pip install -e .` would)."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())
     groups = {g: v for g, v in project["project"]["entry-points"].items() if g.startswith("obspy.plugin")}
-    assert groups["obspy.plugin.waveform"]["CSMIP"] == "pipeline.records.csmip"
+    assert groups["obspy.plugin.waveform"]["CSMIP"] == "rockfrag.records.csmip"
     info = tmp_path / "rockfrag_plugin_check-0.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: rockfrag-plugin-check\nVersion: 0\n")

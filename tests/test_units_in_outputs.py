@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from pipeline.config import load_study
-from pipeline.measures import (
+from rockfrag.config import load_study
+from rockfrag.measures import (
     MEASURES,
     convert_units,
     file_units,
@@ -20,7 +20,7 @@ from pipeline.measures import (
     udunits,
     unit_label,
 )
-from pipeline.study import run_study
+from rockfrag.study import run_study
 
 from .test_study import SMALL
 

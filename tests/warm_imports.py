@@ -21,8 +21,8 @@ modules with tornado and msgpack, imported by the dask tests in-process and in `
 
 
 def warm() -> int:
-    """Import pipeline.* and collect the tests; returns pytest's exit status (0: collected)."""
-    for module in pkgutil.walk_packages([str(ROOT / "pipeline")], "pipeline."):
+    """Import rockfrag.* (the folder pipeline/) and collect the tests; returns pytest's exit status (0: collected)."""
+    for module in pkgutil.walk_packages([str(ROOT / "pipeline")], "rockfrag."):
         if module.name.rsplit(".", 1)[-1] != "__main__":  # (it would run the command line)
             importlib.import_module(module.name)
     for name in LAZY:

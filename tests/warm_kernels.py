@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.blocks import Block
-from pipeline.measures import response_spectrum
-from pipeline.models import MODELS, simulate, simulate_batch, simulate_histories
+from rockfrag.blocks import Block
+from rockfrag.measures import response_spectrum
+from rockfrag.models import MODELS, simulate, simulate_batch, simulate_histories
 
 
 def warm() -> None:

@@ -1,9 +1,9 @@
-"""pipeline.models - stage 5: rocking solvers (Housner, the paper's SSI model, the Winkler bed).
+"""rockfrag.models - stage 5: rocking solvers (Housner, the paper's SSI model, the Winkler bed).
 
 Input : a model name, ground acceleration [m/s^2] sampled at dt [s] (optionally a vertical one,
         ``ag_vertical``, same sampling, up positive), a ``Block`` and, for models with a foundation,
         the interface stiffness k [N/m] and damping ratio xi [-] (winkler: or a target restitution that
-        calibrates xi, pipeline.models.restitution).
+        calibrates xi, rockfrag.models.restitution).
 Output: a ``RockingResult`` (histories, peak angle, impacts, overturning, foundation checks), or for
         many scale factors and cases at once summary records (``fields.SUMMARY_DTYPE``) from
         ``simulate_batch`` and ``simulate_histories``.
@@ -23,13 +23,13 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from pipeline.blocks import Block
-from pipeline.errors import SolverError
-from pipeline.models import fields, kernels
-from pipeline.models.base import MESSAGES, Outcome, RockingModel, RockingResult
-from pipeline.models.contact import LAWS
-from pipeline.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS
-from pipeline.models.options import (  # noqa: F401  (the API)
+from rockfrag.blocks import Block
+from rockfrag.errors import SolverError
+from rockfrag.models import fields, kernels
+from rockfrag.models.base import MESSAGES, Outcome, RockingModel, RockingResult
+from rockfrag.models.contact import LAWS
+from rockfrag.models.fields import SUMMARY_DTYPE, SUMMARY_FIELDS
+from rockfrag.models.options import (  # noqa: F401  (the API)
     BED_TYPES,
     DEFAULT_ATOL,
     DEFAULT_RTOL,
@@ -42,10 +42,10 @@ from pipeline.models.options import (  # noqa: F401  (the API)
     SolverOptions,
     case_record,
 )
-from pipeline.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
-from pipeline.models.variants import BAND_LABELS, split_variant
-from pipeline.units import STANDARD_GRAVITY
-from pipeline.validation import did_you_mean
+from rockfrag.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
+from rockfrag.models.variants import BAND_LABELS, split_variant
+from rockfrag.units import STANDARD_GRAVITY
+from rockfrag.validation import did_you_mean
 
 MODELS: dict[str, RockingModel] = {}
 
@@ -62,7 +62,7 @@ def get_model(name: str) -> RockingModel:
     """The registered model called ``name``; a ``SolverError`` listing the valid names otherwise.
 
     A band variant of a bed model (``winkler-low``, ``winkler-centre``, ``winkler-high``;
-    pipeline.models.variants) is that model: the variant only sets its restitution target.
+    rockfrag.models.variants) is that model: the variant only sets its restitution target.
     """
     model, role = split_variant(name) if isinstance(name, str) else (name, None)
     try:
@@ -177,7 +177,7 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
     dt : float
         Sampling interval of ``ag`` [s], > 0.
     block : Block
-        The block (half-width b and half-height h [m], mass [kg]; pipeline.blocks).
+        The block (half-width b and half-height h [m], mass [kg]; rockfrag.blocks).
     ag_vertical : array_like, shape (n,), optional
         Vertical ground acceleration [m/s^2, up positive], sampled as ``ag``: gravity becomes
         g + ag_vertical(t) in the ground's frame. Where g + ag_vertical < 0 the block is in free flight:
@@ -206,7 +206,7 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         ``restitution`` [-]: pivot models, the impact coefficient from 0 to 1 (default: Housner's
         1 - 1.5 sin^2 alpha for housner, 1 for ssi, whose spring-dashpot dissipates); winkler, the target
         effective restitution < 1 of free rocking to which the bed's damping is calibrated (the continuous
-        bed then takes Hunt-Crossley damping; pipeline.models.restitution); ``"housner"`` is
+        bed then takes Hunt-Crossley damping; rockfrag.models.restitution); ``"housner"`` is
         1 - 1.5 sin^2 alpha of the block;
         ``g`` [m/s^2]: gravity, default 9.80665;
         ``overturn_angle`` [rad]: the |theta| of overturning (terminal), up to pi/2 (default);
@@ -402,9 +402,9 @@ def simulate_histories(model: str, ag: ArrayLike, dt: float, cases: Sequence[tup
     return np.arange(n_total) * dt, histories[:, :, 0], histories[:, :, 2], summaries[:, 0]
 
 
-from pipeline.models import housner as _housner  # noqa: E402  (registration at import)
-from pipeline.models import ssi as _ssi  # noqa: E402
-from pipeline.models import winkler as _winkler  # noqa: E402
+from rockfrag.models import housner as _housner  # noqa: E402  (registration at import)
+from rockfrag.models import ssi as _ssi  # noqa: E402
+from rockfrag.models import winkler as _winkler  # noqa: E402
 
 register(_housner.MODEL)
 register(_ssi.MODEL)

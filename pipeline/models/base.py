@@ -1,4 +1,4 @@
-"""pipeline.models.base - the model contract, the outcome enum and the result object.
+"""rockfrag.models.base - the model contract, the outcome enum and the result object.
 
 Input : nothing (definitions). Output: ``RockingModel`` (what a model registers), ``Outcome`` (the one
 spelling of a run's outcome, used by the kernels, the cube's flag variable, IDA and fragility) and
@@ -14,7 +14,7 @@ The contract for a model (as scipy's ``integrate/_ivp/base.py`` states its own),
 2. Pivot models (``kernel_code`` HOUSNER or SSI) rest until the uplift condition, rock on one corner
    and switch pivot at theta = 0 through an impact rule; bed models (WINKLER) have no rest phase and
    no impact rule: their contact law does everything. A new contact law of the bed is one module and
-   one registration in ``pipeline.models.contact``, not a new model.
+   one registration in ``rockfrag.models.contact``, not a new model.
 3. ``needs_foundation``: the model needs the interface stiffness k [N/m] and damping ratio xi [-];
    ``is_rigid_base``: its result does not depend on the soil (computed once per block).
 4. ``uses_restitution``, ``uses_switch``, ``uses_bed``, ``slides``: which solver options apply

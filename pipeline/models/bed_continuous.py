@@ -1,7 +1,7 @@
-"""pipeline.models.bed_continuous - the continuous Kelvin-Voigt bed, a contact law of ``winkler``.
+"""rockfrag.models.bed_continuous - the continuous Kelvin-Voigt bed, a contact law of ``winkler``.
 
 Input : the state x = [theta, theta_dot, y, y_dot] and a parameter record (b, omega = sqrt(K/m), xi).
-Output: the hooks of a bed contact law (pipeline.models.contact): ``NAME``, ``force``,
+Output: the hooks of a bed contact law (rockfrag.models.contact): ``NAME``, ``force``,
         ``indicator``, ``indicators`` and ``full_contact``; all per unit mass.
 
 The bed's stiffness K and dashpot C = 2 xi sqrt(K m) are spread uniformly over the footprint width 2b.
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from pipeline.models.jit import kernel
+from rockfrag.models.jit import kernel
 
 NAME = "continuous"  # selects this law: simulate(..., bed="continuous"), [solver] bed
 

@@ -1,7 +1,7 @@
-"""pipeline.models.bed_hunt_crossley - the continuous bed with Hunt-Crossley damping, a contact law of ``winkler``.
+"""rockfrag.models.bed_hunt_crossley - the continuous bed with Hunt-Crossley damping, a contact law of ``winkler``.
 
 Input : the state x = [theta, theta_dot, y, y_dot] and a parameter record (b, g, omega = sqrt(K/m), xi).
-Output: the hooks of a bed contact law (pipeline.models.contact): ``NAME``, ``force``,
+Output: the hooks of a bed contact law (rockfrag.models.contact): ``NAME``, ``force``,
         ``indicator``, ``indicators`` and ``full_contact``; all per unit mass.
 
 The continuous bed's springs (K spread uniformly over the footprint width 2b, k = K/2b, as in
@@ -20,7 +20,7 @@ c [s/m] is set by the damping ratio xi of the vertical mode at rest, as for the 
 about the settled state delta = y_static = g / omega^2 the linearised damping force is
 K y_static c y' = C y' with C = 2 xi sqrt(K m), so c = 2 xi omega / g. The bed at rest damps its
 vertical vibration as the Kelvin-Voigt bed of the same xi; its impacts lose more, because the damping
-is weighted by the penetration and so acts nearer the landing corner (pipeline.models.restitution
+is weighted by the penetration and so acts nearer the landing corner (rockfrag.models.restitution
 calibrates xi to a target restitution; the README gives the range it reaches). q(s) is a product of
 two linear functions of s, so the force and its moment are integrated exactly over the loaded length
 (where both factors are positive).
@@ -30,11 +30,11 @@ from __future__ import annotations
 
 import math
 
-from pipeline.models.bed_continuous import (
+from rockfrag.models.bed_continuous import (
     _clip,
     full_contact,  # noqa: F401  (the same springs: same elastic energy)
 )
-from pipeline.models.jit import kernel
+from rockfrag.models.jit import kernel
 
 NAME = "hunt-crossley"  # selects this law: simulate(..., bed="hunt-crossley"), [solver] bed
 

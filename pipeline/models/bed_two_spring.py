@@ -1,7 +1,7 @@
-"""pipeline.models.bed_two_spring - two Kelvin-Voigt corner springs, a contact law of ``winkler``.
+"""rockfrag.models.bed_two_spring - two Kelvin-Voigt corner springs, a contact law of ``winkler``.
 
 Input : the state x = [theta, theta_dot, y, y_dot] and a parameter record (b, omega = sqrt(K/m), xi).
-Output: the hooks of a bed contact law (pipeline.models.contact): ``NAME``, ``force``,
+Output: the hooks of a bed contact law (rockfrag.models.contact): ``NAME``, ``force``,
         ``indicator``, ``indicators`` and ``full_contact``; all per unit mass.
 
 The classic model of Psycharis & Jennings (1983) and Chopra & Yim (1985): K/2 and C/2 at each corner
@@ -12,8 +12,8 @@ indicators are the continuous bed's.
 
 from __future__ import annotations
 
-from pipeline.models.bed_continuous import indicator, indicators  # noqa: F401  (the same Kelvin-Voigt corners)
-from pipeline.models.jit import kernel
+from rockfrag.models.bed_continuous import indicator, indicators  # noqa: F401  (the same Kelvin-Voigt corners)
+from rockfrag.models.jit import kernel
 
 NAME = "two-spring"  # selects this law: simulate(..., bed="two-spring"), [solver] bed
 

@@ -1,4 +1,4 @@
-"""pipeline.models.contact - the registry of the bed contact laws: the one place a new law is added.
+"""rockfrag.models.contact - the registry of the bed contact laws: the one place a new law is added.
 
 Input : a law's option name (``SolverOptions.bed``) on the Python side; in the kernels, the law code
         in the parameter record (``params["bed"]``) and the state x = [theta, theta_dot, y, y_dot].
@@ -29,8 +29,8 @@ as arguments, so the dispatch is an if/elif on the integer law code, written out
 
 from __future__ import annotations
 
-from pipeline.models import bed_continuous, bed_hunt_crossley, bed_two_spring
-from pipeline.models.jit import kernel
+from rockfrag.models import bed_continuous, bed_hunt_crossley, bed_two_spring
+from rockfrag.models.jit import kernel
 
 # contact indicators every law reports (see the module docstring)
 N_CONTACT_INDICATORS = 4
@@ -43,7 +43,7 @@ HUNT_CROSSLEY = 2  # the continuous bed's springs with Hunt-Crossley damping (va
 LAWS = {CONTINUOUS: bed_continuous, TWO_SPRING: bed_two_spring, HUNT_CROSSLEY: bed_hunt_crossley}
 BED_LAWS = {law.NAME: code for code, law in LAWS.items()}  # option name (SolverOptions.bed) -> law code
 
-UNREGISTERED = "bed contact law code not registered in pipeline.models.contact"
+UNREGISTERED = "bed contact law code not registered in rockfrag.models.contact"
 
 
 # ---- the dispatchers: one branch per registered law ---------------------------------------------

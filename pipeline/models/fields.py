@@ -1,11 +1,11 @@
-"""pipeline.models.fields - the named fields that cross the compiled-kernel boundary.
+"""rockfrag.models.fields - the named fields that cross the compiled-kernel boundary.
 
 Input : nothing (definitions). Output: ``PARAMS_DTYPE`` (what a kernel is told about one case),
 ``SUMMARY_FIELDS``/``SUMMARY_DTYPE`` (what it reports about one run), the layout of the state, the
 model codes and the event kinds. (The codes of the bed contact laws are registered with the laws, in
-pipeline.models.contact.) Both records are NumPy structured dtypes: numba reads and writes their fields by name
+rockfrag.models.contact.) Both records are NumPy structured dtypes: numba reads and writes their fields by name
 (``params["alpha"]``, ``summary["peak_angle"]``), so no slot index leaks out of the kernels, and the
-cube's variables are generated from ``SUMMARY_FIELDS`` (pipeline.cube).
+cube's variables are generated from ``SUMMARY_FIELDS`` (rockfrag.cube).
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ TIED_STATE_SIZE = 4
 SLIP = 4       # index of u in the state
 SLIP_RATE = 5  # index of u_dot
 
-# Kernel codes: which right-hand side and which time loop a model uses (pipeline.models.kernels
+# Kernel codes: which right-hand side and which time loop a model uses (rockfrag.models.kernels
 # dispatches on them; a model states its code in its ``RockingModel``).
 HOUSNER = 0   # rigid base, pivot rocking with a restitution rule
 SSI = 1       # one vertical spring-dashpot under the active pivot (the paper's model)
-WINKLER = 2   # tensionless bed of vertical contact (pipeline.models.contact: the bed's contact law)
+WINKLER = 2   # tensionless bed of vertical contact (rockfrag.models.contact: the bed's contact law)
 
 # Pivot-switch rules of the SSI model at theta = 0.
 SWITCH_CONSISTENT = 0
@@ -65,7 +65,7 @@ PARAMS_DTYPE = np.dtype([
     ("xi", "f8"),           # damping ratio of the vertical foundation mode [-]
     ("restitution", "f8"),  # factor on theta' at each impact (pivot models)
     ("switch", "f8"),       # SWITCH_* (SSI)
-    ("bed", "f8"),          # code of the bed's contact law (winkler; pipeline.models.contact.BED_LAWS)
+    ("bed", "f8"),          # code of the bed's contact law (winkler; rockfrag.models.contact.BED_LAWS)
     ("overturn", "f8"),     # |theta| of overturning [rad]
     ("rtol", "f8"),         # relative error per step [-]
     ("atol", "f8"),         # absolute error per step as a fraction of each state's scale [-]
@@ -96,7 +96,7 @@ MODE_TIMES = {
 """Summary field and long name of the time in each contact mode [s], in the order of the MODE_* codes."""
 
 SUMMARY_FIELDS = (
-    SummaryField("status", "1", "outcome of the run (pipeline.models.base.Outcome)"),
+    SummaryField("status", "1", "outcome of the run (rockfrag.models.base.Outcome)"),
     SummaryField("peak_angle", "rad", "peak absolute rocking angle"),
     SummaryField("time_of_peak", "s", "time of the peak rocking angle"),
     SummaryField("n_impacts", "1", "number of impacts (pivot switches; winkler: a lifted corner landing)"),

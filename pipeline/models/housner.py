@@ -1,4 +1,4 @@
-"""pipeline.models.housner - Housner's rigid-base rocking block (paper eqs. 1-6).
+"""rockfrag.models.housner - Housner's rigid-base rocking block (paper eqs. 1-6).
 
 Input : block (R, alpha), ground acceleration. Output: registered model ``housner`` and its
 compiled physics: ``housner_rhs`` (rocking), ``housner_rest_rhs`` and ``housner_support``.
@@ -34,9 +34,9 @@ impulse ratio.
 
 import math
 
-from pipeline.models.base import RockingModel
-from pipeline.models.fields import HOUSNER
-from pipeline.models.jit import kernel
+from rockfrag.models.base import RockingModel
+from rockfrag.models.fields import HOUSNER
+from rockfrag.models.jit import kernel
 
 
 @kernel

@@ -1,7 +1,7 @@
-"""pipeline.models.jit - the one switch between compiled and plain-Python kernels.
+"""rockfrag.models.jit - the one switch between compiled and plain-Python kernels.
 
-Input : the environment variable PIPELINE_NO_NUMBA. Output: two decorators, or no-ops with the same
-call forms when PIPELINE_NO_NUMBA=1 (debugging, coverage, and the property test that the compiled
+Input : the environment variable ROCKFRAG_NO_NUMBA. Output: two decorators, or no-ops with the same
+call forms when ROCKFRAG_NO_NUMBA=1 (debugging, coverage, and the property test that the compiled
 kernels equal the plain-Python ones):
 
 - ``njit``: numba's decorator, for the few functions that allocate arrays (the entry points, which allocate
@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import os
 
-if os.environ.get("PIPELINE_NO_NUMBA", "") not in ("", "0"):
+if os.environ.get("ROCKFRAG_NO_NUMBA", "") not in ("", "0"):
     def njit(*args, **kwargs):
         """Stand-in for numba's ``njit``: returns the function unchanged (``@njit`` and ``@njit(...)``)."""
         if args and callable(args[0]):

@@ -1,4 +1,4 @@
-"""pipeline.models.kernels - the compiled time loops shared by every rocking model.
+"""rockfrag.models.kernels - the compiled time loops shared by every rocking model.
 
 Input : plain float64 arrays, a parameter record (``fields.PARAMS_DTYPE``) and an initial state;
         no Python objects cross this line.
@@ -28,12 +28,12 @@ Two time loops:
   corner, and at theta = 0 an impact rule switches the pivot. Where g + a_v(t) < 0 the ground falls
   faster than gravity: these models have no flight phase, so the run stops there (``Outcome.FREE_FLIGHT``).
 - ``bed_loop`` (winkler): no rest phase and no impact rule; the block tilts on its bed from the first
-  sample and the bed's contact law (registered in pipeline.models.contact) decides everything.
+  sample and the bed's contact law (registered in rockfrag.models.contact) decides everything.
 
 The physics of each model sits in its own module (housner.py, ssi.py, winkler.py and the bed laws) as
 small compiled functions. What differs between models is dispatched on the model's kernel code
 (``rhs``, ``support``, ``static_settlement``, ``vertical_at_rest``, ``pivot_impact``); what differs
-between beds, on the law code (pipeline.models.contact). Set PIPELINE_NO_NUMBA=1 to run as plain Python.
+between beds, on the law code (rockfrag.models.contact). Set ROCKFRAG_NO_NUMBA=1 to run as plain Python.
 """
 
 from __future__ import annotations
@@ -43,9 +43,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from pipeline.models.base import Outcome
-from pipeline.models.contact import N_CONTACT_INDICATORS, contact_indicator, contact_indicators
-from pipeline.models.fields import (
+from rockfrag.models.base import Outcome
+from rockfrag.models.contact import N_CONTACT_INDICATORS, contact_indicator, contact_indicators
+from rockfrag.models.fields import (
     EVENT_CONTACT,
     EVENT_IMPACT,
     EVENT_NONE,
@@ -69,7 +69,7 @@ from pipeline.models.fields import (
     WINKLER,
     new_summaries,
 )
-from pipeline.models.housner import (
+from rockfrag.models.housner import (
     friction_impact,
     housner_rest_rhs,
     housner_rhs,
@@ -79,9 +79,9 @@ from pipeline.models.housner import (
     rock_forces,
     slide_rock_accelerations,
 )
-from pipeline.models.jit import kernel, njit
-from pipeline.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
-from pipeline.models.winkler import (
+from rockfrag.models.jit import kernel, njit
+from rockfrag.models.ssi import ssi_pivot_switch, ssi_rest_rhs, ssi_rhs, ssi_support
+from rockfrag.models.winkler import (
     bed_force,
     friction_demand,
     settled_beyond_reach,
@@ -119,7 +119,7 @@ MAX_STEPS = 50_000_000          # runaway guard
 FRICTION_MIN_SUPPORT = 0.1      # friction demand |H|/N is read only while N >= this fraction of m g
 TINY_INDICATOR = 1e-300         # a contact indicator that ended exactly on zero, booked on its far side
 SLIP_STOP_FRACTION = 1e-12      # of the slip rate's scale: a slide ending a step this slow has stopped there
-UNKNOWN_CODE = "model kernel code not handled by pipeline.models.kernels"
+UNKNOWN_CODE = "model kernel code not handled by rockfrag.models.kernels"
 
 # rows of the ground motion's samples (``GroundMotion.samples``, what the entry points take)
 HORIZONTAL = 0  # ag [m/s^2]
@@ -1191,7 +1191,7 @@ def pivot_loop(code, samples, dt, n_tail, params, x, history, impact_times, summ
 
 
 # ---------------------------------------------------------------------------------------------
-# bed models: winkler (the bed's contact law: pipeline.models.contact)
+# bed models: winkler (the bed's contact law: rockfrag.models.contact)
 # ---------------------------------------------------------------------------------------------
 
 @kernel

@@ -1,4 +1,4 @@
-"""pipeline.models.options - the solver options and the kernel's parameter record of one case.
+"""rockfrag.models.options - the solver options and the kernel's parameter record of one case.
 
 Input : ``SolverOptions`` fields (validated once), a model, a ``Block``, the interface stiffness k [N/m]
         and the damping ratio xi [-].
@@ -7,8 +7,8 @@ Output: ``SolverOptions`` and its schema ``SOLVER_OPTIONS``; ``FOUNDATION`` (k a
         case with an explicit xi; ``pivot_restitution``, a ``restitution`` option as a number for a block;
         ``friction_coefficients``, a ``friction`` option as (mu_s, mu_k).
 
-``pipeline.models.parameter_record`` is ``case_record`` plus the calibration of a restitution target for
-bed models (pipeline.models.restitution), which runs ``case_record`` itself: this module is below both.
+``rockfrag.models.parameter_record`` is ``case_record`` plus the calibration of a restitution target for
+bed models (rockfrag.models.restitution), which runs ``case_record`` itself: this module is below both.
 """
 
 from __future__ import annotations
@@ -18,18 +18,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pipeline.blocks import Block
-from pipeline.errors import ConfigError, SolverError
-from pipeline.models import fields
-from pipeline.models.base import RockingModel
-from pipeline.models.bed_hunt_crossley import NAME as HUNT_CROSSLEY
-from pipeline.models.contact import BED_LAWS
-from pipeline.soils import MAX_KINETIC_FRICTION
-from pipeline.units import STANDARD_GRAVITY
-from pipeline.validation import Checked, Nullable, Number, Table, Text, shown
+from rockfrag.blocks import Block
+from rockfrag.errors import ConfigError, SolverError
+from rockfrag.models import fields
+from rockfrag.models.base import RockingModel
+from rockfrag.models.bed_hunt_crossley import NAME as HUNT_CROSSLEY
+from rockfrag.models.contact import BED_LAWS
+from rockfrag.soils import MAX_KINETIC_FRICTION
+from rockfrag.units import STANDARD_GRAVITY
+from rockfrag.validation import Checked, Nullable, Number, Table, Text, shown
 
 SWITCH_RULES = {"consistent": fields.SWITCH_CONSISTENT, "continuous": fields.SWITCH_CONTINUOUS}
-BED_TYPES = BED_LAWS  # the winkler bed's contact laws, registered in pipeline.models.contact
+BED_TYPES = BED_LAWS  # the winkler bed's contact laws, registered in rockfrag.models.contact
 
 DEFAULT_RTOL = 1e-6  # relative error per step; peak angles agree with scipy at 1e-10 to ~1e-6
 DEFAULT_ATOL = 1e-7  # absolute error per step, as a fraction of alpha, alpha*p, y_static, y_static*omega
@@ -39,13 +39,13 @@ MAX_EVENTS = 200_000
 
 HOUSNER = "housner"  # restitution = "housner": Housner's r = 1 - 1.5 sin^2(alpha) of the block
 RIGID_BASE_MAX_KINETIC_FRICTION = MAX_KINETIC_FRICTION
-"""Largest kinetic friction coefficient of a rigid base (pipeline.soils.MAX_KINETIC_FRICTION, 4/3). A bed has no
+"""Largest kinetic friction coefficient of a rigid base (rockfrag.soils.MAX_KINETIC_FRICTION, 4/3). A bed has no
 such limit."""
 FRICTION_RANGE = "a number mu > 0 or a pair [mu_s, mu_k] with mu_s >= mu_k > 0 (static, kinetic)"
 MAX_XI = {HUNT_CROSSLEY: 10.0}
 """Largest damping ratio xi of a bed law whose xi may reach 1 or more (default: xi < 1). Hunt-Crossley's
 xi sets its damping at rest only (an overdamped vertical mode at rest is still a bed); its impacts need up
-to a few on soft beds (pipeline.models.restitution)."""
+to a few on soft beds (rockfrag.models.restitution)."""
 
 
 def _restitution_option(value, field: str, source: str | None):
@@ -99,14 +99,14 @@ class SolverOptions:
     """Settings shared by every case of a call (validated once).
 
     ``restitution``: pivot models, the impact coefficient (None: the model's default); bed models
-    (winkler), the target of the calibrated bed dissipation (pipeline.models.restitution; None: xi is
+    (winkler), the target of the calibrated bed dissipation (rockfrag.models.restitution; None: xi is
     given). A number, or "housner" for Housner's value 1 - 1.5 sin^2(alpha) of each block.
     ``friction``: Coulomb friction at the base of a model that ``slides`` (housner, winkler): one
     coefficient (static = kinetic) or (mu_s, mu_k); None ties the base horizontally (no sliding).
     """
 
     switch: str = "consistent"               # ssi pivot-switch rule: consistent | continuous
-    bed: str = "continuous"                  # winkler bed: a law of pipeline.models.contact
+    bed: str = "continuous"                  # winkler bed: a law of rockfrag.models.contact
     restitution: float | str | None = None   # see the class docstring
     g: float = STANDARD_GRAVITY
     overturn_angle: float = math.pi / 2
@@ -128,7 +128,7 @@ SOLVER_OPTIONS = Table({
     "atol": Number(0.0, 1.0, low_open=True, high_open=True),
     "friction": Nullable(Checked(_friction_option, FRICTION_RANGE)),
 })
-"""The schema of ``SolverOptions`` (pipeline.validation)."""
+"""The schema of ``SolverOptions`` (rockfrag.validation)."""
 FOUNDATION = Table({"k": Number(0.0, low_open=True, unit="N/m"), "xi": Number(0.0, 1.0, high_open=True)})
 """The schema of a foundation's interface stiffness k and damping ratio xi (a law in ``MAX_XI``: xi up to that)."""
 
@@ -157,7 +157,7 @@ def case_record(model: RockingModel, block: Block, k=None, xi=None, options: Sol
     """The kernel's parameter record and initial state [theta, theta', y, y', u, u'] (static) for one case.
 
     The damping ratio xi is explicit (None: ``DEFAULT_XI``); a bed model's ``restitution`` option is not read
-    here (pipeline.models.parameter_record calibrates xi to it first).
+    here (rockfrag.models.parameter_record calibrates xi to it first).
     """
     params = fields.new_params(1)[0]
     mu_s, mu_k = friction_coefficients(options.friction)

@@ -1,4 +1,4 @@
-"""pipeline.models.restitution - the bed's dissipation anchored to a restitution, and radiation damping.
+"""rockfrag.models.restitution - the bed's dissipation anchored to a restitution, and radiation damping.
 
 Input : a ``Block``, the bed's total vertical stiffness K [N/m] (eq. 19), a bed contact law name and a
         target effective restitution r (a number below 1, or "housner"); for radiation damping a block
@@ -37,16 +37,16 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import brentq
 
-from pipeline.blocks import Block
-from pipeline.errors import SolverError
-from pipeline.models import fields, kernels
-from pipeline.models.bed_continuous import NAME as CONTINUOUS
-from pipeline.models.bed_hunt_crossley import NAME as HUNT_CROSSLEY
-from pipeline.models.bed_two_spring import NAME as TWO_SPRING
-from pipeline.models.options import BED_TYPES, HOUSNER, MAX_XI, SolverOptions, case_record
-from pipeline.models.winkler import MODEL as WINKLER
-from pipeline.soils import SoilClass, soil_block_stiffness
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.blocks import Block
+from rockfrag.errors import SolverError
+from rockfrag.models import fields, kernels
+from rockfrag.models.bed_continuous import NAME as CONTINUOUS
+from rockfrag.models.bed_hunt_crossley import NAME as HUNT_CROSSLEY
+from rockfrag.models.bed_two_spring import NAME as TWO_SPRING
+from rockfrag.models.options import BED_TYPES, HOUSNER, MAX_XI, SolverOptions, case_record
+from rockfrag.models.winkler import MODEL as WINKLER
+from rockfrag.soils import SoilClass, soil_block_stiffness
+from rockfrag.units import STANDARD_GRAVITY
 
 LAUNCH_FRACTION = 0.6  # the launch takes a rigid block to this fraction of alpha
 PEAK_FLOOR = 0.1       # peaks below this fraction of alpha are not counted (elastic tilting on the bed)
@@ -118,7 +118,7 @@ def free_rocking_restitution(block: Block, k: float, bed: str, xi: float, g: flo
     k : float
         Total vertical stiffness of the bed [N/m].
     bed : str
-        The bed's contact law (pipeline.models.contact), used as given (no calibration).
+        The bed's contact law (rockfrag.models.contact), used as given (no calibration).
     xi : float
         Its damping ratio [-].
     g : float
@@ -233,7 +233,7 @@ def calibrate_dissipation(block: Block, k: float, bed: str, restitution: float |
         Gravity [m/s^2].
     xi_floor : float, optional
         Search xi only from this value up (the study's band: below it a block bounces on a stiff bed and r
-        jumps between grid points; pipeline.models.variants).
+        jumps between grid points; rockfrag.models.variants).
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""pipeline.models.ssi - the 2-DOF SSI-rocking model, derived from the paper's Lagrangian.
+"""rockfrag.models.ssi - the 2-DOF SSI-rocking model, derived from the paper's Lagrangian.
 
 Input : block (R, alpha, m), interface stiffness k [N/m] and damping ratio xi [-].
 Output: registered models ``ssi`` (derived here) and ``ssi-paper`` (the printed eqs. 15-16).
@@ -44,9 +44,9 @@ equations does; tends to Housner with r = 1).
 
 import math
 
-from pipeline.models.base import RockingModel
-from pipeline.models.fields import SSI
-from pipeline.models.jit import kernel
+from rockfrag.models.base import RockingModel
+from rockfrag.models.fields import SSI
+from rockfrag.models.jit import kernel
 
 PAPER_TITLE = "A Simplified Mechanical Model for Rocking Structures on Compliant Foundations"
 PAPER_CITATION = (f"{PAPER_TITLE}. Article; preprint at Preprints.org, 2026, doi:10.20944/preprints202603.1401.v1. "

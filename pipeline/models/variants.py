@@ -1,4 +1,4 @@
-"""pipeline.models.variants - a bed model run at the edges and centre of a restitution band.
+"""rockfrag.models.variants - a bed model run at the edges and centre of a restitution band.
 
 Input : a registered bed model (``winkler``), the band's edges as multiples of Housner's restitution
         (``[solver] restitution_band``), the blocks, their bed stiffnesses K [N/m] per soil and the bed law.
@@ -10,7 +10,7 @@ Why a band: the restitution of a real block's impacts is measured, not free. Exp
 (ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollar 2017) find real blocks lose about as much as
 Housner predicts, or a few percent less; the band runs the admissible model from Housner's value
 r_H = 1 - 1.5 sin^2(alpha) to min(1.05 r_H, 0.99) and its spread is the model uncertainty of the recommended
-fragility (pipeline.fragility). The centre is the arithmetic middle of the two edges.
+fragility (rockfrag.fragility). The centre is the arithmetic middle of the two edges.
 
 Where a bed cannot reach an edge (``restitution.reachable_range``: a stiff two-spring bed stays within
 0.5% of Housner's value; the squat skid's bed never dissipates as much as Housner's formula for alpha 0.64),
@@ -26,14 +26,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pipeline.blocks import Block
-from pipeline.errors import SolverError
-from pipeline.models.restitution import calibrate_dissipation, calibrated_law, reachable_range, restitution_target
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.blocks import Block
+from rockfrag.errors import SolverError
+from rockfrag.models.restitution import calibrate_dissipation, calibrated_law, reachable_range, restitution_target
+from rockfrag.units import STANDARD_GRAVITY
 
 RECOMMENDED = "recommended"
 """The model name of the recommended curves the fragility stage combines from a band's variants
-(pipeline.fragility.with_recommended); every output that carries them uses this name."""
+(rockfrag.fragility.with_recommended); every output that carries them uses this name."""
 BAND_ROLES = {"low": 0.0, "centre": 0.5, "high": 1.0}
 """A variant's position in the band, from the low edge (Housner's value) to the high edge."""
 BAND_LABELS = {"low": "band low edge", "centre": "band centre", "high": "band high edge"}

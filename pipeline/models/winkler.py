@@ -1,8 +1,8 @@
-"""pipeline.models.winkler - a rigid block on a tensionless viscoelastic Winkler bed.
+"""rockfrag.models.winkler - a rigid block on a tensionless viscoelastic Winkler bed.
 
 Input : block (b, h, m), the bed's total vertical stiffness K [N/m] (eq. 19, as for ``ssi``), its
         damping ratio xi [-] relative to the vertical mode (total dashpot C = 2 xi sqrt(K m)) and the
-        bed's contact law, a registered law of pipeline.models.contact: ``continuous`` (K spread
+        bed's contact law, a registered law of rockfrag.models.contact: ``continuous`` (K spread
         uniformly over the footprint width 2b, bed_continuous.py), ``two-spring`` (K/2 and C/2 at
         each corner, the classic Psycharis & Jennings 1983 / Chopra & Yim 1985 model, bed_two_spring.py)
         or ``hunt-crossley`` (the continuous springs with Hunt-Crossley damping, bed_hunt_crossley.py).
@@ -14,7 +14,7 @@ the block down whenever it rebounds, which real ground cannot do. Here every poi
 carries pressure = max(0, k delta + c delta') while it is in the ground (delta > 0) and nothing
 otherwise: the contact opens by itself, the block tilts elastically before it uplifts, it can leave
 the ground entirely (flight), and impacts dissipate through the bed's damping - no impact rule (a
-restitution can instead be the target to which pipeline.models.restitution calibrates xi).
+restitution can instead be the target to which rockfrag.models.restitution calibrates xi).
 
 Coordinates: theta (> 0 tilts towards +x: the +b corner presses in) and y, the settlement of the
 base centre (positive down; static y = m g / K). No sliding: the base centre follows the ground
@@ -55,10 +55,10 @@ from __future__ import annotations
 
 import math
 
-from pipeline.models.base import RockingModel
-from pipeline.models.contact import bed_force_at, bed_full_contact
-from pipeline.models.fields import WINKLER
-from pipeline.models.jit import kernel
+from rockfrag.models.base import RockingModel
+from rockfrag.models.contact import bed_force_at, bed_full_contact
+from rockfrag.models.fields import WINKLER
+from rockfrag.models.jit import kernel
 
 
 @kernel
@@ -66,7 +66,7 @@ def bed_force(x, params):
     """Vertical force F and its moment M about the base centre, both per unit mass, for state x.
 
     F [m/s^2] pushes the block up; M [m^2/s^2] is int q(s) s ds (positive when the +b side carries more).
-    The bed's contact law (``params["bed"]``, pipeline.models.contact) gives them.
+    The bed's contact law (``params["bed"]``, rockfrag.models.contact) gives them.
     """
     return bed_force_at(x, params, math.sin(x[0]), math.cos(x[0]))
 

@@ -1,4 +1,4 @@
-"""pipeline.records - stage 1: record files -> acceleration traces in m/s^2 with metadata.
+"""rockfrag.records - stage 1: record files -> acceleration traces in m/s^2 with metadata.
 
 Input : a record set name from the catalogue (``far-field``, ``near-field-pulse``, ``bolu``, ...),
         a folder of the user's own files, or single files, in any registered format.
@@ -10,12 +10,12 @@ Formats: rockfrag's own readers (PEER AT2, CSMIP Volume 1, ASDF, text/CSV) sit i
 tried in that order; their readers take the user's ``units`` and ``dt``. Every other format goes
 through ``obspy.read``, which detects its built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and
 third-party ones through obspy's own entry-point group ``obspy.plugin.waveform``: that is the one
-extension mechanism (the former ``pipeline.record_formats`` group is gone). Units: from the file where
+extension mechanism (the former ``rockfrag.record_formats`` group is gone). Units: from the file where
 it states them (PEER AT2: g; K-NET/KiK-net: the header's scale factor in gal; CSMIP: the data-start
 line; ASDF: the StationXML response of raw counts; text: a header such as ``acc [g]``), else the user's.
 
 Components: a file may hold several components (CSMIP, ASDF: ``read_stream``); each becomes one ``Record``
-whose metadata say its orientation (``pipeline.records.components``, whose API is re-exported here).
+whose metadata say its orientation (``rockfrag.records.components``, whose API is re-exported here).
 ``group_components`` groups records by event and station into H1, H2 and Z; verticals are marked
 (``Record.is_vertical``) and sit only in their own record sets (``three-component``), never in the
 horizontal ones.
@@ -32,17 +32,17 @@ from typing import Callable, Iterable, NamedTuple
 import numpy as np
 import obspy
 
-from pipeline.errors import ManifestError, RecordError
-from pipeline.records import asdf, csmip, peer_at2
-from pipeline.records import text as text_records
-from pipeline.records.components import ComponentGroup as ComponentGroup
-from pipeline.records.components import component_label, header_metadata, orientation_metadata
-from pipeline.records.components import component_labels as component_labels
-from pipeline.records.components import group_components as group_components
-from pipeline.records.components import split_vertical as split_vertical
-from pipeline.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
-from pipeline.units import STANDARD_GRAVITY, acceleration_factor
-from pipeline.validation import did_you_mean
+from rockfrag.errors import ManifestError, RecordError
+from rockfrag.records import asdf, csmip, peer_at2
+from rockfrag.records import text as text_records
+from rockfrag.records.components import ComponentGroup as ComponentGroup
+from rockfrag.records.components import component_label, header_metadata, orientation_metadata
+from rockfrag.records.components import component_labels as component_labels
+from rockfrag.records.components import group_components as group_components
+from rockfrag.records.components import split_vertical as split_vertical
+from rockfrag.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
+from rockfrag.units import STANDARD_GRAVITY, acceleration_factor
+from rockfrag.validation import did_you_mean
 
 RECORDS_DIR = Path(os.environ.get("ROCKFRAG_RECORDS", Path(__file__).resolve().parents[2] / "records"))
 """Folder holding the shipped records and ``MANIFEST.csv`` (override with $ROCKFRAG_RECORDS)."""

@@ -1,4 +1,4 @@
-"""pipeline.records.asdf - ASDF (Adaptable Seismic Data Format) files: raw waveforms in counts -> acceleration.
+"""rockfrag.records.asdf - ASDF (Adaptable Seismic Data Format) files: raw waveforms in counts -> acceleration.
 
 Input : an ASDF file (HDF5 with the root attribute ``file_format = "ASDF"``; Krischer et al. 2016): per
         station a group ``/Waveforms/NET.STA`` holding the station's ``StationXML`` (bytes) and one dataset
@@ -37,8 +37,8 @@ import obspy
 from obspy import Stream, Trace, UTCDateTime
 from obspy.core.util import AttribDict
 
-from pipeline.errors import RecordError
-from pipeline.units import acceleration_factor
+from rockfrag.errors import RecordError
+from rockfrag.units import acceleration_factor
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 """The first eight bytes of an HDF5 file (without a user block)."""

@@ -1,4 +1,4 @@
-"""pipeline.records.components - a record is one component of a station's motion: H1, H2 or Z.
+"""rockfrag.records.components - a record is one component of a station's motion: H1, H2 or Z.
 
 Input : read traces (their format's header: CSMIP ``stats.csmip``, ASDF ``stats.asdf``, or only a channel
         name) and loaded ``Record`` objects.
@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from pipeline.errors import RecordError
+from rockfrag.errors import RecordError
 
 _VERTICAL_NAME = re.compile(r"^(?:[A-Z0-9]{2}Z|Z|UD\d?|U-D|UP|DWN|DOWN|V|VER|VERT|VERTICAL)$")
 _FIRST_HORIZONTAL = {"N", "1", "NS"}

@@ -1,4 +1,4 @@
-"""pipeline.records.csmip - CSMIP Volume 1 ("Uncorrected Accelerogram Data") files, as an obspy waveform plugin.
+"""rockfrag.records.csmip - CSMIP Volume 1 ("Uncorrected Accelerogram Data") files, as an obspy waveform plugin.
 
 Input : a CSMIP/CGS Volume 1 text file (the format of the California Strong Motion Instrumentation
         Program, also written by CGS for SCSN stations: ``.RAW``, ``.V1``). One block per channel, each:
@@ -39,9 +39,9 @@ import numpy as np
 from obspy import Stream, Trace, UTCDateTime
 from obspy.core.util import AttribDict
 
-from pipeline.errors import RecordError
-from pipeline.records.sources import HEAD_BYTES, read_head, read_source
-from pipeline.units import acceleration_factor
+from rockfrag.errors import RecordError
+from rockfrag.records.sources import HEAD_BYTES, read_head, read_source
+from rockfrag.units import acceleration_factor
 
 V1_MARKER = "UNCORRECTED ACCELEROGRAM DATA"
 """The first line of every channel block of a Volume 1 file starts with this (any case)."""

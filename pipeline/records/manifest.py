@@ -1,4 +1,4 @@
-"""pipeline.records.manifest - the record catalogue ``records/MANIFEST.csv``.
+"""rockfrag.records.manifest - the record catalogue ``records/MANIFEST.csv``.
 
 Input : ``records/MANIFEST.csv`` (one row per file: id, file, event, year, magnitude, station,
         component, sets, source, units, npts, dt_s, pga_g, sha256, ...).
@@ -14,7 +14,7 @@ import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from pipeline.errors import ManifestError
+from rockfrag.errors import ManifestError
 
 REQUIRED_COLUMNS = ("id", "file", "event", "year", "magnitude", "station", "component", "sets",
                     "source", "units", "sha256")

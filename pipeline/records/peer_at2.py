@@ -1,4 +1,4 @@
-"""pipeline.records.peer_at2 - PEER AT2 acceleration files, as an obspy waveform plugin.
+"""rockfrag.records.peer_at2 - PEER AT2 acceleration files, as an obspy waveform plugin.
 
 Input : a PEER ``.AT2`` text file (every header variant described in ``records/SOURCE-README.md``:
         NGA-West2 with or without filter text, NGA-West1 ``NPTS, DT`` line, old PEER / Pacific
@@ -20,9 +20,9 @@ import numpy as np
 from obspy import Stream, Trace
 from obspy.core.util import AttribDict
 
-from pipeline.errors import RecordError
-from pipeline.records.sources import HEAD_BYTES, read_head, read_source
-from pipeline.units import acceleration_factor
+from rockfrag.errors import RecordError
+from rockfrag.records.sources import HEAD_BYTES, read_head, read_source
+from rockfrag.units import acceleration_factor
 
 HEADER_SEARCH_LINES = 10
 """The NPTS/DT line must appear within this many lines of the top of the file."""

@@ -1,4 +1,4 @@
-"""pipeline.records.sources - reading a record source for the format plugins: a path or a binary file object.
+"""rockfrag.records.sources - reading a record source for the format plugins: a path or a binary file object.
 
 Input : what obspy hands a plugin (a path, or a file object whose position must be left where it was).
 Output: ``read_source`` gives the whole content as bytes and a name for messages; ``read_head`` gives the

@@ -1,4 +1,4 @@
-"""pipeline.records.text - plain text / CSV acceleration records, and the one reader of numeric text tables.
+"""rockfrag.records.text - plain text / CSV acceleration records, and the one reader of numeric text tables.
 
 Text is the most common exchange format; tables with units in the header are read here also for
 calibration references.
@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 from obspy import Stream, Trace
 
-from pipeline.errors import RecordError
-from pipeline.units import acceleration_factor
+from rockfrag.errors import RecordError
+from rockfrag.units import acceleration_factor
 
 TEXT_SUFFIXES = {".csv", ".txt", ".dat", ".acc", ".tsv"}
 """File endings tried as text records (content decides: see ``is_text_record``)."""

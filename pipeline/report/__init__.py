@@ -1,8 +1,8 @@
-"""pipeline.report - stage 9: the study's result files -> a numbered client report (PDF and HTML).
+"""rockfrag.report - stage 9: the study's result files -> a numbered client report (PDF and HTML).
 
 Input : the study configuration and the datasets written by the earlier stages: ``cube.nc``, ``ida.nc``,
         ``fragility.nc`` (with the risk variables), ``showcase.nc`` (record-set spectra and the showcase
-        histories, written at study time by pipeline.showcase), optionally ``applicability.nc`` and
+        histories, written at study time by rockfrag.showcase), optionally ``applicability.nc`` and
         ``efficiency.nc``. The report only reads; it never runs a solver.
 Output: ``report.pdf`` (A4 landscape, every page numbered, the contents after the answer pages),
         ``report.html`` (the same pages in the same order: text pages as HTML text, figures embedded as
@@ -10,9 +10,9 @@ Output: ``report.pdf`` (A4 landscape, every page numbered, the contents after th
         and ``figures/NN-name.png`` (one per figure page). Neither file carries the date it was drawn: the
         same results give the same files (the title page gives the date the results were computed).
 
-Page order: title, one answer page per block (pipeline.report.answer_page), contents, summary, methods,
+Page order: title, one answer page per block (rockfrag.report.answer_page), contents, summary, methods,
 limitations, records, showcase record, IDA, fragility, outcomes, vertical component (a ``[study] vertical
-= true`` study: ``cube_without_vertical.nc`` beside ``cube.nc``; pipeline.report.vertical), applicability,
+= true`` study: ``cube_without_vertical.nc`` beside ``cube.nc``; rockfrag.report.vertical), applicability,
 measure efficiency, glossary, references. Pages for blocks, soils, models and records come from the
 result files, so only what the study ran is shown. Every intensity axis is logarithmic and marks the
 site's return-period intensities and, shaded, the extrapolation by scaling beyond the largest recorded
@@ -39,15 +39,15 @@ import xarray as xr  # noqa: E402
 from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from pipeline import __version__  # noqa: E402
-from pipeline.config import StudyConfig  # noqa: E402
-from pipeline.damage_states import damage_states_from_config  # noqa: E402
-from pipeline.outputs import atomic_path  # noqa: E402
-from pipeline.report import figures as pages  # noqa: E402
-from pipeline.report.adapters import block_name, models_of, record_pga_g, short_label  # noqa: E402
-from pipeline.report.answer_page import answer_items  # noqa: E402
-from pipeline.report.layout import Page, add_footer, new_page  # noqa: E402
-from pipeline.report.sections import (  # noqa: E402
+from rockfrag import __version__  # noqa: E402
+from rockfrag.config import StudyConfig  # noqa: E402
+from rockfrag.damage_states import damage_states_from_config  # noqa: E402
+from rockfrag.outputs import atomic_path  # noqa: E402
+from rockfrag.report import figures as pages  # noqa: E402
+from rockfrag.report.adapters import block_name, models_of, record_pga_g, short_label  # noqa: E402
+from rockfrag.report.answer_page import answer_items  # noqa: E402
+from rockfrag.report.layout import Page, add_footer, new_page  # noqa: E402
+from rockfrag.report.sections import (  # noqa: E402
     Results,
     limitations_items,
     methods_items,
@@ -55,10 +55,10 @@ from pipeline.report.sections import (  # noqa: E402
     summary_items,
     title_items,
 )
-from pipeline.report.text import Item, draw_text_page, items_html, note, paginate, table  # noqa: E402
-from pipeline.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
-from pipeline.report.words import glossary_items, references_items  # noqa: E402
-from pipeline.units import STANDARD_GRAVITY  # noqa: E402
+from rockfrag.report.text import Item, draw_text_page, items_html, note, paginate, table  # noqa: E402
+from rockfrag.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
+from rockfrag.report.words import glossary_items, references_items  # noqa: E402
+from rockfrag.units import STANDARD_GRAVITY  # noqa: E402
 
 PNG_DPI = 100
 G = STANDARD_GRAVITY
@@ -520,7 +520,7 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
     cube, ida, fragility : xarray.Dataset
         The opened ``cube.nc``, ``ida.nc`` and ``fragility.nc`` of the study.
     risk : xarray.Dataset or None
-        The risk variables (``pipeline.risk.risk_dataset``), merged into ``fragility`` when they are a
+        The risk variables (``rockfrag.risk.risk_dataset``), merged into ``fragility`` when they are a
         separate dataset; None when ``fragility`` holds them or there is no risk.
     output : str or os.PathLike
         The study's output folder: ``showcase.nc``, ``efficiency.nc``, ``applicability.nc`` and, when
@@ -535,7 +535,7 @@ def report_stage(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragili
     workers : int, optional
         1 draws every page in this process; otherwise the PNGs are drawn in one forked worker.
     run : dict, optional
-        The study's statistics (``pipeline.study.run_study``: ``runs_computed``, ``cells_reused``, ``cells``):
+        The study's statistics (``rockfrag.study.run_study``: ``runs_computed``, ``cells_reused``, ``cells``):
         the title page says how many runs this run computed and how many cells came from checkpoints.
 
     Returns

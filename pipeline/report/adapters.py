@@ -1,4 +1,4 @@
-"""pipeline.report.adapters - what the report asks of the result files, whatever their layout.
+"""rockfrag.report.adapters - what the report asks of the result files, whatever their layout.
 
 Input : the study's datasets (cube, ida, fragility + risk) and the model registry.
 Output: small answers the pages draw: model labels and roles (rigid base or on a foundation), the
@@ -16,16 +16,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from pipeline.answer import level_at_or_below
-from pipeline.damage_states import DAMAGE_STATES
-from pipeline.errors import SolverError
-from pipeline.measures import MEASURES, convert_units, file_units, parse_units, unit_label
-from pipeline.measures import short_label as measure_short_label
-from pipeline.models import get_model, model_label
-from pipeline.models.base import Outcome
-from pipeline.models.variants import RECOMMENDED
-from pipeline.report.layout import MODEL_STYLES, RECOMMENDED_STYLE, RIGID_STYLE, pretty
-from pipeline.soils import DEFAULT_FRICTION
+from rockfrag.answer import level_at_or_below
+from rockfrag.damage_states import DAMAGE_STATES
+from rockfrag.errors import SolverError
+from rockfrag.measures import MEASURES, convert_units, file_units, parse_units, unit_label
+from rockfrag.measures import short_label as measure_short_label
+from rockfrag.models import get_model, model_label
+from rockfrag.models.base import Outcome
+from rockfrag.models.variants import RECOMMENDED
+from rockfrag.report.layout import MODEL_STYLES, RECOMMENDED_STYLE, RIGID_STYLE, pretty
+from rockfrag.soils import DEFAULT_FRICTION
 
 OUTCOME_ROCKING, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = int(Outcome.ROCKING), int(Outcome.FAILED), \
     int(Outcome.FREE_FLIGHT)
@@ -64,7 +64,7 @@ def model_info(name: str) -> ModelInfo:
 
     ``recommended`` (the fragility stage's combined curve) is labelled in words; a restitution-band variant of
     a registered model (``winkler-low``, ``winkler-centre``, ``winkler-high``) is that model, labelled with
-    its place in the band (``pipeline.models.model_label``).
+    its place in the band (``rockfrag.models.model_label``).
     """
     if name == RECOMMENDED:
         return ModelInfo(name, "Recommended (tensionless bed, restitution band)", False,
@@ -160,7 +160,7 @@ def measure_label(dataset) -> str:
     unit = unit_label(source.attrs.get("units", dataset.im_level.attrs.get("units", "")))
     measure = str(dataset.attrs.get("intensity_measure", "")).lower()
     long_name = str(dataset.im_level.attrs.get("long_name", ""))
-    return f"{measure_short_label(measure, long_name)} [{unit}]"  # the registry's label (pipeline.measures)
+    return f"{measure_short_label(measure, long_name)} [{unit}]"  # the registry's label (rockfrag.measures)
 
 
 def state_title(label: str) -> str:

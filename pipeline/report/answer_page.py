@@ -1,6 +1,6 @@
-"""pipeline.report.answer_page - the answer page of each block, right after the title page.
+"""rockfrag.report.answer_page - the answer page of each block, right after the title page.
 
-Input : a ``Results`` bundle (its ``answers``: pipeline.answer.block_answers at the study's return periods,
+Input : a ``Results`` bundle (its ``answers``: rockfrag.answer.block_answers at the study's return periods,
         with the verdict limits of ``[decision]``) and the block.
 Output: the page's items (``answer_items``): the verdict in one sentence (saying when the hazard is the
         shipped example), which curve answers and why, the site's intensity at each return period and the
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pipeline.answer import (
+from rockfrag.answer import (
     ANCHOR,
     RECOMMENDED,
     BlockAnswer,
@@ -25,10 +25,10 @@ from pipeline.answer import (
     percent,
     verdict_sentence,
 )
-from pipeline.fragility import first_overturn_outcomes  # the fits' counting rule (resurrection), in one place
-from pipeline.models.base import Outcome
-from pipeline.models.variants import split_variant
-from pipeline.report.adapters import (
+from rockfrag.fragility import first_overturn_outcomes  # the fits' counting rule (resurrection), in one place
+from rockfrag.models.base import Outcome
+from rockfrag.models.variants import split_variant
+from rockfrag.report.adapters import (
     block_description,
     block_name,
     measure_label,
@@ -38,8 +38,8 @@ from pipeline.report.adapters import (
     sliding_candidates,
     state_labels,
 )
-from pipeline.report.text import Item, note, paragraph, strong, table
-from pipeline.report.words import state_short_label
+from rockfrag.report.text import Item, note, paragraph, strong, table
+from rockfrag.report.words import state_short_label
 
 
 def _number(value: float) -> str:
@@ -144,7 +144,7 @@ def curve_reason(results, model: str, block=None) -> str:
 
 MODE_WORDS = {"time_at_rest": "at rest", "time_sliding": "slides", "time_rocking": "rocks",
               "time_slide_rocking": "slides and rocks", "time_in_flight": "flies", "overturns": "overturns"}
-"""The contact modes of a run (the time fields pipeline.models.fields.MODE_TIME_FIELDS) and overturning in words."""
+"""The contact modes of a run (the time fields rockfrag.models.fields.MODE_TIME_FIELDS) and overturning in words."""
 
 
 MODE_SEVERITY = ("time_at_rest", "time_sliding", "time_rocking", "time_slide_rocking", "time_in_flight", "overturns")
@@ -159,7 +159,7 @@ def _motions(runs, overturned) -> np.ndarray | None:
     """Each record's most severe motion (an index of ``MODE_SEVERITY``), -1 for a failed run.
 
     From the mode times where the base slides; from the outcome where it is tied (no mode times). ``overturned``:
-    the record has overturned at this level or a lower one (``pipeline.fragility.first_overturn_outcomes``).
+    the record has overturned at this level or a lower one (``rockfrag.fragility.first_overturn_outcomes``).
     """
     outcome = np.asarray(runs.outcome.values)
     times = {field: np.asarray(runs[field].values, float) for field in MODE_SEVERITY[:-1] if field in runs}
@@ -176,7 +176,7 @@ def _motions(runs, overturned) -> np.ndarray | None:
 def governing_modes(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
     """What the block does at each intensity: the most severe motion that at least half the records reach.
 
-    One definition, level and counting rule with the probability table (``pipeline.answer``): each record's
+    One definition, level and counting rule with the probability table (``rockfrag.answer``): each record's
     motion is the most severe it enters (a block that rocks for 2 s of a 40 s record rocks), ``MODE_SEVERITY``,
     overturning counted from the record's first overturning level on (as the fits count it: resurrection); the
     share is that of the records reaching the motion or a more severe one, so "at rest" is always 100%. Read at
@@ -218,7 +218,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     Parameters
     ----------
     results : Results
-        The study's results (pipeline.report.sections.Results).
+        The study's results (rockfrag.report.sections.Results).
     answer : BlockAnswer
         The block's answer (``results.answers``).
 
@@ -344,7 +344,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
 def sliding_rows(cube, answer: BlockAnswer, scale: float) -> list[list[str]]:
     """Per soil, the share of records whose tied base needs more friction than μ_s at each return period's level.
 
-    ``pipeline.report.adapters.sliding_at`` at the level run at or below each intensity (``scale``: the answer's
+    ``rockfrag.report.adapters.sliding_at`` at the level run at or below each intensity (``scale``: the answer's
     unit per the cube's); "sliding computed" where the cell runs with friction (its slip states answer). Empty
     when the cube has no friction demand.
     """

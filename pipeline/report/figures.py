@@ -1,7 +1,7 @@
-"""pipeline.report.figures - the figure pages of the report, each drawn on one A4-landscape page.
+"""rockfrag.report.figures - the figure pages of the report, each drawn on one A4-landscape page.
 
 Input : the opened result datasets (cube, ida, fragility, showcase, applicability) and labels from the
-        registries (pipeline.report.adapters). Output: matplotlib figures of the page size (layout.new_page)
+        registries (rockfrag.report.adapters). Output: matplotlib figures of the page size (layout.new_page)
         with axis labels in units, one legend outside the data, and a caption. Nothing is simulated.
 """
 
@@ -14,10 +14,10 @@ import textwrap
 import numpy as np
 import xarray as xr
 
-from pipeline.damage_states import NOT_APPLICABLE
-from pipeline.fragility import lognormal_cdf
-from pipeline.measures import MEASURES
-from pipeline.report.adapters import (
+from rockfrag.damage_states import NOT_APPLICABLE
+from rockfrag.fragility import lognormal_cdf
+from rockfrag.measures import MEASURES
+from rockfrag.report.adapters import (
     OUTCOME_ROCKING,
     CredibleMarks,
     block_levels,
@@ -32,7 +32,7 @@ from pipeline.report.adapters import (
     state_title,
     uplift_intensity,
 )
-from pipeline.report.layout import (
+from rockfrag.report.layout import (
     FRACTILE_STYLES,
     GRID,
     chars_across,
@@ -45,8 +45,8 @@ from pipeline.report.layout import (
     pretty,
     soil_colour,
 )
-from pipeline.report.words import plain
-from pipeline.units import STANDARD_GRAVITY
+from rockfrag.report.words import plain
+from rockfrag.units import STANDARD_GRAVITY
 
 G = STANDARD_GRAVITY
 IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (the flatline)

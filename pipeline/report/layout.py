@@ -1,4 +1,4 @@
-"""pipeline.report.layout - one page size, colours and line styles for every page of the report.
+"""rockfrag.report.layout - one page size, colours and line styles for every page of the report.
 
 Input : nothing (definitions). Output: ``Page`` (one report page: its place in the contents, the function
 that draws its figure of the page size, a caption, an optional HTML body and, once rendered, its PNG),
@@ -69,7 +69,7 @@ class Page:
     html : str or None
         The page's body as HTML for text pages; figure pages are embedded as their PNG.
     png : bytes
-        The rendered page (empty until ``pipeline.report.render`` has drawn it).
+        The rendered page (empty until ``rockfrag.report.render`` has drawn it).
     also : tuple of str
         Further sections that start on this page (text sections packed onto one page when they fit).
     heading : str

@@ -1,4 +1,4 @@
-"""pipeline.report.sections - the text of the report, generated from the study and its results.
+"""rockfrag.report.sections - the text of the report, generated from the study and its results.
 
 Input : a ``Results`` bundle (study config, cube, ida, fragility + risk, showcase, output folder).
 Output: lists of ``text.Item`` for the summary, methods and limitations pages. No number is typed in
@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline import __version__
-from pipeline.answer import (
+from rockfrag import __version__
+from rockfrag.answer import (
     DEFAULT_LIMITS,
     DEFAULT_RETURN_PERIODS,
     DEFAULT_SLIDING_SHARE,
@@ -30,13 +30,13 @@ from pipeline.answer import (
     percent,
     records_reaching,
 )
-from pipeline.checkpoints import FOLDER as CHECKPOINT_FOLDER
-from pipeline.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
-from pipeline.config import StudyConfig
-from pipeline.damage_states import NOT_APPLICABLE
-from pipeline.errors import PipelineError
-from pipeline.hazard import HazardCurve, study_hazard
-from pipeline.report.adapters import (
+from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
+from rockfrag.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
+from rockfrag.config import StudyConfig
+from rockfrag.damage_states import NOT_APPLICABLE
+from rockfrag.errors import PipelineError
+from rockfrag.hazard import HazardCurve, study_hazard
+from rockfrag.report.adapters import (
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
     CredibleMarks,
@@ -61,11 +61,11 @@ from pipeline.report.adapters import (
     tension_flag,
     vertical_applied,
 )
-from pipeline.report.layout import pretty
-from pipeline.report.text import Item, bullet, heading, note, paragraph, table
-from pipeline.report.vertical import VerticalEffect
-from pipeline.report.words import PAPER_CITATION, plain, state_short_label
-from pipeline.soils import SOILS
+from rockfrag.report.layout import pretty
+from rockfrag.report.text import Item, bullet, heading, note, paragraph, table
+from rockfrag.report.vertical import VerticalEffect
+from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
+from rockfrag.soils import SOILS
 
 EXTRAPOLATION_ROWS = 30
 
@@ -83,7 +83,7 @@ class Results:
     applicability: xr.Dataset | None = None
     efficiency: xr.Dataset | None = None
     runtime_s: float = float("nan")  # wall time of the pipeline run up to the report [s]; NaN: not stated
-    run: dict | None = None  # the study's statistics (pipeline.study.run_study): runs computed, cells reused
+    run: dict | None = None  # the study's statistics (rockfrag.study.run_study): runs computed, cells reused
     vertical: VerticalEffect | None = None  # [study] vertical = true: the runs with and without the verticals
 
     @property
@@ -138,7 +138,7 @@ class Results:
 
     @property
     def decision(self) -> dict:
-        """``[decision]``: the limits of the verdict (defaults of pipeline.answer where the study is silent)."""
+        """``[decision]``: the limits of the verdict (defaults of rockfrag.answer where the study is silent)."""
         table = (self.config.raw.get("decision") or {}) if self.config is not None else {}
         return {"max_probability_in_life": dict(table.get("max_probability_in_life", DEFAULT_LIMITS)),
                 "max_sliding_share": float(table.get("max_sliding_share", DEFAULT_SLIDING_SHARE))}
@@ -151,7 +151,7 @@ class Results:
 
     @cached_property
     def answers(self) -> list[BlockAnswer]:
-        """The answer of every block (pipeline.answer.block_answers) at the study's return periods."""
+        """The answer of every block (rockfrag.answer.block_answers) at the study's return periods."""
         hazard, periods = self.hazard, self.return_periods
         model = answer_model(self.fragility)
         scale, _ = display_scale(_level_units(self.cube))
@@ -566,15 +566,15 @@ LIMIT_SOURCES = {
                    "applied here to damage short of collapse: " + STUDY_CHOICE,
     "slip-0.30": "the 10% in 50 years of the design-basis earthquake, as for θmax/α ≥ 0.5: " + STUDY_CHOICE,
 }
-"""Where the shipped verdict limits (pipeline.answer.DEFAULT_LIMITS) come from."""
+"""Where the shipped verdict limits (rockfrag.answer.DEFAULT_LIMITS) come from."""
 
 
 def _kinetic_words(soils) -> str:
-    """Kinetic over static friction of the shipped soils, read from pipeline.soils.
+    """Kinetic over static friction of the shipped soils, read from rockfrag.soils.
 
     "Kinetic friction 0.85 × static (rounded to 0.01) on clay, sand; on steel 0.8 × static".
     """
-    from pipeline.soils import KINETIC_OVER_STATIC
+    from rockfrag.soils import KINETIC_OVER_STATIC
 
     usual = [soil.name for soil in soils
              if round(KINETIC_OVER_STATIC * soil.friction_static, 2) == soil.friction_kinetic]
@@ -586,8 +586,8 @@ def _kinetic_words(soils) -> str:
 
 def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
-    from pipeline.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
-    from pipeline.models.variants import DEFAULT_BAND
+    from rockfrag.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
+    from rockfrag.models.variants import DEFAULT_BAND
 
     config, fragility = results.config, results.fragility
     labels = state_labels(fragility)

@@ -1,4 +1,4 @@
-"""pipeline.report.text - text pages (contents, methods, limitations, tables) laid out on the page size.
+"""rockfrag.report.text - text pages (contents, methods, limitations, tables) laid out on the page size.
 
 Input : a list of ``Item`` (heading, paragraph, bullet, table, note). Output: the items split over as
 many pages as they need (``paginate``, pure: the page count is known before anything is drawn), each
@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 
 import matplotlib.lines
 
-from pipeline.report.layout import new_page
+from rockfrag.report.layout import new_page
 
 TOP, BOTTOM = 0.925, 0.085  # figure fractions available to text
 LINE = 0.021  # one line of 9.5 pt text on the A4-landscape page [figure fraction]

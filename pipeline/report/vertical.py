@@ -1,16 +1,16 @@
-"""pipeline.report.vertical - the effect of the vertical component: the same records with and without it.
+"""rockfrag.report.vertical - the effect of the vertical component: the same records with and without it.
 
 Input : the study cube ``cube.nc`` of a ``[study] vertical = true`` study (every record run with its
         station's vertical component), its comparison cube ``cube_without_vertical.nc``
-        (``pipeline.cube.COMPARISON_CUBE``: the same records, levels and scale factors, horizontal components
+        (``rockfrag.cube.COMPARISON_CUBE``: the same records, levels and scale factors, horizontal components
         alone) and the study's damage states.
 Output: ``VerticalEffect`` (both cubes and their fits), the figure page of a block (``vertical_page``: median
         IDA curves and overturning fractions with and without the vertical, per soil) and the table of the
         report's "Vertical component" page (``vertical_items``: fragility medians and median capacities with
         and without, per block, model and soil, with the share of runs in free flight).
 
-Both sides are fitted alike (pipeline.fragility.fragility_dataset, no bootstrap: the point estimates are
-those of fragility.nc for cube.nc), the capacities of both from their refined IDA runs (pipeline.ida). Runs
+Both sides are fitted alike (rockfrag.fragility.fragility_dataset, no bootstrap: the point estimates are
+those of fragility.nc for cube.nc), the capacities of both from their refined IDA runs (rockfrag.ida). Runs
 that stopped in free flight (g + a_v < 0 under a pivot model) are censored by ``fragility.exceedance``;
 where most runs of a level flew, the pivot models say nothing about overturning there, and the page says so.
 """
@@ -24,11 +24,11 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from pipeline.cube import COMPARISON_CUBE, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED, VERTICAL_APPLIED
-from pipeline.damage_states import DamageState
-from pipeline.fragility import exceedance, first_overturn_outcomes, fragility_dataset, lognormal_cdf
-from pipeline.ida import ida_dataset
-from pipeline.report.adapters import (
+from rockfrag.cube import COMPARISON_CUBE, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT, OUTCOME_OVERTURNED, VERTICAL_APPLIED
+from rockfrag.damage_states import DamageState
+from rockfrag.fragility import exceedance, first_overturn_outcomes, fragility_dataset, lognormal_cdf
+from rockfrag.ida import ida_dataset
+from rockfrag.report.adapters import (
     block_levels,
     cell,
     measure_label,
@@ -37,9 +37,9 @@ from pipeline.report.adapters import (
     panel_label,
     soils_of,
 )
-from pipeline.report.figures import axis_range, mark_intensities
-from pipeline.report.layout import OUTCOME_COLOURS, log_axis, log_y_axis, new_page, outside_legend, panels
-from pipeline.report.text import Item, heading, note, paragraph, table
+from rockfrag.report.figures import axis_range, mark_intensities
+from rockfrag.report.layout import OUTCOME_COLOURS, log_axis, log_y_axis, new_page, outside_legend, panels
+from rockfrag.report.text import Item, heading, note, paragraph, table
 
 IDA_CAP = 1.6  # theta_max/alpha drawn for overturned runs (as on the IDA pages)
 MOST_FLEW = 0.5  # a level's median IDA point is not drawn where more than this share of the runs flew
@@ -89,7 +89,7 @@ def vertical_effect(cube: xr.Dataset, comparison: xr.Dataset, states: list[Damag
     cube, comparison : xarray.Dataset
         ``cube.nc`` (with the verticals) and ``cube_without_vertical.nc``.
     states : list of DamageState
-        The study's damage states (``pipeline.damage_states.damage_states_from_config``).
+        The study's damage states (``rockfrag.damage_states.damage_states_from_config``).
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""pipeline.report.words - the words a client reads: plain names for identifiers, glossary, references.
+"""rockfrag.report.words - the words a client reads: plain names for identifiers, glossary, references.
 
 Input : identifiers as the result files write them (fit methods, row statuses, pivot-switch rules, bed
         laws, damage-state names, models that are not in the registry).
@@ -10,8 +10,8 @@ Output: plain words for each (``FIT_METHODS``, ``STATUS_WORDS``, ``SWITCH_WORDS`
 
 from __future__ import annotations
 
-from pipeline.models.ssi import PAPER_CITATION, PAPER_TITLE  # noqa: F401 (the report's names for them)
-from pipeline.report.text import Item, bullet, heading, paragraph
+from rockfrag.models.ssi import PAPER_CITATION, PAPER_TITLE  # noqa: F401 (the report's names for them)
+from rockfrag.report.text import Item, bullet, heading, paragraph
 
 FIT_METHODS = {
     "mle-binomial": "maximum likelihood on the counts per level",
@@ -189,11 +189,11 @@ def state_short_label(name: str, description: str) -> str:
 
     A slip state says its threshold with its unit ("slip ≥ 0.05 m"): its name alone ("slip 0.05") gives no unit.
     """
-    from pipeline.damage_states import DAMAGE_STATES, is_slip_state
+    from rockfrag.damage_states import DAMAGE_STATES, is_slip_state
 
     state = DAMAGE_STATES.get(name)
     if state is not None and is_slip_state(state):
-        return f"slip ≥ {state.threshold:.2f} m"  # the slip EDP is in metres (pipeline.damage_states)
+        return f"slip ≥ {state.threshold:.2f} m"  # the slip EDP is in metres (rockfrag.damage_states)
     text = description.replace("theta_max", "θmax").replace("alpha", "α").replace(">=", "≥")
     if text and len(text) <= 16:
         return text

@@ -1,5 +1,5 @@
 """Fuzzing (issue 13): Hypothesis-made corrupt AT2 files, processing recipes, study files and
-calibration CSVs, run through ``pipeline.cli.main`` in this process (a thousand processes would be
+calibration CSVs, run through ``rockfrag.cli.main`` in this process (a thousand processes would be
 too slow; tests/test_reliability.py checks real processes). Every corrupt input must end in exit
 status 1 or 2 with one line per problem on stderr, each starting with ``rockfrag:``, and no traceback.
 
@@ -21,7 +21,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pipeline import cli
+from rockfrag import cli
 from tests.reliability_helpers import at2_text, error_lines
 
 FUZZ = settings(derandomize=True, database=None, deadline=None,

@@ -16,10 +16,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pipeline.blocks import Block
-from pipeline.errors import ConfigError
-from pipeline.plausibility import PlausibilityWarning, check_study
-from pipeline.soils import SoilClass
+from rockfrag.blocks import Block
+from rockfrag.errors import ConfigError
+from rockfrag.plausibility import PlausibilityWarning, check_study
+from rockfrag.soils import SoilClass
 from tests.fuzz.test_fuzz_inputs import FUZZ
 
 EXAMPLES = 150

@@ -7,9 +7,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from pipeline.blocks import Block
-from pipeline.processing import load_recipe, process_record
-from pipeline.records import load_records
+from rockfrag.blocks import Block
+from rockfrag.processing import load_recipe, process_record
+from rockfrag.records import load_records
 
 BLOCK = Block(name="reference", R=2.0, alpha=0.25, mass=5000.0)  # b/h = 0.255
 SAMPLES = 2000  # the strong part: 20 s of Bolu (dt 0.01 s), 10 s of Capitola (dt 0.005 s)

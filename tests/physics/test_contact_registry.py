@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.models import BED_TYPES, SolverOptions, contact, get_model, parameter_record
+from rockfrag.blocks import Block
+from rockfrag.models import BED_TYPES, SolverOptions, contact, get_model, parameter_record
 
 BLOCK = Block(name="registry", R=2.0, alpha=0.25, mass=5000.0)
 STIFFNESS = 5000.0 * 300.0**2  # [N/m]

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from pipeline.models import kernels
-from pipeline.models.fields import HOUSNER, SSI, new_params
+from rockfrag.models import kernels
+from rockfrag.models.fields import HOUSNER, SSI, new_params
 
 
 def _lagrange_accelerations():

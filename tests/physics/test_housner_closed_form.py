@@ -11,8 +11,8 @@ from scipy.integrate import quad
 from scipy.optimize import brentq
 from scipy.special import ellipkinc
 
-from pipeline.blocks import Block
-from pipeline.models import Outcome, simulate
+from rockfrag.blocks import Block
+from rockfrag.models import Outcome, simulate
 
 G = 9.80665
 BLOCK = Block(name="test", R=1.0, alpha=0.2, mass=1000.0)

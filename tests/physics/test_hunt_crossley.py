@@ -18,11 +18,11 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.models import SolverOptions, get_model, parameter_record, simulate
-from pipeline.models import bed_continuous as kelvin_voigt
-from pipeline.models import bed_hunt_crossley as law
-from pipeline.models.restitution import launch_rate
+from rockfrag.blocks import Block
+from rockfrag.models import SolverOptions, get_model, parameter_record, simulate
+from rockfrag.models import bed_continuous as kelvin_voigt
+from rockfrag.models import bed_hunt_crossley as law
+from rockfrag.models.restitution import launch_rate
 
 from . import winkler_reference as reference
 from .motions import BLOCK as RECORD_BLOCK

@@ -1,4 +1,4 @@
-"""The rules that make ``pipeline.models.jit.kernel`` (compiled without reference counting) safe.
+"""The rules that make ``rockfrag.models.jit.kernel`` (compiled without reference counting) safe.
 
 A ``kernel`` borrows the arrays its caller hands it: it must not allocate one (numba refuses to compile
 that) nor return one (its caller would release an array nobody counted). And a whole run, friction,
@@ -13,10 +13,10 @@ import pkgutil
 import numpy as np
 import pytest
 
-import pipeline.models
-from pipeline.blocks import Block
-from pipeline.models import simulate_batch, simulate_histories
-from pipeline.models.jit import kernel
+import rockfrag.models
+from rockfrag.blocks import Block
+from rockfrag.models import simulate_batch, simulate_histories
+from rockfrag.models.jit import kernel
 
 numba = pytest.importorskip("numba")
 from numba.core import types  # noqa: E402
@@ -24,7 +24,7 @@ from numba.core.registry import CPUDispatcher  # noqa: E402
 from numba.core.runtime import _nrt_python, rtsys  # noqa: E402
 
 pytestmark = pytest.mark.skipif(not isinstance(kernel(lambda: 0), CPUDispatcher),
-                                reason="PIPELINE_NO_NUMBA=1: plain Python has no reference counts")
+                                reason="ROCKFRAG_NO_NUMBA=1: plain Python has no reference counts")
 
 BLOCK = Block(name="rules", R=2.0, alpha=0.2, mass=1.0)
 STIFFNESS = (300.0 * BLOCK.p()) ** 2  # [N/m] for a 1 kg block: omega_v / p = 300
@@ -56,10 +56,10 @@ def contains_array(numba_type) -> bool:
 
 
 def compiled_kernels():
-    """(name, dispatcher) of every function of pipeline.models compiled as a ``kernel``."""
+    """(name, dispatcher) of every function of rockfrag.models compiled as a ``kernel``."""
     found = []
-    for module_info in pkgutil.iter_modules(pipeline.models.__path__):
-        module = importlib.import_module(f"pipeline.models.{module_info.name}")
+    for module_info in pkgutil.iter_modules(rockfrag.models.__path__):
+        module = importlib.import_module(f"rockfrag.models.{module_info.name}")
         for name, value in vars(module).items():
             if (isinstance(value, CPUDispatcher) and value.__module__ == module.__name__
                     and value.targetoptions.get("_nrt") is False):

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.models import simulate
-from pipeline.processing import process_record
-from pipeline.records import load_records
+from rockfrag.blocks import Block
+from rockfrag.models import simulate
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
 
 from .reference import reference_response
 

@@ -8,11 +8,11 @@ import math
 
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.config import load_study
-from pipeline.errors import SolverError
-from pipeline.models import radiation_damping
-from pipeline.soils import SOILS, SoilClass
+from rockfrag.blocks import Block
+from rockfrag.config import load_study
+from rockfrag.errors import SolverError
+from rockfrag.models import radiation_damping
+from rockfrag.soils import SOILS, SoilClass
 
 
 def test_the_formula_by_hand():

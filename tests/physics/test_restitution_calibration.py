@@ -16,12 +16,12 @@ import re
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.errors import SolverError
-from pipeline.models import calibrate_dissipation, get_model, parameter_record, simulate, simulate_batch
-from pipeline.models import restitution as calibration
-from pipeline.models.options import SolverOptions
-from pipeline.models.restitution import calibrated_law, launch_rate
+from rockfrag.blocks import Block
+from rockfrag.errors import SolverError
+from rockfrag.models import calibrate_dissipation, get_model, parameter_record, simulate, simulate_batch
+from rockfrag.models import restitution as calibration
+from rockfrag.models.options import SolverOptions
+from rockfrag.models.restitution import calibrated_law, launch_rate
 
 from . import winkler_reference as reference
 

@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from pipeline.blocks import Block
-from pipeline.errors import SolverError
-from pipeline.models import simulate
+from rockfrag.blocks import Block
+from rockfrag.errors import SolverError
+from rockfrag.models import simulate
 
 G = 9.80665
 SQUAT = Block(name="squat", R=math.hypot(1.0, 0.5), alpha=math.atan2(1.0, 0.5), mass=1000.0)  # b/h = 2

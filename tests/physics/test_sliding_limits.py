@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.models import simulate
+from rockfrag.blocks import Block
+from rockfrag.models import simulate
 
 from .test_sliding_vs_reference import case_motion
 

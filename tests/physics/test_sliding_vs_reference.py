@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import pytest
 
-from pipeline.models import simulate
+from rockfrag.models import simulate
 
 from .motions import BLOCK, TAIL, case_motion
 from .sliding_reference import reference_sliding

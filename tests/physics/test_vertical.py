@@ -22,9 +22,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from pipeline.blocks import Block
-from pipeline.errors import SolverError
-from pipeline.models import (
+from rockfrag.blocks import Block
+from rockfrag.errors import SolverError
+from rockfrag.models import (
     Outcome,
     SolverOptions,
     get_model,
@@ -34,10 +34,10 @@ from pipeline.models import (
     simulate,
     simulate_batch,
 )
-from pipeline.models.fields import STATE_SIZE
-from pipeline.models.winkler import bed_force
-from pipeline.processing import process_record
-from pipeline.records import load_records
+from rockfrag.models.fields import STATE_SIZE
+from rockfrag.models.winkler import bed_force
+from rockfrag.processing import process_record
+from rockfrag.records import load_records
 
 from .reference import free_flight_time, reference_response
 from .winkler_reference import energy as bed_energy

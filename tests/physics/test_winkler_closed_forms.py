@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
+from rockfrag.blocks import Block
 
 from .winkler_reference import bed_force, energy, solve
 

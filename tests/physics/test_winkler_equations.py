@@ -4,7 +4,7 @@ resultant force and moment against a brute-force quadrature of the pointwise ten
 sympy builds T and V from the positions of the centre of mass and of a base point (not from the
 spec's printed T), takes the bed's generalised forces from the virtual work of a vertical point
 force at the base, and solves the Euler-Lagrange equations for theta'' and y''. The product's
-``pipeline.models.winkler.accelerations`` (and the scipy reference's) must match at random states.
+``rockfrag.models.winkler.accelerations`` (and the scipy reference's) must match at random states.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from pipeline.blocks import Block
-from pipeline.models import SolverOptions, get_model, parameter_record
-from pipeline.models import winkler as product
+from rockfrag.blocks import Block
+from rockfrag.models import SolverOptions, get_model, parameter_record
+from rockfrag.models import winkler as product
 
 from . import winkler_reference as reference
 

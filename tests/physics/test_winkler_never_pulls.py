@@ -17,8 +17,8 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from pipeline.blocks import Block
-from pipeline.models import simulate
+from rockfrag.blocks import Block
+from rockfrag.models import simulate
 
 from .winkler_reference import bed_force
 

@@ -23,8 +23,8 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.models import simulate
+from rockfrag.blocks import Block
+from rockfrag.models import simulate
 
 from .motions import BLOCK, ground_motion
 from .winkler_reference import accelerations

@@ -14,8 +14,8 @@ import math
 import numpy as np
 import pytest
 
-from pipeline.blocks import Block
-from pipeline.models import simulate
+from rockfrag.blocks import Block
+from rockfrag.models import simulate
 
 from .winkler_reference import effective_restitution, rocking_peaks
 

@@ -13,7 +13,7 @@ from functools import lru_cache
 import numpy as np
 import pytest
 
-from pipeline.models import simulate
+from rockfrag.models import simulate
 
 from .motions import BLOCK, TAIL, case_motion
 from .winkler_reference import reference_winkler

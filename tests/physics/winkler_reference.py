@@ -337,8 +337,8 @@ def effective_restitution(peaks, alpha):
 def product_response(ag, dt, b, h, mass, K, xi, bed="continuous", t_end=None, g=G, theta0=0.0,
                      thetadot0=0.0):
     """The product's ``simulate("winkler", ...)`` in the reference's dict form (for side-by-side tests)."""
-    from pipeline.blocks import Block
-    from pipeline.models import simulate
+    from rockfrag.blocks import Block
+    from rockfrag.models import simulate
 
     block = Block(name="winkler-test", b=b, h=h, mass=mass)
     result = simulate("winkler", ag, dt, block, k=K, xi=xi, bed=bed, t_end=t_end, theta0=theta0,

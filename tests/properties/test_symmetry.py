@@ -11,9 +11,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from pipeline.blocks import Block
-from pipeline.measures import response_spectrum
-from pipeline.models import simulate
+from rockfrag.blocks import Block
+from rockfrag.measures import response_spectrum
+from rockfrag.models import simulate
 
 BLOCK = Block(name="p", R=1.0, alpha=0.2, mass=1000.0)
 
@@ -61,14 +61,14 @@ def test_spectrum_is_linear_in_the_input(motion, factor):
 
 @pytest.mark.slow
 def test_plain_python_kernels_give_the_compiled_numbers():
-    """PIPELINE_NO_NUMBA=1 runs the same kernels as plain Python (debugging): same results."""
-    code = ("import numpy as np; from pipeline.models import simulate; from pipeline.blocks import Block;"
+    """ROCKFRAG_NO_NUMBA=1 runs the same kernels as plain Python (debugging): same results."""
+    code = ("import numpy as np; from rockfrag.models import simulate; from rockfrag.blocks import Block;"
             "b = Block(name='p', R=1.0, alpha=0.2, mass=1000.0);"
             "r = simulate('ssi', np.zeros(2), 0.01, b, k=1e8, xi=0.05, theta0=0.1, t_end=2.0);"
             "print(repr(r.peak_angle), r.n_impacts, repr(float(r.impact_times[0])))")
     outputs = []
     for flag in ("0", "1"):
-        environment = dict(os.environ, PIPELINE_NO_NUMBA=flag)
+        environment = dict(os.environ, ROCKFRAG_NO_NUMBA=flag)
         result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=environment,
                                 check=True)
         outputs.append(result.stdout.split())
