@@ -6,6 +6,12 @@ Output: the interface stiffness k [N/m] of paper eq. 19, k = (A/H) / (1/G_s + 1/
         circular frequency w = sqrt(k/m) [rad/s] and dashpot c = 2 xi w m [N s/m] (eq. 10); with
         ``foundation`` also the static settlement m g / k [m] and w / p, which rockfrag.plausibility checks.
 
+Site: each soil class also states the Vs30 [m/s] of the site it stands for (``vs30``): the time-averaged shear-wave
+velocity of the top 30 m of the ground profile, which sets how the ground shakes (rockfrag.site_amplification), not
+the stiffness of the 1-2 m bed under the block (``shear_modulus``). ``site_class`` gives its ASCE 7-16 class
+(``SITE_CLASSES``); ``vs30 = None`` means the reference site of the hazard curve itself (a steel deck: its site is
+the ground below the structure, which the user states).
+
 Base friction: each soil class also carries the Coulomb friction coefficients of a block's base on it,
 static ``friction_static`` and kinetic ``friction_kinetic`` [-] (``FRICTION_SOURCES``), which the study uses
 for the runs that slide (rockfrag.study.cell_friction).
@@ -27,6 +33,36 @@ MAX_KINETIC_FRICTION = 4.0 / 3.0
 """Largest kinetic coefficient a soil may state: a rigid base's limit. Above it a block rocking on a sliding corner
 can meet Painleve's paradox (no solution of its equations; pipeline/models/housner.py). The models read it from here
 (rockfrag.models.options.RIGID_BASE_MAX_KINETIC_FRICTION)."""
+
+VS30_RANGE = Number(0, 5000, low_open=True, unit="m/s")
+"""Allowed Vs30 of a soil's site (``vs30``, ``[soils_custom.NAME] vs30``, ``[hazard] vs30``)."""
+
+SITE_CLASSES = {"A": (1500.0, math.inf), "B": (760.0, 1500.0), "C": (360.0, 760.0), "D": (180.0, 360.0),
+                "E": (0.0, 180.0)}
+"""Site classes by Vs30 [m/s], (lower, upper], ASCE 7-16 Table 20.3-1 (NEHRP 2015; the same bounds as ASCE 7-10): A
+hard rock > 5,000 ft/s (1500 m/s); B rock 2,500-5,000 ft/s (760-1500 m/s); C very dense soil and soft rock
+1,200-2,500 ft/s (360-760 m/s); D stiff soil 600-1,200 ft/s (180-360 m/s); E soft clay < 600 ft/s (180 m/s). The
+SI bounds as printed beside the ft/s ones (e.g. UFC 3-310-03A's copy of the NEHRP table). ASCE 7-22 splits them
+into nine (A, B, BC, C, CD, D, DE, E) with other bounds; the A-E classes are the ones site coefficients and most
+hazard tools still name."""
+
+SITE_CLASS_VS30 = {"A": 2000.0, "B": 1080.0, "C": 530.0, "D": 260.0, "E": 150.0}
+"""The Vs30 [m/s] that stands for each site class: the values the USGS hazard tools use (nshmp-haz, enum
+``gov.usgs.earthquake.nshmp...SiteClass``, the 2018 'new' column: B 1080, C 530, D 260, E 150; A 2000): the
+geometric mean of the class bounds in ft/s (D: sqrt(600 x 1200) x 0.3048 = 259 m/s), and 150 m/s for E, the lowest
+Vs30 of the NGA-West2 site term's data (rockfrag.site_amplification.VS30_DATA)."""
+
+
+def site_class(vs30: float | None) -> str:
+    """The ASCE 7-16 site class ("A"-"E", ``SITE_CLASSES``) of a site's Vs30 [m/s]; "" for None (the reference site).
+
+    A Vs30 on a bound belongs to the softer class, as ASCE 7-16 writes 2,500 < v_s <= 5,000 ft/s for B: 760 m/s
+    is C.
+    """
+    if vs30 is None:
+        return ""
+    return next(name for name, (low, high) in SITE_CLASSES.items() if low < vs30 <= high)
+
 
 SOIL_RANGES = {
     "shear_modulus": Number(0, 1e13, low_open=True, unit="Pa"),
@@ -70,14 +106,22 @@ class SoilClass:
     description: str = ""
     friction_static: float = DEFAULT_FRICTION[0]  # mu_s of a block's base on this soil [-]
     friction_kinetic: float = DEFAULT_FRICTION[1]  # mu_k [-], at most mu_s
+    vs30: float | None = None  # Vs30 of the site [m/s]; None: the hazard curve's reference site
 
     def __post_init__(self):
         for key, allowed in SOIL_RANGES.items():
             allowed.check(getattr(self, key), f"soil {self.name}.{key}", None)
+        if self.vs30 is not None:
+            VS30_RANGE.check(self.vs30, f"soil {self.name}.vs30", None)
         if self.friction_kinetic > self.friction_static:
             raise ConfigError(f"soil {self.name}.friction_kinetic",
                               f"{self.friction_kinetic:g} exceeds friction_static {self.friction_static:g}; "
                               "must be > 0 and <= friction_static")
+
+    @property
+    def site_class(self) -> str:
+        """The ASCE 7-16 site class of the soil's site ("A"-"E"); "" when it is the hazard's reference site."""
+        return site_class(self.vs30)
 
     @property
     def friction(self) -> tuple[float, float]:
@@ -153,9 +197,9 @@ def foundation(soil: SoilClass, block, g: float = STANDARD_GRAVITY) -> Foundatio
                       frequency_ratio=omega / block.p(g))
 
 
-def _from_constrained(name, constrained_mpa, nu, density, description, friction):
+def _from_constrained(name, constrained_mpa, nu, density, description, friction, vs30):
     shear = constrained_mpa * 1e6 * (1 - 2 * nu) / (2 * (1 - nu))
-    return SoilClass(name, shear, nu, density, 0.05, description, *friction)
+    return SoilClass(name, shear, nu, density, 0.05, description, *friction, vs30=vs30)
 
 
 def _navfac(static: float) -> tuple[float, float]:
@@ -163,12 +207,23 @@ def _navfac(static: float) -> tuple[float, float]:
     return static, round(KINETIC_OVER_STATIC * static, 2)
 
 
+SITE_CLASS_OF_SOIL = {"clay": "E", "sand": "D", "gravel": "C", "rock": "B"}
+"""The site class each shipped soil stands for (soft clay E, sand D stiff soil, gravel C very dense soil, rock B; the
+names of ASCE 7-16 Table 20.3-1). Its site's Vs30 is the class's ``SITE_CLASS_VS30``. Steel is a deck on a
+structure: its site is the ground below, which the study states (``[hazard] vs30 = { steel = ... }``); without it,
+the hazard curve's own reference site. The bed's own shear-wave velocity sqrt(G/rho) (clay 144, sand 205, gravel
+387, rock 632 m/s) is not the site's Vs30: a 1-2 m bed does not make the top 30 m."""
+
 # Paper Table 1 (G_max, nu, rho); clay from the text (E_d = 130 MPa, nu = 0.3 assumed). Friction: FRICTION_SOURCES.
+# Site Vs30: SITE_CLASS_OF_SOIL.
 SOILS = {
     "clay": _from_constrained("clay", 130.0, 0.3, 1800.0, "soft clay, E_d = 130 MPa (paper Figs. 9-11)",
-                              _navfac(0.35)),
-    "sand": SoilClass("sand", 80e6, 0.3, 1900.0, 0.05, "sand, G = 80 MPa (paper Table 1)", *_navfac(0.45)),
-    "gravel": SoilClass("gravel", 300e6, 0.3, 2000.0, 0.05, "gravel, G = 300 MPa (paper Table 1)", *_navfac(0.55)),
-    "rock": SoilClass("rock", 1000e6, 0.3, 2500.0, 0.05, "rock, G = 1000 MPa (paper Table 1)", *_navfac(0.70)),
+                              _navfac(0.35), SITE_CLASS_VS30["E"]),
+    "sand": SoilClass("sand", 80e6, 0.3, 1900.0, 0.05, "sand, G = 80 MPa (paper Table 1)", *_navfac(0.45),
+                      vs30=SITE_CLASS_VS30["D"]),
+    "gravel": SoilClass("gravel", 300e6, 0.3, 2000.0, 0.05, "gravel, G = 300 MPa (paper Table 1)", *_navfac(0.55),
+                        vs30=SITE_CLASS_VS30["C"]),
+    "rock": SoilClass("rock", 1000e6, 0.3, 2500.0, 0.05, "rock, G = 1000 MPa (paper Table 1)", *_navfac(0.70),
+                      vs30=SITE_CLASS_VS30["B"]),
     "steel": SoilClass("steel", 80e9, 0.3, 7800.0, 0.05, "steel base, G = 80 GPa (paper Table 1)", 0.50, 0.40),
 }

@@ -276,8 +276,9 @@ def cells_for_record(record, config, recipe, block_scales=None, vertical=None) -
     return cells
 
 
-SOIL_KEY_EXCLUDED = ("name", "description", "friction_static", "friction_kinetic")
-"""Soil fields left out of a cell's checkpoint key: labels, and the friction (in the key only where a cell slides)."""
+SOIL_KEY_EXCLUDED = ("name", "description", "friction_static", "friction_kinetic", "vs30")
+"""Soil fields left out of a cell's checkpoint key: labels, the friction (in the key only where a cell slides), and
+the site's Vs30 (it sets the site's hazard, not a run)."""
 
 
 def friction_grid(config) -> np.ndarray:

@@ -23,8 +23,9 @@ LAYERS: list[tuple[str, ...]] = [
     ("rockfrag.validation", "rockfrag.locking", "rockfrag.checkpoints", "rockfrag.executors"),
     # 2 inputs: record readers and signal processing
     ("rockfrag.records", "rockfrag.records.*", "rockfrag.processing"),
-    # 3 facts every stage reads: measures, blocks, soils, damage states, hazard curves
+    # 3 facts every stage reads: measures, blocks, soils, damage states, hazard curves and each soil's site hazard
     ("rockfrag.measures", "rockfrag.blocks", "rockfrag.soils", "rockfrag.damage_states", "rockfrag.hazard",
+     "rockfrag.site_amplification", "rockfrag.site_hazard",
      "rockfrag.plausibility"),  # plausibility: issue 21's checks of a study's blocks and soils
     # 4 the solvers
     ("rockfrag.models", "rockfrag.models.*"),
