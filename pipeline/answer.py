@@ -31,7 +31,7 @@ import numpy as np
 import xarray as xr
 
 from rockfrag.damage_states import families_of
-from rockfrag.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency
+from rockfrag.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency, hazard_of
 from rockfrag.lognormal_fit import lognormal_cdf
 from rockfrag.models.variants import RECOMMENDED
 from rockfrag.risk import annual_frequency as risk_annual_frequency
@@ -312,6 +312,7 @@ class SoilAnswer:
     sliding_share: float
     verdict: str
     sliding_level: float = float("nan")
+    intensities: tuple = ()  # the soil's site intensity at each return period (shown unit); its states' P use them
 
 
 @dataclass(frozen=True)
@@ -323,7 +324,8 @@ class BlockAnswer:
     block, model : str
         The block and the model whose curves answer (``answer_model``).
     return_periods, intensities : tuple of float
-        Return periods [years] and the site's intensity at each (shown unit); empty without a hazard.
+        Return periods [years] and the hazard's intensity at each (shown unit; the reference site's when each
+        soil has its own curve, whose intensities are ``SoilAnswer.intensities``); empty without a hazard.
     soils : tuple of SoilAnswer
     example_hazard : bool
         The hazard is the shipped example, not the site's.
@@ -453,7 +455,7 @@ def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnsw
     return rows
 
 
-def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
+def block_answers(fragility: xr.Dataset, hazard: HazardCurve | Mapping[str, HazardCurve] | None,
                   return_periods: Sequence[float] = DEFAULT_RETURN_PERIODS,
                   limits: Mapping[str, float] | None = None, design_life: float | None = None,
                   largest_recorded: Mapping[str, float] | None = None,
@@ -465,9 +467,9 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     ----------
     fragility : xarray.Dataset
         ``fragility.nc`` (risk variables optional: computed here from ``hazard`` where missing).
-    hazard : HazardCurve or None
-        The site's hazard curve for the study's measure (``rockfrag.hazard.study_hazard``); None: no
-        return-period intensities, no risk, verdict ``NO_VERDICT``.
+    hazard : HazardCurve, mapping of soil to HazardCurve, or None
+        The hazard curve of each soil's site for the study's measure (``rockfrag.site_hazard.study_site_hazards``),
+        or one curve for every soil; None: no return-period intensities, no risk, verdict ``NO_VERDICT``.
     return_periods : sequence of float
         Return periods [years].
     limits : mapping, optional
@@ -495,7 +497,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
     model = answer_model(fragility)
     scale, unit = display_scale(fragility["median"].attrs.get("units", fragility.attrs.get("intensity_unit", "")))
     periods = tuple(float(t) for t in return_periods) if hazard is not None else ()
-    intensities = tuple(intensity_at_frequency(hazard, 1.0 / t) for t in periods)
+    shown = (getattr(hazard, "first", None) or next(iter(hazard.values()))) if isinstance(hazard, Mapping) else hazard
+    intensities = tuple(intensity_at_frequency(shown, 1.0 / t) for t in periods)
     states = [str(s) for s in fragility.damage_state.values]
     families = nested_families(fragility)
     n_records = int(fragility["n_records"]) if "n_records" in fragility else 0
@@ -508,6 +511,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
         soils = []
         for soil in map(str, fragility.soil.values):
             rows = []
+            site = hazard_of(hazard, soil)  # this soil's site curve: its probabilities and return-period intensities
+            at_site = tuple(intensity_at_frequency(site, 1.0 / t) for t in periods)
             for state in states:
                 row = fragility.sel(model=model, block=block, soil=soil, damage_state=state)
                 empirical = _empirical(fragility, model, block, soil, state)
@@ -518,30 +523,30 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                     if inside.any() and np.isfinite(known).any() and np.nanmax(known) == 0:
                         not_reached = float(credible)
                 frequency = float(row["annual_frequency"]) if "annual_frequency" in row else np.nan
-                if not np.isfinite(frequency) and hazard is not None:
-                    frequency = risk_annual_frequency(float(row["median"]) * scale, float(row["beta"]), hazard)
-                if not_reached is not None and hazard is not None:  # no curve below the limit: P(im > limit)
-                    frequency = float(hazard_frequency(hazard, not_reached))
+                if not np.isfinite(frequency) and site is not None:
+                    frequency = risk_annual_frequency(float(row["median"]) * scale, float(row["beta"]), site)
+                if not_reached is not None and site is not None:  # no curve below the limit: P(im > limit)
+                    frequency = float(hazard_frequency(site, not_reached))
                 probability = float(risk_probability_in_life(frequency, design_life)) if np.isfinite(frequency) \
                     else np.nan
                 first = _first_reached(levels, empirical)
                 supported = np.nan
-                if hazard is not None and empirical.size and np.isfinite(probability):
+                if site is not None and empirical.size and np.isfinite(probability):
                     # the curve's tail below the first level any record reached it cut off
                     supported = 0.0 if first is None else float(risk_probability_in_life(risk_annual_frequency(
-                        float(row["median"]) * scale, float(row["beta"]), hazard, lower=first), design_life))
-                records = tuple(_records_at(levels, empirical, n_records, im) for im in intensities) \
+                        float(row["median"]) * scale, float(row["beta"]), site, lower=first), design_life))
+                records = tuple(_records_at(levels, empirical, n_records, im) for im in at_site) \
                     if n_records and empirical.size else ()
-                at = tuple(_at(row, im, scale, levels, empirical) for im in intensities)
+                at = tuple(_at(row, im, scale, levels, empirical) for im in at_site)
                 below = None
                 median = float(row["median"]) * scale
                 if empirical.size and levels.size and np.isfinite(empirical[0]) and empirical[0] > 0 \
                         and np.isfinite(median) and median < levels[0] * (1 - 1e-9):
                     # the fit's median below every level run: its tail there is no data; bound it by the records
                     below = (float(levels[0]), records_reaching(empirical[0], n_records), n_records)
-                    at = tuple(_lower_bound(levels, empirical, im) for im in intensities)
-                    if hazard is not None:
-                        frequency = float(empirical[0] * hazard_frequency(hazard, float(levels[0])))
+                    at = tuple(_lower_bound(levels, empirical, im) for im in at_site)
+                    if site is not None:
+                        frequency = float(empirical[0] * hazard_frequency(site, float(levels[0])))
                         probability = float(risk_probability_in_life(frequency, design_life))
                         supported = probability
                 rows.append(StateAnswer(state, at, frequency, probability, limits.get(state), not_reached, records,
@@ -556,8 +561,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | None,
                 verdict = CHECK_SLIDING
             else:
                 verdict = NO_ACTION
-            soils.append(SoilAnswer(soil, tuple(rows), share, verdict, decision_level))
-        example = hazard is not None and EXAMPLE_HAZARD in hazard.source
+            soils.append(SoilAnswer(soil, tuple(rows), share, verdict, decision_level, at_site))
+        example = shown is not None and EXAMPLE_HAZARD in shown.source
         answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit,
                                    float(max_sliding_share)))
     return answers

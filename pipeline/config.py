@@ -32,13 +32,15 @@ import numpy as np
 from rockfrag.blocks import BLOCK_RANGES, Block
 from rockfrag.damage_states import EDPS, DamageState, damage_states_from_config
 from rockfrag.errors import ConfigError, PipelineError
-from rockfrag.hazard import check_site, hazard_for
+from rockfrag.hazard import check_site
 from rockfrag.measures import MEASURES, scaling_measures
 from rockfrag.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
 from rockfrag.models.options import HOUSNER
 from rockfrag.models.variants import DEFAULT_BAND, band_variants
 from rockfrag.plausibility import ON_IMPLAUSIBLE, check_study
-from rockfrag.soils import DEFAULT_FRICTION, SOIL_RANGES, SOILS, SoilClass
+from rockfrag.site_amplification import REFERENCE_VS30, SCENARIO, VS30_SIGMA
+from rockfrag.site_hazard import check_site_hazards
+from rockfrag.soils import DEFAULT_FRICTION, SITE_CLASSES, SOIL_RANGES, SOILS, VS30_RANGE, SoilClass
 from rockfrag.validation import (
     Checked,
     Either,
@@ -81,7 +83,7 @@ def _table(fields: dict) -> Table:
 
 
 TEXT = Text()
-SOIL_TABLE = _table({**SOIL_RANGES, "why": TEXT})
+SOIL_TABLE = _table({**SOIL_RANGES, "vs30": VS30_RANGE, "why": TEXT})
 # The ranges of a block are Block's own (pipeline/blocks.py BLOCK_RANGES), declared once for both.
 BLOCK_TABLE = _table({**BLOCK_RANGES, "why": TEXT})
 LEVEL = Number(0, 1e3, low_open=True)
@@ -123,9 +125,17 @@ SCHEMA = Table({
                                              f"{BAND!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
                       "restitution_band": Interval(Number(0.5, 1.5), strict=False),
                       "friction": Text(FRICTION_MODES)}),
-    "hazard": _table({"file": TEXT, "design_life": Number(0.0, 10000.0, low_open=True, unit="years"),
+    "hazard": _table({"file": Checked(lambda value, field, source: _hazard_files(value, field, source),
+                                      "a file name, or a table of soil or site class = file name"),
+                      "design_life": Number(0.0, 10000.0, low_open=True, unit="years"),
                       "return_periods": Numbers(Number(1.0, 1e6, unit="years")),  # the report's answer pages
-                      "site": Checked(check_site, "[lon, lat] in degrees, lon >= -180 and < 360, lat -90 to 90")}),
+                      "site": Checked(check_site, "[lon, lat] in degrees, lon >= -180 and < 360, lat -90 to 90"),
+                      "reference_vs30": VS30_RANGE,
+                      "vs30": Checked(lambda value, field, source: _named(value, field, source, VS30_RANGE),
+                                      "a table of soil = its site's Vs30 [m/s]"),
+                      "vs30_sigma": Number(0.0, 2.0),
+                      "scenario_magnitude": Number(3.0, 8.5),
+                      "scenario_distance": Number(0.0, 400.0, unit="km")}),
     "decision": _table({"max_probability_in_life": Checked(lambda value, field, source: _named(
                             value, field, source, Number(0.0, 1.0, low_open=True)),
                             "a table of damage state = probability, each > 0 and <= 1"),
@@ -154,6 +164,15 @@ def _restitution(value, field, source):
     if isinstance(value, str):
         return Text((BAND, HOUSNER, "")).check(value, field, source)
     return Number(0.0, 1.0, low_open=True, high_open=True).check(value, field, source)
+
+
+def _hazard_files(value, field, source):
+    """``[hazard] file``: a file name ("" for the shipped example), or a table of soil or site class = file name."""
+    if isinstance(value, dict):
+        if not value:
+            raise ConfigError(field, "empty table; name a file for each soil or site class", source)
+        return _named(value, field, source, Text(nonempty=True))
+    return TEXT.check(value, field, source)
 
 
 def _named(value, field, source, item):
@@ -243,8 +262,17 @@ class StudyConfig:
         Free vibration simulated after the record [s].
     overturn_angle : float
         |theta| at which a block has overturned [rad].
-    hazard_file : str
-        Hazard curve CSV (intensity, annual frequency); "" for the shipped example.
+    hazard_file : str or dict
+        The reference site's hazard curve file ("" for the shipped example), or a table soil or site class ->
+        file (a curve per soil; rockfrag.site_hazard).
+    reference_vs30 : float
+        Vs30 of the hazard curve's site [m/s] (``[hazard] reference_vs30``), from which each soil's curve is
+        amplified.
+    vs30_sigma : float
+        Standard deviation of ln Vs30 of each soil's site [-] (``[hazard] vs30_sigma``).
+    scenario : (float, float)
+        Magnitude and Joyner-Boore distance [km] of the rock medians that relate a non-PGA measure to the rock PGA
+        of the site term (``[hazard] scenario_magnitude``, ``scenario_distance``).
     hazard_site : (float, float) or None
         ``[hazard] site``: the study's [lon, lat] [degrees], which picks the nearest site of a multi-site file.
     design_life : float
@@ -286,7 +314,7 @@ class StudyConfig:
     switch: str
     tail: float
     overturn_angle: float
-    hazard_file: str
+    hazard_file: str | dict[str, str]
     design_life: float
     bootstrap: int
     seed: int
@@ -305,6 +333,9 @@ class StudyConfig:
     restitution: str | float = ""  # bed models' restitution target: "band", "housner", a number, "" (none)
     restitution_band: tuple[float, float] = DEFAULT_BAND  # edges as multiples of Housner's r
     friction: str = "where-it-matters"  # which cells slide: where-it-matters | all | none
+    reference_vs30: float = REFERENCE_VS30  # Vs30 of the hazard curve's site [m/s]
+    vs30_sigma: float = VS30_SIGMA  # standard deviation of ln Vs30 of each soil's site [-]
+    scenario: tuple[float, float] = SCENARIO  # (magnitude, Joyner-Boore distance [km]) of the rock-PGA ratio
 
     @property
     def calibrates_bed(self) -> bool:
@@ -427,7 +458,8 @@ def _soil(name, data, source) -> SoilClass:
         return SoilClass(name, float(data["shear_modulus"]), float(data.get("poisson_ratio", 0.3)),
                          float(data.get("density", 2000.0)), float(data.get("damping_ratio", 0.05)),
                          data.get("why", "user soil"), float(data.get("friction_static", DEFAULT_FRICTION[0])),
-                         float(data.get("friction_kinetic", DEFAULT_FRICTION[1])))
+                         float(data.get("friction_kinetic", DEFAULT_FRICTION[1])),
+                         float(data["vs30"]) if "vs30" in data else None)
     except KeyError:
         raise ConfigError(f"soils_custom.{name}.shear_modulus", "missing; must be a number > 0 [Pa]",
                           source) from None
@@ -460,22 +492,44 @@ def _check_damage_states(data, source):
                               f"the states are {', '.join(names)}", source)
 
 
-def _check_hazard(path, source, measure="pga", period=None, site=None):
-    """Check that the hazard curve loads and is for the study's intensity measure (and Sa period).
+def _site_vs30(soils, overrides: dict, source) -> tuple[SoilClass, ...]:
+    """The soils with ``[hazard] vs30`` applied: each named soil's site Vs30 [m/s] replaced."""
+    names = [soil.name for soil in soils]
+    for name in overrides:
+        if name not in names:
+            raise ConfigError(f"hazard.vs30.{name}", f"not a soil of the study{did_you_mean(name, names)}; the soils "
+                              f"are {', '.join(names)}", source)
+    return tuple(dataclasses.replace(soil, vs30=float(overrides[soil.name])) if soil.name in overrides else soil
+                 for soil in soils)
 
-    Loads means: the file exists, is numeric, and its frequencies decrease. No file and a measure other than
-    the shipped example's: no risk, nothing to check (rockfrag.hazard.hazard_for).
+
+def _check_hazard(config: StudyConfig) -> None:
+    """Check the hazard as the risk stage reads it (rockfrag.site_hazard.check_site_hazards).
+
+    Every curve loads (the file exists, is numeric, its frequencies decrease), is for the study's measure, and every
+    soil has one; a soil amplified from the reference site has a site term for the measure. No file and a measure
+    other than the shipped example's: no risk, nothing to check (rockfrag.hazard.hazard_for).
     """
-    if path and Path(path).is_dir():
-        raise ConfigError("hazard.file", f"{path} is a folder; expected a CSV file", source)
+    files = config.hazard_file if isinstance(config.hazard_file, dict) else {"": config.hazard_file}
+    for key, path in files.items():
+        if path and Path(path).is_dir():
+            raise ConfigError(f"hazard.file{'.' + key if key else ''}", f"{path} is a folder; expected a CSV file",
+                              config.source)
+    names = {soil.name for soil in config.soils}
+    for key in files:
+        if key and key not in names and key not in SITE_CLASSES:
+            raise ConfigError(f"hazard.file.{key}", f"neither a soil of the study nor a site class"
+                              f"{did_you_mean(key, [*names, *SITE_CLASSES])}; the soils are "
+                              f"{', '.join(sorted(names))}, the classes {', '.join(SITE_CLASSES)}", config.source)
     try:
-        hazard_for(path, measure, period, site)
+        check_site_hazards(config)
     except ConfigError as error:
-        raise ConfigError(error.field, f"{error.source}: {error.reason}", source) from None
+        reason = error.reason if error.source == config.source else f"{error.source}: {error.reason}"
+        raise ConfigError(error.field, reason, config.source) from None
     except (ValueError, UnicodeDecodeError, OSError) as error:
         reason = str(error).splitlines()[0] if str(error) else type(error).__name__
-        raise ConfigError("hazard.file", f"{path}: not a table of numbers (intensity, annual frequency) "
-                          f"({reason})", source) from None
+        raise ConfigError("hazard.file", f"not a table of numbers (intensity, annual frequency) ({reason})",
+                          config.source) from None
 
 
 def _period_range(value) -> tuple[float, float] | None:
@@ -496,6 +550,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
 
     custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
     soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
+    soils = _site_vs30(soils, hazard.get("vs30", {}), source)
     models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
     restitution = solver.get("restitution", "")
     if restitution == BAND:
@@ -510,10 +565,9 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
     _check_damage_states(data, source)
     site = check_site(hazard["site"], "hazard.site", source) if "site" in hazard else None
-    _check_hazard(hazard.get("file", ""), source, measure, float(intensity.get("period", 1.0)), site)
     sweep = data.get("applicability", {})
     defaults = ApplicabilitySettings()
-    return StudyConfig(
+    config = StudyConfig(
         name=study.get("name", "study"), record_sets=tuple(study.get("record_sets", ["far-field"])),
         processing=study.get("processing", ""), output=Path(study.get("output", "reports")),
         measure=measure, period=float(intensity.get("period", 1.0)), damping=float(intensity.get("damping", 0.05)),
@@ -526,6 +580,10 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         friction=solver.get("friction", "where-it-matters"),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
         hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)), hazard_site=site,
+        reference_vs30=float(hazard.get("reference_vs30", REFERENCE_VS30)),
+        vs30_sigma=float(hazard.get("vs30_sigma", VS30_SIGMA)),
+        scenario=(float(hazard.get("scenario_magnitude", SCENARIO[0])),
+                  float(hazard.get("scenario_distance", SCENARIO[1]))),
         bootstrap=int(fragility.get("bootstrap", 100)), seed=int(fragility.get("seed", 0)),
         confidence=float(fragility.get("confidence", 0.9)),
         record_units=study.get("units", ""), record_dt=study.get("dt"), vertical=bool(study.get("vertical", False)),
@@ -536,6 +594,8 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
             block_moduli=tuple(float(v) for v in sweep.get("block_moduli", defaults.block_moduli)),
             tolerance=float(sweep.get("tolerance", defaults.tolerance))),
         source=source, raw=data)
+    _check_hazard(config)
+    return config
 
 
 def read_study_file(path) -> dict:

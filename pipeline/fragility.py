@@ -68,7 +68,6 @@ from rockfrag.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exp
     write_exchange_files,
 )
 from rockfrag.exchange import intensity_unit_label as _unit_label
-from rockfrag.hazard import study_hazard
 from rockfrag.ida import resurrected
 from rockfrag.lognormal_fit import (  # noqa: F401
     CROSSING_TOLERANCE,
@@ -87,6 +86,7 @@ from rockfrag.models import MODELS
 from rockfrag.models.variants import BAND_ROLES, RECOMMENDED, split_variant
 from rockfrag.outputs import write_dataset
 from rockfrag.risk import risk_dataset
+from rockfrag.site_hazard import site_hazard_dataset, study_site_hazards
 from rockfrag.units import STANDARD_GRAVITY
 
 STATUS = {
@@ -763,7 +763,8 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
                     log: Callable[[str], object] | None = None) -> tuple[xr.Dataset, xr.Dataset]:
     """Fit, add the risk, and write fragility.nc, fragility.csv and the exchange files (``rockfrag.exchange``).
 
-    The hazard curve is read (and checked against the study's intensity measure) before any fit.
+    The hazard curve of each soil's site is read (and checked against the study's intensity measure) before any
+    fit (rockfrag.site_hazard); each soil's risk uses its own, and fragility.nc holds them as ``site_hazard``.
     Fit warnings are printed to ``log`` (stderr by default) and kept in the dataset.
 
     Parameters
@@ -796,16 +797,19 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
     log = log or (lambda message: print(message, file=sys.stderr))
     progress = sys.stderr.isatty() if progress is None else progress
     output = Path(output)
-    hazard = study_hazard(config)
+    hazard = study_site_hazards(config)  # each soil's site curve
     states = damage_states_from_config(config.raw)
     dataset = fragility_dataset(cube, states=states, ida=ida, n_bootstrap=config.bootstrap, seed=config.seed,
                                 confidence=config.confidence, progress=progress)
     for line in json.loads(dataset.attrs["fit_warnings"]):
         log(f"fragility warning: {line}")
     risk = risk_dataset(dataset, hazard, config.design_life)
-    combined = dataset.merge(risk)
+    # the curve each soil's risk used: site_hazard(soil, hazard_intensity)
+    sites = site_hazard_dataset(hazard, config.soils, config.measure) if hazard is not None else xr.Dataset()
+    combined = dataset.merge(risk).merge(sites)
     combined.attrs.update(dataset.attrs)
     combined.attrs.update(risk.attrs)
+    combined.attrs.update(sites.attrs)
     write_dataset(combined, output / "fragility.nc")
     table = fragility_table(dataset)
     table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])

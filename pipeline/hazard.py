@@ -10,6 +10,16 @@ Output: a ``HazardCurve`` (intensity in the measure's display unit, annual frequ
         chosen ``HazardSite`` with its great-circle distance [km] from the study's site) and lambda(im)
         by log-log interpolation (``hazard_frequency``).
 
+Horizontal component: every curve states the definition of its horizontal intensity (``HazardCurve.component``,
+``COMPONENTS``). A rockfrag CSV says it in a header line, ``# component = RotD50``; without one it is RotD50, the
+definition of the NGA-West2 models. USGS NSHMP curves and OpenQuake curves are RotD50: both come from NGA-West2
+ground motion models (an OpenQuake export does not name its models; a run with other models is the user's to
+state by converting the curve to a rockfrag CSV with its component).
+
+Every value of a file is a finite number: a NaN, an empty cell or a word where a number belongs is one
+ConfigError naming the file, the line and the column (for a USGS JSON file, the line and column of the value in
+the file and its place in the response).
+
 A hazard curve for another measure (or another Sa period) than the study's is a ConfigError; the study
 file's check (rockfrag.config) and the risk stage (rockfrag.risk) both read curves here. Measures,
 their units, labels and OpenQuake IMT names come from the registry in rockfrag.measures. Beyond the
@@ -25,9 +35,11 @@ than ``FAR_SITE_KM`` is a ``HazardSiteWarning`` when the study reads its hazard 
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
@@ -38,7 +50,7 @@ from numpy.typing import ArrayLike
 
 from rockfrag.errors import ConfigError
 from rockfrag.measures import MEASURES, display_units, scaling_measures
-from rockfrag.validation import Number, shown
+from rockfrag.validation import Number, did_you_mean, shown
 
 EXAMPLE_HAZARD = "hazard_example.csv"
 """Shipped example, PGA only: H(s) = 1e-4 s^-2.5 [1/yr], s = PGA [g] (Cornell et al. 2002 power-law form)."""
@@ -46,6 +58,19 @@ EXAMPLE_MEASURE = "pga"
 """The measure of the shipped example: a study of another measure needs its own hazard file for a risk."""
 
 PERIOD_TOLERANCE = 1e-6
+
+COMPONENTS = {
+    "RotD50": "the median over all orientations of the two horizontal components' response (Boore 2010); the "
+              "definition of the NGA-West2 ground motion models, hence of USGS NSHMP and most OpenQuake curves",
+    "RotD100": "the largest over all orientations (Boore 2010): the maximum direction",
+    "GMRotI50": "the orientation-independent geometric mean of Boore et al. (2006), the NGA-West1 definition",
+    "geometric-mean": "the geometric mean of the two recorded horizontal components",
+    "larger": "the larger of the two recorded horizontal components",
+    "arbitrary": "one recorded horizontal component, its orientation arbitrary",
+}
+"""Horizontal-component definitions a hazard curve may state (``# component = NAME`` in a rockfrag CSV)."""
+DEFAULT_COMPONENT = "RotD50"
+"""The component of a curve that does not state one, and of USGS and OpenQuake curves (module docstring)."""
 
 EARTH_RADIUS_KM = 6371.0088
 """Mean Earth radius R1 of the IUGG [km]: the sphere of the great-circle distances."""
@@ -124,6 +149,7 @@ class HazardCurve:
     source: str
     notes: dict = field(default_factory=dict)
     site: HazardSite | None = None  # the file's site nearest the study's [hazard] site; None without one
+    component: str = DEFAULT_COMPONENT  # the horizontal-component definition of the intensity (COMPONENTS)
 
     @property
     def label(self) -> str:
@@ -166,15 +192,35 @@ def _measure_from_imt(imt: str, source: str) -> tuple[str, float | None, float]:
     _fail(f"intensity measure type {imt!r} not supported; allowed {allowed}", source)
 
 
-def _read_rockfrag_csv(text: str, source: str):
-    rows = [line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+def _number(cell: str, line: int, column: int, name: str, source: str) -> float:
+    """A cell of a table as a finite float, or a ConfigError naming the file, line and column (1-based)."""
+    text = cell.strip()
     try:
-        values = np.array([[float(v) for v in line.split(",")[:2]] for line in rows[1:]])
-    except ValueError as error:
-        _fail(f"not a table of numbers (intensity, annual frequency of exceedance): {error}", source)
-    if values.ndim != 2 or values.shape[1] < 2:
-        _fail("not a table of numbers: expected two columns, intensity and annual frequency of exceedance", source)
-    header = dict(re.findall(r"^#\s*(measure|period|units)\s*[=:]\s*(\S+)", text, flags=re.M | re.I))
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        shown = repr(text) if text else "an empty cell"
+        _fail(f"line {line}, column {column} ({name}): {shown} is not a number", source)
+    return value
+
+
+def _read_rockfrag_csv(text: str, source: str):
+    numbered = [(number, line) for number, line in enumerate(text.splitlines(), start=1)
+                if line.strip() and not line.lstrip().startswith("#")]
+    if len(numbered) < 2:
+        _fail("not a table of numbers: expected a header line and rows of intensity, annual frequency of exceedance",
+              source)
+    names = [c.strip() or f"column {i + 1}" for i, c in enumerate(numbered[0][1].split(","))] + ["", ""]
+    rows = []
+    for number, line in numbered[1:]:
+        cells = line.split(",")
+        if len(cells) < 2:
+            _fail(f"line {number}: {len(cells)} column; expected two, intensity and annual frequency of exceedance",
+                  source)
+        rows.append([_number(cells[i], number, i + 1, names[i], source) for i in (0, 1)])
+    values = np.array(rows)
+    header = dict(re.findall(r"^#\s*(measure|period|units|component)\s*[=:]\s*(\S+)", text, flags=re.M | re.I))
     header = {k.lower(): v for k, v in header.items()}
     if "measure" not in header:
         _fail("the file does not state its intensity measure; add a line '# measure = pga' (or sa, pgv; "
@@ -191,7 +237,16 @@ def _read_rockfrag_csv(text: str, source: str):
     unit = header.get("units", display)
     if unit != display:
         _fail(f"units {unit!r}; a {measure} hazard curve must be in {display}", source)
-    return [(None, None, values[:, 0], values[:, 1])], measure, (period if uses_period else None), {}
+    component = header.get("component", DEFAULT_COMPONENT)
+    if component not in COMPONENTS:
+        known = {name.lower(): name for name in COMPONENTS}
+        if component.lower() not in known:
+            _fail(f"component {component!r} unknown{did_you_mean(component, COMPONENTS)}; allowed "
+                  f"{', '.join(COMPONENTS)}", source)
+        component = known[component.lower()]
+    stated = "stated in the file" if "component" in header else "not stated in the file: RotD50 taken"
+    notes = {"component": component, "component_basis": stated}
+    return [(None, None, values[:, 0], values[:, 1])], measure, (period if uses_period else None), notes
 
 
 def _read_openquake_csv(text: str, source: str):
@@ -200,15 +255,15 @@ def _read_openquake_csv(text: str, source: str):
     The file holds a '#...investigation_time=T, imt='PGA'' line, then a header naming lon, lat (and
     depth, sometimes custom_site_id) and the poe-<level> columns, then one row per site.
     """
-    lines = [line for line in text.splitlines() if line.strip()]
-    first = lines[0]
+    lines = [(number, line) for number, line in enumerate(text.splitlines(), start=1) if line.strip()]
+    first = lines[0][1]
     time_match = re.search(r"investigation_time\s*=\s*([0-9.eE+-]+)", first)
     imt_match = re.search(r"imt\s*=\s*['\"]([^'\"]+)['\"]", first)
     if not (time_match and imt_match):
         _fail("OpenQuake header line without investigation_time and imt", source)
     investigation_time = float(time_match.group(1))
     measure, period, factor = _measure_from_imt(imt_match.group(1), source)
-    columns = [c.strip() for c in lines[1].split(",")] if len(lines) > 1 else []
+    columns = [c.strip() for c in lines[1][1].split(",")] if len(lines) > 1 else []
     poe_columns = [i for i, c in enumerate(columns) if c.startswith("poe-")]
     if not poe_columns:
         _fail("no 'poe-<level>' columns in the OpenQuake header", source)
@@ -216,26 +271,57 @@ def _read_openquake_csv(text: str, source: str):
         _fail("no 'lon' and 'lat' columns in the OpenQuake header", source)
     if len(lines) < 3:
         _fail("no site rows below the OpenQuake header", source)
-    intensity = np.array([float(columns[i][4:]) for i in poe_columns]) * factor
+    header_line = lines[1][0]
+    intensity = np.array([_number(columns[i][4:], header_line, i + 1, columns[i], source) for i in poe_columns])
+    intensity = intensity * factor
     sites = []
-    for number, line in enumerate(lines[2:], start=3):
+    for number, line in lines[2:]:
         cells = line.split(",")
-        try:
-            lon, lat = float(cells[columns.index("lon")]), float(cells[columns.index("lat")])
-            poe = np.array([float(cells[i]) for i in poe_columns])
-        except (ValueError, IndexError):
-            _fail(f"line {number}: not a site row of numbers (lon, lat, poe-...)", source)
-        if np.any((poe < 0) | (poe >= 1)):
-            _fail(f"line {number}: probabilities of exceedance must lie in [0, 1)", source)
+        if len(cells) < len(columns):
+            _fail(f"line {number}: {len(cells)} columns where the header has {len(columns)}", source)
+        lon, lat = (_number(cells[columns.index(name)], number, columns.index(name) + 1, name, source)
+                    for name in ("lon", "lat"))
+        poe = np.array([_number(cells[i], number, i + 1, columns[i], source) for i in poe_columns])
+        outside = np.flatnonzero((poe < 0) | (poe >= 1))
+        if outside.size:
+            column = poe_columns[outside[0]]
+            _fail(f"line {number}, column {column + 1} ({columns[column]}): {poe[outside[0]]:g}; probabilities of "
+                  "exceedance must lie in [0, 1)", source)
         keep = poe > 0  # a zero probability has no place on a log-log curve
         sites.append((lon, lat, intensity[keep], -np.log1p(-poe[keep]) / investigation_time))
-    notes = {"investigation_time_years": investigation_time, "imt": imt_match.group(1)}
+    notes = {"investigation_time_years": investigation_time, "imt": imt_match.group(1),
+             "component": DEFAULT_COMPONENT,
+             "component_basis": "an OpenQuake curve from NGA-West2 ground motion models (the export names none)"}
     return sites, measure, period, notes
 
 
 def _usgs_imt(metadata: dict) -> str:
     imt = metadata.get("imt", "")
     return str(imt.get("value", imt.get("id", "")) if isinstance(imt, dict) else imt)
+
+
+_JSON_NUMBER = re.compile(r"-?(?:0|[1-9][0-9]*)(?:\.[0-9]+)?(?:[eE][+-]?[0-9]+)?")
+_JSON_ARRAY = re.compile(r'"([xy]values)"\s*:\s*\[([^\]]*)\]')
+
+
+def _check_json_arrays(text: str, source: str) -> None:
+    """Every value of the file's ``xvalues`` and ``yvalues`` arrays is a JSON number.
+
+    NaN, Infinity (which Python's json reads), null and strings are a ConfigError naming the line and column of
+    the value in the file, the array and the value's index in it.
+    """
+    for array in _JSON_ARRAY.finditer(text):
+        start = array.start(2)
+        offset = 0
+        for index, item in enumerate(array.group(2).split(",")):
+            value = item.strip()
+            if value and not _JSON_NUMBER.fullmatch(value) or not value and array.group(2).strip():
+                at = start + offset + (len(item) - len(item.lstrip()))
+                line = text.count("\n", 0, at) + 1
+                column = at - (text.rfind("\n", 0, at) + 1) + 1
+                shown = value if value else "an empty value"
+                _fail(f"line {line}, column {column} ({array.group(1)}[{index}]): {shown} is not a number", source)
+            offset += len(item) + 1
 
 
 def _read_usgs_json(text: str, source: str):
@@ -245,6 +331,7 @@ def _read_usgs_json(text: str, source: str):
     response[i].data[j].{component, yvalues}. The file may hold one response or a JSON list of them
     (one per site, e.g. saved from a loop over the sites of a region); each site must hold exactly one IMT.
     """
+    _check_json_arrays(text, source)
     try:
         document = json.loads(text)
     except json.JSONDecodeError as error:
@@ -284,6 +371,8 @@ def _read_usgs_json(text: str, source: str):
                       intensity[keep], frequency[keep]))
     first = next(iter(by_site))
     notes = {"imt": imt, "latitude": first[1], "longitude": first[0]} if len(sites) == 1 else {"imt": imt}
+    notes.update({"component": DEFAULT_COMPONENT,
+                  "component_basis": "a USGS NSHMP curve, from NGA-West2 ground motion models"})
     return sites, measure, period, notes
 
 
@@ -379,7 +468,8 @@ def load_hazard(path: str | os.PathLike | None = None, measure: str = "pga",
         _fail("intensities must increase and be > 0", where)
     if np.any(frequency <= 0) or np.any(np.diff(frequency) > 0):
         _fail("annual frequency of exceedance must be > 0 and decrease with intensity", where)
-    return HazardCurve(intensity, frequency, file_measure, file_period, source, notes, chosen)
+    return HazardCurve(intensity, frequency, file_measure, file_period, source, notes, chosen,
+                       notes.get("component", DEFAULT_COMPONENT))
 
 
 def hazard_for(path: str | os.PathLike | None, measure: str, period: float | None = None,
@@ -400,8 +490,8 @@ class HazardSettings(Protocol):
     """What ``study_hazard`` reads of a study; ``rockfrag.config.StudyConfig`` has it."""
 
     @property
-    def hazard_file(self) -> str:
-        """The hazard curve file ("" for none)."""
+    def hazard_file(self) -> str | Mapping[str, str]:
+        """The hazard curve file ("" for none), or a table soil or site class -> file."""
 
     @property
     def measure(self) -> str:
@@ -418,6 +508,10 @@ class HazardSettings(Protocol):
 
 def study_hazard(config: HazardSettings) -> HazardCurve | None:
     """The study's hazard curve: its ``hazard.file`` checked against its measure, at its site.
+
+    The reference-site curve the soils' curves are amplified from; with a curve per soil (``hazard.file`` a
+    table), the first soil's (none: the shipped example's rules). Every soil's own curve:
+    rockfrag.site_hazard.study_site_hazards.
 
     Parameters
     ----------
@@ -438,13 +532,38 @@ def study_hazard(config: HazardSettings) -> HazardCurve | None:
         The file is missing or malformed, or is for another measure or period, or holds several sites
         and the study gives none (``load_hazard``).
     """
-    hazard = hazard_for(config.hazard_file, config.measure, config.period, getattr(config, "hazard_site", None))
+    path = config.hazard_file
+    if isinstance(path, Mapping):
+        found = soil_file(path, config.soils[0])
+        path = found[1] if found is not None else ""
+    hazard = hazard_for(path, config.measure, config.period, getattr(config, "hazard_site", None))
+    warn_far_site(hazard)
+    return hazard
+
+
+def soil_file(files: Mapping[str, str], soil) -> tuple[str, str] | None:
+    """(key, file) naming ``soil``'s curve in a table of curves (``[hazard] file``): by soil name, else site class.
+
+    ``soil`` is a ``rockfrag.soils.SoilClass`` (its ``name`` and ``site_class``); None when neither is a key.
+    """
+    for key in (soil.name, soil.site_class):
+        if key and key in files:
+            return key, files[key]
+    return None
+
+
+def warn_far_site(hazard: HazardCurve | None) -> None:
+    """A ``HazardSiteWarning`` when the file's site chosen for the study is farther than ``FAR_SITE_KM`` from it."""
     if hazard is not None and hazard.site is not None and hazard.site.distance_km > FAR_SITE_KM:
         warnings.warn(HazardSiteWarning(
             f"the hazard file's nearest site is {hazard.site.distance_km:.0f} km from the study's site (more than "
             f"{FAR_SITE_KM:g} km): {hazard.source}, {hazard.site.describe()}; its curve is another site's"))
         # stacklevel 1: one location, so the CLI's read and the fragility stage's re-read warn once
-    return hazard
+
+
+def hazard_of(hazard: HazardCurve | Mapping[str, HazardCurve] | None, soil: str) -> HazardCurve | None:
+    """``soil``'s curve: ``hazard[soil]`` of a per-soil mapping (rockfrag.site_hazard.SiteHazards), else ``hazard``."""
+    return hazard[soil] if isinstance(hazard, Mapping) else hazard
 
 
 def hazard_frequency(hazard: HazardCurve, intensity: ArrayLike) -> np.ndarray | float:

@@ -1,8 +1,10 @@
 """rockfrag.risk - fragility x site hazard -> mean annual frequency and probability in a design life.
 
-Input : lognormal fragility parameters (median [IM units], beta [-], beta = 0 a step) and the site's
-        hazard curve for the study's intensity measure (read and checked by ``rockfrag.hazard``).
-Output: lambda_DS = integral P(DS | im) |d lambda(im)| [1/yr] and P(DS in T years) = 1 - exp(-lambda_DS T).
+Input : lognormal fragility parameters (median [IM units], beta [-], beta = 0 a step) and the hazard curve of
+        each soil's site for the study's intensity measure (rockfrag.site_hazard; one curve for every soil is
+        also taken), read and checked by ``rockfrag.hazard``.
+Output: lambda_DS = integral P(DS | im) |d lambda(im)| [1/yr] and P(DS in T years) = 1 - exp(-lambda_DS T), each
+        row with its own soil's curve.
 
 The hazard is interpolated log-log (``rockfrag.hazard.hazard_frequency``) and integrated on a fine
 logarithmic grid.
@@ -10,12 +12,14 @@ logarithmic grid.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 from scipy.special import ndtr
 
-from rockfrag.hazard import HazardCurve, hazard_frequency
+from rockfrag.hazard import HazardCurve, hazard_frequency, hazard_of
 from rockfrag.hazard import study_hazard as study_hazard  # re-exported: cli.py imports it from here
 
 
@@ -50,17 +54,18 @@ def probability_in_life(frequency: ArrayLike, years: float) -> np.ndarray:
     return 1.0 - np.exp(-np.asarray(frequency) * years)
 
 
-def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life: float = 50.0) -> xr.Dataset:
-    """lambda_DS and P(DS in design_life) for every soil x block x model x damage state.
+def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | Mapping[str, HazardCurve] | None,
+                 design_life: float = 50.0) -> xr.Dataset:
+    """lambda_DS and P(DS in design_life) for every soil x block x model x damage state, each with its soil's hazard.
 
     Parameters
     ----------
     fragility : xarray.Dataset
         The fitted fragility (``rockfrag.fragility``): ``median`` [the measure's display unit, as the
         hazard curve] and ``beta`` [-] over (soil, block, model, damage_state); beta = 0 is a step.
-    hazard : HazardCurve or None
-        The site's hazard curve for the study's measure (``study_hazard``); None: no risk computed,
-        every value NaN.
+    hazard : HazardCurve, mapping of soil to HazardCurve, or None
+        The hazard curve of each soil's site (``rockfrag.site_hazard.study_site_hazards``), or one curve for every
+        soil; None: no risk computed, every value NaN.
     design_life : float, optional
         Years of the probability in life (default 50).
 
@@ -68,15 +73,25 @@ def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life:
     -------
     xarray.Dataset
         ``annual_frequency`` [1/yr] and ``probability_in_life`` [-] on the dimensions of ``median``,
-        with the attributes ``hazard_source``, ``design_life_years`` and ``hazard_measure``; with a
-        ``[hazard] site``, also the chosen site (in ``hazard_source`` and ``hazard_site_longitude_deg``,
+        with the attributes ``hazard_source``, ``design_life_years``, ``hazard_measure`` and ``hazard_component``;
+        with a ``[hazard] site``, also the chosen site (in ``hazard_source`` and ``hazard_site_longitude_deg``,
         ``hazard_site_latitude_deg``, ``hazard_site_distance_km``, ``study_site_longitude_deg``/``_latitude_deg``).
     """
-    medians = fragility["median"].values
-    betas = fragility["beta"].values
-    rate = np.vectorize(lambda m, b: annual_frequency(m, b, hazard), otypes=[float])(medians, betas) \
-        if medians.size else medians
     dims = fragility["median"].dims
+    if isinstance(hazard, Mapping) and "soil" not in dims:
+        raise ValueError("a hazard curve per soil needs a fragility over soils")
+    by_soil = "soil" in dims
+    medians = np.moveaxis(fragility["median"].values, dims.index("soil"), 0) if by_soil \
+        else fragility["median"].values[None]
+    betas = np.moveaxis(fragility["beta"].values, dims.index("soil"), 0) if by_soil else fragility["beta"].values[None]
+    soils = [str(s) for s in fragility["soil"].values] if by_soil else [None]
+    rate = np.full(medians.shape, np.nan)
+    for index, soil in enumerate(soils):
+        curve = hazard_of(hazard, soil) if soil is not None else hazard
+        if medians[index].size:
+            rate[index] = np.vectorize(lambda m, b, c=curve: annual_frequency(m, b, c),
+                                       otypes=[float])(medians[index], betas[index])
+    rate = np.moveaxis(rate, 0, dims.index("soil")) if by_soil else rate[0]
     dataset = xr.Dataset({
         "annual_frequency": (dims, rate, {"long_name": "mean annual frequency of reaching the damage state",
                                           "units": "yr-1"}),
@@ -84,11 +99,14 @@ def risk_dataset(fragility: xr.Dataset, hazard: HazardCurve | None, design_life:
                                 {"long_name": f"probability of reaching the damage state in {design_life:g} years",
                                  "units": "1"}),
     }, coords={d: fragility[d] for d in dims})
-    source = hazard.source if hazard is not None else \
+    first = (getattr(hazard, "first", None) or next(iter(hazard.values()), None)) if isinstance(hazard, Mapping) \
+        else hazard
+    source = getattr(hazard, "source", first.source if first is not None else "") if hazard is not None else \
         f"none: no hazard curve for {fragility.attrs.get('intensity_measure', '?')} (risk not computed)"
     dataset.attrs = {"hazard_source": source, "design_life_years": design_life,
-                     "hazard_measure": hazard.label if hazard is not None else ""}
-    site = hazard.site if hazard is not None else None
+                     "hazard_measure": first.label if first is not None else "",
+                     "hazard_component": first.component if first is not None else ""}
+    site = first.site if first is not None else None
     if site is not None:  # [hazard] site picked one site of a multi-site file: say which, and how far
         dataset.attrs.update({
             "hazard_source": f"{source}, {site.describe()}", "hazard_site_distance_km": site.distance_km,

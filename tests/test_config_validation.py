@@ -89,7 +89,7 @@ def test_hazard_with_a_text_cell_is_reported_before_the_run(tmp_path, capsys):
     path.write_text(f'[hazard]\nfile = "{hazard}"\n')
     status, lines = _run_study_command(path, tmp_path, capsys)
     assert status == 2 and len(lines) == 1
-    assert f"{path}: hazard.file: " in lines[0] and "not a table of numbers" in lines[0]
+    assert f"{path}: hazard.file: {hazard}: line 3, column 2 (frequency): 'abc' is not a number" in lines[0]
 
 
 def test_binary_study_file(tmp_path, capsys):

@@ -65,6 +65,7 @@ from rockfrag.report.layout import pretty
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, table
 from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
+from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS
 
 EXTRAPOLATION_ROWS = 30
@@ -130,6 +131,16 @@ class Results:
         except PipelineError:  # the file changed since the run: the pages say "no hazard curve"
             return None
 
+    @cached_property
+    def site_hazards(self) -> SiteHazards | None:
+        """Each soil's hazard curve (rockfrag.site_hazard.study_site_hazards), or None as ``hazard``."""
+        if self.config is None:
+            return None
+        try:
+            return study_site_hazards(self.config)
+        except PipelineError:  # the file changed since the run: the pages say "no hazard curve"
+            return None
+
     @property
     def return_periods(self) -> tuple[float, ...]:
         """``[hazard] return_periods`` [years], else 475, 975 and 2,475."""
@@ -162,7 +173,7 @@ class Results:
             sliding = {(str(b), str(s)): sliding_share(self.cube, candidates, b, s, None, top)
                        for b in self.cube.block.values for s in self.cube.soil.values}
         decision = self.decision
-        return block_answers(self.fragility, hazard, periods, decision["max_probability_in_life"],
+        return block_answers(self.fragility, self.site_hazards or hazard, periods, decision["max_probability_in_life"],
                              largest_recorded=self.largest_recorded, sliding=sliding,
                              max_sliding_share=decision["max_sliding_share"])
 
