@@ -12,8 +12,9 @@ Output: ``SiteHazards``, soil name -> ``HazardCurve`` of that soil's site (annua
 
 A soil whose site is the reference site (a Vs30 equal to ``reference_vs30``, or none stated, as the steel deck)
 keeps the reference curve as it is. Any other soil's curve is the reference curve carried through the NGA-West2
-site term with its Vs30 dispersion by convolution (rockfrag.site_amplification), on a grid from a quarter of the
-reference curve's lowest intensity to four times its highest (the site term's factors lie well inside 0.25-4).
+site term with its Vs30 dispersion by convolution (rockfrag.site_amplification), tabulated from a quarter of the
+reference curve's lowest intensity to four times its highest (the site term's factors lie between 0.33 and 5.6
+over its periods and Vs30 range); beyond, as for any curve, its end slopes extend it (rockfrag.hazard).
 """
 
 from __future__ import annotations
@@ -151,7 +152,7 @@ def study_amplification(config, vs30: float, who: str) -> SiteAmplification:
 
 def amplified_curve(reference: HazardCurve, site: SiteAmplification, grid: np.ndarray) -> np.ndarray:
     """lambda_site [1/yr] on ``grid`` [the measure's unit] of the reference curve through ``site``'s site term."""
-    low, high = grid[0] / 32.0, grid[-1] * 32.0  # AF within 0.25-4 and 4 sigma of spread at most: a factor 32 spans it
+    low, high = grid[0] / 32.0, grid[-1] * 32.0  # AF 0.33-5.6 times 4 sigma of spread (e^1.2): a factor 32 spans it
     rock = np.exp(np.arange(np.log(low), np.log(high) + ROCK_STEP, ROCK_STEP))
     median, sigma = site(rock)
     return convolve_hazard(rock, hazard_frequency(reference, rock), median, sigma, grid)
