@@ -581,15 +581,12 @@ def build_parser() -> argparse.ArgumentParser:
                                help="allowed |SSI/Housner - 1| (study default 0.1)")
     applicability.set_defaults(handler=command_applicability)
 
-    study_command = commands.add_parser("study", parents=[study],
+    study_command = commands.add_parser("study", parents=[study, record_set, reading, output],
                                         help="check a study file (nothing is run or written); --keys lists every "
                                              "study key with its value, allowed range and unit")
     study_command.add_argument("--keys", action="store_true",
                                help="print every study key: its value in this study, what it must be (type, range, "
                                     "unit) and the shipped defaults' note")
-    study_command.add_argument("--force", action="store_true",
-                               help="accept blocks or soils that look physically implausible (one warning each), "
-                                    "as run and fragility do")
     study_command.set_defaults(handler=command_study, writes_output=False)
     return parser
 
@@ -657,10 +654,12 @@ def _file_problem(error: OSError) -> str | None:
 
 
 def _output_folder(args) -> Path | None:
-    """The folder the command writes to: --output, else the study's study.output."""
+    """The folder the command writes to: --output, else the study's study.output (None: it writes nothing)."""
+    if not getattr(args, "writes_output", True):
+        return None
     if getattr(args, "output", None) is not None:
         return Path(args.output)
-    if not hasattr(args, "study") or not getattr(args, "writes_output", True):
+    if not hasattr(args, "study"):
         return None
     return _study_config(args)[1]
 

@@ -17,6 +17,7 @@ cannot hold both forms under one key): then exactly those blocks run, and the pr
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import dataclasses
 import hashlib
@@ -31,7 +32,7 @@ import numpy as np
 
 from rockfrag.blocks import BLOCK_RANGES, Block
 from rockfrag.damage_states import EDPS, DamageState, damage_states_from_config
-from rockfrag.errors import ConfigError, PipelineError
+from rockfrag.errors import ConfigError, ManifestError, PipelineError
 from rockfrag.hazard import check_site
 from rockfrag.measures import MEASURES, scaling_measures
 from rockfrag.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
@@ -532,6 +533,84 @@ def _check_hazard(config: StudyConfig) -> None:
                           config.source) from None
 
 
+def _check_bed_dissipation(data, soils, models, restitution, source):
+    """Refuse a user soil's explicit ``damping_ratio`` where a restitution target calibrates the bed's instead.
+
+    With ``[solver] restitution`` set, every bed model (winkler) runs at the damping ratio calibrated to that
+    target, never at the soil's: an explicit ``damping_ratio`` of a soil the study runs would be ignored there
+    without a word. ``rockfrag.models.simulate`` refuses the same pair (``xi`` with ``restitution``).
+    """
+    if restitution == "" or not any(get_model(name).uses_bed for name in models):
+        return
+    custom = data.get("soils_custom", {})
+    for soil in soils:
+        if "damping_ratio" in custom.get(soil.name, {}):
+            target = f"{restitution!r}" if isinstance(restitution, str) else f"{restitution:g}"
+            raise ConfigError(f"soils_custom.{soil.name}.damping_ratio",
+                              f"{soil.damping_ratio:g} together with [solver] restitution = {target}: the target "
+                              "calibrates the bed models' damping ratio, so winkler would not use this one; remove "
+                              "damping_ratio, or set [solver] restitution = \"\" to run the bed at the soil's "
+                              "damping ratio", source)
+
+
+STUDY_FILE_PATHS = (("study", "processing"), ("hazard", "file"))
+"""The keys of a study file that name an input file, or a table of them (``[hazard] file`` per soil or site
+class), besides the folders and files in ``study.record_sets``.
+
+A relative path there is relative to the folder of the study file that holds it, so a study folder copied
+elsewhere runs from any working folder; the same option on the command line (``--processing``, ``--set``) is
+relative to the working folder. ``study.output`` is an output, relative to the working folder (as ``--output``).
+"""
+
+
+def _relative_to_study(user: dict, folder: Path) -> dict:
+    """The user's study with the relative input paths it names joined to its own folder ``folder``.
+
+    In ``study.record_sets`` record-set names and catalogue record ids stay as written, and so does a bare
+    name (no folder separator, no suffix) that is no file or folder in ``folder``: it is a misspelt set name
+    more likely than a path (the error then offers the nearest set). Absolute paths stay; ``~`` is the user's
+    home folder. A joined path under the working folder is written relative to it (messages stay short).
+    """
+    def joined(text: str) -> str:
+        path = Path(text).expanduser()
+        if path.is_absolute():
+            return str(path)
+        path = folder / path
+        if path.is_absolute():
+            with contextlib.suppress(ValueError):
+                path = path.relative_to(Path.cwd())
+        return str(path)
+
+    def is_path(text: str) -> bool:
+        path = Path(text)
+        return len(path.parts) > 1 or bool(path.suffix) or text.startswith((".", "~")) or (folder / path).exists()
+
+    resolved = copy.deepcopy(user)
+    for table, key in STUDY_FILE_PATHS:
+        value = resolved.get(table, {}).get(key)
+        if isinstance(value, str) and value.strip():
+            resolved[table][key] = joined(value)
+        elif isinstance(value, dict):  # a file per soil or site class ([hazard] file)
+            resolved[table][key] = {name: joined(text) if isinstance(text, str) and text.strip() else text
+                                    for name, text in value.items()}
+    selection = resolved.get("study", {}).get("record_sets")
+    if isinstance(selection, list) and selection:
+        names = _catalogue_names()
+        resolved["study"]["record_sets"] = [joined(entry) if entry not in names and is_path(entry) else entry
+                                            for entry in selection]
+    return resolved
+
+
+def _catalogue_names() -> set[str]:
+    """The record-set names and record ids of the catalogue (none when there is no catalogue to read)."""
+    from rockfrag.records import catalogue, record_sets
+
+    try:
+        return {*record_sets(), *(entry.id for entry in catalogue())}
+    except ManifestError:
+        return set()
+
+
 def _period_range(value) -> tuple[float, float] | None:
     """``[intensity] period_range`` (AvgSa periods [s], checked by ``SCHEMA``): (low, high), or None."""
     return None if value is None else (float(value[0]), float(value[1]))
@@ -553,6 +632,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     soils = _site_vs30(soils, hazard.get("vs30", {}), source)
     models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
     restitution = solver.get("restitution", "")
+    _check_bed_dissipation(data, soils, models, restitution, source)
     if restitution == BAND:
         models = tuple(variant for name in models
                        for variant in (band_variants(name) if get_model(name).uses_bed else [name]))
@@ -630,7 +710,9 @@ def load_study(path: str | Path | None = None, overrides: dict | None = None) ->
     ----------
     path : str or Path, optional
         A TOML study file with the layout of ``pipeline/defaults.toml`` (SI units unless a key says
-        otherwise: levels of PGA and Sa in g). None: the shipped default study.
+        otherwise: levels of PGA and Sa in g). None: the shipped default study. The input files it names
+        (``study.record_sets`` folders and files, ``study.processing``, ``hazard.file``) are relative to its
+        folder; ``study.output`` is relative to the working folder.
     overrides : dict, optional
         Tables and keys replacing those of the file, in the same layout (``{"study": {"output": ...}}``).
 
@@ -654,6 +736,7 @@ def load_study(path: str | Path | None = None, overrides: dict | None = None) ->
         user = read_study_file(path)
         source = str(path)
         validate(user, source)
+        user = _relative_to_study(user, Path(path).parent)
         merged = _merge(merged, _user_blocks(default, user))
     if overrides:
         validate(overrides, "command line")

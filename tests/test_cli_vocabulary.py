@@ -11,8 +11,8 @@ import xarray as xr
 from rockfrag.cli import _executor_options, _study_config, build_parser, main
 from rockfrag.errors import PipelineError
 
-RECORD_COMMANDS = ("records", "run", "fragility", "applicability")
-SHARED = ("--set", "--units", "--dt", "--processing", "--output", "--no-progress")
+RECORD_COMMANDS = ("records", "run", "fragility", "applicability", "study")
+SHARED = ("--set", "--units", "--dt", "--processing", "--output", "--no-progress", "--force", "--wait")
 
 
 def _subparsers():
@@ -34,6 +34,23 @@ def test_shared_options_are_the_same_on_every_record_command():
         for name, action in actions.items():
             assert (action.default, action.help, action.type) == (reference.default, reference.help, reference.type), \
                 (flag, name)
+
+
+def test_every_command_takes_the_shared_options():
+    """Calibrate names its one record with --record instead of --set; every other shared option is everywhere."""
+    commands = _subparsers()
+    assert set(commands) == {*RECORD_COMMANDS, "calibrate"}
+    missing = [(name, flag) for name in commands for flag in SHARED
+               if _option(commands[name], flag) is None and (name, flag) != ("calibrate", "--set")]
+    assert not missing
+
+
+def test_the_study_check_accepts_them_and_writes_nothing(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "--no-progress", "--output", "elsewhere", "--set", "bolu", "--wait", "--force"]) == 0
+    out = capsys.readouterr().out
+    assert "record sets bolu" in out and "output elsewhere" in out
+    assert list(tmp_path.iterdir()) == []  # no output folder, no lock file
 
 
 def test_processing_and_output_on_every_command_that_processes_records():

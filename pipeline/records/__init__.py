@@ -40,12 +40,13 @@ from rockfrag.records.components import component_label, header_metadata, orient
 from rockfrag.records.components import component_labels as component_labels
 from rockfrag.records.components import group_components as group_components
 from rockfrag.records.components import split_vertical as split_vertical
-from rockfrag.records.manifest import CatalogueEntry, load_catalogue, sha256_of, verify
+from rockfrag.records.manifest import CatalogueEntry, load_catalogue, sha256_of, shipped_records_dir, verify
 from rockfrag.units import STANDARD_GRAVITY, acceleration_factor
 from rockfrag.validation import did_you_mean
 
-RECORDS_DIR = Path(os.environ.get("ROCKFRAG_RECORDS", Path(__file__).resolve().parents[2] / "records"))
-"""Folder holding the shipped records and ``MANIFEST.csv`` (override with $ROCKFRAG_RECORDS)."""
+RECORDS_DIR = shipped_records_dir()
+"""Folder holding the shipped records and ``MANIFEST.csv`` (override with $ROCKFRAG_RECORDS; see
+``manifest.shipped_records_dir``)."""
 
 RECORD_SUFFIXES = {".at2"}
 """File endings picked up when a folder is given, plus text records (``text.TEXT_SUFFIXES`` whose content

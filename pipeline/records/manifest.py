@@ -4,6 +4,10 @@ Input : ``records/MANIFEST.csv`` (one row per file: id, file, event, year, magni
         component, sets, source, units, npts, dt_s, pga_g, sha256, ...).
 Output: ``CatalogueEntry`` objects; ``verify`` reports any listed file that is missing or whose
         sha256 differs from the catalogue, by name.
+
+Where the shipped records are (``shipped_records_dir``): the folder ``$ROCKFRAG_RECORDS`` names, else the
+package data of an installed wheel (``rockfrag/shipped_records/``, the build maps the checkout's ``records/``
+there), else ``records/`` at the top of a clone (an editable install runs the sources in ``pipeline/``).
 """
 
 from __future__ import annotations
@@ -11,10 +15,33 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from rockfrag.errors import ManifestError
+
+RECORDS_ENVIRONMENT = "ROCKFRAG_RECORDS"
+"""The environment variable that names another folder of records (with its ``MANIFEST.csv``)."""
+
+
+def shipped_records_dir() -> Path:
+    """The folder of the shipped records and their ``MANIFEST.csv``.
+
+    Returns
+    -------
+    Path
+        ``$ROCKFRAG_RECORDS`` if set; else ``shipped_records/`` inside the installed package (a wheel); else
+        ``records/`` beside the source folder ``pipeline/`` (a clone, or an editable install of it). A folder
+        that does not exist is returned as it is: the catalogue's reader names it when it finds no catalogue.
+    """
+    override = os.environ.get(RECORDS_ENVIRONMENT)
+    if override:
+        return Path(override)
+    package = Path(__file__).resolve().parents[1]
+    installed = package / "shipped_records"
+    return installed if installed.is_dir() else package.parent / "records"
+
 
 REQUIRED_COLUMNS = ("id", "file", "event", "year", "magnitude", "station", "component", "sets",
                     "source", "units", "sha256")
@@ -63,7 +90,8 @@ def load_catalogue(manifest_path) -> list[CatalogueEntry]:
     """
     manifest_path = Path(manifest_path)
     if not manifest_path.is_file():
-        raise ManifestError(f"{manifest_path}: record catalogue not found")
+        raise ManifestError(f"{manifest_path}: record catalogue not found; set ${RECORDS_ENVIRONMENT} to the "
+                            "folder holding MANIFEST.csv and its record files")
     key = (str(manifest_path), manifest_path.read_bytes())
     if key not in _PARSED:
         _PARSED[key] = tuple(_parse_catalogue(manifest_path, key[1].decode("utf-8")))
