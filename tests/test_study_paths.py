@@ -151,3 +151,10 @@ def test_a_damping_ratio_that_is_used_is_accepted(tmp_path, text):
     study.write_text(text)
     config = load_study(study)
     assert [soil.name for soil in config.soils][0] == "loam"
+
+
+def test_a_hazard_file_per_soil_resolves_from_the_study_folder_too(tmp_path, monkeypatch):
+    study = _study_folder(tmp_path / "project")
+    study.write_text(STUDY.replace('file = "site/hazard.csv"', 'file = { rock = "site/hazard.csv" }'))
+    monkeypatch.chdir(tmp_path)
+    assert load_study(study).hazard_file == {"rock": str(Path("project") / "site" / "hazard.csv")}
