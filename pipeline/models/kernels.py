@@ -858,13 +858,14 @@ def friction_pivot_impact(system, x, zeno_speed, t, impact_times, summary):
     """Impact at theta = 0 of a rigid base with friction (``housner.friction_impact``); (phase, sigma, slip) after.
 
     The block rocks on the other corner (sliding if its slip rate is not zero, else stuck if the friction
-    holds), or, when the next excursion would be below the Zeno angle, lies flat: sliding or at rest.
+    holds), or lies flat, sliding or at rest: where it landed on both corners, or where the next excursion would be
+    below the Zeno angle.
     """
     book_impact(summary, impact_times, t)
     x[0] = 0.0
-    friction_impact(system.sigma, x, system.params)
+    flat = friction_impact(system.sigma, x, system.params)
     slip = 0.0 if x[SLIP_RATE] == 0.0 else (1.0 if x[SLIP_RATE] > 0.0 else -1.0)
-    if abs(x[1]) < zeno_speed:
+    if flat or abs(x[1]) < zeno_speed:
         x[1] = 0.0
         if slip == 0.0:
             return REST, 0.0, 0.0
