@@ -8,6 +8,15 @@ Output: ``DamageState`` objects in order of increasing severity, read by the stu
 A state is reached when its engineering demand parameter ``edp`` (a cube variable, or the outcome
 ``uplifted`` / ``overturned``) is at least ``threshold``; overturning exceeds every rocking threshold.
 
+Uplift has a size: a run uplifts when a corner of the base rises at least ``UPLIFT_FRACTION`` of the block's
+half-width b or at least ``UPLIFT_MIN_LIFT`` (whichever is smaller, ``uplift_lift``) above the ground, or the
+block overturns or leaves the ground (free flight). A smaller lift is a tilt on the bed: the heel of a block on a
+compliant bed parts from it by fractions of a millimetre long before the block rocks about its toe, and calling
+that rocking would count the bed's give as the block's motion. A pivot model (Housner's rigid base, the paper's
+model) has no bed to tilt on: its corner lifts only when the block pivots about the other one, at g tan(alpha), and
+any lift is rocking. The fits (rockfrag.fragility.exceedance, ``tilts``) and the report's words ("tilts on the
+bed", "rocks") read this one rule.
+
 Slip states (``edp = "peak_slip"``, threshold in metres) are a family of their own beside the rocking ones:
 they apply only to the cells that run with friction at the base (rockfrag.study.cell_friction; elsewhere the
 fits mark them ``not-applicable``), do not nest with the rocking states, and sort after uplift and before the
@@ -57,7 +66,31 @@ def register_damage_state(state: DamageState) -> None:
     DAMAGE_STATES.update((s.name, s) for s in ordered)
 
 
-register_damage_state(DamageState("uplift", "uplifted", 1.0, "rocking starts (the heel lifts off)"))
+UPLIFT_FRACTION = 0.01
+"""Uplift: the lift of a base corner, as a fraction of the half-width b, that counts as lift-off [-]."""
+UPLIFT_MIN_LIFT = 0.001
+"""Uplift: a lift of a base corner of at least this much counts as lift-off whatever the block's size [m]."""
+
+
+def uplift_lift(b):
+    """The smallest lift of a base corner [m] that counts as uplift for a block of half-width ``b`` [m].
+
+    ``UPLIFT_FRACTION`` of b or ``UPLIFT_MIN_LIFT``, whichever is smaller (a small object lifts off in less than a
+    millimetre); works on floats and arrays (xarray included).
+    """
+    scaled = UPLIFT_FRACTION * b
+    return scaled.clip(max=UPLIFT_MIN_LIFT) if hasattr(scaled, "clip") else min(scaled, UPLIFT_MIN_LIFT)
+
+
+UPLIFT_WORDS = (f"a base corner lifts at least {UPLIFT_MIN_LIFT * 1000:g} mm (or {UPLIFT_FRACTION:.0%} of the "
+                "half-width b, if that is less) off a compliant bed, or the block pivots about an edge of a rigid "
+                "base")
+"""What uplift means, in the words every page uses (a smaller lift is a tilt on the bed)."""
+
+TILT_WORDS = "tilts on the bed"
+"""A run whose base corner lifts less than ``uplift_lift``: the bed gives under the toe, the block does not rock."""
+
+register_damage_state(DamageState("uplift", "uplifted", 1.0, f"lift-off: {UPLIFT_WORDS}"))
 register_damage_state(DamageState("rocking-0.2", "peak_angle_ratio", 0.2, "theta_max/alpha >= 0.2"))
 register_damage_state(DamageState("rocking-0.5", "peak_angle_ratio", 0.5, "theta_max/alpha >= 0.5"))
 register_damage_state(DamageState("overturning", "overturned", 1.0, "the block overturns"))

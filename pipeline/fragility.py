@@ -59,6 +59,7 @@ from rockfrag.damage_states import (
     damage_states_from_config,
     is_slip_state,
     state_family,
+    uplift_lift,
 )
 from rockfrag.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
     OPENQUAKE_FILE,
@@ -131,6 +132,21 @@ def first_overturn_outcomes(cube: xr.Dataset) -> xr.DataArray:
     return cube.outcome.where(~since, OUTCOME_OVERTURNED)
 
 
+def tilts(cube: xr.Dataset, outcome: xr.DataArray) -> xr.DataArray | bool:
+    """True for the runs that only tilt on a compliant bed: a corner lifted less than the uplift size, no more.
+
+    The size is the damage-state registry's (``rockfrag.damage_states.uplift_lift``). A pivot model (Housner, the
+    paper's model: ``uplift_is_rigid_threshold``) lifts a corner only by pivoting about the other one, at
+    g tan(alpha): it has no tilt, and any lift is rocking. False where the cube has no corner lift.
+    """
+    if "peak_uplift" not in cube or "block_b" not in cube or "model" not in cube.coords:
+        return False
+    models = cube.model
+    bed = xr.DataArray(np.array([not uplift_is_rigid_threshold(str(m)) for m in np.atleast_1d(models.values)]
+                                ).reshape(models.shape), dims=models.dims, coords=models.coords)
+    return (outcome == OUTCOME_ROCKING) & bed & (cube.peak_uplift < uplift_lift(cube.block_b))
+
+
 def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
     """1.0 where a run reached the damage state, 0.0 where not, NaN where unknown.
 
@@ -156,6 +172,7 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
     flight = outcome == OUTCOME_FREE_FLIGHT
     if state.edp == "uplifted":
         reached = outcome >= OUTCOME_ROCKING  # rocking, overturned or free flight (failed: masked below)
+        reached = reached & ~tilts(cube, outcome)
         known = outcome != OUTCOME_FAILED
     elif state.edp == "overturned":
         reached = outcome == OUTCOME_OVERTURNED

@@ -57,7 +57,8 @@ def test_one_numbered_a4_document_with_an_html_twin(small_pipeline):
         assert 1 <= int(target) <= pages
     headed = set(re.findall(r"<section id='page-(\d+)'>\s*<h2>", html))  # a text section over pages: one heading
     assert set(re.findall(r"href='#page-(\d+)'", html)) == headed  # each heading; the contents by the back links
-    text_pages = r"\d+-(title|answer|contents|summary|methods|limitations|records-table|glossary|references|provenance)"
+    text_pages = (r"\d+-(title|answer|contents|summary|fitted|methods|limitations|records-table|glossary|references"
+                  r"|reproduce)")
     assert not [png.name for png in pngs if re.match(text_pages, png.name)]  # text pages have no PNG
     assert html.count("data:image/png;base64,") == len(pngs)  # figure pages embedded, text pages as HTML
     assert "src='http" not in html and "href='http" not in html  # self-contained
@@ -72,7 +73,8 @@ def test_title_project_author_and_sections_from_the_study(small_pipeline):
     # a section that starts part-way down a shared page is headed there (h3), not in the page title (h2)
     order = [min(found.start() if (found := re.search(f"<h{level}[^>]*>{title}", html)) else len(html) + 1
                  for level in (2, 3))
-             for title in ("Contents", "Summary", "Methods", "Limitations", "Intensity measures", "IDA curves")]
+             for title in ("Summary", "Contents", "Reading the answer pages", "Fitted fragility functions", "Methods",
+                           "Limitations", "IDA curves")]
     assert order == sorted(order)
     assert "θmax/α ≥ 0.5" in html  # damage states by their registry description, not ids
     assert "rocking-0.5:" not in html.split("Methods")[0]

@@ -159,25 +159,28 @@ def test_the_study_states_the_limits_and_return_periods(tmp_path):
         assert error.value.field == field
 
 
-def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_level_at_or_below():
-    """Issue 19: which mode governs at each return-period intensity. Mode times where the base slides; the
-    outcome where it is tied (no mode times); the recommended curve reads the band centre's runs; the level is
-    the one at or below the intensity, as the probability table reads it (issue 20, finding 4)."""
+def test_the_motion_at_each_return_period_comes_from_the_runs_at_the_level_at_or_below():
+    """Issue 19, 36: what the block does at each return-period intensity, each record counted at its most severe
+    motion. Mode times where the base slides; the outcome where it is tied (no mode times); the recommended curve
+    reads the band centre's runs; the level is the one at or below the intensity, as the probability table reads
+    it (issue 20, finding 4)."""
     import xarray as xr
 
     from rockfrag.models.fields import MODE_TIME_FIELDS
     from rockfrag.models.variants import RECOMMENDED
-    from rockfrag.report.answer_page import governing_modes
+    from rockfrag.report.answer_page import NO_LEVEL, motion_counts
 
     levels = np.array([0.1, 0.3, 1.0])  # g
     times = np.zeros((4, 3, 1, 1, 2, len(MODE_TIME_FIELDS)))  # record, level, soil, block, model, mode
     times[:, 0, ..., 0] = 10.0   # at rest at 0.1 g
-    times[:, 1, ..., 1] = 10.0   # slides at 0.3 g (one record also rocks for 2 s: not half of them)
+    times[:, 1, ..., 1] = 10.0   # slides at 0.3 g; one record also rocks for 2 s
     times[0, 1, ..., 2] = 2.0
     times[:, 2, ..., 0] = 30.0   # at 1 g mostly at rest, but every record slides and rocks for a while: that
     times[:, 2, ..., 3] = 1.0    # is what it does (the longest mode would say "at rest")
     times[..., 1, :] = np.nan    # the second model is tied: no mode times
     outcome = np.zeros((4, 3, 1, 1, 2), np.int8)
+    outcome[0, 1, ..., 0] = 1    # the centre: the record that rocked lifted off, and all do at 1 g
+    outcome[:, 2, ..., 0] = 1
     outcome[:, 1:, ..., 1] = 1   # tied: rocks from 0.3 g
     outcome[:3, 2, ..., 1] = 2   # ... and 3 of 4 records overturn at 1 g
     dims = ("record", "im_level", "soil", "block", "model")
@@ -185,14 +188,13 @@ def test_the_governing_mode_at_each_return_period_comes_from_the_runs_at_the_lev
                       {"outcome": (dims, outcome)},
                       coords={"soil": ["clay"], "block": ["skid"], "model": ["winkler-centre", "housner"],
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
-    assert governing_modes(cube, "skid", RECOMMENDED, "clay", [0.11, 0.32, 1.1], 1.0) == \
-        ["at rest (100% of the records)", "slides (100% of the records)", "slides and rocks (100% of the records)"]
-    assert governing_modes(cube, "skid", "housner", "clay", [0.1, 0.3, 1.0], 1.0) == \
-        ["at rest (100% of the records)", "rocks (100% of the records)", "overturns (75% of the records)"]
+    assert motion_counts(cube, "skid", RECOMMENDED, "clay", [0.11, 0.32, 1.1], 1.0) == \
+        ["at rest 4 (of 4)", "slides 3, rocks 1 (of 4)", "slides and rocks 4 (of 4)"]
+    assert motion_counts(cube, "skid", "housner", "clay", [0.1, 0.3, 1.0], 1.0) == \
+        ["at rest 4 (of 4)", "rocks 4 (of 4)", "rocks 1, overturns 3 (of 4)"]
     # 0.28 g reads the 0.1 g level (at or below, as the P table), not the nearer 0.3 g; below 0.1 g no level
-    assert governing_modes(cube, "skid", "housner", "clay", [0.28, 0.09], 1.0) == \
-        ["at rest (100% of the records)", "no level run this low"]
-    assert governing_modes(None, "skid", "housner", "clay", [0.1], 1.0) == ["-"]
+    assert motion_counts(cube, "skid", "housner", "clay", [0.28, 0.09], 1.0) == ["at rest 4 (of 4)", NO_LEVEL]
+    assert motion_counts(None, "skid", "housner", "clay", [0.1], 1.0) == ["-"]
 
 
 def _tied_cube(outcome):
@@ -204,28 +206,29 @@ def _tied_cube(outcome):
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
 
 
-def test_the_governing_motion_counts_as_the_fits_do_and_a_milder_motion_is_never_below_100_percent():
-    """The client read "at rest (98%)" (at rest or worse is always 100%), "rocks (50%)" where 22 of 44 rocked
-    and 22 overturned, and a record that overturned at a lower level counted as rocking (resurrection)."""
-    from rockfrag.report.answer_page import governing_modes
+def test_the_motions_count_as_the_fits_do_and_every_record_once():
+    """The client read "at rest (100% of the records)" beside 10 of 44 records lifting off (at rest or worse is
+    always 100%), "rocks (50%)" where 22 of 44 rocked and 22 overturned, and a record that overturned at a lower
+    level counted as rocking (resurrection). Each record is now counted once, at its most severe motion."""
+    from rockfrag.report.answer_page import motion_counts
 
     outcome = np.zeros((44, 3), int)
     outcome[0, 0] = 1                     # one record of 44 lifts off at 0.1 g: the rest stay at rest
     outcome[:22, 1], outcome[22:, 1] = 1, 2  # 22 rock, 22 overturn at 0.3 g
     outcome[:, 2] = 1                     # at 1 g every record rocks: the 22 overturned at 0.3 g resurrect
     outcome[0, 2] = 2
-    modes = governing_modes(_tied_cube(outcome), "cabinet", "housner", "sand", [0.1, 0.3, 1.0], 1.0)
-    assert modes == ["at rest (100% of the records)", "overturns (50% of the records)",
-                     "overturns (52% of the records)"]
+    motions = motion_counts(_tied_cube(outcome), "cabinet", "housner", "sand", [0.1, 0.3, 1.0], 1.0)
+    assert motions == ["at rest 43, rocks 1 (of 44)", "rocks 22, overturns 22 (of 44)",
+                       "rocks 21, overturns 23 (of 44)"]
 
 
 def test_the_motion_table_and_the_probability_table_agree_on_one_cell():
-    """One definition, level and counting rule: the share of records that overturn in the motion table is the
-    count of records in the probability table's cell, at the same level (issue 20, finding 4)."""
+    """One definition, level and counting rule: the records that overturn in the motion table are the count of
+    records in the probability table's cell, at the same level (issue 20, finding 4)."""
     from rockfrag.answer import _records_at
     from rockfrag.damage_states import DAMAGE_STATES
     from rockfrag.fragility import exceedance
-    from rockfrag.report.answer_page import governing_modes
+    from rockfrag.report.answer_page import motion_counts
 
     outcome = np.zeros((10, 3), int)
     outcome[:, 1:] = 1
@@ -236,9 +239,8 @@ def test_the_motion_table_and_the_probability_table_agree_on_one_cell():
         .mean("record").values
     for im in (0.5, 2.0):
         reached, total, level = _records_at(np.array([0.1, 0.3, 1.0]), fraction, 10, im)
-        mode = governing_modes(cube, "cabinet", "housner", "sand", [im], 1.0)[0]
-        shown = percent(reached / total)
-        assert f"overturns: {shown})" in mode or mode == f"overturns ({shown} of the records)", (im, level, mode)
+        motion = motion_counts(cube, "cabinet", "housner", "sand", [im], 1.0)[0]
+        assert f"overturns {reached} (of {total})" in motion, (im, level, motion)
     assert reached == 5  # the resurrected records count as overturned at 1 g
 
 
@@ -300,9 +302,12 @@ def _supported(lower, median=1.0, beta=0.6):
 
 
 def test_a_verdict_from_the_fits_tail_below_every_record_is_said_so():
-    """The client read 2.2% at 0.3 g where no record overturned: each cell says what the records did at the level
-    at or below the intensity, and the verdict says when it rests on the fitted curve's tail alone."""
-    from rockfrag.report.answer_page import _at_cell, _period_header
+    """The client read 2.2% at 0.3 g where no record overturned: the records table says what the records did at the
+    level at or below the intensity, and the reason says when the verdict rests on the fitted curve's tail alone."""
+    from types import SimpleNamespace
+
+    from rockfrag.report import numbers
+    from rockfrag.report.summary import p_at_return_period, reason
 
     levels, answer = _tail_case(5)  # first overturning at 1.39 g, far above the 2,475-year 0.57 g
     overturning = answer.soils[0].states[1]
@@ -315,19 +320,20 @@ def test_a_verdict_from_the_fits_tail_below_every_record_is_said_so():
     assert f"rests on the fitted curve's tail alone on clay and rock: no record reached the state below " \
            f"{levels[5]:.2g} g" in sentence
     assert percent(overturning.supported_probability) in sentence
+    results = SimpleNamespace(facts=numbers.Facts())
+    assert reason(results, answer, answer.soils[0]) == f"fitted tail only: no record below {levels[5]:.2g} g"
     im = (K0 * 475.0) ** (1 / K)
     below = levels[levels <= im][-1]
     assert overturning.records[0] == (0, 10, pytest.approx(below))
     p = lognorm.cdf(im, 0.6, scale=1.0)
-    assert _at_cell(overturning, 0, answer).startswith(percent(p))
-    assert _at_cell(overturning, 0, answer).endswith("; fit only, 0 of 10 records")
-    assert _period_header(answer, answer.soils[0], 0, "PGA").endswith(f"(records at {below:.2g}\u00a0g)")
+    assert p_at_return_period(overturning, 0, answer.intensities) == numbers.probability(p)
 
     levels, answer = _tail_case(2)  # 3 of 10 overturned at 0.29 g, below the 475-year 0.30 g
     overturning = answer.soils[0].states[1]
     assert not overturning.tail_only and "tail" not in verdict_sentence(answer, "cabinet")
+    assert "tail" not in reason(results, answer, answer.soils[0])
     assert overturning.supported_probability == pytest.approx(_supported(levels[2]), rel=0.02)
-    assert _at_cell(overturning, 0, answer).endswith("; 3 of 10 records")
+    assert overturning.records[0][0] == 3
     no_records = block_answers(_fragility([[[[0.5, 1.0]]]], betas=0.6), _power_law())[0]
     assert not no_records.soils[0].states[1].records  # no n_records: the cell keeps its value and band only
 
@@ -343,24 +349,30 @@ def test_the_data_supported_part_of_the_annual_frequency_is_the_integral_above_t
     assert annual_frequency(1.0, 0.0, hazard, lower=2.0) == pytest.approx(K0 * 2.0 ** -K)  # a step below it
 
 
-def test_each_answer_page_states_the_planar_model_and_where_the_friction_comes_from(small_pipeline):
-    """A client took the soil's friction for the plinth's, and the planar model's limits were on another page."""
-    from rockfrag.report.answer_page import answer_items
+def test_the_answer_pages_state_the_planar_model_and_where_the_friction_comes_from_once(small_pipeline):
+    """A client took the soil's friction for the plinth's, and the planar model's limits were on another page; the
+    same paragraph then stood on every block's page (issue 36: common text once). The page before the answers
+    says both once; the limitations give each block's b."""
+    from rockfrag.report.answer_page import answer_items, reading_items
     from rockfrag.report.sections import limitations_items, sources_items
     from tests.helpers import pipeline_results
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    common = " ".join(item.text for item in reading_items(results))
+    assert "planar model" in common and "bottom edge" in common
+    for soil in results.config.soils:
+        assert f"{soil.name} {soil.friction_static:g}/{soil.friction_kinetic:g}" in common
+    assert "soil class's default coefficient" in common and "plinth" in common and "shim" in common
     for answer in results.answers:
         text = " ".join(item.text for item in answer_items(results, answer))
-        b = float(results.cube.block_b.sel(block=answer.block))
-        assert f"b = {b:.3g} m is its half-width" in text and "bottom edge" in text
-        assert "twisting (wobbling)" in text and "three-dimensional rocking" in text
-        for soil in results.config.soils:
-            assert f"{soil.name} {soil.friction_static:g}/{soil.friction_kinetic:g}" in text
-        assert "soil class's default coefficient" in text and "plinth" in text and "shim" in text
-        assert "[soils_custom.NAME]" in text and "friction_static" in text and "friction_kinetic" in text
-    limitations = " ".join(item.text for item in limitations_items(results))
-    assert "Planar model" in limitations and results.friction_words in limitations
+        assert results.friction_words not in text and "bottom edge" not in text  # said once, before
+    limitations = limitations_items(results)
+    words = " ".join(item.text for item in limitations)
+    assert "Planar model" in words and "twisting (wobbling)" in words and "three-dimensional rocking" in words
+    planar = next(item for item in limitations if item.kind == "table" and "half-width b" in item.header[1])
+    for block, row in zip(results.cube.block.values, planar.rows):
+        assert row[1] == f"{float(results.cube.block_b.sel(block=block)):.3g}"
+    assert results.friction_words in words
     assert results.friction_words in [item.text for item in sources_items(results)]
 
 
@@ -380,7 +392,10 @@ def test_the_seed_paper_is_cited_from_its_copy_and_named_in_full_on_the_methods_
 def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from_the_fits_tail():
     """The client read "uplift 98%, once in 13 years" from a median of 0.069 g, below the lowest level run (0.1 g),
     where every record had already lifted off: the page gives the records' fraction there as a lower bound."""
-    from rockfrag.report.answer_page import _at_cell, _below_lowest
+    from types import SimpleNamespace
+
+    from rockfrag.report import numbers
+    from rockfrag.report.summary import p_at_return_period, p_in_life, reason
 
     levels = np.geomspace(0.1, 4.0, 8)
     empirical = np.ones((levels.size, 2, 1, 2, 2))
@@ -393,17 +408,19 @@ def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from
     assert uplift.annual_frequency == pytest.approx(K0 * 0.1 ** -K, rel=1e-6)
     fitted = K0 * 0.069 ** -K * math.exp(K ** 2 * 0.3 ** 2 / 2)
     assert uplift.annual_frequency < 0.5 * fitted
-    cell = _below_lowest(uplift, "g")
-    assert cell.startswith("\u2265") and "every record at the lowest level run (0.1 g)" in cell
-    assert _at_cell(uplift, 0, answer) == "100%; 10 of 10 records"  # every record: a certainty
-    assert not _at_cell(overturning, 0, answer).startswith("\u2265")
+    assert p_in_life(uplift) == numbers.bound(uplift.probability_in_life, "≥") and p_in_life(uplift).startswith("≥")
+    assert p_at_return_period(uplift, 0, answer.intensities) == "100%"  # every record: a certainty
+    assert not p_in_life(overturning).startswith("≥")
     judged = block_answers(fragility, _power_law(), limits={"rocking-0.5": 0.1})[0]
     assert "in 50 years at least " in verdict_sentence(judged, "cabinet")  # a lower bound is said so in the verdict
+    assert reason(SimpleNamespace(facts=numbers.Facts()), judged, judged.soils[0]) == \
+        "10 of 10 records already at 0.1 g: a bound"
 
 
 def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run():
     """The client read the study-wide β ranges and the cabinet's r on the crane's and the skid's pages, and the skid's
-    page did not say that its band's three runs were one run (beta_model 0 by construction)."""
+    page did not say that its band's three runs were one run (beta_model 0 by construction). The β of each row is
+    the summary's now; the calibrated damping ratio is printed nowhere (issue 36's precision policy)."""
     from types import SimpleNamespace
 
     from rockfrag.report.answer_page import curve_reason
@@ -431,12 +448,11 @@ def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run(
                                    "damage_state": ["overturning"]})
     results = SimpleNamespace(fragility=fragility, cube=cube)
     crane, cabinet, skid = (curve_reason(results, "recommended", b) for b in blocks)
-    assert "record to record is 0.50 to 0.50 and β of the model 0.30 to 0.30" in crane
-    assert "cannot dissipate" not in crane and "collapses" not in crane
+    assert crane == ""  # the band reached and not collapsed: nothing of its own to say
     assert "0.990" in cabinet and "0.950" in cabinet and "collapses" not in cabinet
-    assert "0.41" in cabinet and "1.17" not in crane and "1.17" not in skid
-    assert "On every soil the band collapses to one run" in skid and "ξ = 0.15" in skid
+    assert "On every soil the restitution band collapses to one run" in skid
     assert "it reaches none of them" in skid and "because there is one run" in skid and "0.990" not in skid
+    assert all("ξ" not in text and "0.15" not in text for text in (crane, cabinet, skid))  # no calibrated ξ
 
 
 def _friction_cube():
@@ -500,7 +516,8 @@ def test_answer_page_says_when_the_measure_is_not_sufficient():
                             coords={"soil": ["clay"], "block": ["a", "b"], "model": ["housner"],
                                     "measure": ["pga", "pgv"]})
     words = sufficiency_words(efficiency, "a", "pga", "PGA")
-    assert "pulse period (p < 0.001)" in words and "magnitude" not in words and "PGA" in words
+    assert "pulse period" in words and "magnitude" not in words and "PGA" in words
+    assert "p <" not in words and "p =" not in words  # the p-values are on the efficiency page
     assert sufficiency_words(efficiency, "b", "pga", "PGA") == ""
     assert sufficiency_words(efficiency, "a", "pgv", "PGV") == ""
     assert sufficiency_words(efficiency, "missing", "pga", "PGA") == ""
@@ -508,24 +525,27 @@ def test_answer_page_says_when_the_measure_is_not_sufficient():
 
 
 def test_an_anchor_verdict_says_how_the_anchorage_is_designed(small_pipeline):
-    """'Anchor it' came without a design basis (client read): the page points to the code procedure, exactly where a
-    soil's verdict is 'anchor'."""
-    from rockfrag.report.answer_page import ANCHOR_DESIGN, answer_items
-    from tests.helpers import pipeline_results
-
-    results = pipeline_results(small_pipeline.output, small_pipeline.study)
-    assert "ASCE 7-22 Chapter 13" in ANCHOR_DESIGN and "F_p" in ANCHOR_DESIGN
+    """'Anchor it' came without a design basis (client read): the answer pages point to the code procedure, once,
+    exactly where a verdict is 'anchor'."""
     from dataclasses import replace
 
-    for answer in results.answers:
-        for verdicts in ([s.verdict for s in answer.soils], [ANCHOR] + [s.verdict for s in answer.soils][1:]):
-            changed = replace(answer, soils=[replace(s, verdict=v) for s, v in zip(answer.soils, verdicts)])
-            texts = [item.text for item in answer_items(results, changed)]
-            assert (ANCHOR_DESIGN in texts) == (ANCHOR in verdicts)
+    from rockfrag.report.answer_page import ANCHOR_DESIGN, reading_items
+    from tests.helpers import pipeline_results
+
+    assert "ASCE 7-22 Chapter 13" in ANCHOR_DESIGN and "F_p" in ANCHOR_DESIGN
+    for anchored in (False, True):
+        results = pipeline_results(small_pipeline.output, small_pipeline.study)
+        answers = results.answers
+        verdicts = [[ANCHOR if anchored and i == 0 else NO_ACTION for i, _ in enumerate(a.soils)] for a in answers]
+        results.__dict__["answers"] = [replace(answer, soils=[replace(s, verdict=v) for s, v in zip(answer.soils, vs)])
+                                       for answer, vs in zip(answers, verdicts)]
+        texts = [item.text for item in reading_items(results)]
+        assert (ANCHOR_DESIGN in texts) == anchored
 
 
 def test_a_lower_bound_of_every_record_is_printed_as_a_certainty():
     """'\u2265100%' read oddly on the default report (every record uplifted at that level): it is 100%."""
-    from rockfrag.report.answer_page import _at_least
+    from rockfrag.report.numbers import bound
 
-    assert _at_least(1.0) == "100%" and _at_least(0.61) == "\u226561%" and _at_least(0.996) == ">99%"
+    assert bound(1.0, "\u2265") == "100%" and bound(0.61, "\u2265") == "\u2265 61%"
+    assert bound(0.996, "\u2265") == "> 99%"

@@ -68,12 +68,13 @@ def test_every_page_leads_back_to_the_contents_and_sections_have_anchors(small_p
     contents = next(number for number, body in sections if "<h2>Contents</h2>" in body)
     back = f"<a href='#page-{contents}'>Back to the contents</a>"
     assert all(back in body for number, body in sections if number != contents)
-    for section in ("Answer", "Summary", "Methods", "Limitations", "Glossary", "References"):
-        slug = "section-" + section.lower()
+    for section in ("Summary", "Answers", "Methods", "Limitations", "Glossary", "References",
+                    "How to reproduce this report"):
+        slug = "section-" + re.sub(r"[^a-z0-9]+", "-", section.lower())
         assert f"id='{slug}'" in html and f"href='#{slug}'" in html, section
-    answers = [body for number, body in sections if 1 < int(number) < int(contents)]  # one heading per block
-    assert answers and all("<img" not in body and "<table>" in body for body in answers)  # text, not images
-    assert int(contents) == len(answers) + 2  # title, the answer pages, then the contents
+    front = [body for number, body in sections if 1 < int(number) < int(contents)]  # the summary, as text
+    assert front and all("<img" not in body and "<table>" in body for body in front)
+    assert int(contents) == len(front) + 2  # the title, the summary, then the contents
 
 
 def test_a_missing_chromium_fails_where_required_and_skips_elsewhere_with_the_install_command(monkeypatch):

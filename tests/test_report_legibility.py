@@ -190,17 +190,34 @@ def _marked_axis(intensities, low=0.1, high=50.0):
 
 
 def test_close_return_period_marks_share_one_label_and_far_ones_keep_their_own():
-    figure, axis, _ = _marked_axis([])
+    """On a probability panel (intensity along x) the return periods are named above the axes, outside the data,
+    each label over its own lines; close lines share one label. On an IDA panel (intensity along y) the legend
+    names them (issue 36: a label on the 0.82 g line instead of the hazard lines)."""
+    marks = figures.CredibleMarks((475.0, 975.0, 2475.0, 10000.0), (0.30, 0.39, 0.57, 20.0), None)
+    figure = new_page("marks")
+    axis = figure.add_axes([0.1, 0.2, 0.3, 0.2])
+    axis.set_xscale("log")
+    axis.set_xlim(0.1, 50.0)
     try:
-        marks = figures.CredibleMarks((475.0, 975.0, 2475.0, 10000.0), (0.30, 0.39, 0.57, 20.0), None)
-        groups = figures.mark_groups(axis, marks, along="y")
+        groups = figures.mark_groups(axis, marks, along="x")
         assert [label for _, label in groups] == ["475 / 975 / 2,475 yr", "10,000 yr"]
-        figures.mark_intensities(axis, marks, along="y")
-        labels = [t.get_text() for t in axis.texts]
+        figures.mark_intensities(axis, marks, along="x")
+        assert len(axis.texts) == 0  # nothing over the data
+        top = axis.child_axes[0]
+        figure.canvas.draw()
+        labels = [t.get_text() for t in top.get_xticklabels() if t.get_text()]
         assert labels == ["475 / 975 / 2,475 yr", "10,000 yr"]
         assert overprinted(figure) == []
         for intensity in marks.intensities:  # every intensity keeps its own line
-            assert any(np.allclose(line.get_ydata(), intensity) for line in axis.lines)
+            assert any(np.allclose(line.get_xdata(), intensity) for line in axis.lines)
+    finally:
+        plt.close(figure)
+    figure, axis, _ = _marked_axis([])
+    try:
+        figures.mark_intensities(axis, marks, along="y")
+        assert len(axis.texts) == 0 and len(axis.child_axes) == 0
+        legend = " ".join(axis.get_legend_handles_labels()[1])
+        assert "475, 975, 2,475, 10,000 years (from the lowest line up)" in legend
     finally:
         plt.close(figure)
 
@@ -433,19 +450,19 @@ def test_a_table_too_wide_for_the_page_is_set_smaller_not_cut():
 # ---------------------------------------------------------------- title page and provenance (FINDINGS 22)
 
 @pytest.mark.slow
-def test_the_title_page_has_no_code_identifiers_and_the_provenance_keeps_them(small_pipeline):
-    from rockfrag.report.sections import provenance_items, run_time_words, title_items
+def test_the_title_page_has_no_code_identifiers_and_the_appendix_keeps_them(small_pipeline):
+    from rockfrag.report.sections import reproduce_items, run_time_words, title_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study, runtime_s=0.0)
     title = " ".join(item.text for item in title_items(results))
     fingerprint = str(results.cube.attrs["config_hash"])
     for word in (fingerprint, "hash", "rockfrag", "seed", ".toml", "Run time"):
         assert word not in title, word
-    provenance = provenance_items(results)
-    cells = " ".join(cell for item in provenance for row in item.rows for cell in row)
+    appendix = reproduce_items(results)
+    cells = " ".join(cell for item in appendix for row in item.rows for cell in row)
     assert fingerprint in cells and "configuration fingerprint" in cells
     assert str(results.fragility.attrs["bootstrap_seed"]) in cells
-    run_time = next(row[1] for item in provenance for row in item.rows if row[0] == "run time")
+    run_time = next(row[1] for item in appendix for row in item.rows if row[0] == "run time")
     assert run_time.startswith("not recorded") and "0 s" not in run_time
     assert run_time_words(315.0) == "5 min" and run_time_words(42.0) == "42 s"
 
@@ -464,7 +481,7 @@ def test_every_reference_is_cited_and_every_citation_listed(small_pipeline):
     html = (small_pipeline.output / "report.html").read_text()
     text = html_module.unescape(re.sub(r"<[^>]+>", " ", re.sub(r"<img[^>]*>", " ", html)))
     references = text.index("The pages cite these works")
-    body = text[:references] + text[text.index("Provenance", references):]
+    body = text[:references] + text[text.index("How to reproduce this report", references):]
     for key in REFERENCES:
         if key != "paper":
             assert key in body, f"{key} is listed but never cited"

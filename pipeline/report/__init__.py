@@ -44,17 +44,18 @@ from rockfrag.config import StudyConfig  # noqa: E402
 from rockfrag.damage_states import damage_states_from_config  # noqa: E402
 from rockfrag.outputs import atomic_path  # noqa: E402
 from rockfrag.report import figures as pages  # noqa: E402
-from rockfrag.report.adapters import block_name, models_of, record_pga_g, short_label  # noqa: E402
-from rockfrag.report.answer_page import answer_items  # noqa: E402
+from rockfrag.report.adapters import block_name, models_of, record_pga_g, short_label, soils_of  # noqa: E402
+from rockfrag.report.answer_page import answer_items, reading_items  # noqa: E402
 from rockfrag.report.layout import Page, add_footer, new_page  # noqa: E402
 from rockfrag.report.sections import (  # noqa: E402
     Results,
+    fitted_items,
     limitations_items,
     methods_items,
-    provenance_items,
-    summary_items,
+    reproduce_items,
     title_items,
 )
+from rockfrag.report.summary import summary_items  # noqa: E402
 from rockfrag.report.text import Item, draw_text_page, items_html, note, paginate, table  # noqa: E402
 from rockfrag.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
 from rockfrag.report.words import glossary_items, references_items  # noqa: E402
@@ -173,14 +174,18 @@ CAPTIONS = {
            "overturn at one level and survive a higher one (resurrection).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
-                       "the fitted lognormal; band, the confidence bounds of the median; black dashed, the rigid "
-                       "base. Shaded: extrapolation by scaling.",
+                       "the fitted lognormal, one colour per soil; light shading around a line, the confidence "
+                       "bounds of its median; {rigid}. Grey shading: extrapolation by scaling. The notes under the "
+                       "legend say which curves could not be fitted, and why.",
     "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil, bottom the "
-                        "stiffest. Points: records; lines: fits; bands: confidence bounds. Dotted: the site's "
-                        "return-period intensities; shaded: extrapolation by scaling.",
+                        "stiffest. Points: records; lines: fits, one style per model (legend); light shading around "
+                        "a line: the confidence bounds of its median. Dotted: the site's return-period intensities; "
+                        "grey shading: extrapolation by scaling. The notes under the legend: curves that could not "
+                        "be fitted, and why.",
     "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
-                "uplifts (rocks or overturns); dashed, that it overturns; between them it rocks and stays up. "
-                "Shaded: extrapolation by scaling.",
+                "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
+                "bed); dashed, that it overturns; between them it rocks and stays up. Grey shading: extrapolation "
+                "by scaling.",
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
@@ -201,6 +206,20 @@ CAPTIONS = {
 """What each figure page lets the reader read, one caption per kind of page."""
 
 
+def _rigid_words(fragility, block) -> str:
+    """How the fragility-by-soil page draws the rigid base of ``block``: the caption says the style it has."""
+    rigid = [m for m in models_of(fragility) if m.rigid_base]
+    if not rigid:
+        return "no rigid-base reference in this study"
+    per_soil = [m for m in rigid if soils_of(fragility, m, block, "median") != [None]]
+    if not per_soil:
+        return "black dashed: the rigid base (the same on every soil)"
+    if len(per_soil) == len(rigid):
+        return "dashed in each soil's colour: the rigid base (its base slides on some soils, so it differs by soil)"
+    return ("dashed: the rigid base, black where it is the same on every soil, in each soil's colour where its base "
+            "slides on some soils")
+
+
 def _twins_words(efficiency) -> str:
     """The efficiency caption's sentence on the measures left out because they repeat another ("" if none)."""
     twins = pages.efficiency_twins(efficiency)
@@ -218,11 +237,21 @@ def plan(results: Results) -> list[Page]:
     blocks = list(map(str, cube.block.values))
     names = {block: block_name(config, block) for block in blocks}
     planned = [title_page(results)]
-    for answer in results.answers:
-        name = names.get(answer.block, answer.block)
-        planned += _text_pages(f"answer-{answer.block}", "Answer", f"Answer: {name}", answer_items(results, answer))
+    with results.facts.writing("Summary"):
+        planned += _text_pages("summary", "Summary", "Summary: the action for each asset and soil",
+                               summary_items(results))
+    answers = []
+    if results.answers:
+        with results.facts.writing("Answers"):
+            answers.append(("answers", "Answers", "Reading the answer pages", reading_items(results)))
+        for answer in results.answers:
+            name = names.get(answer.block, answer.block)
+            with results.facts.writing(f"Answer: {name}"):
+                answers.append((f"answer-{answer.block}", f"Answer: {name}", f"Answer: {name}",
+                                answer_items(results, answer)))
+    planned += _packed_pages(answers) if answers else []
     planned += _packed_pages([
-        ("summary", "Summary", "Summary of the fitted fragility functions", summary_items(results)),
+        ("fitted", "Fitted curves", "Fitted fragility functions", fitted_items(results)),
         ("methods", "Methods", "Methods and assumptions", methods_items(results)),
         ("limitations", "Limitations", "Limitations: where the models are outside their validity",
          limitations_items(results)),
@@ -251,7 +280,8 @@ def plan(results: Results) -> list[Page]:
             planned.append(_figure(f"fragility-soils-{block}-{model.name}", "Fragility",
                                    f"Fragility by soil: {names[block]}, {short_label(model)}",
                                    pages.fragility_by_soil_page, fragility, block, model,
-                                   caption=CAPTIONS["fragility-soils"], marks=results.marks(block), name=names[block]))
+                                   caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block)),
+                                   marks=results.marks(block), name=names[block]))
         planned.append(_figure(f"fragility-models-{block}", "Fragility", f"Fragility by model: {names[block]}",
                                pages.fragility_by_model_page, fragility, block, extremes,
                                caption=CAPTIONS["fragility-models"], marks=results.marks(block), name=names[block]))
@@ -282,8 +312,8 @@ def plan(results: Results) -> list[Page]:
                                names=names))
     planned += _packed_pages([("glossary", "Glossary", "Glossary", glossary_items()),
                               ("references", "References", "References", references_items()),
-                              ("provenance", "Provenance", "Provenance: how this report was computed",
-                               provenance_items(results))])
+                              ("reproduce", "How to reproduce this report", "How to reproduce this report",
+                               reproduce_items(results))])
     return planned
 
 
@@ -300,20 +330,24 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
 
     Titles are wrapped, never cut; the HTML links every page and every section.
     """
-    rows, last = [], None
+    rows, last, listed = [], None, None
     for number, page in enumerate(planned, start=1):
         shown = number + (1 if number >= position else 0)  # the contents is inserted at ``position``
+        heading = page.heading or page.title
         if page.section != last:
             rows.append(("section", page.section, shown))
             last = page.section
-        rows.append(("page", page.title, shown))
+        if heading != listed and heading != page.section:  # a text section over pages: once, without "(2/5)"
+            rows.append(("page", heading, shown))
+        listed = heading
         for section in page.also:  # a section that starts part-way down this page
             rows.append(("section", section, shown))
-            rows.append(("page", f"{section} (from part-way down the page)", shown))
-            last = section
+            last, listed = section, section
     lines = []
-    for kind, text, number in rows:
-        wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" else 0)) or [""]
+    for index, (kind, text, number) in enumerate(rows):
+        if kind == "section" and index + 1 < len(rows) and rows[index + 1][0] == "page":
+            number = None  # the page row below carries it
+        wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" or number is not None else 0)) or [""]
         lines += [(kind, line, number if index == 0 else None) for index, line in enumerate(wrapped)]
 
     def draw():
@@ -328,7 +362,7 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
             indent = 0.0 if kind == "section" else 0.012
             figure.text(x + indent, y, text, fontsize=size, weight="bold" if kind == "section" else "normal",
                         va="top")
-            if kind == "page" and number is not None:
+            if number is not None:
                 figure.text(x + width - 0.03, y, str(number), fontsize=size, va="top", ha="right")
         return figure
 
@@ -490,10 +524,14 @@ def write_report(planned: list[Page], output_dir, title="rockfrag report", foote
     return output_dir / "report.pdf", pngs
 
 
+FRONT = ("Title", "Summary")
+"""The sections before the contents: the title page and the one-page summary."""
+
+
 def build_plan(results: Results) -> list[Page]:
-    """The numbered page list: the title, the answer pages, then the contents and the rest."""
+    """The numbered page list: the title, the summary, then the contents and the rest."""
     planned = plan(results)
-    position = 1 + next((i for i, page in enumerate(planned[1:], start=1) if page.section != "Answer"), len(planned))
+    position = 1 + next((i for i, page in enumerate(planned) if page.section not in FRONT), len(planned))
     return [*planned[:position - 1], contents_page(planned, results.title, position), *planned[position - 1:]]
 
 

@@ -33,8 +33,10 @@ from rockfrag.report.adapters import (
     uplift_intensity,
 )
 from rockfrag.report.layout import (
+    CAPTION_Y,
     FRACTILE_STYLES,
     GRID,
+    LEGEND_ANCHOR,
     chars_across,
     log_axis,
     log_minor_ticks,
@@ -45,7 +47,7 @@ from rockfrag.report.layout import (
     pretty,
     soil_colour,
 )
-from rockfrag.report.words import plain
+from rockfrag.report.words import plain, state_short_label
 from rockfrag.units import STANDARD_GRAVITY
 
 G = STANDARD_GRAVITY
@@ -55,7 +57,6 @@ WINDOW_BEFORE, WINDOW_AFTER = 3.0, 8.0  # s around the strong-motion window on t
 
 MARK_COLOUR = "#6a3d9a"  # the site's return-period intensities
 EXTRAPOLATION = dict(color="0.55", alpha=0.13, lw=0, zorder=0)  # beyond the largest recorded intensity
-NO_CURVE = "no curve: "
 
 
 MARK_SIZE = 6.5  # pt, the return-period labels
@@ -64,8 +65,9 @@ MARK_SIZE = 6.5  # pt, the return-period labels
 def mark_groups(axis, marks: CredibleMarks, along: str = "x") -> list[tuple[list[float], str]]:
     """The return-period marks inside the axis, grouped where their labels would overlap.
 
-    Marks closer on the page than 1.4 label heights share one label ("475 / 975 / 2,475 yr", in the order
-    of the lines along the axis), so labels never overprint. Needs the axis limits and scale set.
+    Marks closer on the page than one label's width (a label set across the axis, above it) or 1.4 label
+    heights (along a y axis) share one label ("475 / 975 / 2,475 yr", in the order of the lines along the
+    axis), so labels never overprint. Needs the axis limits and scale set.
 
     Returns
     -------
@@ -78,9 +80,11 @@ def mark_groups(axis, marks: CredibleMarks, along: str = "x") -> list[tuple[list
         return []
     to_pixels = axis.transData.transform
     where = [to_pixels((im, 1.0) if along == "x" else (1.0, im))[0 if along == "x" else 1] for im, _ in inside]
-    room = 1.4 * MARK_SIZE * axis.figure.dpi / 72.0
+    pixels = axis.figure.dpi / 72.0 * MARK_SIZE
     groups = [[0]]
     for index in range(1, len(inside)):
+        room = 1.4 * pixels if along == "y" else \
+            0.3 * pixels * (len(f"{inside[index][1]:,.0f} yr") + len(f"{inside[groups[-1][-1]][1]:,.0f} yr"))
         if abs(where[index] - where[groups[-1][-1]]) < room:
             groups[-1].append(index)
         else:
@@ -89,12 +93,18 @@ def mark_groups(axis, marks: CredibleMarks, along: str = "x") -> list[tuple[list
             for group in groups]
 
 
+HAZARD_LABEL = "dotted: the site's intensity at each return period"
+"""The legend's entry for the return-period lines (each is named on the axis, outside the data, or in the caption)."""
+
+
 def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> None:
     """Mark the site's return-period intensities and the extrapolation by scaling on an intensity axis.
 
-    Dotted lines at the return-period intensities, labelled in groups that never overlap (``mark_groups``);
-    beyond the largest recorded intensity, a shade; ``along`` is the intensity axis ("x" or "y"). Call it
-    after the axis limits and scale are set: the shading runs to the axis end.
+    Dotted lines at the return-period intensities; beyond the largest recorded intensity, a shade; ``along`` is
+    the intensity axis ("x" or "y"). On an x axis the return periods are named above the panel, outside the data,
+    each over its own line (close lines share a label: ``mark_groups``); on a y axis (IDA panels) the lines are
+    named in the legend, from the lowest up. Call it after the axis limits and scale are set: the shading runs to
+    the axis end.
     """
     if marks is None:
         return
@@ -105,16 +115,23 @@ def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> Non
         span(max(marks.largest, low), high, **EXTRAPOLATION, label="beyond the largest recorded intensity: "
                                                                    "extrapolation by scaling")
         line(marks.largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
-    for intensities, text in mark_groups(axis, marks, along):
+    groups = mark_groups(axis, marks, along)
+    periods = sorted(float(t) for t in marks.return_periods)
+    named = ", ".join(f"{t:,.0f}" for t in periods) + " years"
+    for intensities, _ in groups:
         for intensity in intensities:
-            line(intensity, color=MARK_COLOUR, lw=0.9, ls=":", label="site hazard at the return periods")
-        box = dict(facecolor="white", edgecolor="none", alpha=0.7, pad=0.5)
-        if along == "x":
-            axis.text(intensities[-1], 0.98, text, transform=axis.get_xaxis_transform(), rotation=90,
-                      fontsize=MARK_SIZE, color=MARK_COLOUR, ha="right", va="top", bbox=box)
-        else:
-            axis.text(0.98, intensities[-1], text, transform=axis.get_yaxis_transform(), fontsize=MARK_SIZE,
-                      color=MARK_COLOUR, ha="right", va="bottom", bbox=box)
+            line(intensity, color=MARK_COLOUR, lw=0.9, ls=":",
+                 label=f"{HAZARD_LABEL}: {named}" + (" (from the lowest line up)" if along == "y" else ""))
+    if along == "x" and groups:
+        centres = [float(np.exp(np.mean(np.log(intensities)))) for intensities, _ in groups]
+        width = axis.get_position().width * axis.figure.get_figwidth() * 72.0  # pt
+        texts = [text if 0.6 * MARK_SIZE * len(text) < 0.8 * width or " / " not in text
+                 else f"{text.split(' / ')[0]}-{text.split(' / ')[-1]}" for _, text in groups]  # narrow: first-last
+        top = axis.secondary_xaxis("top")
+        top.set_xticks(centres, texts)
+        top.minorticks_off()
+        top.tick_params(labelsize=MARK_SIZE, colors=MARK_COLOUR, length=2, pad=1)
+        top.spines["top"].set_visible(False)
 
 
 def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
@@ -204,9 +221,10 @@ def showcase_response_page(showcase, caption, name: str | None = None):
     One y-scale per column, time cropped to the strong motion.
     """
     block = showcase.attrs["showcase_block"]
-    figure = new_page(f"{record_words(showcase)}, {name or block} (R = "
-                      f"{float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g} "
-                      "rad): rocking on each soil", caption)
+    size = f"R = {float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g}"
+    shown = name or block
+    figure = new_page(f"{record_words(showcase)}: the {shown}" + ("" if "R = " in shown else f" ({size} rad)")
+                      + ", rocking on each soil", caption)
     soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
     models = models_of(xr.Dataset(coords={"model": list(dict.fromkeys(map(str, showcase.case_model.values)))}))
     styles = model_styles(models)
@@ -272,6 +290,7 @@ def _finite_capped(values):
 
 
 ROW_GAP = 0.5  # in between two rows of IDA panels: the row's heading and the panels' titles
+VISIBLE_ROCKING = 0.01  # θmax/α: below it every IDA curve of a panel lies on its frame, and the panel says so
 
 
 def _ida_rows(models, soils, per_soil=(), most_columns=5):
@@ -324,6 +343,11 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
             model, soil = cells[column]
             drawn.append(axis)
             picked = cell(ida, model, block, soil)
+            edp = np.asarray(picked.edp.values, float)
+            if not (~np.isnan(edp) & (edp >= VISIBLE_ROCKING)).any():  # every curve on the frame, or none run
+                empty_note(axis, f"no record rocked the block: θmax/α below {VISIBLE_ROCKING:g} at every level"
+                           if (~np.isnan(edp)).any() else "not run")
+                axis.rockfrag_empty = True
             for curve in picked.edp.transpose("record", "im_level").values:
                 axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
             for q in ida.fractile.values:
@@ -346,10 +370,11 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     for axis in drawn:
         log_y_axis(axis, span)
     for axis in drawn:
-        mark_intensities(axis, marks, along="y")
+        if not getattr(axis, "rockfrag_empty", False):  # an empty panel's note stays clear of the marks
+            mark_intensities(axis, marks, along="y")
     drawn[0].plot([], [], color="0.65", lw=0.5, label="one record")
     drawn[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at θmax/α = {IDA_CAP})")
-    outside_legend(figure, [drawn[0]])
+    outside_legend(figure, drawn)  # every panel: an empty first one has no marks
     return figure
 
 
@@ -358,8 +383,9 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
 
     Returns
     -------
-    str
-        "" when the curve is drawn, else why not (the panel prints it).
+    tuple of (str, str) or str
+        "" when the curve is drawn (or nothing is drawn), else the series' label and why it has no curve (the
+        page's notes list it).
     """
     values = picked.sel(damage_state=state)
     grid = np.geomspace(*(span or (levels[0], levels[-1])), 200)
@@ -374,26 +400,78 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
             axis.fill_between(grid, lognormal_cdf(grid, high, beta), lognormal_cdf(grid, low, beta),
                               color=colour, alpha=0.12, lw=0)
         return ""
-    axis.plot([], [], label=label, **style)  # listed once in the legend; the panel says why there is no curve
+    axis.plot([], [], label=label, **style)  # listed once in the legend; the page's notes say why there is no curve
     status = str(values["status"].values) if "status" in values else ""
-    if status == NOT_APPLICABLE:  # e.g. a slip state of a model run with a tied base: nothing to explain
-        return ""
+    if status == NOT_APPLICABLE or not np.isfinite(values.empirical_fraction.values).any():
+        return ""  # e.g. a slip state of a model run with a tied base: nothing drawn (the empty panel says why)
     reason = {"below-range": "reached by most records at the lowest level",
               "not-reached": "not reached at any level"}.get(status, plain(status) if status else "no fit")
-    return f"{label.split(' (')[0]}: {reason}"
+    return label, reason
 
 
-NOTE_SIZE = 6.0  # pt, the no-curve note inside a panel
+NOTE_SIZE = 6.5  # pt, the notes of a page: under its legend, or inside an empty panel
 
 
-def _no_curve_note(axis, reasons) -> None:
-    """Say in the panel which series have points but no curve, and why (wrapped to the panel's width)."""
-    reasons = [r for r in reasons if r]
-    if reasons:
-        width = chars_across(axis, NOTE_SIZE) - 3
-        text = "\n".join(textwrap.fill(line, width) for line in [NO_CURVE.rstrip(": ") + ":", *reasons])
-        axis.text(0.97, 0.5, text, transform=axis.transAxes, fontsize=NOTE_SIZE, va="center", ha="right",
-                  bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.9, pad=2), zorder=10)
+def _no_curve_note(axis, reasons, state: str, soil: str = "") -> None:
+    """Keep which series of a panel (``state``, on ``soil``) have points but no curve, and why.
+
+    The notes go under the page's legend (``page_notes``), never over the data. A panel with nothing drawn
+    says why inside it (``empty_note``).
+    """
+    notes = getattr(axis.figure, "rockfrag_notes", {})
+    for series, reason in dict.fromkeys(r for r in reasons if r):
+        notes.setdefault(reason, {}).setdefault(series, []).append((soil, state))
+    axis.figure.rockfrag_notes = notes
+
+
+def empty_note(axis, text: str) -> None:
+    """Say inside a panel with nothing drawn why it is empty ("not computed: the base is tied")."""
+    axis.text(0.5, 0.5, textwrap.fill(text, chars_across(axis, NOTE_SIZE) - 4), transform=axis.transAxes,
+              fontsize=NOTE_SIZE + 1, ha="center", va="center", color="0.3")
+
+
+def page_notes(figure) -> None:
+    """The page's notes (``_no_curve_note``) under its legend, in the legend's column.
+
+    Which curves could not be fitted, and why, with the panels they concern.
+    """
+    notes = getattr(figure, "rockfrag_notes", {})
+    if not notes:
+        return
+    renderer = figure.canvas.get_renderer()
+    bottom = LEGEND_ANCHOR[1]
+    if figure.legends:
+        bottom = figure.transFigure.inverted().transform(figure.legends[0].get_window_extent(renderer))[0][1]
+    width = int((0.99 - LEGEND_ANCHOR[0]) * figure.get_figwidth() * 72.0 / (0.62 * NOTE_SIZE)) - 1
+    lines = textwrap.wrap("No curve, points only (the limitations list each):", width)
+    for reason, series in notes.items():
+        lines += textwrap.wrap(f"{reason}: {'; '.join(series)}.", width, initial_indent="- ", subsequent_indent="  ")
+    room = (bottom - 0.015 - (CAPTION_Y + 0.015)) * figure.get_figheight() * 72.0 / (1.2 * NOTE_SIZE)  # lines
+    if len(lines) > room:  # more than the column holds: the count, and where the list is
+        count = sum(len(series) for series in notes.values())
+        lines = textwrap.wrap(f"No curve, points only: {count} series on this page; the limitations list each, with "
+                              "why.", width)
+    figure.text(LEGEND_ANCHOR[0] + 0.005, bottom - 0.015, "\n".join(lines), fontsize=NOTE_SIZE, va="top", ha="left",
+                color="0.25")
+
+
+def short_states(fragility) -> dict:
+    """Damage state -> its short name ("uplift", "θmax/α ≥ 0.5", "slip ≥ 0.05 m", "overturning")."""
+    descriptions = fragility["damage_state_description"].values if "damage_state_description" in fragility.coords \
+        else [""] * fragility.sizes["damage_state"]
+    return {str(s): state_short_label(str(s), str(d)) for s, d in zip(fragility.damage_state.values, descriptions)}
+
+
+def _empty_if_nothing(axis, fragility, block, state, models, soil=None) -> None:
+    """An empty panel's note: why no series of ``models`` has a point for ``state`` (else nothing)."""
+    where = dict(block=block, damage_state=state, model=[m.name for m in models], **({} if soil is None
+                                                                                     else {"soil": soil}))
+    if np.isfinite(fragility.empirical_fraction.sel(where).values).any():
+        return
+    status = fragility["status"].sel(where) if "status" in fragility else None
+    tied = status is not None and bool((status == NOT_APPLICABLE).all())
+    empty_note(axis, "not computed: the base is tied (no sliding) in these runs" if tied else "no run to count")
+    axis.rockfrag_empty = True  # nothing to read against the site's intensities: no marks over the note
 
 
 def _state_axes(figure, fragility, n_rows=1):
@@ -422,7 +500,8 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
         log_axis(axis, span)
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
-        mark_intensities(axis, marks, along="x")
+        if not getattr(axis, "rockfrag_empty", False):
+            mark_intensities(axis, marks, along="x")
         axis.tick_params(labelbottom=True, labelsize=8)  # every row: a panel is read on its own
     for axis in axes[:, 0]:
         axis.set_ylabel(y_label)
@@ -438,7 +517,7 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
     styles = model_styles(models)
     figure = new_page(f"Fragility by soil: {name or block}, {short_label(model)}", caption)
     states, axes = _state_axes(figure, fragility)
-    labels = state_labels(fragility)
+    labels, short = state_labels(fragility), short_states(fragility)
     levels = block_levels(fragility, block)
     span = axis_range(levels, marks)
     for axis, state in zip(axes.flat, states):
@@ -454,10 +533,14 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
                 label = short_label(reference) + ("" if soil is None else f" on {soil}")
                 reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block, soil),
                                                  state, style, label, span))
-        _no_curve_note(axis, reasons)
-        axis.set_title(textwrap.fill(state_title(labels[state]), chars_across(axis, 9)), fontsize=9)
+        title = state_title(labels[state])
+        _no_curve_note(axis, reasons, short[state])
+        _empty_if_nothing(axis, fragility, block, state, [model, *(m for m in models if m.rigid_base)])
+        axis.set_title(textwrap.fill(title, chars_across(axis, 9)), fontsize=9)
+    figure.rockfrag_panels = len(states)
     _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
     outside_legend(figure, list(axes.flat))
+    page_notes(figure)
     return figure
 
 
@@ -468,7 +551,7 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
     styles = model_styles(models)
     figure = new_page(f"Fragility by model: {name or block}", caption)
     states, axes = _state_axes(figure, fragility, n_rows=len(soils))
-    labels = state_labels(fragility)
+    labels, short = state_labels(fragility), short_states(fragility)
     levels = block_levels(fragility, block)
     span = axis_range(levels, marks)
     for row, soil in enumerate(soils):
@@ -477,12 +560,30 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
             axis = axes[row, column] if len(soils) > 1 else axes.flat[column]
             reasons = [_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                          styles[model.name], short_label(model), span) for model in models]
-            _no_curve_note(axis, reasons)
-            axis.set_title(textwrap.fill(f"{state_title(labels[state])} on {soil}", chars_across(axis, 8.5)),
-                           fontsize=8.5)
+            title = f"{state_title(labels[state])} on {soil}"
+            _no_curve_note(axis, reasons, short[state], soil)
+            _empty_if_nothing(axis, fragility, block, state, models, soil)
+            axis.set_title(textwrap.fill(title, chars_across(axis, 8.5)), fontsize=8.5)
+    figure.rockfrag_panels = len(soils) * len(states)
     _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
     outside_legend(figure, list(axes.flat))
+    page_notes(figure)
     return figure
+
+
+def _uplift_fraction(fragility, model, block, soil) -> np.ndarray | None:
+    """The records' fraction reaching the uplift damage state per level (its size rule: a tilt is not uplift).
+
+    None when the fragility has no uplift state or no fraction for this model (e.g. a combined curve).
+    """
+    if "damage_state_edp" not in fragility.coords or "empirical_fraction" not in fragility:
+        return None
+    states = [str(s) for s, edp in zip(fragility.damage_state.values, fragility.damage_state_edp.values)
+              if str(edp) == "uplifted"]
+    if not states:
+        return None
+    values = cell(fragility, model, block, soil).empirical_fraction.sel(damage_state=states[0]).values
+    return np.asarray(values, float) if np.isfinite(values).any() else None
 
 
 def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
@@ -501,7 +602,9 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
         for index, soil in enumerate(soils):
             picked = cell(probability.to_dataset(name="p"), model, block, soil)["p"]
             colour = "black" if soil is None else soil_colour(soil, index)
-            uplift = 1 - picked.sel(outcome_class="no_uplift").values
+            uplift = _uplift_fraction(fragility, model, block, soil)
+            if uplift is None:  # no uplift state: any lift of the outcome
+                uplift = 1 - picked.sel(outcome_class="no_uplift").values
             overturn = picked.sel(outcome_class="overturned").values
             axis.plot(levels, uplift, color=colour, ls="-", lw=1.5,
                       label="any soil (rigid base)" if soil is None else soil)
@@ -510,7 +613,7 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
         axis.set_title(textwrap.fill(short_label(model), chars_across(axis, 9.5)), fontsize=9.5)
     _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
-    axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): rocking or overturning")
+    axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): lift-off, rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
     axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
     for axis in axes.flat:
@@ -587,7 +690,7 @@ def sweep_page(dataset, caption, names: dict | None = None):
     models = list(dataset.model.values)
     figure = new_page(f"Rigid-base error against soil stiffness (grey: ±{tolerance:.0%}; green: paper's "
                       "300-1000 MPa)", caption)
-    axes = panels(figure, len(models), len(blocks), sharey=True, gridspec_kw=dict(hspace=0.5))
+    axes = panels(figure, len(models), len(blocks), sharey=True, gridspec_kw=dict(hspace=0.6, top=0.8))  # 3-line titles
     shear = dataset.shear_modulus.values / 1e6
     dash = ["-", "--", ":", "-."]
     for row, model in enumerate(models):
@@ -674,15 +777,21 @@ def efficiency_page(dataset, caption, names: dict | None = None):
         low, high = dispersion.min(["soil", "model"]).values, dispersion.max(["soil", "model"]).values
         top.bar(x + (index - (len(blocks) - 1) / 2) * width, middle, width, label=names.get(block, block),
                 yerr=[middle - low, high - middle], capsize=2, color=f"C{index % 10}")
+    if not blocks:
+        empty_note(top, "no dispersion: no block's overturning capacity was found in enough records to measure one")
     top.set_xticks(x, labels, fontsize=8)
     top.set_ylabel("dispersion of ln capacity [-]", fontsize=9)
     top.set_title("Efficiency: dispersion of the overturning capacity per block (smaller is better)", fontsize=10)
     top.grid(alpha=0.3, axis="y")
+    tested = False
     for name, marker, colour, what in P_MARKERS:
         if name not in dataset:
             continue
         p = dataset[name].sel(measure=measures).median(["soil", "model", "block"]).values
+        tested |= bool(np.isfinite(p).any())
         bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, color=colour, label=f"p-value {what}")
+    if not tested:
+        empty_note(bottom, "no p-value: too few records overturned for the test (it needs their capacities)")
     bottom.axhline(0.05, color="k", lw=0.8, ls="--", label="0.05: below it the measure is not sufficient")
     bottom.set_yscale("log")
     bottom.set_ylim(P_FLOOR * 0.7, 1.5)

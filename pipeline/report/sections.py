@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from functools import cached_property
 from pathlib import Path
@@ -27,7 +27,6 @@ from rockfrag.answer import (
     block_answers,
     display_scale,
     intensity_at_frequency,
-    percent,
     records_reaching,
 )
 from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
@@ -36,6 +35,7 @@ from rockfrag.config import StudyConfig
 from rockfrag.damage_states import NOT_APPLICABLE
 from rockfrag.errors import PipelineError
 from rockfrag.hazard import HazardCurve, study_hazard
+from rockfrag.report import numbers
 from rockfrag.report.adapters import (
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
@@ -49,7 +49,6 @@ from rockfrag.report.adapters import (
     measure_label,
     model_info,
     models_of,
-    planar_words,
     record_pga_g,
     run_fraction,
     scale_factor_summary,
@@ -86,6 +85,7 @@ class Results:
     runtime_s: float = float("nan")  # wall time of the pipeline run up to the report [s]; NaN: not stated
     run: dict | None = None  # the study's statistics (rockfrag.study.run_study): runs computed, cells reused
     vertical: VerticalEffect | None = None  # [study] vertical = true: the runs with and without the verticals
+    facts: numbers.Facts = field(default_factory=numbers.Facts)  # what the pages printed (the one-number test)
 
     @property
     def settings(self) -> dict:
@@ -116,10 +116,9 @@ class Results:
         own = [soil.name for soil in self.config.soils if soil.name not in shipped]
         sources = ([f"the soil class's default coefficient ({', '.join(shipped)}: a concrete base on that soil)"]
                    if shipped else []) + ([f"the study file's own value ({', '.join(own)})"] if own else [])
-        return (f"Base friction: static/kinetic μ_s/μ_k {pairs}, {' and '.join(sources)}, not a value of this "
-                "block's own base: a plinth, a grout bed or a steel shim under the block changes it. To use yours, "
-                "give the soil a table of its own in the study file, [soils_custom.NAME] with its moduli and "
-                "friction_static = μ_s, friction_kinetic = μ_k, and list NAME in soils = [...].")
+        return (f"Base friction: static/kinetic μ_s/μ_k {pairs}, {' and '.join(sources)}, not a value of each "
+                "block's own base: a plinth, a grout bed or a steel shim under the block changes it. The study file "
+                "can give each soil its own coefficients (see 'How to reproduce this report').")
 
     @cached_property
     def hazard(self) -> HazardCurve | None:
@@ -199,8 +198,7 @@ def _g(value):
 
 
 def _percent(value):
-    return "-" if value is None or not np.isfinite(value) else f"{value:.0%}" if value >= 0.01 or value == 0 \
-        else "<1%"
+    return numbers.probability(value)
 
 
 def n_runs(cube) -> int:
@@ -319,11 +317,12 @@ def title_items(results: Results) -> list[Item]:
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
         *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
-        paragraph("The next pages answer the question for each block: at the site's return periods, how likely it "
-                  "is to rock or overturn, how likely in its design life, and what to do. Then the fragility of "
-                  "each block on each soil for each model, the methods and assumptions behind the numbers, and "
-                  "where the models are outside their validity (page 'Limitations'). Where the study's files and "
-                  "software version are recorded: page 'Provenance', at the end."),
+        paragraph("The next page is the summary: the action for each block on each soil, and why. Then the "
+                  "contents, one answer page per block (at the site's return periods, how likely each damage state "
+                  "is, how likely in the design life, and what the records did), the fragility of each block on each "
+                  "soil for each model, the methods behind the numbers, and where the models are outside their "
+                  "validity (page 'Limitations'). How to compute it again, and which settings would change a "
+                  "verdict: the appendix 'How to reproduce this report', at the end."),
     ]
     return items
 
@@ -346,19 +345,89 @@ def run_time_line(runtime_s: float) -> str:
     return f"{words} up to this report (simulations, fits and result files; drawing the report not included)"
 
 
-def provenance_items(results: Results) -> list[Item]:
-    """The colophon at the end: the study file, configuration fingerprint, software version, seed, run time, files."""
+def _toml(value) -> str:
+    """A study-file value as a user types it in TOML ("all", 0.1, { overturning = 0.01 })."""
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f'{key if key.replace("_", "").isalnum() else repr(key)} = {_toml(item)}'
+                                for key, item in value.items()) + " }"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml(item) for item in value) + "]"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def verdict_settings(results: Results) -> list[list[str]]:
+    """The study-file settings that change a verdict: [key, its value in this study, what it changes].
+
+    Read from the study (its file, else the shipped defaults), so the appendix states what this report ran.
+    """
+    config = results.config
+    raw = config.raw
+    hazard = raw.get("hazard") or {}
+    decision = results.decision
+    hazard_file = config.hazard_file or ""
+    source = results.hazard.source if results.hazard is not None else "none"
+    rows = [["[hazard] file", _toml(hazard_file) + ("" if hazard_file else f" (the shipped example, {source})"),
+             "the site's hazard curve: every probability at a return period and in the design life, so every "
+             "verdict; the shipped example is no site's"],
+            ["[hazard] design_life", _toml(float(hazard.get("design_life", config.design_life))),
+             "the probability in the design life that the limits judge"],
+            ["[hazard] return_periods", _toml([float(t) for t in results.return_periods]),
+             "the return periods of the summary and the answer pages; the largest sets the level the sliding "
+             "check reads"],
+            ["[decision] max_probability_in_life", _toml(decision["max_probability_in_life"]),
+             "the limit of each judged damage state: above it, 'anchor or restrain'"],
+            ["[decision] max_sliding_share", _toml(decision["max_sliding_share"]),
+             "above this share of records a tied base that needs more friction gets a sliding check"],
+            ["[solver] friction", _toml(config.friction),
+             "where sliding is computed (\"all\": everywhere; its slip damage states then judge the base)"],
+            ["[soils_custom.NAME] friction_static, friction_kinetic", results.friction_text,
+             "the base friction of a soil (list NAME in soils = [...]): sliding, and where it is computed"],
+            ["[blocks.NAME] b, h, mass, E_b", "the blocks of the methods pages",
+             "the block itself: its slenderness and size set when it rocks and overturns"],
+            ["[damage_states.NAME] edp, threshold", "the shipped damage states",
+             "which outcomes are judged, and at what size"]]
+    return rows
+
+
+def reproduce_items(results: Results) -> list[Item]:
+    """The closing appendix: the commands, the study file, the settings that change a verdict, the provenance.
+
+    The only pages that name study keys, commands and files: every other page speaks the client's language.
+    """
     config, cube, fragility = results.config, results.cube, results.fragility
+    study = str(config.source)
+    shipped = not study.endswith(".toml") or "defaults.toml" in study
+    folder = str((config.raw.get("study") or {}).get("output") or "reports")
+    command = "rockfrag fragility" if shipped else f"rockfrag fragility {study}"
     rows = [["study", f"'{config.name}', read from {config.source}"],
             ["configuration fingerprint", str(cube.attrs.get("config_hash", "not recorded"))],
             ["software", f"rockfrag {cube.attrs.get('rockfrag_version', __version__)}"],
             ["random seed of the bootstrap", str(fragility.attrs.get("bootstrap_seed", "not recorded"))],
+            ["hazard curve", results.hazard.source if results.hazard is not None else "none"],
             ["simulations", runs_words(results)],
             ["run time", run_time_line(results.runtime_s)],
-            ["result files read", ", ".join(_result_files(results))]]
-    return [paragraph("What this report was computed from, to reproduce it. The configuration fingerprint changes "
-                      "with any setting of the study; the same fingerprint, software version and records give the "
-                      "same numbers."), table(["item", "value"], rows)]
+            ["result files read", ", ".join(_result_files(results))],
+            ["tables of every fitted curve", "fragility.csv (confidence bounds, goodness of fit, fit warnings)"]]
+    return [paragraph("The commands, the study file and the settings behind this report. The other pages speak of "
+                      "the blocks and the site; this appendix names what an operator types."),
+            heading("Commands"),
+            bullet(f"{command}: runs the study (records, simulations, fits) and writes this report to its output "
+                   f"folder ('{folder}', or the one given with --output); run again, it reuses the simulations "
+                   "already computed."),
+            bullet(("rockfrag study --keys" if shipped else f"rockfrag study {study} --keys")
+                   + ": every key of the study with its value, allowed range and unit (nothing is run)."),
+            heading("Settings that would change a verdict"),
+            paragraph("Each is a key of the study file (TOML); a study file gives only the keys it changes, the "
+                      "others keep the shipped defaults."),
+            table(["key", "in this study", "what it changes"], verdict_settings(results)),
+            heading("What this report was computed from"),
+            paragraph("The configuration fingerprint changes with any setting of the study; the same fingerprint, "
+                      "software version and records give the same numbers."),
+            table(["item", "value"], rows)]
 
 
 def _ordered_models(results: Results):
@@ -368,19 +437,19 @@ def _ordered_models(results: Results):
     return [m for m in models if m.name == first] + [m for m in models if m.name != first]
 
 
-def summary_items(results: Results) -> list[Item]:
-    """Per block, model and soil: median/beta of the two most severe states, P(most severe in life)."""
+def fitted_items(results: Results) -> list[Item]:
+    """Per block, model and soil: median and β of the two most severe states, the answering model first.
+
+    Medians and dispersions only: a probability in the design life is a fact of the answer pages (and the
+    summary), printed there once, from the answer objects.
+    """
     fragility = results.fragility
     labels = state_labels(fragility)
-    states = [str(s) for s in fragility.damage_state.values][-2:]
+    states = [str(s) for s in fragility.damage_state.values if str(s) in labels][-2:]
     status = extrapolation(fragility, results.output).set_index(["soil", "block", "model", "damage_state"])["status"]
     unit = measure_label(fragility)
     scale, shown_unit = display_scale(_level_units(fragility))
-    life = fragility.attrs.get("design_life_years", results.config.design_life)
     header = ["block", "model", "soil"] + [f"{labels[s]}: median / β" for s in states]
-    has_risk = "probability_in_life" in fragility and np.isfinite(fragility["probability_in_life"].values).any()
-    if has_risk:
-        header.append(f"P({labels[states[-1]].lower()}) in {float(life):g} years")
     rows, marks = [], set()
     for block in fragility.block.values:
         largest = results.largest_recorded.get(str(block), np.inf)
@@ -401,13 +470,11 @@ def summary_items(results: Results) -> list[Item]:
                         mark += "†"
                     marks.update(mark)
                     row.append(f"{_g(median)}{mark} / {_beta(beta)}")
-                if has_risk:
-                    p = float(picked["probability_in_life"].sel(damage_state=states[-1]))
-                    row.append(percent(p))
                 rows.append(row)
     items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β), the answering model "
                        "first. A rigid-base model has one row per block (soil '(any)') unless base friction lets "
-                       "the block slide on some soils: then one row per soil."),
+                       "the block slide on some soils: then one row per soil. '-': no curve (the limitations say "
+                       "why). The probabilities these curves give at the site are on the answer pages."),
              table(header, rows)]
     if "*" in marks:
         items.append(note("* the median lies outside the studied intensity range (an extrapolation of the fit; see "
@@ -417,10 +484,18 @@ def summary_items(results: Results) -> list[Item]:
                             for b, v in results.largest_recorded.items())
         items.append(note(f"† the median lies above the largest intensity any record reached unscaled ({largest}): "
                           "it comes from records scaled up beyond what they recorded (extrapolation by scaling)."))
-    items.append(note("Confidence bounds and goodness of fit: fragility.csv."))
-    if has_risk:
-        items.append(note(f"Hazard: {fragility.attrs.get('hazard_source', 'see Methods')}."))
     return items
+
+
+def _hazard_words(results: Results) -> str:
+    """The hazard curve in words: the shipped example (not a site's) or the site's (its file: the appendix)."""
+    from rockfrag.hazard import EXAMPLE_HAZARD
+
+    if results.hazard is None:
+        return "none for the study's intensity measure"
+    if EXAMPLE_HAZARD in results.hazard.source:
+        return "the shipped example curve, which is no site's: its verdicts do not apply to a real site"
+    return "the site's curve given with the study (its file is named in 'How to reproduce this report')"
 
 
 def _beta(value: float) -> str:
@@ -494,21 +569,26 @@ def methods_items(results: Results) -> list[Item]:
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
         f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
         f"failed integration (excluded from the fits){_vertical_outcome(cube)}."))
-    header = ["soil or base", "G_s [MPa]", "E_d [MPa]", "ξ [-]"]
+    header = ["soil or base", "G_s [MPa]", "E_d [MPa]", "damping ratio ξ [-]"]
     rows = [[str(soil) if is_soil(cube, soil) else f"{soil} (structural base, not a soil)",
              _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
              _g(float(cube.soil_constrained_modulus.sel(soil=soil)) / 1e6),
              _g(float(cube.soil_damping_ratio.sel(soil=soil)))] for soil in cube.soil.values]
     items += [heading("Soils and blocks"), table(header, rows)]
     stiffness = cube.interface_stiffness
-    header = ["block", "b [m]", "h [m]", "α [rad]", "mass [kg]", "uplift g·tanα [g]"] + \
+    modulus = {block.name: block.E_b for block in config.blocks}
+    header = ["block", "b [m]", "h [m]", "α [rad]", "mass [kg]", "E_b [GPa]", "uplift g·tanα [g]"] + \
         [f"k on {soil} [N/m]" for soil in cube.soil.values]
     rows = [[block_name(config, b), _g(float(cube.block_b.sel(block=b))), _g(float(cube.block_h.sel(block=b))),
              _g(float(cube.block_alpha.sel(block=b))), _g(float(cube.block_mass.sel(block=b))),
+             _g(modulus[str(b)] / 1e9) if str(b) in modulus else "-",
              _g(math.tan(float(cube.block_alpha.sel(block=b))))]
             + [f"{float(stiffness.sel(soil=soil, block=b)):.2g}" for soil in cube.soil.values]
             for b in cube.block.values]
     items.append(table(header, rows))
+    items.append(note("b, h: half-width and half-height; E_b: the block's Young's modulus, which with the soil's "
+                      "modulus sets the interface stiffness k (the paper's eq. 19); uplift: the ground acceleration "
+                      "at which the block starts to rock on a rigid base."))
 
     pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
@@ -517,7 +597,7 @@ def methods_items(results: Results) -> list[Item]:
                         f"from {events} earthquake{'s' if events != 1 else ''}; PGA of the processed records "
                         f"{pga.min():.2g} to {pga.max():.2g} g. {_vertical_records(cube)}"
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
-                        "files and each record's processing steps are stored in cube.nc.")]
+                        "files and each record's processing steps are stored with the results.")]
 
     levels = cube.im_level.values
     spacing = "geometric" if levels.size > 2 and np.allclose(np.diff(np.log(levels)), np.log(levels[1] / levels[0]),
@@ -549,10 +629,10 @@ def methods_items(results: Results) -> list[Item]:
                         "overturned, and beyond every damage state, from its first overturning level on (Vamvatsikos "
                         f"& Cornell 2002); {resurrected} record-cells here survived a higher level after overturning "
                         "(resurrection). The overturning capacities refined between the levels are fitted too, as a "
-                        "check (fragility.csv). "
+                        "check (in the result tables: see 'How to reproduce this report'). "
                         f"Confidence bounds ({config.confidence:.0%}) from "
                         f"{fragility.attrs.get('bootstrap_samples', '?')} "
-                        f"bootstrap samples of the records (seeded: see Provenance). States "
+                        f"bootstrap samples of the records (seeded: see 'How to reproduce this report'). States "
                         "that would cross inside the studied range are refitted with one shared β; a state reached at "
                         "one intensity by every record is a deterministic threshold. Fit methods used: "
                         f"{'; '.join(plain(m) for m in methods)}.")]
@@ -560,8 +640,7 @@ def methods_items(results: Results) -> list[Item]:
     if "annual_frequency" in fragility:
         periods = ", ".join(f"{t:,.0f}" for t in results.return_periods)
         items += [heading("Hazard and risk"),
-                  paragraph("Hazard curve: "
-                            f"{fragility.attrs.get('hazard_source', config.hazard_file or 'shipped example')}. "
+                  paragraph(f"Hazard curve: {_hazard_words(results)}. "
                             "Mean annual frequency of each damage state λ = ∫ P(DS | im) |dλ(im)|, the hazard "
                             "interpolated log-log (Cornell et al. 2002); probability in the design life "
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
@@ -569,7 +648,7 @@ def methods_items(results: Results) -> list[Item]:
     return items
 
 
-STUDY_CHOICE = "the study's choice (its study file, else the shipped defaults, pipeline/defaults.toml)"
+STUDY_CHOICE = "the study's choice (its study file, else the shipped defaults)"
 LIMIT_SOURCES = {
     "overturning": "the 1% probability of collapse in 50 years that ASCE 7-22's risk-targeted ground motions aim at "
                    "(ASCE 7-22)",
@@ -734,7 +813,11 @@ def limitations_items(results: Results) -> list[Item]:
         items.append(paragraph("No foundation model of this study can pull on the block: tension does not arise."))
 
     items.append(heading("Planar model"))
-    items += [paragraph(f"{block_name(config, block)}: {planar_words(cube, block)}") for block in cube.block.values]
+    items.append(paragraph(PLANAR_WORDS))
+    items.append(table(["block", "rocks across: half-width b [m]", "half-height h [m]"],
+                       [[block_name(config, block), f"{float(cube.block_b.sel(block=block)):.3g}",
+                         f"{float(cube.block_h.sel(block=block)):.3g}"] for block in cube.block.values]))
+    items += what_the_blocks_are_not(results)
     coefficient = f"the soil's μ_s ({results.friction_text})"
     items.append(heading("Sliding"))
     items.append(paragraph(results.friction_words))
@@ -750,8 +833,8 @@ def limitations_items(results: Results) -> list[Item]:
                                    f"never exceeded {coefficient}."))
             continue
         items.append(paragraph(
-            f"{model.label}, runs with a tied base (no friction: [solver] friction; the runs with friction slide "
-            f"where they must, and their slip is in the cube and the slip damage states): holding the base needed "
+            f"{model.label}, runs with a tied base (no sliding computed; the runs with friction slide where they "
+            f"must, and the slip damage states judge them): holding the base needed "
             f"a friction coefficient above {coefficient} in {_percent(float(fraction.mean()))} of those runs (all "
             "levels); there the block would slide or slide-rock, which the rocking results do not describe. The "
             "answer pages count the records at the level run at or below each return-period intensity. Fraction of "
@@ -797,7 +880,8 @@ def limitations_items(results: Results) -> list[Item]:
         items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
                             "median lies"], rows[:EXTRAPOLATION_ROWS]))
         if len(rows) > EXTRAPOLATION_ROWS:
-            items.append(note(f"... and {len(rows) - EXTRAPOLATION_ROWS} more: see fragility.csv."))
+            items.append(note(f"... and {len(rows) - EXTRAPOLATION_ROWS} more: in the result tables (see 'How to "
+                              "reproduce this report')."))
     unfitted = status[status.status == "no fit"]
     if "status" in fragility and not unfitted.empty:  # a tied cell's slip states have no curve by design
         applicable = [str(fragility["status"].sel(soil=r.soil, block=r.block, model=r.model,
@@ -825,6 +909,36 @@ def limitations_items(results: Results) -> list[Item]:
                 items.append(paragraph(f"{model.label}: {_percent(share)} of the runs stopped (too many events or "
                                        "steps); they are left out of the fits."))
     return items
+
+
+PLANAR_WORDS = ("Each block rocks about one bottom edge, in the vertical plane across that edge, in which b is its "
+                "half-width: rocking in the other direction, twisting (wobbling) and three-dimensional rocking on a "
+                "corner are not modelled. Check the other direction as a block of its own b.")
+"""The planar model's limitation, said once (the table beside it gives each block's b)."""
+
+WHAT_A_CRANE_ADDS = ("A rail-mounted crane or ship-loader portal is not a solid block: it stands on wheels on rails "
+                     "(it can roll, and a wheel can lift off a rail or derail), it is held by storm tie-downs and "
+                     "rail clamps, its portal frame is flexible (its own modes of vibration amplify or filter the "
+                     "rocking), its mass sits high in the boom and machinery house, and a hoisted load swings as a "
+                     "pendulum. None of these is modelled: for a crane these curves describe only a rigid block of "
+                     "its proportions, and the crane's own checks (wheel uplift, derailment, tie-down forces, frame "
+                     "stresses) need a model of the crane.")
+"""What a crane adds that a rigid block lacks: the only page that may let a block be called a crane."""
+
+WHAT_EQUIPMENT_ADDS = ("Cabinets and machinery are modelled as rigid solid blocks of their outer size and mass, "
+                       "with the mass at the centre of the section: a real cabinet is hollow and flexible, its mass "
+                       "where its contents are; a machine skid has feet, pads or bolts, and its own modes. Where "
+                       "these matter, the curves are those of the rigid block, not of the equipment.")
+"""What real equipment adds to the rigid block the report models."""
+
+
+def what_the_blocks_are_not(results: Results) -> list[Item]:
+    """The limitations' section on what the modelled blocks leave out of the objects they stand for."""
+    return [heading("What the blocks are, and are not"),
+            paragraph("Every block of this study is a rigid solid block: its half-width, half-height, mass and "
+                      "stiffness are on the methods pages, and nothing else of the object it stands for is "
+                      "modelled."),
+            paragraph(WHAT_A_CRANE_ADDS), paragraph(WHAT_EQUIPMENT_ADDS)]
 
 
 def _soils_words(names, every_soil) -> str:

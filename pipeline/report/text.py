@@ -66,8 +66,17 @@ def note(text: str) -> Item:
 
 
 def table(header, rows) -> Item:
-    """A table: ``header`` a list of column titles, ``rows`` lists of cells (each cell shown as ``str``)."""
+    """A table: ``header`` a list of column titles, ``rows`` lists of cells (each cell shown as ``str``).
+
+    A row whose only text is its first cell is a group heading (``is_span``): drawn in bold across the table,
+    its text does not widen the first column.
+    """
     return Item("table", header=[str(h) for h in header], rows=[[str(c) for c in row] for row in rows])
+
+
+def is_span(row) -> bool:
+    """A table row that heads a group of rows: text in the first cell only, drawn across the table."""
+    return len(row) > 1 and bool(row[0]) and not any(row[1:])
 
 
 def _header_lines(item) -> int:
@@ -112,8 +121,8 @@ def paginate(items, capacity=None) -> list[list[Item]]:
                 queue.insert(0, item)
                 continue
             room = max(room, 3)
-            while 1 < room < len(item.rows) and not item.rows[room][0]:  # a wrapped cell's lines stay on one page
-                room -= 1
+            while 1 < room < len(item.rows) and (not item.rows[room][0] or is_span(item.rows[room - 1])):
+                room -= 1  # a wrapped cell's lines stay on one page, and a group heading with its first row
             head = replace(item, rows=item.rows[:room])
             tail = replace(item, rows=item.rows[room:])
             current.append(head)
@@ -146,7 +155,7 @@ MIN_TABLE_SIZE = 7.5  # pt: below it a client cannot read a printed table; a wid
 
 def _column_widths(item) -> list[int]:
     """Characters each column needs: its widest cell, or its header wrapped no narrower than ``MIN_HEADER``."""
-    return [max(max((len(row[c]) for row in item.rows), default=0),
+    return [max(max((len(row[c]) for row in item.rows if not is_span(row)), default=0),
                 min(len(item.header[c]), MIN_HEADER)) for c in range(len(item.header))]
 
 
@@ -203,6 +212,9 @@ def _wrapped_rows(item, room: int):
             break  # the other columns alone fill the page: nothing more to gain
         rows = []
         for row in item.rows:
+            if is_span(row):
+                rows.append(row)
+                continue
             lines = [textwrap.wrap(cell, target, break_long_words=False) or [""] if c == widest else [cell]
                      for c, cell in enumerate(row)]
             for index in range(max(len(cell) for cell in lines)):
@@ -228,7 +240,7 @@ def table_layout(item) -> tuple[list[list[str]], list[float], float]:
     size : float
         The type size [pt].
     """
-    cells = [max((len(row[c]) for row in item.rows), default=0) for c in range(len(item.header))]
+    cells = [max((len(row[c]) for row in item.rows if not is_span(row)), default=0) for c in range(len(item.header))]
     limit = max((len(h) for h in item.header), default=1)
     while True:
         wrapped = [textwrap.wrap(h, max(limit, 1), break_long_words=False) or [""] for h in item.header]
@@ -269,6 +281,10 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
             right = positions[-1] + (max(len(text) for text in header[-1]) + 12) * CHAR * size / TABLE_SIZE
             figure.add_artist(_rule(y + 0.25 * line, right))
             for row in item.rows:
+                if is_span(row):  # a group heading across the table
+                    figure.text(positions[0], y, row[0], fontsize=size, weight="bold", va="top")
+                    y -= line
+                    continue
                 for x, text in zip(positions, row):
                     figure.text(x, y, text, fontsize=size, va="top")
                 y -= line
@@ -314,7 +330,8 @@ def items_html(items) -> str:
             parts.append(f"<p class='note'>{html.escape(item.text)}</p>")
         elif item.kind == "table":
             head = "".join(f"<th>{html.escape(h)}</th>" for h in item.header)
-            body = "".join("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
+            body = "".join(f"<tr><th colspan='{len(row)}'>{html.escape(row[0])}</th></tr>" if is_span(row) else
+                           "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>"
                            for row in item.rows)
             parts.append(f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
         else:

@@ -10,8 +10,16 @@ Output: plain words for each (``FIT_METHODS``, ``STATUS_WORDS``, ``SWITCH_WORDS`
 
 from __future__ import annotations
 
-from rockfrag.models.ssi import PAPER_CITATION, PAPER_TITLE  # noqa: F401 (the report's names for them)
+import re
+
+from rockfrag.damage_states import TILT_WORDS, UPLIFT_WORDS
+from rockfrag.models.ssi import PAPER_CITATION as _CITATION
+from rockfrag.models.ssi import PAPER_TITLE  # noqa: F401 (the report's name for it)
 from rockfrag.report.text import Item, bullet, heading, paragraph
+
+PAPER_CITATION = re.sub(r" \([^()]*/[^()]*\)", "", _CITATION)
+"""The seed paper's citation as the client reads it: without the path of the project's copy (a file path is no
+client's word; the appendix and cube.nc keep it)."""
 
 FIT_METHODS = {
     "mle-binomial": "maximum likelihood on the counts per level",
@@ -120,6 +128,11 @@ GLOSSARY = (
     ("α, R", "slenderness angle (tan α = half-width over half-height) and the half-diagonal of the block; of two "
              "blocks with the same α the larger (larger R) is the more stable (Makris & Vassiliou 2012)."),
     ("uplift threshold", "the ground acceleration at which the block starts to rock on a rigid base: g·tanα."),
+    ("uplift (lift-off)", f"{UPLIFT_WORDS}; the first damage state. A smaller lift is not uplift: see 'tilts on "
+                          "the bed'."),
+    (TILT_WORDS, "a base corner parts from a compliant bed by less than the uplift size: the bed gives under the "
+                 "toe and the block leans, but it does not rock about its edge."),
+    ("rocks", "the block pivots about a bottom edge with a base corner lifted at least the uplift size."),
     ("anchor (verdict)", "the block must not stand free; the report does not size the anchorage, which is designed "
                          "as a nonstructural component fixed to its support (ASCE 7-22 Chapter 13) or to the "
                          "equipment's own qualification standard (IEEE 693 for substation equipment)."),
@@ -130,9 +143,10 @@ GLOSSARY = (
     ("β (dispersion)", "the standard deviation of the logarithm of the intensity at which the state is reached; "
                        "from record to record, plus the model's own uncertainty where the recommended curve "
                        "adds it."),
-    ("band", "two meanings, named apart on the pages: the confidence band of a fitted curve (the bounds of its "
-             "median from re-fitting with the records resampled, bootstrap), and the restitution band (the "
-             "range of impact restitution the recommended curve runs: its low edge, centre and high edge)."),
+    ("confidence bounds", "the bounds of a fitted curve's median from fitting it again with the records "
+                          "resampled (bootstrap); drawn as shading around the curve."),
+    ("restitution band", "the range of impact restitution the recommended curve runs: its low edge, centre and "
+                         "high edge (the word 'band' means only this)."),
     ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
                                "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, the "
                                "integral of the squared acceleration), D5-95 (the time between 5% and 95% of Ia)."),

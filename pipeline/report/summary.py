@@ -1,0 +1,249 @@
+"""rockfrag.report.summary - the verdicts in the client's words: the one-page summary and each answer page's verdict.
+
+Input : a ``Results`` bundle (its ``answers``: rockfrag.answer.block_answers, and ``fragility``: the betas of
+        each fitted row).
+Output: ``summary_items`` (the page after the title: one row per asset and soil with the action, the governing
+        damage state, its probability at each return period and in the design life, one sentence of reason and
+        the confidence), and the pieces the answer pages print for the same facts (``p_at_return_period``,
+        ``p_in_life``, ``verdict_items``), so that a fact reads the same on every page (``Results.facts``).
+
+Nothing here decides a verdict: rockfrag.answer does. This module only says it, reading the answer objects.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT
+from rockfrag.report import numbers
+from rockfrag.report.adapters import block_name, state_labels
+from rockfrag.report.text import Item, bullet, note, paragraph, strong, table
+
+ACTION_WORDS = {ANCHOR: "anchor or restrain", CHECK_SLIDING: "specialist check",
+                NO_ACTION: "no action", NO_VERDICT: "no verdict"}
+"""The verdicts of rockfrag.answer as the client reads them (a verdict not listed prints as it is named)."""
+
+BETA_PARTS = (("beta_record_to_record", "records"),
+              ("beta_parameters", "parameters"),
+              ("beta_form", "model form"),
+              ("beta_model", "model"))
+"""The parts of a fitted row's total dispersion β that fragility.nc may hold, and their words. ``beta_model`` is
+the whole model part: it is named only when the file does not split it into parameters and form."""
+
+EXAMPLE_WARNING = ("The hazard of this report is the shipped example curve, not a site's: no verdict in this "
+                   "report applies to a real site. The probabilities show how the method reads a hazard; a site's own "
+                   "hazard curve gives the verdicts.")
+"""The summary's first line when the hazard is the shipped example."""
+
+
+def action(verdict: str) -> str:
+    """A verdict in the client's words ("anchor or restrain")."""
+    return ACTION_WORDS.get(verdict, str(verdict).replace("_", " "))
+
+
+def labels_of(results) -> dict:
+    """Damage state -> its label in running text, lower case ("lift-off", "the block overturns")."""
+    return {state: text[0].lower() + text[1:] for state, text in state_labels(results.fragility).items()}
+
+
+def short_names(results) -> dict:
+    """Damage state -> its short name for table cells and headers ("overturning", "θmax/α ≥ 0.5")."""
+    from rockfrag.report.words import state_short_label
+
+    fragility = results.fragility
+    descriptions = dict(zip(map(str, fragility.damage_state.values),
+                            map(str, fragility["damage_state_description"].values))) \
+        if "damage_state_description" in fragility.coords else {}
+    return {state: state_short_label(state, descriptions.get(state, "")) for state in labels_of(results)}
+
+
+def governing(soil) -> object | None:
+    """The damage state that governs a block's verdict on one soil (a ``StateAnswer``), or None.
+
+    An exceeded state with the largest probability over its limit; else the judged state nearest its limit;
+    None where no state is judged or none has a probability.
+    """
+    judged = [row for row in soil.states if row.limit and np.isfinite(row.probability_in_life)]
+    if not judged:
+        return None
+    exceeded = [row for row in judged if row.exceeds]
+    return max(exceeded or judged, key=lambda row: row.probability_in_life / row.limit)
+
+
+def p_in_life(row) -> str:
+    """The probability of a state in the design life as every page prints it (a bound says so)."""
+    if row.below_lowest is not None:
+        return numbers.bound(row.probability_in_life, "≥")
+    if row.not_reached_below is not None:
+        return numbers.bound(row.probability_in_life, "<")
+    return numbers.probability(row.probability_in_life)
+
+
+def soil_intensities(answer, soil) -> tuple:
+    """The site's intensity at each return period on ``soil`` (its own site hazard), else the block's."""
+    return tuple(getattr(soil, "intensities", ()) or answer.intensities)
+
+
+def p_at_return_period(row, index: int, intensities) -> str:
+    """P(state) at return period ``index``'s intensity as every page prints it ("not reached", "≥ 61%", "-").
+
+    ``intensities``: the soil's site intensity at each return period (``soil_intensities``).
+    """
+    p = row.at_return_periods[index][0]
+    if row.not_reached_below is not None and intensities[index] <= row.not_reached_below:
+        return "not reached"
+    if row.below_lowest is not None:
+        return numbers.bound(p, "≥") if np.isfinite(p) else "-"
+    return numbers.probability(p)
+
+
+def say_p_in_life(results, answer, soil, row) -> str:
+    """``p_in_life``, recorded in the ledger as this block's, soil's and state's probability in the design life."""
+    return results.facts.say("P in the design life", (answer.block, soil.soil, row.state), p_in_life(row))
+
+
+def say_p_at(results, answer, soil, row, index: int) -> str:
+    """``p_at_return_period``, recorded in the ledger."""
+    return results.facts.say("P at a return period",
+                             (answer.block, soil.soil, row.state, answer.return_periods[index]),
+                             p_at_return_period(row, index, soil_intensities(answer, soil)))
+
+
+def beta_words(results, answer, soil: str, state: str) -> str:
+    """The total dispersion β of the answering row and the part that dominates it: "0.52 (records)"."""
+    fragility = results.fragility
+    try:
+        row = fragility.sel(model=answer.model, block=answer.block, soil=soil, damage_state=state)
+    except KeyError:
+        return "-"
+    total = float(row["beta"]) if "beta" in row else np.nan
+    if not np.isfinite(total):
+        return "-"
+    present = {name for name, _ in BETA_PARTS if name in row and np.isfinite(float(row[name]))}
+    parts = [(float(row[name]), words) for name, words in BETA_PARTS if name in present
+             and not (name == "beta_model" and {"beta_parameters", "beta_form"} & present)]
+    text = numbers.intensity(total, "").strip()
+    if parts:
+        largest, words = max(parts)
+        if largest > 0:
+            text += f" ({words})"
+    return results.facts.say("total beta", (answer.block, soil, state), text)
+
+
+def reason(results, answer, soil) -> str:
+    """One short sentence: what in the records (or the fit) the verdict on this soil rests on.
+
+    The probability and its limit are in the row already; the sentence says where they come from: how many
+    records reach the governing state at the level run at or below the largest return period's intensity (the
+    level the sliding check reads too), or that none did up to the largest recorded intensity, or that the
+    verdict rests on the fitted curve's tail or on a bound. Short enough for one line of the summary's table.
+    """
+    row = governing(soil)
+    unit = answer.unit
+    if soil.verdict == NO_VERDICT:
+        return "no hazard curve for the study's measure"
+    if soil.verdict == CHECK_SLIDING:
+        share = results.facts.say("sliding share", (answer.block, soil.soil), numbers.probability(soil.sliding_share))
+        return f"{share} of records at {numbers.intensity(soil.sliding_level, unit)} would slide"
+    if row is None:
+        return "no state judged against a limit"
+    if row.not_reached_below is not None:
+        up_to = numbers.intensity(row.not_reached_below, unit)
+        return f"bound only: none reached it up to {up_to}" if row.exceeds else f"no record reached it up to {up_to}"
+    if row.below_lowest is not None:
+        level, reached, total = row.below_lowest
+        return f"{numbers.count(reached, total)} records already at {numbers.intensity(level, unit)}: a bound"
+    if row.tail_only:
+        first = numbers.intensity(row.first_reached, unit) if row.first_reached is not None else "any level"
+        return f"fitted tail only: no record below {first}"
+    if row.records and row.records[-1][0] >= 0:
+        reached, total, level = row.records[-1]
+        return f"{numbers.count(reached, total)} records reach it at {numbers.intensity(level, unit)}"
+    return "from the fitted curve"
+
+
+def hazard_words(results, answer) -> str:
+    """The hazard the probabilities come from, named: the shipped example or the site's, per soil or not."""
+    if not answer.return_periods:
+        return "no hazard curve"
+    source = "the shipped example hazard, which is no site's" if answer.example_hazard else "the site's hazard"
+    sites = getattr(results, "site_hazards", None)
+    if sites is None or len(sites) < 2:
+        return source
+    if sites.reference is not None:
+        return f"each soil's site hazard, amplified from {source} to the soil's site class"
+    return "each soil's own site hazard, as the study gives it" + (" (the shipped example)"
+                                                                  if answer.example_hazard else "")
+
+
+def summary_items(results) -> list[Item]:
+    """The summary page: a first line on the hazard, then one row per asset and soil, then how to read it."""
+    answers = results.answers
+    if not answers:
+        return [paragraph("The study has no block, so no verdict.")]
+    first = answers[0]
+    short = short_names(results)
+    items = []
+    if any(answer.example_hazard for answer in answers):
+        items.append(strong(EXAMPLE_WARNING))
+    periods = first.return_periods
+    life = numbers.years(first.design_life)
+    header = ["asset, soil", "action", "governing damage state", *(f"P at {numbers.years(t)}" for t in periods),
+              f"P in {life} (limit)", "β (dominated by)", "reason"]
+    rows = []
+    for answer in answers:
+        rows.append([block_name(results.config, answer.block)] + [""] * (len(header) - 1))
+        for soil in answer.soils:
+            row = governing(soil)
+            if soil.verdict == CHECK_SLIDING:
+                state, at, life_text, beta = "sliding", ["-"] * len(periods), "-", "-"
+            elif row is None:
+                state, at, life_text, beta = "-", ["-"] * len(periods), "-", "-"
+            else:
+                state = short[row.state]
+                at = [say_p_at(results, answer, soil, row, i) for i in range(len(periods))]
+                life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.probability(row.limit)})"
+                beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
+            rows.append([soil.soil, action(soil.verdict), state, *at, life_text, beta, reason(results, answer, soil)])
+    items.append(paragraph(
+        f"Per asset and soil: the action, the damage state that governs it, that state's probability at the site's "
+        f"intensity of each return period and in the design life of {life}, with {hazard_words(results, first)}; the "
+        "dispersion β of its fragility curve with the part that dominates it; and what the verdict rests on."))
+    items.append(table(header, rows))
+    items.append(note("'Anchor or restrain': a probability in the design life is above its limit; the block must not "
+                      "stand free. 'Specialist check': the base would slide, and its sliding was not computed. 'No "
+                      "action': every judged damage state is within its limit. '< X': no record reached the state up "
+                      "to the largest intensity recorded, so its probability is at most X, that of exceeding it. "
+                      "Reason: the records at the level run at or below the largest return period's intensity. β: "
+                      "records, the variability from record to record; model, the model's own uncertainty. The "
+                      "answer pages give every damage state and the records behind each number."))
+    return items
+
+
+def verdict_items(results, answer) -> list[Item]:
+    """The answer page's verdict: the summary's rows of this block, as a sentence per soil group."""
+    name = block_name(results.config, answer.block)
+    groups: dict[str, list] = {}
+    for soil in answer.soils:
+        groups.setdefault(soil.verdict, []).append(soil)
+    lead = (f"With the shipped example hazard (not a site's, so no verdict for a real site), the {name}: "
+            if answer.example_hazard else f"Verdict for the {name}: ")
+    parts = []
+    for verdict, soils in groups.items():
+        where = _and([soil.soil for soil in soils])
+        parts.append(f"{action(verdict)} on {where}")
+    items = [strong(lead + "; ".join(parts) + ".")]
+    for soil in answer.soils:
+        row = governing(soil)
+        state = f" ({short_names(results)[row.state]})" if row is not None and soil.verdict != CHECK_SLIDING else ""
+        items.append(bullet(f"On {soil.soil}{state}: {reason(results, answer, soil)}"))
+    return items
+
+
+def _and(words) -> str:
+    words = list(words)
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+__all__ = ["ACTION_WORDS", "action", "beta_words", "governing", "p_at_return_period", "p_in_life", "reason",
+           "summary_items", "verdict_items"]

@@ -1,0 +1,142 @@
+"""The report an engineer signs (issue 36, items 1, 2, 5 and 6): the summary is page 2 with every asset and soil,
+the client's pages speak no tool syntax (only the closing appendix names keys, commands and files), the blocks are
+named for what is modelled, and the contents come first."""
+
+from __future__ import annotations
+
+import re
+
+from tests.helpers import pipeline_results
+
+TABLES = ("study", "intensity", "solver", "hazard", "decision", "fragility", "damage_states", "applicability",
+          "blocks", "blocks_custom", "soils_custom", "checks", "report")
+TOOL_SYNTAX = {
+    "study key": rf"\[(?:{'|'.join(TABLES)})(?:\.[^\]]+)?\]",
+    "snake_case name": r"\b[a-z]{2,}_[a-z0-9_]+\b",
+    "file": r"\b[\w-]+\.(?:nc|csv|toml|py|json|xml|txt|png|pdf|html)\b",
+    "path": r"\b(?:pipeline|shared|reports|studies|tests)/",
+    "setting": r"\b[a-z]{2,}(?:_[a-z]+)* = ",
+    "call": r"\b[a-z_]+\(\)",
+    "calibrated ξ": r"ξ = \d",
+}
+"""What an operator types and a client should never read: study keys, names of variables and functions, files,
+paths, settings, calls, and the damping ratio the bed was calibrated to."""
+
+
+def tool_syntax(text: str) -> list[str]:
+    """Every piece of tool syntax in ``text``, named by kind ("study key: [decision]")."""
+    return [f"{kind}: {found}" for kind, pattern in TOOL_SYNTAX.items() for found in re.findall(pattern, text)]
+
+
+def _texts(items) -> str:
+    return " ".join([item.text for item in items] + [cell for item in items for cell in [*item.header,
+                                                                                       *sum(item.rows, [])]])
+
+
+def test_the_check_finds_tool_syntax():
+    """It can fail: the words the client read on the answer pages before (issue 36, 'Speaks to the operator')."""
+    found = tool_syntax('above the 10% the study allows ([decision] max_sliding_share = 0.1); compute it with '
+                        '[solver] friction = "all"; see pipeline/hazard_example.csv and fragility.csv; ξ = 0.158')
+    kinds = {entry.split(":")[0] for entry in found}
+    assert kinds == {"study key", "snake_case name", "file", "path", "setting", "calibrated ξ"}
+    assert tool_syntax("PGA [g], mass [kg], Housner's r = 1 − 1.5 sin²α, μ_s, a_p = 2π·PGV/T_p") == []
+
+
+def test_no_client_page_speaks_tool_syntax_and_the_appendix_holds_it(small_pipeline):
+    from rockfrag.report import build_plan
+    from rockfrag.report.answer_page import answer_items, reading_items
+    from rockfrag.report.sections import (
+        fitted_items,
+        limitations_items,
+        methods_items,
+        reproduce_items,
+        title_items,
+    )
+    from rockfrag.report.summary import summary_items
+    from rockfrag.report.words import glossary_items, references_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    pages = {"title": title_items(results), "summary": summary_items(results), "reading": reading_items(results),
+             "methods": methods_items(results), "limitations": limitations_items(results),
+             "fitted": fitted_items(results), "glossary": glossary_items(), "references": references_items()}
+    pages.update({f"answer {answer.block}": answer_items(results, answer) for answer in results.answers})
+    found = {name: tool_syntax(_texts(items)) for name, items in pages.items()}
+    assert {name: entries for name, entries in found.items() if entries} == {}
+    planned = build_plan(results)
+    headings = {page.name: tool_syntax(f"{page.title} {page.caption}") for page in planned}
+    assert {name: entries for name, entries in headings.items() if entries} == {}
+    appendix = _texts(reproduce_items(results))
+    for key in ("[hazard] file", "[decision] max_probability_in_life", "[decision] max_sliding_share",
+                "[solver] friction", "rockfrag fragility", str(small_pipeline.study)):
+        assert key in appendix, key
+    assert planned[-1].section == "How to reproduce this report" or "How to reproduce this report" in \
+        planned[-1].also
+
+
+def test_the_summary_is_page_two_with_every_asset_and_soil_and_the_contents_follow(small_pipeline):
+    from rockfrag.report import build_plan
+    from rockfrag.report.adapters import block_name
+    from rockfrag.report.summary import EXAMPLE_WARNING, summary_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    planned = build_plan(results)
+    assert [page.section for page in planned[:3]] == ["Title", "Summary", "Contents"]
+    items = summary_items(results)
+    assert items[0].text == EXAMPLE_WARNING and items[0].kind == "strong"  # the shipped example: said first
+    table = next(item for item in items if item.kind == "table")
+    rows, block = set(), None
+    for row in table.rows:
+        if row[0] and not any(row[1:]):
+            block = row[0]
+        else:
+            rows.add((block, row[0]))
+            assert row[1] in ("anchor or restrain", "no action", "specialist check", "no verdict"), row
+            assert row[-1] and row[-1] != "-", row  # a reason on every row
+    expected = {(block_name(results.config, b), str(s)) for b in results.cube.block.values
+                for s in results.cube.soil.values}
+    assert rows == expected
+    for head in ("governing damage state", "P in 50 years (limit)", "β (dominated by)", "reason"):
+        assert head in table.header, head
+
+
+def test_a_site_hazard_removes_the_warning(small_pipeline, tmp_path):
+    from dataclasses import replace
+
+    from rockfrag.report.summary import EXAMPLE_WARNING, summary_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    answers = [replace(answer, example_hazard=False) for answer in results.answers]
+    site = pipeline_results(small_pipeline.output, small_pipeline.study)
+    site.__dict__["answers"] = answers  # the cached property, as a study with its own hazard file gives it
+    assert EXAMPLE_WARNING not in [item.text for item in summary_items(site)]
+
+
+def test_the_default_blocks_are_named_for_what_is_modelled_and_crane_only_beside_what_a_crane_adds():
+    """Issue 36 item 5: "crane portal" was the paper's solid block; its name and description now say what it is,
+    and "crane" appears only where the limitations name what a crane adds."""
+    from rockfrag.config import load_study
+    from rockfrag.report.adapters import block_description, block_name
+    from rockfrag.report.sections import WHAT_A_CRANE_ADDS
+
+    config = load_study(None)
+    names = {block.name: block_name(config, block.name) for block in config.blocks}
+    assert names["paper"] == "solid block with the paper's proportions (R = 9.39 m, α = 0.44)"
+    assert all("crane" not in name and "solid block" in name for name in names.values())
+    for block in config.blocks:
+        description = block_description(config, block.name)
+        assert description.count("kg/m^3") + description.count("t,") + description.count(" t ") >= 1
+        if "crane" in description:
+            assert "limitations" in description
+    for mechanism in ("wheels on rails", "derail", "tie-downs", "flexible", "pendulum"):
+        assert mechanism in WHAT_A_CRANE_ADDS, mechanism
+
+
+def test_each_word_of_the_glossary_has_one_meaning():
+    """'band' had two meanings: the glossary names the restitution band and the confidence bounds apart."""
+    from rockfrag.report.words import GLOSSARY
+
+    terms = [term for term, _ in GLOSSARY]
+    assert len(terms) == len(set(terms))
+    assert "band" not in terms and "restitution band" in terms and "confidence bounds" in terms
+    text = " ".join(meaning for _, meaning in GLOSSARY)
+    assert "two meanings" not in text

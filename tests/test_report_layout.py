@@ -1,0 +1,224 @@
+"""Figures without defects (issue 36, item 4): a layout check of every figure page of the small study, shown to
+fail on seeded defects. It measures the drawn figure (matplotlib's extents of texts, legends and data paths in
+pixels), never the code's own layout numbers:
+
+- a legend (or any text) that runs past the page edge;
+- a text over plotted data (a line, its markers, a shaded band or bar of an axes) or over another text;
+- an axes with nothing drawn inside it and no note saying why.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.container import BarContainer
+from matplotlib.transforms import Bbox
+
+from tests.test_report_legibility import _shown_texts, off_page, overprinted
+
+EDGE = 1.5
+"""Pixels a box is shrunk by before it counts as touching: a text set beside a line does not overlap it."""
+
+
+def _shrunk(box: Bbox, by: float = EDGE) -> Bbox:
+    return Bbox.from_extents(box.x0 + by, box.y0 + by, box.x1 - by, box.y1 - by)
+
+
+def _inside(points: np.ndarray, box: Bbox) -> np.ndarray:
+    return (points[:, 0] > box.x0) & (points[:, 0] < box.x1) & (points[:, 1] > box.y0) & (points[:, 1] < box.y1)
+
+
+def _dense(points: np.ndarray, step: float = 1.0) -> np.ndarray:
+    """A polyline's points at most ``step`` pixels apart (NaN breaks it into pieces), for tests against a box."""
+    points = np.asarray(points, float)
+    finite = np.isfinite(points).all(axis=1)
+    if len(points) < 2:
+        return points[finite]
+    start, end = points[:-1], points[1:]
+    keep = finite[:-1] & finite[1:]
+    start, end = start[keep], end[keep]
+    counts = np.maximum(2, np.ceil(np.hypot(*(end - start).T) / step).astype(int) + 1)
+    segment = np.repeat(np.arange(len(start)), counts)
+    fraction = (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)) / np.repeat(counts - 1,
+                                                                                                    counts)
+    dense = start[segment] + fraction[:, None] * (end[segment] - start[segment])
+    return np.concatenate([dense, points[finite]])
+
+
+def data_points(axis, references: bool = True) -> np.ndarray:
+    """Pixels of everything plotted in ``axis``: its lines (drawn segments and markers), filled bands, scatter
+    points and bars, densified to one pixel, clipped to the axes. Spans (axvspan/axhspan shading) are not data;
+    reference lines across the axes (axvline/axhline: the site's intensities) are, unless ``references`` is
+    False (they alone do not fill a panel)."""
+    box = axis.get_window_extent()
+    points = []
+    for line in axis.get_lines():
+        if not line.get_visible() or (not references and line.get_transform() != axis.transData):
+            continue
+        xy = line.get_transform().transform(np.asarray(line.get_xydata(), float))
+        if line.get_linestyle() not in ("None", "none", "", " "):
+            points.append(_dense(xy))
+        elif line.get_marker() not in (None, "None", "none", "", " "):
+            points.append(xy[np.isfinite(xy).all(axis=1)])
+    for collection in axis.collections:
+        if not collection.get_visible():
+            continue
+        transform = collection.get_transform()
+        for path in collection.get_paths():
+            if len(path.vertices):
+                points.append(_dense(transform.transform(path.vertices)))
+        offsets = collection.get_offsets()
+        if len(offsets) and collection.get_offset_transform() is not None:
+            points.append(collection.get_offset_transform().transform(np.asarray(offsets, float)))
+    for container in axis.containers:
+        if isinstance(container, BarContainer):
+            for patch in container.patches:
+                corners = patch.get_window_extent().corners()[[0, 1, 3, 2, 0]]
+                points.append(_dense(corners))
+    if not points:
+        return np.empty((0, 2))
+    points = np.concatenate(points)
+    return points[_inside(points, box)]
+
+
+def layout_defects(figure) -> list[str]:
+    """Every layout defect of the figure, in words (empty: none).
+
+    The figure is laid out as for drawing (``draw_without_rendering``: every position and extent, no pixels).
+    """
+    figure.draw_without_rendering()
+    shown = _shown_texts(figure, drawn=True)
+    defects = [f"off the page: {text}" for text in off_page(figure, shown)]
+    defects += [f"text over text: {first!r} / {second!r}" for first, second in overprinted(figure, shown)]
+    page = figure.bbox
+    for legend in [*figure.legends, *(axis.get_legend() for axis in figure.axes if axis.get_legend())]:
+        box = legend.get_window_extent()
+        if box.x0 < page.x0 - 0.5 or box.y0 < page.y0 - 0.5 or box.x1 > page.x1 + 0.5 or box.y1 > page.y1 + 0.5:
+            defects.append(f"legend clipped: {box.x0:.0f}-{box.x1:.0f} px across a page of {page.x1:.0f} px")
+    axes = [axis for axis in figure.axes if axis.get_visible() and axis.axison and not _is_secondary(axis)]
+    data = {axis: data_points(axis) for axis in axes}
+    for text, box in shown:
+        inner = _shrunk(box)
+        if inner.width <= 0 or inner.height <= 0:
+            continue
+        for axis, points in data.items():
+            if points.size and box.overlaps(axis.get_window_extent()) and _inside(points, inner).any():
+                defects.append(f"text over data: {text.get_text()[:40]!r}")
+                break
+    for axis in data:
+        inner = _shrunk(axis.get_window_extent())
+        points = data_points(axis, references=False)
+        if len(points) and _inside(points, inner).any():
+            continue
+        notes = [text for text, box in shown if inner.contains(*box.get_points().mean(axis=0))]
+        if not notes:
+            defects.append(f"empty axes without a note: {axis.get_title()!r}")
+    return defects
+
+
+def _is_secondary(axis) -> bool:
+    """A secondary axis (secondary_xaxis/_yaxis) carries labels only: it is not a panel."""
+    return type(axis).__name__ == "SecondaryAxis"
+
+
+# ---------------------------------------------------------------- the check can fail: seeded defects
+
+def _clean_figure():
+    from rockfrag.report.layout import new_page, outside_legend, panels
+
+    figure = new_page("A page", "Read the caption.")
+    left, right = panels(figure, 1, 2)[0]
+    x = np.linspace(0.0, 1.0, 50)
+    left.plot(x, x ** 2, label="a curve")
+    right.plot(x, 1 - x, label="another curve")
+    outside_legend(figure, [left, right])
+    return figure, left, right
+
+
+def test_a_clean_page_has_no_layout_defect():
+    figure, _, _ = _clean_figure()
+    try:
+        assert layout_defects(figure) == []
+    finally:
+        plt.close(figure)
+
+
+def test_the_layout_check_fails_on_a_clipped_legend():
+    figure, _, _ = _clean_figure()
+    try:
+        figure.legends[0].set_bbox_to_anchor((0.97, 0.885), transform=figure.transFigure)
+        assert any(defect.startswith("legend clipped") for defect in layout_defects(figure))
+    finally:
+        plt.close(figure)
+
+
+def test_the_layout_check_fails_on_a_note_over_data_and_on_overlapping_texts():
+    figure, left, right = _clean_figure()
+    try:
+        left.text(0.5, 0.25, "no curve: not reached", transform=left.transAxes, ha="center", va="center",
+                  bbox=dict(facecolor="white"))  # over x**2 at x = 0.5
+        right.text(0.2, 0.2, "one label", transform=right.transAxes)
+        right.text(0.21, 0.2, "another label", transform=right.transAxes)
+        defects = layout_defects(figure)
+        assert "text over data: 'no curve: not reached'" in defects
+        assert "text over text: 'one label' / 'another label'" in defects
+    finally:
+        plt.close(figure)
+
+
+def test_the_layout_check_fails_on_an_empty_panel_without_a_note_and_passes_with_one():
+    figure, _, right = _clean_figure()
+    try:
+        right.lines[0].set_ydata(np.full(50, np.nan))  # nothing to draw
+        right.set_title("slip on clay")
+        assert "empty axes without a note: 'slip on clay'" in layout_defects(figure)
+        right.text(0.5, 0.5, "not computed: base tied", transform=right.transAxes, ha="center")
+        assert layout_defects(figure) == []
+    finally:
+        plt.close(figure)
+
+
+def test_lines_drawn_on_the_frame_do_not_fill_a_panel():
+    """An IDA panel whose records never rock draws every curve at θmax/α = 0, on the frame: it looks empty."""
+    figure, left, _ = _clean_figure()
+    try:
+        left.set_xlim(0.0, 1.0)
+        left.set_ylim(0.0, 1.0)
+        left.lines[0].set_data(np.zeros(50), np.linspace(0.0, 1.0, 50))
+        left.set_title("on clay")
+        assert "empty axes without a note: 'on clay'" in layout_defects(figure)
+    finally:
+        plt.close(figure)
+
+
+# ---------------------------------------------------------------- every figure page of the small study
+
+@pytest.mark.slow
+def test_every_figure_of_the_small_study_is_free_of_layout_defects(small_pipeline):
+    import xarray as xr
+
+    from rockfrag.config import load_study
+    from rockfrag.report import build_plan, report_results
+    from rockfrag.report.layout import add_footer
+
+    output = small_pipeline.output
+    opened = {name: xr.load_dataset(output / f"{name}.nc") for name in ("cube", "ida", "fragility")}
+    results = report_results(load_study(small_pipeline.study), opened["cube"], opened["ida"], opened["fragility"],
+                             None, output)  # every result file the run wrote: the applicability sweep too
+    planned = build_plan(results)
+    figures = [page for page in planned if page.html is None]
+    assert len(figures) >= 15
+    found = {}
+    for number, page in enumerate(planned, start=1):
+        if page.html is not None:
+            continue
+        figure = page.draw()
+        try:
+            add_footer(figure, "a report title", number, len(planned))
+            defects = layout_defects(figure)
+            if defects:
+                found[page.name] = defects
+        finally:
+            plt.close(figure)
+    assert found == {}
