@@ -140,3 +140,34 @@ def test_each_word_of_the_glossary_has_one_meaning():
     assert "band" not in terms and "restitution band" in terms and "confidence bounds" in terms
     text = " ".join(meaning for _, meaning in GLOSSARY)
     assert "two meanings" not in text
+
+
+def test_no_paragraph_is_repeated(small_pipeline):
+    """The same paragraph stood on every block's answer page (issue 36): a text common to the blocks is said once."""
+    from rockfrag.report import build_plan
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    paragraphs = [text for page in build_plan(results) if page.html
+                  for text in re.findall(r"<(?:p|li)[^>]*>(.*?)</(?:p|li)>", page.html, flags=re.S)
+                  if len(text) >= 100]
+    repeated = {text[:80] for text in paragraphs if paragraphs.count(text) > 1}
+    assert repeated == set()
+
+
+def test_the_last_page_of_a_run_of_text_is_never_near_empty():
+    """Pages 13 and 25 of the default report held a few lines each (issue 36): a run's last page that would hold
+    less than half a page shares the last two pages' lines evenly."""
+    import rockfrag.report.text as text
+    from rockfrag.report.text import BALANCE, _lines, paginate, paragraph, table
+
+    capacity = 40
+    items = [paragraph("a line of text " * 8) for _ in range(14)] + [table(["a", "b"], [[str(n), "x"] for n in
+                                                                                      range(18)])]
+    unbalanced = text._paginate(items, capacity)  # 28 lines of text and a 20-line table: 8 lines left over
+    assert [sum(_lines(item) for item in page) for page in unbalanced][-1] < BALANCE * capacity
+    pages = paginate(items, capacity)
+    lines = [sum(_lines(item) for item in page) for page in pages]
+    assert len(pages) == 2 and all(count <= capacity for count in lines)
+    assert min(lines) >= BALANCE * capacity * 0.8, lines
+    rows = [row for page in pages for item in page if item.kind == "table" for row in item.rows]
+    assert rows == [[str(n), "x"] for n in range(18)]  # every row once, in order

@@ -249,8 +249,8 @@ def plan(results: Results) -> list[Page]:
             with results.facts.writing(f"Answer: {name}"):
                 answers.append((f"answer-{answer.block}", f"Answer: {name}", f"Answer: {name}",
                                 answer_items(results, answer)))
-    planned += _packed_pages(answers) if answers else []
-    planned += _packed_pages([
+    planned += _packed_pages([  # one run of text: a section starts where the one before ends (no near-empty page)
+        *answers,
         ("fitted", "Fitted curves", "Fitted fragility functions", fitted_items(results)),
         ("methods", "Methods", "Methods and assumptions", methods_items(results)),
         ("limitations", "Limitations", "Limitations: where the models are outside their validity",
@@ -291,7 +291,7 @@ def plan(results: Results) -> list[Page]:
                                marks=results.marks(block), name=names[block]))
     if results.vertical is not None:
         planned += _text_pages("vertical", "Vertical component", "Vertical component: medians with and without it",
-                               vertical_items(results.vertical))
+                               vertical_items(results.vertical, names))
         for block in blocks:
             planned.append(_figure(f"vertical-{block}", "Vertical component", f"Vertical component: {names[block]}",
                                    vertical_page, results.vertical, block, caption=CAPTIONS["vertical"],

@@ -240,17 +240,14 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     largest = results.largest_recorded.get(answer.block)
     periods = answer.return_periods
     items.append(heading(f"At the site's intensity of each return period ({' / '.join(map(numbers.years, periods))})"))
-    items.append(paragraph(
-        f"The site's {measure} at each return period ({hazard_words(results, answer)}), and the level run nearest at "
-        f"or below it, whose records the tables count. The largest {measure} of the records, unscaled, is "
-        f"{numbers.intensity(largest, unit)}."))
+    items.append(paragraph(f"The largest {measure} of the records, unscaled: {numbers.intensity(largest, unit)}."))
     sites = [[soil.soil, " / ".join(results.facts.say("site intensity", (answer.block, soil.soil, t),
                                                       numbers.intensity(im, unit))
                                     for t, im in zip(periods, soil_intensities(answer, soil))),
               _levels_read(answer, soil)] for soil in answer.soils]
     if len({tuple(row[1:]) for row in sites}) == 1:  # one site hazard for every soil: one row
         sites = [["every soil", *sites[0][1:]]]
-    items.append(table(["soil", f"site {measure}", "records counted at"], sites))
+    items.append(table(["soil", f"site {measure}", "records counted at the level"], sites))
     header = ["damage state", *(f"on {soil.soil}" for soil in answer.soils)]
     rows = [[short[state], *(_not_computed(results, answer, soil.soil, state)
                              or _joined(say_p_at(results, answer, soil, soil.states[index], i)
@@ -261,21 +258,19 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                for soil in answer.soils)] for index, state in enumerate(short)]
     n = int(fragility["n_records"]) if "n_records" in fragility else None
     if any(cell.strip(" /-") for row in counts for cell in row[1:]):
-        items.append(paragraph(f"Records that reached each state at those levels{f' (of {n})' if n else ''}; a "
-                               "probability where no record reached the state is the fitted curve's tail alone:"))
+        items.append(paragraph(f"Records that reached each state at those levels{f' (of {n})' if n else ''}:"))
         items.append(table(header, counts))
     scale = display_scale(cube.intensity.attrs.get("units", ""))[0] if cube is not None and "intensity" in cube \
         else 1.0
     modes = [[soil.soil, *motion_counts(cube, answer.block, answer.model, soil.soil, soil_intensities(answer, soil),
                                         scale)] for soil in answer.soils]
     if any(cell != "-" for row in modes for cell in row[1:]):
-        items.append(paragraph("What the records make the block do at those levels, each record at its most "
-                               "severe motion:"))
+        items.append(paragraph("What the records make the block do at those levels:"))
         items.append(table(["soil", *map(numbers.years, periods)], modes))
     sliding = sliding_rows(cube, answer, scale)
     if any(cell not in ("-", NO_LEVEL) for row in sliding for cell in row[1:]):
-        items.append(paragraph("Share of the records whose tied base needs more friction than the soil offers, at "
-                               "the same levels:"))
+        items.append(paragraph("Records whose tied base would slide (it needs more friction than the soil "
+                               "offers), at those levels:"))
         items.append(table(["soil", *map(numbers.years, periods)], sliding))
     life = numbers.years(answer.design_life)
     limits = results.decision["max_probability_in_life"]
@@ -358,11 +353,17 @@ def reading_items(results) -> list[Item]:
              paragraph("Each block rocks in one vertical plane about one bottom edge (a planar model): the "
                        "limitations name the half-width b each block rocks across, and what that leaves out."),
              heading("The tables of each answer page"),
+             paragraph(f"The site's intensity at each return period ({hazard_words(results, answers[0])}), on each "
+                       "soil, and the level run nearest at or below it: the tables count the records of that level. "
+                       "Above the largest intensity of the unscaled records every result comes from records scaled "
+                       "up (extrapolation by scaling)."),
              paragraph("P(damage state) at the site's intensity of each return period, the three return periods in "
                        "one cell (for example 5.6% / 17% / 43%), each read as 'this state or worse', so a milder "
                        "state is never less likely than a more severe one. 'not reached': no record reached the "
                        "state up to the largest intensity recorded. '≥ X': the fitted median lies below every level "
-                       "run, and the records at the lowest level give a lower bound instead of the fit's tail."),
+                       "run, and the records at the lowest level give a lower bound instead of the fit's tail. Beside "
+                       "it, how many records reached each state at those levels: a probability where none did is the "
+                       "fitted curve's tail alone."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. A smaller "
                        f"lift off a bed is not rocking: the block {TILT_WORDS} (the bed gives under its toe). The "
                        "motion table counts each record once, at its most severe motion; the records that rock, "

@@ -345,8 +345,8 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
             picked = cell(ida, model, block, soil)
             edp = np.asarray(picked.edp.values, float)
             if not (~np.isnan(edp) & (edp >= VISIBLE_ROCKING)).any():  # every curve on the frame, or none run
-                empty_note(axis, f"no record rocked the block: θmax/α below {VISIBLE_ROCKING:g} at every level"
-                           if (~np.isnan(edp)).any() else "not run")
+                empty_note(axis, f"θmax/α below {VISIBLE_ROCKING:g} in every record at every level: the "
+                           "curves lie on the frame" if (~np.isnan(edp)).any() else "not run")
                 axis.rockfrag_empty = True
             for curve in picked.edp.transpose("record", "im_level").values:
                 axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)

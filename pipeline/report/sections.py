@@ -703,7 +703,6 @@ def sources_items(results: Results) -> list[Item]:
                             "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
                             "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
                             f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + STUDY_CHOICE + "."))
-    items.append(bullet(results.friction_words))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
     band = tuple(float(v) for v in config.restitution_band)
@@ -820,7 +819,8 @@ def limitations_items(results: Results) -> list[Item]:
     items += what_the_blocks_are_not(results)
     coefficient = f"the soil's μ_s ({results.friction_text})"
     items.append(heading("Sliding"))
-    items.append(paragraph(results.friction_words))
+    items.append(paragraph("Each soil's base friction and where it comes from: the page 'Reading the answer pages' "
+                           "and the methods. It is the soil class's, not the block's own base."))
     flag = friction_flag(cube)
     found = False
     for model in models:
@@ -998,7 +998,7 @@ def free_flight_items(cube, models) -> list[Item]:
         return items + [paragraph("g + a_v(t) stayed above zero in every run: no block was thrown off the ground.")]
     items.append(paragraph(
         f"Where g + a_v(t) < 0 the ground falls faster than gravity and the block leaves it. The pivot models have "
-        f"no flight phase and stop there (outcome free_flight, {total} runs); the Winkler bed flies on. The fits "
+        f"no flight phase and stop there (free flight, {total} runs); the Winkler bed flies on. The fits "
         "count such a run as uplifted, as reaching a rocking state only if it did before the stop, and as unknown "
         "for overturning (censored). Fraction of runs in free flight:"))
     for model in models:

@@ -92,19 +92,50 @@ def _lines(item) -> int:
     return max(1, len(textwrap.wrap(item.text, width))) + (1 if item.kind in ("paragraph", "strong") else 0)
 
 
+BALANCE = 0.5
+"""A run's last page holding less than this share of a page shares the last two pages' lines evenly instead."""
+
+
 def paginate(items, capacity=None) -> list[list[Item]]:
     """Split items into pages of ``capacity`` lines (default: a full page).
 
     A table too wide for the page is split first (``fit_table``); a table longer than a page is split with its
     header repeated; a heading never ends a page. When what
     is left overflows the last page by at most ``STRETCH`` lines, it goes on that page with its lines set
-    closer (``draw_text_page``) rather than alone on a near-empty page.
+    closer (``draw_text_page``) rather than alone on a near-empty page; when it is more, and the last page would
+    hold less than ``BALANCE`` of a page, the last two pages share their lines evenly (no near-empty page).
     """
     capacity = capacity or int((TOP - BOTTOM) / LINE)
+    pages = _paginate(items, capacity)
+    if len(pages) >= 2 and sum(_lines(item) for item in pages[-1]) < BALANCE * capacity:
+        tail = _joined_tables(pages[-2] + pages[-1])
+        total = sum(_lines(item) for item in tail)
+        for target in range(-(-total // 2), capacity):
+            even = _paginate(tail, target, stretch=0)
+            if len(even) == 2:
+                return pages[:-2] + even
+    return pages
+
+
+def _joined_tables(items) -> list[Item]:
+    """Consecutive pieces of one table (split by a page break: same header, same part) joined again."""
+    joined = []
+    for item in items:
+        last = joined[-1] if joined else None
+        if last is not None and item.kind == last.kind == "table" and item.header == last.header \
+                and item.part == last.part:
+            joined[-1] = replace(last, rows=last.rows + item.rows)
+        else:
+            joined.append(item)
+    return joined
+
+
+def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
+    """``paginate`` without the balancing of its last two pages; ``stretch`` as ``STRETCH``."""
     pages, current, used = [], [], 0
     queue = [part for item in items for part in fit_table(item)]
     while queue:
-        if sum(_lines(rest) for rest in queue) <= capacity - used + STRETCH:  # the rest fits, a little closer
+        if sum(_lines(rest) for rest in queue) <= capacity - used + stretch:  # the rest fits, a little closer
             current += queue
             break
         item = queue.pop(0)

@@ -209,14 +209,22 @@ def _pair(with_value, without_value) -> str:
     return text
 
 
-def vertical_items(effect: VerticalEffect) -> list[Item]:
-    """The table page: per block, model and soil, medians with / without the vertical and the free-flight share."""
+def vertical_items(effect: VerticalEffect, names: dict | None = None) -> list[Item]:
+    """The table page: per block, model and soil, medians with / without the vertical and the free-flight share.
+
+    ``names``: block -> the name the client knows it by (``[report] block_names``).
+    """
+    from rockfrag.report.adapters import short_label, state_labels
+    from rockfrag.report.layout import pretty
+
     cube, fits = effect.cube, effect.fits
     states = [str(s) for s in fits[True].damage_state.values]
     shown_states = states[-2:]
+    labels = state_labels(fits[True]) if "damage_state_description" in fits[True].coords else {}
     unit = measure_label(cube)
     flew = free_flight_share(cube)
-    header = ["block", "model", "soil"] + [f"{s}: median with / without" for s in shown_states] + [
+    header = ["block", "model", "soil"] + [f"{pretty(labels.get(s, s))}: median with / without"
+                                           for s in shown_states] + [
         "capacity median with / without", "runs in free flight"]
     rows = []
     for block in map(str, cube.block.values):
@@ -225,7 +233,7 @@ def vertical_items(effect: VerticalEffect) -> list[Item]:
             for soil in ["(any)" if s is None else s for s in own]:
                 picked = {applied: cell(fits[applied], model, block, None if soil == "(any)" else soil)
                           for applied in (True, False)}
-                row = [block, model.name, soil]
+                row = [(names or {}).get(block, block), short_label(model), soil]
                 for state in shown_states:
                     row.append(_pair(*(float(picked[a]["median"].sel(damage_state=state)) for a in (True, False))))
                 row.append(_pair(*(float(picked[a]["capacity_median"].sel(damage_state=shown_states[-1]))
@@ -241,13 +249,13 @@ def vertical_items(effect: VerticalEffect) -> list[Item]:
         paragraph(f"The {n_with} records of this study ran twice at the same levels and scale factors: with their "
                   "station's vertical component (gravity g + a_v(t) in every model, a_v scaled with the "
                   f"horizontal, so the vertical-to-horizontal PGA ratio, {np.nanmin(ratio):.2f} to "
-                  f"{np.nanmax(ratio):.2f} here, is kept) and without it ({COMPARISON_CUBE}). Medians in {unit} "
+                  f"{np.nanmax(ratio):.2f} here, is kept) and without it. Medians in {unit} "
                   "(stripe fits of both cubes alike; capacity: lognormal fit of the refined overturning "
                   "capacities), with / without the vertical, and the change in percent."),
         table(header, rows),
         heading("Free flight"),
         note("Where g + a_v(t) < 0 the ground falls faster than gravity and the block leaves it: the pivot models "
-             "(Housner, SSI) have no flight phase and stop there (outcome free_flight); the Winkler bed flies on. "
+             "(Housner, SSI) have no flight phase and stop there (free flight); the Winkler bed flies on. "
              "Such a run counts as uplifted, as reaching a rocking state only if it did before the stop, and as "
              "unknown for overturning (censored). A '-' with the vertical where the run without it has a median: "
              "the free-flight runs left too few known outcomes for a fit. Share of runs in free flight: over all "
