@@ -280,7 +280,8 @@ def _calibration_variables(calibration, model_names, shape) -> dict:
     out = {name: (("soil", "block", "model"), arrays[name], {"long_name": long_name, "units": "1"})
            for name, long_name in CALIBRATION_VARIABLES.items()}
     out["restitution_reachable"] = (("soil", "block", "bound"), calibration.reachable, {
-        "long_name": "lowest and highest effective restitution the bed's calibrated law reaches", "units": "1"})
+        "long_name": "lowest and highest effective restitution the bed's calibrated law reaches at its admissible xi",
+        "units": "1"})
     return out
 
 

@@ -59,7 +59,7 @@ from rockfrag.measures import MEASURES, pga
 from rockfrag.models import DEFAULT_ATOL, DEFAULT_RTOL, calibrated_law, get_model, simulate_batch
 from rockfrag.models.base import Outcome
 from rockfrag.models.fields import SUMMARY_DTYPE, new_summaries
-from rockfrag.models.variants import BAND_XI_FLOOR, BandCalibration, calibrate_models, split_variant
+from rockfrag.models.variants import BandCalibration, calibrate_models, split_variant
 from rockfrag.outputs import write_dataset
 from rockfrag.processing import ProcessingRecipe, load_recipe, process_records
 from rockfrag.records import Record, group_components, load_records, split_vertical
@@ -360,13 +360,16 @@ def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
             wanted = calibration.requested[0, b, v]
             if moved:
                 where = ", ".join(f"{config.soils[s].name} {calibration.target[s, b, v]:.3f}" for s in moved)
-                lines.append(f"rockfrag: {model}, block {block.name}: the bed (xi >= {BAND_XI_FLOOR}) cannot reach "
-                             f"the band's r = {wanted:.3f}; it runs at the nearest r it reaches ({where})")
+                lines.append(f"rockfrag: {model}, block {block.name}: the bed at its admissible xi (where free "
+                             f"rocking is reproducible) cannot reach the band's r = {wanted:.3f}; it runs at the "
+                             f"nearest r it reaches ({where})")
             if unmeasurable:
+                at = ", ".join(f"{config.soils[s].name} {calibration.xi[s, b, v]:.3g}" for s in range(len(
+                    config.soils)) if config.soils[s].name in unmeasurable)
                 lines.append(f"rockfrag: {model}, block {block.name}: free rocking on {', '.join(unmeasurable)} loses "
-                             f"more at every xi >= {BAND_XI_FLOOR} than the restitution measure resolves (at least "
-                             f"about Housner's r = {block.housner_restitution():.3f}); it runs at xi = "
-                             f"{BAND_XI_FLOOR}")
+                             f"more at every admissible xi than the restitution measure resolves (at least about "
+                             f"Housner's r = {block.housner_restitution():.3f}); it runs at the smallest admissible "
+                             f"xi ({at})")
     return lines
 
 

@@ -19,9 +19,8 @@ from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
 from rockfrag.errors import ConfigError, SolverError
 from rockfrag.fragility import RECOMMENDED, fragility_dataset, fragility_table
 from rockfrag.models import get_model, model_label
-from rockfrag.models.restitution import free_rocking_restitution
+from rockfrag.models.restitution import admissible_xi, free_rocking_restitution, stability, tolerance
 from rockfrag.models.variants import (
-    BAND_XI_FLOOR,
     RESTITUTION_CAP,
     band_target,
     band_variants,
@@ -78,7 +77,7 @@ def _stiffness(block, soils):
     return np.array([[soil_block_stiffness(SOILS[s], block)] for s in soils])
 
 
-def test_reachable_band_targets_are_hit_by_free_rocking_within_one_percent():
+def test_reachable_band_targets_are_hit_by_free_rocking_within_the_tolerance():
     stiffness = _stiffness(PAPER, ["clay", "rock"])
     calibration = calibrate_models([PAPER], ["clay", "rock"], stiffness, band_variants("winkler"), "band",
                                    (1.0, 1.05), "two-spring")
@@ -88,7 +87,14 @@ def test_reachable_band_targets_are_hit_by_free_rocking_within_one_percent():
         for v in range(3):
             measured = free_rocking_restitution(PAPER, float(stiffness[s, 0]), "two-spring",
                                                 float(calibration.xi[s, 0, v]))
-            assert measured == pytest.approx(calibration.target[s, 0, v], rel=0.01)
+            target = calibration.target[s, 0, v]
+            assert abs(measured - target) <= tolerance(target)
+            # at an admissible xi: the smallest, on clay, is above the 0.15 the study used to impose (r spreads 2.4 %
+            # between launches 0.5 and 0.6 alpha at 0.158), and each variant's xi passes the checks itself
+            assert calibration.xi[s, 0, v] >= calibration.smallest_xi[s, 0]
+            assert stability(PAPER, float(stiffness[s, 0]), "two-spring", float(calibration.xi[s, 0, v])).admissible
+    assert calibration.smallest_xi[0, 0] > 0.15 and not stability(PAPER, float(stiffness[0, 0]), "two-spring",
+                                                                    0.158).admissible
 
 
 def test_a_band_edge_the_bed_cannot_reach_runs_at_the_nearest_reachable_r_and_says_so():
@@ -101,21 +107,28 @@ def test_a_band_edge_the_bed_cannot_reach_runs_at_the_nearest_reachable_r_and_sa
     assert high == pytest.approx(CABINET.housner_restitution(), abs=0.005)
     assert calibration.target[0, 0, 2] == pytest.approx(high)
     assert calibration.moved[0, 0].tolist() == [False, True, True]
-    assert calibration.xi.min() >= BAND_XI_FLOOR  # not the bouncing regime below it
+    # not the bouncing regime: the smallest admissible xi of this bed, below which r moves with the launch
+    assert calibration.xi.min() >= calibration.smallest_xi[0, 0] == admissible_xi(CABINET, float(stiffness[0, 0]),
+                                                                                  "two-spring").smallest
     # the bed really rocks at the target it says it runs at
-    assert free_rocking_restitution(CABINET, float(stiffness[0, 0]), "two-spring", float(calibration.xi[0, 0, 2])) \
-        == pytest.approx(calibration.target[0, 0, 2], rel=0.01)
+    target = calibration.target[0, 0, 2]
+    assert abs(free_rocking_restitution(CABINET, float(stiffness[0, 0]), "two-spring", float(calibration.xi[0, 0, 2]))
+               - target) <= tolerance(target)
 
 
-def test_a_squat_block_whose_restitution_the_measure_cannot_resolve_runs_at_the_floor_with_a_nan_target():
+def test_a_squat_block_whose_restitution_the_measure_cannot_resolve_runs_at_its_smallest_admissible_xi():
     skid = Block(name="skid", b=1.5, h=2.0, mass=30000.0, E_b=30e9, footprint_area=6.0, soil_depth=1.5)
     stiffness = _stiffness(skid, ["clay"])
     calibration = calibrate_models([skid], ["clay"], stiffness, band_variants("winkler"), "band", (1.0, 1.05),
                                    "two-spring")
     assert np.isnan(calibration.target).all() and calibration.moved.all()
-    assert np.all(calibration.xi == BAND_XI_FLOOR)
+    smallest = admissible_xi(skid, float(stiffness[0, 0]), "two-spring").smallest
+    assert np.all(calibration.xi == smallest) and calibration.smallest_xi[0, 0] == smallest
+    assert len(calibration.notes) == 3 and all("dies below the measure's resolution" in n for n in calibration.notes)
     # at that xi the free rocking really decays below the measure's floor: fewer than two peaks above 0.1 alpha
-    assert np.isnan(free_rocking_restitution(skid, float(stiffness[0, 0]), "two-spring", BAND_XI_FLOOR))
+    for fraction in (0.5, 0.6, 0.7):
+        assert np.isnan(free_rocking_restitution(skid, float(stiffness[0, 0]), "two-spring", smallest,
+                                                 fraction=fraction))
 
 
 def test_a_single_target_the_bed_cannot_reach_is_an_error_naming_block_and_soil():

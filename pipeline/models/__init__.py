@@ -95,7 +95,10 @@ def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options
                               f"calibrates xi; restitution = {options.restitution!r}, xi = {xi!r})")
         if k is None:
             raise SolverError(f"model {model.name!r} needs the interface stiffness k [N/m]")
-        xi = calibrate_dissipation(block, k, options.bed, options.restitution, g=options.g)
+        dissipation = calibrate_dissipation(block, k, options.bed, options.restitution, g=options.g)
+        if dissipation.note:
+            warnings.warn(dissipation.note, stacklevel=3)
+        xi = dissipation.xi
         options = replace(options, bed=calibrated_law(options.bed), restitution=None)
     return case_record(model, block, k, xi, options)
 
@@ -205,8 +208,9 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         ``hunt-crossley`` (``BED_TYPES``);
         ``restitution`` [-]: pivot models, the impact coefficient from 0 to 1 (default: Housner's
         1 - 1.5 sin^2 alpha for housner, 1 for ssi, whose spring-dashpot dissipates); winkler, the target
-        effective restitution < 1 of free rocking to which the bed's damping is calibrated (the continuous
-        bed then takes Hunt-Crossley damping; rockfrag.models.restitution); ``"housner"`` is
+        effective restitution < 1 of free rocking to which the bed's damping is calibrated, at the smallest
+        xi where free rocking is reproducible and hits it within 5 % of its loss (the continuous bed then
+        takes Hunt-Crossley damping; ``rockfrag.models.restitution.calibrate_dissipation``); ``"housner"`` is
         1 - 1.5 sin^2 alpha of the block;
         ``g`` [m/s^2]: gravity, default 9.80665;
         ``overturn_angle`` [rad]: the |theta| of overturning (terminal), up to pi/2 (default);
@@ -231,7 +235,9 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         ``ag_vertical`` not sampled as ``ag`` or not finite; no ``k`` for a model with a foundation, or
         ``k``, ``xi`` or an option out of range (``friction`` not a positive coefficient or pair with
         mu_s >= mu_k, or given to a tied model such as ssi); winkler given both ``xi`` and ``restitution``, or
-        a ``restitution`` target its bed cannot reach.
+        a ``restitution`` target its bed reaches only where free rocking is not reproducible, or not at all
+        (the message names the admissible xi and the r they reach). A block whose free rocking dies below
+        the measure's resolution at every admissible xi runs at the smallest one with one warning.
     TypeError
         An option that is not a ``SolverOptions`` field.
 

@@ -12,11 +12,16 @@ Housner predicts, or a few percent less; the band runs the admissible model from
 r_H = 1 - 1.5 sin^2(alpha) to min(1.05 r_H, 0.99) and its spread is the model uncertainty of the recommended
 fragility (rockfrag.fragility). The centre is the arithmetic middle of the two edges.
 
-Where a bed cannot reach an edge (``restitution.reachable_range``: a stiff two-spring bed stays within
-0.5% of Housner's value; the squat skid's bed never dissipates as much as Housner's formula for alpha 0.64),
-the target used is the nearest end of the reachable range. This is the one place a target is moved: a
-``simulate(..., restitution=r)`` call still refuses an unreachable r. Each moved target is written beside
-the requested one in the cube (``restitution_requested``, ``restitution_target``) and listed by the study.
+Each variant is calibrated by the one rule of ``simulate(..., restitution=r)``
+(``restitution.calibrate_dissipation``: the smallest admissible xi, where free rocking is reproducible, that
+hits the target within its tolerance); the floor of xi is that rule's consequence per block and bed
+(``restitution.admissible_xi``), not a constant. Where the admissible xi cannot reach an edge (a stiff
+two-spring bed stays near Housner's value), the target used is the nearest end of the range they reach.
+This is the one place a target is moved: a ``simulate(..., restitution=r)`` call still refuses an
+unreachable r. Each moved target is written beside the requested one in the cube
+(``restitution_requested``, ``restitution_target``) and listed by the study. Where free rocking dies below
+the measure's resolution at every admissible xi (the squat skid), the variant runs at the smallest admissible
+xi with a NaN target and one note.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ import numpy as np
 
 from rockfrag.blocks import Block
 from rockfrag.errors import SolverError
-from rockfrag.models.restitution import calibrate_dissipation, calibrated_law, reachable_range, restitution_target
+from rockfrag.models.restitution import admissible_xi, calibrate_dissipation, calibrated_law, restitution_target
 from rockfrag.units import STANDARD_GRAVITY
 
 RECOMMENDED = "recommended"
@@ -39,11 +44,6 @@ BAND_ROLES = {"low": 0.0, "centre": 0.5, "high": 1.0}
 BAND_LABELS = {"low": "band low edge", "centre": "band centre", "high": "band high edge"}
 RESTITUTION_CAP = 0.99
 """The band's edges are capped here: r = 1 would be a block that never loses energy at an impact."""
-BAND_XI_FLOOR = 0.15
-"""The band's variants are calibrated with xi from here up: below about 0.15 the default blocks bounce on
-stiff two-spring beds and their free-rocking r jumps between neighbouring xi (0.94 to 0.96 for the cabinet on
-steel, 0.74 to 0.85 for the paper block on clay), which is neither reproducible nor cheap (a ringing bed costs
-10-20 times the steps)."""
 DEFAULT_BAND = (1.0, 1.05)
 MOVED_TOLERANCE = 5e-4
 """A target moved by less than this (into a reachable range that ends at it within the grid's resolution) is
@@ -101,7 +101,9 @@ class BandCalibration:
     requested: np.ndarray
     target: np.ndarray
     xi: np.ndarray
-    reachable: np.ndarray  # (n_soil, n_block, 2): the bed's reachable range [-]
+    reachable: np.ndarray  # (n_soil, n_block, 2): the range of r the admissible xi reach [-]
+    smallest_xi: np.ndarray  # (n_soil, n_block): the smallest admissible xi [-] (restitution.admissible_xi)
+    notes: tuple = ()  # one line per cell that runs where free rocking dies below the measure's resolution
 
     @property
     def moved(self) -> np.ndarray:
@@ -148,29 +150,34 @@ def calibrate_models(blocks: list[Block], soil_names: list[str], stiffness: np.n
     shape = (n_soil, n_block, len(models))
     requested, target, xi = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
     reachable = np.full((n_soil, n_block, 2), np.nan)
+    smallest = np.full((n_soil, n_block), np.nan)
+    notes = []
     for s in range(n_soil):
         for b, block in enumerate(blocks):
             k = float(stiffness[s, b])
-            low, high = reachable_range(block, k, bed, g, BAND_XI_FLOOR)
-            reachable[s, b] = low, high
+            where = f"block {block.name!r} on soil {soil_names[s]!r} (K = {k:.3g} N/m)"
+            admissible = admissible_xi(block, k, bed, g)
+            reachable[s, b] = admissible.reachable
+            smallest[s, b] = admissible.smallest if admissible.smallest is not None else np.nan
             for v, name in enumerate(models):
                 role = split_variant(name)[1]
-                if role is None:
-                    wanted = used = restitution_target(block, restitution)
-                    floor = None
-                else:
-                    wanted, floor = band_target(block, band, role), BAND_XI_FLOOR
-                    used = min(max(wanted, low), high) if math.isfinite(low) else math.nan  # NaN: see below
-                requested[s, b, v], target[s, b, v] = wanted, used
-                if role is not None and not math.isfinite(low):
-                    # every xi from the floor up leaves less than the measure can see (a squat block's next peak
-                    # below 0.1 alpha): it loses at least about as much as Housner's rule, the band's low edge;
-                    # the least damping of that range is the nearest to the band
-                    xi[s, b, v] = BAND_XI_FLOOR
-                    continue
+                wanted = restitution_target(block, restitution) if role is None else band_target(block, band, role)
+                requested[s, b, v] = wanted
                 try:
-                    xi[s, b, v] = calibrate_dissipation(block, k, bed, used, g=g, xi_floor=floor)
+                    dissipation = calibrate_dissipation(block, k, bed, wanted, g=g)
                 except SolverError as error:
-                    raise SolverError(f"block {block.name!r} on soil {soil_names[s]!r} (K = {k:.3g} N/m), "
-                                      f"model {name!r}: {error}") from None
-    return BandCalibration(tuple(models), calibrated_law(bed), requested, target, xi, reachable)
+                    low, high = admissible.reachable
+                    if role is None or not math.isfinite(low):
+                        raise SolverError(f"{where}, model {name!r}: {error}") from None
+                    # a band variant runs at the nearest r the admissible xi reach (listed by the study)
+                    try:
+                        dissipation = calibrate_dissipation(block, k, bed, min(max(wanted, low), high), g=g)
+                    except SolverError as error:
+                        raise SolverError(f"{where}, model {name!r}: {error}") from None
+                xi[s, b, v] = dissipation.xi
+                # "dies": the measure cannot resolve r there (NaN); it loses at least about Housner's value
+                target[s, b, v] = dissipation.target if dissipation.decision == "hit" else np.nan
+                if dissipation.note:
+                    notes.append(f"{where}, model {name!r}: {dissipation.note}")
+    return BandCalibration(tuple(models), calibrated_law(bed), requested, target, xi, reachable, smallest,
+                           tuple(dict.fromkeys(notes)))
