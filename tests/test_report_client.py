@@ -90,7 +90,7 @@ def test_the_summary_is_page_two_with_every_asset_and_soil_and_the_contents_foll
             block = row[0]
         else:
             rows.add((block, row[0]))
-            assert row[1] in ("anchor or restrain", "no action", "specialist check", "no verdict"), row
+            assert row[1].split(" (")[0] in ("anchor or restrain", "no action", "specialist check", "no verdict"), row
             assert row[-1] and row[-1] != "-", row  # a reason on every row
     expected = {(block_name(results.config, b), str(s)) for b in results.cube.block.values
                 for s in results.cube.soil.values}
@@ -171,3 +171,17 @@ def test_the_last_page_of_a_run_of_text_is_never_near_empty():
     assert min(lines) >= BALANCE * capacity * 0.8, lines
     rows = [row for page in pages for item in page if item.kind == "table" for row in item.rows]
     assert rows == [[str(n), "x"] for n in range(18)]  # every row once, in order
+
+
+def test_a_verdict_whose_sliding_was_not_computed_says_it_covers_rocking_only():
+    """A study that ties a base (its [solver] friction) gets verdicts that say so (issue 32 item 3): the summary's
+    action reads "no action (rocking only)" there, and a verdict that is itself the sliding check does not."""
+    from types import SimpleNamespace
+
+    from rockfrag.answer import CHECK_SLIDING, NO_ACTION
+    from rockfrag.report.summary import action
+
+    assert action(NO_ACTION, SimpleNamespace(tied=True, verdict=NO_ACTION)) == "no action (rocking only)"
+    assert action(NO_ACTION, SimpleNamespace(tied=False, verdict=NO_ACTION)) == "no action"
+    assert action(CHECK_SLIDING, SimpleNamespace(tied=True, verdict=CHECK_SLIDING)) == "specialist check"
+    assert action(NO_ACTION) == "no action"

@@ -191,9 +191,9 @@ CAPTIONS = {
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
     "applicability": "Read where the rigid-base model is good enough: each line is one foundation model (its colour "
                      "and dashes) for one block (its marker): the median peak angle of the runs between 1.2 and 3 "
-                     "times the block's uplift threshold over the rigid base's. Grey band: within 10% of the rigid "
-                     "base. Green band: 300-1000 MPa, the soil stiffness above which the paper finds the rigid base "
-                     "good enough. Top axis: the study's soils. Lines that coincide hide each other.",
+                     "times the block's uplift threshold over the rigid base's. Grey shading: within 10% of the "
+                     "rigid base. Green shading: 300-1000 MPa, the soil stiffness above which the paper finds the "
+                     "rigid base good enough. Top axis: the study's soils. Lines that coincide hide each other.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "

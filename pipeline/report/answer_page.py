@@ -289,7 +289,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     rows.append(["β of the answering curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
     from rockfrag.report.summary import action
 
-    rows.append(["action", "", *(action(soil.verdict) for soil in answer.soils)])
+    rows.append(["action", "", *(action(soil.verdict, soil) for soil in answer.soils)])
     items.append(table(header, rows))
     return items
 

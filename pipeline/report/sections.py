@@ -61,7 +61,7 @@ from rockfrag.report.adapters import (
     vertical_applied,
 )
 from rockfrag.report.layout import pretty
-from rockfrag.report.text import Item, bullet, heading, note, paragraph, table
+from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
@@ -317,6 +317,8 @@ def title_items(results: Results) -> list[Item]:
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
         *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
+        *([strong("The hazard is the shipped example, not a site's: the verdicts apply to no real site.")]
+          if any(answer.example_hazard for answer in results.answers) else []),
         paragraph("The next page is the summary: the action for each block on each soil, and why. Then the "
                   "contents, one answer page per block (at the site's return periods, how likely each damage state "
                   "is, how likely in the design life, and what the records did), the fragility of each block on each "
@@ -599,14 +601,15 @@ def methods_items(results: Results) -> list[Item]:
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
                         "files and each record's processing steps are stored with the results.")]
 
-    levels = cube.im_level.values
-    spacing = "geometric" if levels.size > 2 and np.allclose(np.diff(np.log(levels)), np.log(levels[1] / levels[0]),
-                                                              rtol=1e-3) else "as listed"
+    # levels re-spaced per block up to the credible cap: im_level numbers them, level_multiple holds the multiples
+    levels = cube.level_multiple.values if "level_multiple" in cube.variables else cube.im_level.values[None, :]
+    spacing = "geometric" if levels.shape[1] > 2 and np.allclose(
+        np.diff(np.log(levels), axis=1), np.log(levels[:, 1:2] / levels[:, :1]), rtol=1e-3) else "as listed"
     measure = measure_label(cube)
     median_factor, largest_factor = scale_factor_summary(cube)
     relative = cube.im_level.attrs.get("units") == "1"
     scale, unit = display_scale(_level_units(cube))
-    text = (f"Each processed record is scaled linearly to {levels.size} levels of {measure}, "
+    text = (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure}, "
             f"{levels.min():.3g} to {levels.max():.3g}"
             f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}. Scale factors: "
             f"median {median_factor:.2g}, largest {largest_factor:.3g}.")
@@ -736,7 +739,7 @@ def _counts(fragility, model, block, soil, state, n_records) -> str:
 
 
 NO_MEDIAN = {"below-range": "reached below the lowest level", "above-range": "reached only at the highest levels",
-             "not-reached": "no record reached it"}
+             "not-reached": "no record reached it", "censored-at-cap": "median above the credible cap"}
 """Why a curve has no median: the reason column of the limitations' table (short: one table row each)."""
 OUTSIDE = {"below": "below the lowest level", "above": "above the highest level"}
 """Where an extrapolated median lies: the reason column of the limitations' table."""

@@ -36,9 +36,21 @@ EXAMPLE_WARNING = ("The hazard of this report is the shipped example curve, not 
 """The summary's first line when the hazard is the shipped example."""
 
 
-def action(verdict: str) -> str:
-    """A verdict in the client's words ("anchor or restrain")."""
-    return ACTION_WORDS.get(verdict, str(verdict).replace("_", " "))
+def action(verdict: str, soil=None) -> str:
+    """A verdict in the client's words ("anchor or restrain").
+
+    With ``soil``: "(rocking only)" beside it where the study did not compute that base's sliding (``SoilAnswer.tied``).
+    """
+    words = ACTION_WORDS.get(verdict, str(verdict).replace("_", " "))
+    return words + (f" ({ROCKING_ONLY})" if _tied(soil) else "")
+
+
+ROCKING_ONLY = "rocking only"
+"""Said beside a verdict whose base the study tied: its sliding was not computed, so it covers rocking only."""
+
+
+def _tied(soil) -> bool:
+    return bool(getattr(soil, "tied", False)) and getattr(soil, "verdict", None) != CHECK_SLIDING
 
 
 def labels_of(results) -> dict:
@@ -204,7 +216,8 @@ def summary_items(results) -> list[Item]:
                 at = [say_p_at(results, answer, soil, row, i) for i in range(len(periods))]
                 life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.probability(row.limit)})"
                 beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
-            rows.append([soil.soil, action(soil.verdict), state, *at, life_text, beta, reason(results, answer, soil)])
+            rows.append([soil.soil, action(soil.verdict, soil), state, *at, life_text, beta,
+                         reason(results, answer, soil)])
     items.append(paragraph(
         f"Per asset and soil: the action, the damage state that governs it, that state's probability at the site's "
         f"intensity of each return period and in the design life of {life}, with {hazard_words(results, first)}; the "
@@ -212,8 +225,10 @@ def summary_items(results) -> list[Item]:
     items.append(table(header, rows))
     items.append(note("'Anchor or restrain': a probability in the design life is above its limit; the block must not "
                       "stand free. 'Specialist check': the base would slide, and its sliding was not computed. 'No "
-                      "action': every judged damage state is within its limit. '< X': no record reached the state up "
-                      "to the largest intensity recorded, so its probability is at most X, that of exceeding it. "
+                      "action': every judged damage state is within its limit. 'Rocking only': the study did not "
+                      "compute this base's sliding, so the verdict covers rocking and overturning only. '< X': no "
+                      "record reached the state up to the largest intensity recorded, so its probability is at most "
+                      "X, that of exceeding it. "
                       "Reason: the records at the level run at or below the largest return period's intensity. β: "
                       "records, the variability from record to record; model, the model's own uncertainty. The "
                       "answer pages give every damage state and the records behind each number."))
@@ -232,6 +247,10 @@ def verdict_items(results, answer) -> list[Item]:
     for verdict, soils in groups.items():
         where = _and([soil.soil for soil in soils])
         parts.append(f"{action(verdict)} on {where}")
+    tied = [soil.soil for soil in answer.soils if _tied(soil)]
+    if tied:
+        parts.append(f"sliding was not computed on {_and(tied)} (the study ties the base there), so those verdicts "
+                     "cover rocking and overturning only")
     items = [strong(lead + "; ".join(parts) + ".")]
     for soil in answer.soils:
         row = governing(soil)

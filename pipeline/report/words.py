@@ -38,6 +38,7 @@ STATUS_WORDS = {
     "above-range": "reached only at the highest levels: median above the studied range",
     "below-range": "reached by most records at the lowest level: median below the studied range",
     "not-reached": "not reached at any level",
+    "censored-at-cap": "median above the credible cap: the records' fraction at the cap instead",
     "deterministic-threshold": "an exact step at the uplift threshold",
     "separated": "a step between two levels",
     "no fit": "no fit",
