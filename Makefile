@@ -16,7 +16,7 @@ CONSUMERS := $(patsubst tests/consumers/%.txt,%,$(filter-out %.no-deps.txt,$(wil
 CONSUMER_STAMPS := $(CONSUMERS:%=.venv-%/.installed)
 
 .DEFAULT_GOAL := help
-.PHONY: help install consumers warm warm-imports lint test test-fast records cube fragility bench clean
+.PHONY: help install consumers warm warm-imports lint test test-fast docs records cube fragility bench clean
 
 help:  ## list the targets
 	@echo "rockfrag make targets:"
@@ -35,10 +35,10 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv --without-pip $(VENV)
 	$(PYTHON) -m pip --python $(BIN)/python install --quiet --no-compile 'uv>=0.5' \
 	  || { $(PYTHON) -m venv $(VENV) && $(BIN)/python -m pip install --quiet --no-compile 'uv>=0.5'; }
-	$(UV) pip install --quiet --python $(BIN)/python -e '.[test]'
+	$(UV) pip install --quiet --python $(BIN)/python -e '.[test,docs]'
 	touch $(STAMP)
 
-install: $(STAMP)  ## create .venv and install rockfrag with its test tools
+install: $(STAMP)  ## create .venv and install rockfrag with its test and documentation tools
 
 # A consumer environment never stops make: a failed build leaves no stamp, and the test that needs it fails
 # under `make test` (ROCKFRAG_CONSUMERS=required) with the log's name, after every other test has run.
@@ -79,6 +79,15 @@ test-fast: warm  ## the tests without the `slow` ones, for while you work (consu
 	$(BIN)/ruff check .
 	$(PYTEST) -m "not slow"
 
+# The site is built afresh each time (what an earlier build generated is removed; -E: autodoc pages would not notice a
+# changed docstring otherwise), warnings are errors, and every tutorial executes (docs/conf.py). `make test` builds it too: tests/test_docs.py runs this target
+# on one pytest worker beside the other tests.
+DOCS_HTML := docs/_build/html
+docs: $(STAMP)  ## build the documentation site into docs/_build/html (tutorials executed, warnings are errors)
+	rm -rf docs/_build docs/_generated docs/tutorials docs/reference/api
+	$(BIN)/python -m sphinx -E -W --keep-going -q -b html -d docs/_build/doctrees docs $(DOCS_HTML)
+	@echo "the site: $(DOCS_HTML)/index.html"
+
 lint: $(STAMP)  ## the style gate alone: ruff (pyflakes, pycodestyle at 120 characters, import order, numpy docstrings)
 	$(BIN)/ruff check .
 
@@ -96,4 +105,5 @@ bench: $(STAMP)  ## solver and study benchmarks (prints figures; not part of the
 
 clean:  ## remove generated reports, caches and the virtual environments
 	rm -rf $(REPORTS) $(VENV) .venv-* .pytest_cache .hypothesis build *.egg-info
+	rm -rf docs/_build docs/_generated docs/tutorials docs/reference/api
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +
