@@ -84,7 +84,7 @@ test-fast: warm  ## the tests without the `slow` ones, for while you work (consu
 # on one pytest worker beside the other tests.
 DOCS_HTML := docs/_build/html
 docs: $(STAMP)  ## build the documentation site into docs/_build/html (tutorials executed, warnings are errors)
-	rm -rf docs/_build docs/_generated docs/tutorials docs/reference/api
+	rm -rf docs/_build docs/_generated docs/tutorials docs/reference/api docs/sg_execution_times.rst
 	$(BIN)/python -m sphinx -E -W --keep-going -q -b html -d docs/_build/doctrees docs $(DOCS_HTML)
 	@echo "the site: $(DOCS_HTML)/index.html"
 
@@ -105,5 +105,5 @@ bench: $(STAMP)  ## solver and study benchmarks (prints figures; not part of the
 
 clean:  ## remove generated reports, caches and the virtual environments
 	rm -rf $(REPORTS) $(VENV) .venv-* .pytest_cache .hypothesis build *.egg-info
-	rm -rf docs/_build docs/_generated docs/tutorials docs/reference/api
+	rm -rf docs/_build docs/_generated docs/tutorials docs/reference/api docs/sg_execution_times.rst
 	find . -name __pycache__ -type d -prune -exec rm -rf {} +
