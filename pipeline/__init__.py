@@ -23,6 +23,70 @@ Beside the flow: ``calibrate`` (fit k and xi to a reference, paper eq. 17) and `
 ``errors``, ``units`` (SI constants), ``outputs`` (atomic writes, the one netCDF writer),
 ``checkpoints`` and ``locking``. ``cli`` ties the stages to the ``rockfrag`` command (``__main__``:
 ``python -m rockfrag``).
+
+The public API is this package's ``__all__``: ``import rockfrag``, then ``rockfrag.simulate``, ``rockfrag.Block``,
+``rockfrag.load_study``, ``rockfrag.run_study``, ... Everything else is internal: its modules may change between
+versions. Each name is imported from its stage on first use (module ``__getattr__``), so ``import rockfrag`` stays
+light for the command line (the version alone, ``rockfrag.version``); ``api`` holds the API's own functions where
+a stage's signature carries internal plumbing.
 """
 
-__version__ = "0.1.0"
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+from rockfrag.version import __version__
+
+if TYPE_CHECKING:  # the names as type checkers and readers see them; at run time __getattr__ imports each
+    from rockfrag.api import run_study
+    from rockfrag.blocks import Block
+    from rockfrag.config import load_study
+    from rockfrag.errors import ConfigError, PipelineError, RecordError, SolverError
+    from rockfrag.fragility import fragility_dataset
+    from rockfrag.hazard import load_hazard
+    from rockfrag.models import simulate
+    from rockfrag.processing import load_recipe, process_record
+    from rockfrag.records import load_records
+    from rockfrag.risk import annual_frequency, probability_in_life, risk_dataset
+    from rockfrag.soils import SoilClass
+
+_HOMES = {
+    # the model
+    "simulate": "rockfrag.models", "Block": "rockfrag.blocks", "SoilClass": "rockfrag.soils",
+    # the study: definition, inputs, run
+    "load_study": "rockfrag.config", "load_records": "rockfrag.records", "load_recipe": "rockfrag.processing",
+    "process_record": "rockfrag.processing", "run_study": "rockfrag.api",
+    # from the cube to the risk
+    "fragility_dataset": "rockfrag.fragility", "load_hazard": "rockfrag.hazard", "risk_dataset": "rockfrag.risk",
+    "annual_frequency": "rockfrag.risk", "probability_in_life": "rockfrag.risk",
+    # what the functions raise
+    "PipelineError": "rockfrag.errors", "ConfigError": "rockfrag.errors", "RecordError": "rockfrag.errors",
+    "SolverError": "rockfrag.errors",
+}
+"""Each public name and the module that defines it."""
+
+__all__ = [
+    "__version__",
+    "simulate", "Block", "SoilClass",
+    "load_study", "load_records", "load_recipe", "process_record", "run_study",
+    "fragility_dataset", "load_hazard", "risk_dataset", "annual_frequency", "probability_in_life",
+    "PipelineError", "ConfigError", "RecordError", "SolverError",
+]
+"""The public API (tests/test_public_api.py: each name has a home in ``_HOMES``, and each function is typed and
+documented)."""
+
+
+def __getattr__(name: str) -> object:
+    """A public name, imported from its module on first use (then cached here)."""
+    home = _HOMES.get(name)
+    if home is None:
+        raise AttributeError(f"module 'rockfrag' has no attribute {name!r}")
+    value = getattr(importlib.import_module(home), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's names with the public ones not imported yet."""
+    return sorted({*globals(), *_HOMES})

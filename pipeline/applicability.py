@@ -22,7 +22,6 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
-from rockfrag import __version__
 from rockfrag.calibrate import correlation
 from rockfrag.executors import shutdown_pool, worker_pool
 from rockfrag.models import get_model, simulate_histories
@@ -30,6 +29,7 @@ from rockfrag.models.base import Outcome
 from rockfrag.outputs import atomic_path, write_dataset
 from rockfrag.soils import interface_stiffness
 from rockfrag.study import StudyRecords, study_records
+from rockfrag.version import __version__
 
 DEFAULT_SHEAR_MODULI = np.geomspace(10e6, 100e9, 13)
 DEFAULT_LEVEL_FACTORS = (1.5, 2.5, 4.0)

@@ -21,10 +21,10 @@ import traceback
 import warnings
 from pathlib import Path
 
-from rockfrag import __version__
 from rockfrag.errors import PipelineError
 from rockfrag.locking import output_lock
 from rockfrag.validation import did_you_mean
+from rockfrag.version import __version__
 
 EXIT_USER_ERROR = 2
 EXIT_PARTIAL = 1

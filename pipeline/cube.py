@@ -24,12 +24,12 @@ import json
 import numpy as np
 import xarray as xr
 
-from rockfrag import __version__
 from rockfrag.measures import MEASURES, file_units, parse_units
 from rockfrag.models import get_model, model_label
 from rockfrag.models.base import Outcome
 from rockfrag.models.fields import FIELDS_BY_NAME, MODE_TIME_FIELDS
 from rockfrag.models.ssi import PAPER_CITATION
+from rockfrag.version import __version__
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is rockfrag.models.base.Outcome.
 OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = (

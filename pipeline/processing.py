@@ -22,6 +22,7 @@ import dataclasses
 import functools
 import inspect
 import math
+import os
 import re
 import tomllib
 from collections.abc import Callable
@@ -32,10 +33,10 @@ from typing import Any
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-from rockfrag import __version__
 from rockfrag.errors import ConfigError, RecordError
 from rockfrag.records import Record
 from rockfrag.validation import Checked, Flag, Number, Table, Text, shown
+from rockfrag.version import __version__
 
 
 @dataclass(frozen=True)
@@ -339,8 +340,27 @@ def recipe_from_dict(data: dict, source="<dict>") -> ProcessingRecipe:
     return ProcessingRecipe(steps, qa, overrides, source)
 
 
-def load_recipe(path=None) -> ProcessingRecipe:
-    """The shipped default recipe, or a user TOML file with the same layout (validated)."""
+def load_recipe(path: str | os.PathLike | None = None) -> ProcessingRecipe:
+    """The shipped default recipe, or a user TOML file with the same layout (validated).
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        A recipe TOML file (the layout of ``pipeline/processing.toml``: ``[[steps]]`` in order, each a
+        ``@processing_step`` name with its parameters, optional ``[qa]`` limits and ``[overrides."RECORD_ID".step]``
+        per record). None: the shipped recipe.
+
+    Returns
+    -------
+    ProcessingRecipe
+        The validated steps, QA limits and per-record overrides, for ``process_record``.
+
+    Raises
+    ------
+    ConfigError
+        Field ``processing``: the file cannot be read or is not TOML; or a step, parameter or value the recipe
+        names is unknown or out of its range.
+    """
     if path is None:
         text = files("rockfrag").joinpath("processing.toml").read_text()
         source = "pipeline/processing.toml"

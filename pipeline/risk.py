@@ -27,9 +27,24 @@ def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, poi
                      lower: float | None = None) -> float:
     """Mean annual frequency of reaching a damage state with a lognormal fragility [1/yr].
 
-    beta = 0 is a step at the median: lambda_DS = lambda(median). ``lower`` (IM units) keeps only the
-    intensities from it on: the part of lambda_DS above the lowest level at which a record reached the
-    state (rockfrag.answer), the rest being the fitted curve's tail alone.
+    Parameters
+    ----------
+    median : float
+        The fragility's median, in the hazard curve's intensity unit (g for PGA and Sa).
+    beta : float
+        Its lognormal dispersion [-]; 0 is a step at the median: lambda_DS = lambda(median).
+    hazard : HazardCurve or None
+        The site's hazard curve (``rockfrag.load_hazard``); None gives NaN.
+    points : int, optional
+        Points of the logarithmic integration grid over median x exp(+-8 beta) (default 4000).
+    lower : float, optional
+        Keep only the intensities from ``lower`` on (IM units): the part of lambda_DS above the lowest level at
+        which a record reached the state (rockfrag.answer), the rest being the fitted curve's tail alone.
+
+    Returns
+    -------
+    float
+        lambda_DS = integral of P(DS | im) |d lambda(im)| [1/yr]; NaN without a hazard or a finite median and beta.
     """
     if hazard is None or not (np.isfinite(median) and np.isfinite(beta)):
         return np.nan
@@ -50,7 +65,20 @@ def annual_frequency(median: float, beta: float, hazard: HazardCurve | None, poi
 
 
 def probability_in_life(frequency: ArrayLike, years: float) -> np.ndarray:
-    """Poisson probability [-] of at least one occurrence in ``years`` at ``frequency`` [1/yr]."""
+    """Poisson probability [-] of at least one occurrence in ``years`` at ``frequency`` [1/yr].
+
+    Parameters
+    ----------
+    frequency : array_like
+        Mean annual frequencies [1/yr] (``annual_frequency``).
+    years : float
+        The design life [years].
+
+    Returns
+    -------
+    numpy.ndarray
+        1 - exp(-frequency x years) [-], shaped as ``frequency``.
+    """
     return 1.0 - np.exp(-np.asarray(frequency) * years)
 
 

@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from rockfrag import __version__
 from rockfrag.errors import ConfigError, PipelineError
 from rockfrag.measures import intensity_measures, response_spectrum, significant_window
 from rockfrag.models import get_model, simulate
@@ -34,6 +33,7 @@ from rockfrag.processing import integrate, process_record
 from rockfrag.records import load_records
 from rockfrag.soils import soil_block_stiffness
 from rockfrag.study import StudyRecords, cell_friction, study_records
+from rockfrag.version import __version__
 
 PAPER_RECORD = "DUZCE/BOL090"
 SPECTRUM_PERIODS = np.geomspace(0.02, 10.0, 60)

@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "pipeline"
 
 LAYERS: list[tuple[str, ...]] = [
     # 0 foundations: the version, exceptions, SI constants, atomic writes, fit numerics on arrays
-    ("rockfrag", "rockfrag.errors", "rockfrag.units", "rockfrag.outputs", "rockfrag.lognormal_fit"),
+    ("rockfrag.version", "rockfrag.errors", "rockfrag.units", "rockfrag.outputs", "rockfrag.lognormal_fit"),
     # 1 plumbing shared by stages: value checks, file locks, checkpoints, worker pools
     ("rockfrag.validation", "rockfrag.locking", "rockfrag.checkpoints", "rockfrag.executors"),
     # 2 inputs: record readers and signal processing
@@ -42,12 +42,19 @@ LAYERS: list[tuple[str, ...]] = [
     ("rockfrag.report", "rockfrag.report.*", "rockfrag.answer"),
     # 10 the command
     ("rockfrag.cli", "rockfrag.__main__"),
+    # 11 the public API: the package root names the stages' functions (imported on first use), api its own
+    ("rockfrag", "rockfrag.api"),
 ]
 """Layer order, bottom first: a module may import its own layer and those below it, never above."""
 
-ALLOWED_EDGES: set[tuple[str, str]] = set()
+ALLOWED_EDGES: set[tuple[str, str]] = {
+    # study.py takes the version from the package root (``from rockfrag import __version__``), which is now the
+    # public API at the top; study.py is being rewritten on another branch (issue 33 left it alone): its import
+    # becomes ``from rockfrag.version import __version__`` there, as in every other module, and this entry goes.
+    ("rockfrag.study", "rockfrag"),
+}
 """Known violations (importer, imported) left for the coordinator to remove after merging the issue 17
-branches; each entry says why. Empty: the graph is clean."""
+branches, or for another branch to remove; each entry says why."""
 
 
 def module_name(path: Path) -> str:

@@ -7,14 +7,22 @@ hold the numpydoc sections a reader looks for (Parameters and Returns, with ever
 
 from __future__ import annotations
 
+import importlib
 import inspect
 import re
+import subprocess
+import sys
 
+import numpy as np
 import pytest
 
+import rockfrag
 from rockfrag import calibrate, config, fragility, hazard, models, outputs, processing, records, risk
 
-PUBLIC_API = [
+ROOT_API = [getattr(rockfrag, name) for name in rockfrag.__all__ if inspect.isfunction(getattr(rockfrag, name))]
+"""The functions of ``import rockfrag`` (the package's ``__all__``)."""
+
+PUBLIC_API = [*ROOT_API,
     models.simulate,
     models.simulate_batch,
     models.simulate_histories,
@@ -30,7 +38,8 @@ PUBLIC_API = [
     hazard.study_hazard,
     outputs.write_dataset,
 ]
-"""The functions the README and the docs tell users to call."""
+"""The functions the README and the docs tell users to call: the package root's and a few of the stages'."""
+PUBLIC_API = list(dict.fromkeys(PUBLIC_API))
 
 
 def _section(doc: str, title: str) -> str | None:
@@ -82,3 +91,76 @@ def test_the_section_parser_can_fail():
         test_public_function_has_numpydoc_sections(undocumented)
     with pytest.raises(AssertionError, match="no 'Parameters' section"):
         test_public_function_has_numpydoc_sections(lambda: None)
+
+
+# ---------------------------------------------------------------- the package root is the API
+
+def test_the_root_names_the_functions_the_issue_lists():
+    wanted = {"simulate", "Block", "SoilClass", "load_study", "load_records", "process_record", "run_study",
+              "fragility_dataset", "risk_dataset", "annual_frequency", "probability_in_life", "load_hazard"}
+    assert wanted <= set(rockfrag.__all__)
+    assert set(rockfrag.__all__) == {"__version__", *rockfrag._HOMES}  # every name has one home, and no more
+
+
+@pytest.mark.parametrize("name", [n for n in rockfrag.__all__ if n != "__version__"])
+def test_each_public_name_is_its_stages_own_object(name):
+    home = importlib.import_module(rockfrag._HOMES[name])
+    assert getattr(rockfrag, name) is getattr(home, name)
+    assert inspect.getdoc(getattr(rockfrag, name)), f"rockfrag.{name} has no docstring"
+    assert name in dir(rockfrag)
+
+
+def test_anything_else_is_no_attribute():
+    with pytest.raises(AttributeError, match="no attribute 'study_records'"):
+        getattr(rockfrag, "study_records")  # an internal function of rockfrag.study
+
+
+def test_import_rockfrag_is_light():
+    """The command line imports the package root first: it loads the version alone, none of the stages."""
+    code = ("import sys, rockfrag; heavy = ('numpy', 'scipy', 'obspy', 'xarray', 'numba', 'pandas', 'matplotlib'); "
+            "print(sorted(m for m in sys.modules if m.startswith('rockfrag') or m.split('.')[0] in heavy))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert loaded.strip() == "['rockfrag', 'rockfrag.version']"
+    code = ("import sys, rockfrag; rockfrag.Block; "
+            "print('rockfrag.blocks' in sys.modules, 'rockfrag.study' in sys.modules)")
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True).stdout.split() == ["True", "False"]
+
+
+STUDY = """
+soils = ["rock"]
+models = ["housner"]
+[study]
+record_sets = ["DUZCE/BOL090"]
+[intensity]
+levels = [0.5, 2.0]
+capacity_resolution = 0.0
+[fragility]
+bootstrap = 0
+[solver]
+friction = "none"
+[blocks.cabinet]
+b = 0.3
+h = 1.1
+mass = 400.0
+"""
+
+
+def test_the_api_runs_a_study_from_file_to_risk_and_its_cube_is_simulate(tmp_path):
+    """load_study -> run_study -> fragility_dataset -> risk_dataset with the shipped hazard, all from the root;
+    each cell of the cube is what rockfrag.simulate gives for the processed record times its scale factor."""
+    (tmp_path / "study.toml").write_text(STUDY)
+    study = rockfrag.load_study(tmp_path / "study.toml")
+    cube, statistics = rockfrag.run_study(study, output=tmp_path / "out", workers=1)
+    assert (tmp_path / "out" / "cube.nc").is_file() and statistics["cells"] >= 1
+    [record], failures = rockfrag.load_records("DUZCE/BOL090")
+    processed = rockfrag.process_record(record, rockfrag.load_recipe())
+    for level in range(2):
+        scale = float(cube.scale_factor.isel(record=0, im_level=level, block=0))
+        result = rockfrag.simulate("housner", processed.acceleration * scale, processed.dt, study.blocks[0])
+        assert float(cube.peak_angle.isel(record=0, im_level=level, soil=0, block=0, model=0)) == result.peak_angle
+    fits = rockfrag.fragility_dataset(cube, n_bootstrap=0)
+    risk_of = rockfrag.risk_dataset(fits, rockfrag.load_hazard(), 50.0)
+    assert set(risk_of.data_vars) >= {"annual_frequency", "probability_in_life"}
+    frequency = rockfrag.annual_frequency(0.5, 0.4, rockfrag.load_hazard())
+    assert 0 < frequency < 1 and np.isclose(rockfrag.probability_in_life(frequency, 50.0), 1 - np.exp(-50 * frequency))

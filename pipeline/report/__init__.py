@@ -39,7 +39,6 @@ import xarray as xr  # noqa: E402
 from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from rockfrag import __version__  # noqa: E402
 from rockfrag.config import StudyConfig  # noqa: E402
 from rockfrag.damage_states import damage_states_from_config  # noqa: E402
 from rockfrag.outputs import atomic_path  # noqa: E402
@@ -60,6 +59,7 @@ from rockfrag.report.text import Item, draw_text_page, items_html, note, paginat
 from rockfrag.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
 from rockfrag.report.words import glossary_items, references_items  # noqa: E402
 from rockfrag.units import STANDARD_GRAVITY  # noqa: E402
+from rockfrag.version import __version__  # noqa: E402
 
 PNG_DPI = 100
 G = STANDARD_GRAVITY

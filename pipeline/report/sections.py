@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from rockfrag import __version__
 from rockfrag.answer import (
     DEFAULT_LIMITS,
     DEFAULT_RETURN_PERIODS,
@@ -66,6 +65,7 @@ from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS
+from rockfrag.version import __version__
 
 EXTRAPOLATION_ROWS = 30
 
