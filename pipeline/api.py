@@ -7,8 +7,11 @@ the stages' own functions, which ``rockfrag/__init__.py`` lists.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+
+from rockfrag.errors import PipelineError
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -52,7 +55,12 @@ def run_study(config: StudyConfig, *, output: str | Path | None = None, workers:
         No record could be read, the output folder is unusable or held by another run, or the executor
         options are invalid (``ConfigError`` and ``RecordError`` are kinds of it).
     """
+    from rockfrag.executors import check_scheduler
     from rockfrag.study import run_study as run
 
-    return run(config, output=output, workers=workers, scheduler=scheduler, dask_workers=None,
-               progress=progress, wait=wait)
+    if scheduler == "local":
+        return run(config, output=output, dask_workers=workers or os.cpu_count(), progress=progress, wait=wait)
+    if scheduler is not None and workers is not None:
+        raise PipelineError(f"workers={workers} with scheduler={scheduler!r}: a running cluster has its own workers")
+    check_scheduler(scheduler)  # whether or not cells remain to compute
+    return run(config, output=output, workers=workers, scheduler=scheduler, progress=progress, wait=wait)

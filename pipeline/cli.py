@@ -190,6 +190,9 @@ def _executor_options(args) -> dict:
     if args.workers is not None:
         raise PipelineError(f"--workers {args.workers} with --scheduler {scheduler}: a running cluster has its "
                             "own workers; use --workers with --scheduler local or without --scheduler")
+    from rockfrag.executors import check_scheduler
+
+    check_scheduler(scheduler)  # whether or not cells remain to compute
     return {"scheduler": scheduler}
 
 

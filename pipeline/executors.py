@@ -225,6 +225,36 @@ def dask_executor(function: Callable[..., Any], scheduler: str | None = None,
     return Executor(lambda *a: client.submit(function, *a, pure=False), dask_completed, shutdown)
 
 
+def check_scheduler(scheduler: str | None) -> None:
+    """Connect to the dask scheduler at ``scheduler`` once and let go: the address is checked before the run.
+
+    A run whose cells are all checkpointed never starts an executor, so without this check an address that
+    answers nothing would pass unnoticed (exit 0); with it, every run with ``--scheduler ADDRESS`` has
+    reached its cluster.
+
+    Parameters
+    ----------
+    scheduler : str or None
+        The address of a running scheduler (``tcp://host:8786``); None and ``"local"`` (a cluster this process
+        starts itself) need no check.
+
+    Raises
+    ------
+    PipelineError
+        No scheduler answered at ``scheduler`` within ``connect_timeout()`` seconds.
+    """
+    if not scheduler or scheduler == "local":
+        return
+    from dask.distributed import Client  # optional dependency, only for dask runs
+
+    try:
+        client = Client(scheduler, timeout=f"{connect_timeout():g}s")
+    except (OSError, TimeoutError, ValueError) as error:
+        raise PipelineError(f"cannot connect to the dask scheduler at {scheduler!r} ({error}); "
+                            "expected the address of a running scheduler, e.g. tcp://host:8786") from None
+    client.close()
+
+
 def make_executor(function: Callable[..., Any], workers: int | None = None, scheduler: str | None = None,
                   dask_workers: int | None = None) -> Executor:
     """The executor a stage's options choose.

@@ -71,6 +71,25 @@ def test_unreachable_scheduler_is_one_line(tmp_path):
     assert not (tmp_path / "out").exists()  # nor its empty .checkpoints folder
 
 
+@pytest.mark.slow
+def test_the_scheduler_is_checked_when_every_cell_is_checkpointed(tmp_path, capsys, monkeypatch):
+    """A rerun with nothing left to compute starts no executor: the address is still checked (issue 33)."""
+    study = tmp_path / "study.toml"
+    study.write_text('soils = ["rock"]\nmodels = ["housner"]\n[study]\nrecord_sets = ["DUZCE/BOL090"]\n'
+                     '[intensity]\nlevels = [0.5]\ncapacity_resolution = 0.0\n'
+                     '[blocks.cabinet]\nb = 0.3\nh = 1.1\nmass = 400.0\n')
+    output = tmp_path / "out"
+    assert main(["run", str(study), "--output", str(output), "--serial", "--no-progress"]) == 0
+    capsys.readouterr()
+    assert main(["run", str(study), "--output", str(output), "--serial", "--no-progress"]) == 0
+    assert "1 of 1 cells reused" in capsys.readouterr().out  # nothing left to compute
+    monkeypatch.setenv("ROCKFRAG_DASK_CONNECT_TIMEOUT", "1")
+    status = main(["run", str(study), "--output", str(output), "--scheduler", "tcp://127.0.0.1:9", "--no-progress"])
+    error = capsys.readouterr().err
+    assert status == 2 and error.count("\n") == 1 and "cannot connect to the dask scheduler at 'tcp://127.0.0.1:9'" \
+        in error
+
+
 # ---------------------------------------------------------------- a failed command leaves no trace (issue 21)
 
 def test_a_failed_command_leaves_no_empty_folder_or_lock_behind(tmp_path, capsys):

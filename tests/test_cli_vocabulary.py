@@ -105,7 +105,9 @@ def test_bad_option_values_stop_at_parse_time(arguments, capsys):
     assert "error: argument" in error
 
 
-def test_workers_is_a_pool_size_and_scheduler_chooses_dask():
+def test_workers_is_a_pool_size_and_scheduler_chooses_dask(monkeypatch):
+    checked = []
+    monkeypatch.setattr("rockfrag.executors.check_scheduler", checked.append)  # no cluster at tcp://h:8786
     parser = build_parser()
     assert _executor_options(parser.parse_args(["run", "--workers", "3"])) == {"workers": 3}
     assert _executor_options(parser.parse_args(["run", "--serial"])) == {"workers": 1}
@@ -114,6 +116,7 @@ def test_workers_is_a_pool_size_and_scheduler_chooses_dask():
         {"dask_workers": 2}
     assert _executor_options(parser.parse_args(["run", "--scheduler", "tcp://h:8786"])) == \
         {"scheduler": "tcp://h:8786"}
+    assert checked == ["tcp://h:8786"]  # the address is checked before the run, whatever the run has left to do
     with pytest.raises(PipelineError):
         _executor_options(parser.parse_args(["run", "--scheduler", "tcp://h:8786", "--workers", "2"]))
 

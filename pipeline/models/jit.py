@@ -17,11 +17,20 @@ time; without them a Housner run is 4-5x and a winkler run 3-4x faster, with bit
 rules that make this safe are checked by numba and by tests/physics/test_kernel_rules.py: a ``kernel`` cannot
 allocate (numba refuses to compile an allocation without reference counting) and must not return an
 array (the test inspects every compiled signature), and a run frees every array it allocates.
+
+The first solver call after an install (or a change of a kernel's source) compiles them, 25-45 s on 2 cores;
+later runs load them from numba's on-disk cache. ``COMPILE_NOTICE`` says so on stderr, once per process, when numba
+starts compiling a solver (its ``numba:compile`` event, which a cache hit does not raise).
 """
 
 from __future__ import annotations
 
 import os
+import sys
+
+COMPILE_NOTICE = ("rockfrag: compiling the solvers (first run after an install or a change of their code, about "
+                  "30 s on 2 cores; later runs load them from the cache)...")
+"""The line printed when the solvers compile (not when they load from numba's cache)."""
 
 if os.environ.get("ROCKFRAG_NO_NUMBA", "") not in ("", "0"):
     def njit(*args, **kwargs):
@@ -45,5 +54,25 @@ else:
     def kernel(function):
         """Compile a function of the time loops: cached, without reference counting (see the module docstring)."""
         return njit(**KERNEL_OPTIONS)(function)
+
+    from numba.core import event
+
+    class CompileNotice(event.Listener):
+        """Prints ``COMPILE_NOTICE`` once, when numba starts compiling a function of ``rockfrag.models``."""
+
+        shown = False
+
+        def on_start(self, started):
+            """A compilation starts: the notice, the first time it is one of the solvers'."""
+            function = getattr(started.data.get("dispatcher"), "py_func", None)
+            if not self.shown and getattr(function, "__module__", "").startswith("rockfrag.models"):
+                self.shown = True
+                print(COMPILE_NOTICE, file=sys.stderr, flush=True)
+
+        def on_end(self, ended):
+            """Nothing to do when it ends."""
+
+    FIRST_COMPILE = CompileNotice()
+    event.register("numba:compile", FIRST_COMPILE)
 
 __all__ = ["kernel", "njit"]

@@ -33,7 +33,7 @@ import numpy as np
 import obspy
 
 from rockfrag.errors import ManifestError, RecordError
-from rockfrag.records import asdf, csmip, peer_at2
+from rockfrag.records import asdf, csmip, knet, peer_at2
 from rockfrag.records import text as text_records
 from rockfrag.records.components import ComponentGroup as ComponentGroup
 from rockfrag.records.components import component_label, header_metadata, orientation_metadata
@@ -50,7 +50,8 @@ RECORDS_DIR = shipped_records_dir()
 
 RECORD_SUFFIXES = {".at2"}
 """File endings picked up when a folder is given, plus text records (``text.TEXT_SUFFIXES`` whose content
-is one or two numeric columns) and CSMIP Volume 1 and ASDF files (by content); other formats: name the files."""
+is one or two numeric columns) and CSMIP Volume 1, ASDF and K-NET/KiK-net ASCII files (by content); other
+formats (MiniSEED, SAC, ...): name the files."""
 
 
 class RecordFormat(NamedTuple):
@@ -153,6 +154,8 @@ def read_stream(path: str | Path, format: str | None = None, units: str | None =
     path = Path(path)
     if not path.is_file():
         raise RecordError(path, "file not found")
+    if path.stat().st_size == 0:
+        raise RecordError(path, "empty file (0 bytes); expected a record")
     name = format if format in FORMATS else (None if format else detect_format(path))
     if name is None and format is None and path.suffix.lower() == ".at2":
         name = "PEER_AT2"  # not recognised, but named as AT2: the reader says what is wrong with it
@@ -197,10 +200,21 @@ def read_record(path: str | Path, format: str | None = None, units: str | None =
 
 
 def _read_with_obspy(path, format, units):
+    knet_file = format in (None, "KNET") and knet.is_knet(path)
+    if knet_file:
+        knet.check_header(path)  # obspy's reader stops with a bare exception on a bad header
     try:
-        stream = obspy.read(str(path), format=format)
+        stream = obspy.read(str(path), format="KNET" if knet_file else format)
     except Exception as error:  # obspy raises TypeError/ValueError/... for unknown content
-        raise RecordError(path, f"not a readable record ({type(error).__name__}: {error}); "
+        reason = " ".join(str(error).split()) or type(error).__name__
+        if knet_file:
+            raise RecordError(path, f"K-NET/KiK-net samples after the header could not be read ({reason}); "
+                              "expected whole numbers of counts, 8 a line") from None
+        if format is None and isinstance(error, TypeError) and "Unknown format" in str(error):
+            raise RecordError(path, f"not a record format rockfrag or obspy recognises; expected one of "
+                              f"{', '.join(list_formats())}, K-NET/KiK-net or another format obspy reads "
+                              "(MiniSEED, SAC, ...)") from None
+        raise RecordError(path, f"not a readable record ({type(error).__name__}: {reason}); "
                           f"expected one of {', '.join(list_formats())} or a format obspy reads") from None
     if len(stream) != 1:
         raise RecordError(path, f"holds {len(stream)} traces; expected one horizontal acceleration "
@@ -545,10 +559,11 @@ def load_records(selection: str | Path | Iterable[str | Path], records_dir: str 
         elif Path(text).is_dir():
             files = sorted(p for p in Path(text).rglob("*")
                            if p.suffix.lower() in RECORD_SUFFIXES or text_records.is_text_record(p)
-                           or csmip.is_csmip(p) or asdf.is_asdf(p))
+                           or csmip.is_csmip(p) or asdf.is_asdf(p) or knet.is_knet(p))
             if not files:
                 raise RecordError(text, f"folder holds no record files ({', '.join(sorted(RECORD_SUFFIXES))}, "
-                                  "CSMIP Volume 1, ASDF, or text/CSV of one or two numeric columns)")
+                                  "CSMIP Volume 1, ASDF, K-NET/KiK-net ASCII, or text/CSV of one or two numeric "
+                                  "columns)")
             for path in files:
                 add(lambda p: _load_user_file(p, units, dt), str(path.resolve()), path)
         elif Path(text).is_file():

@@ -23,7 +23,11 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from rockfrag.errors import RecordError
+from rockfrag.units import STANDARD_GRAVITY
+from rockfrag.version import __version__
 
 _VERTICAL_NAME = re.compile(r"^(?:[A-Z0-9]{2}Z|Z|UD\d?|U-D|UP|DWN|DOWN|V|VER|VERT|VERTICAL)$")
 _FIRST_HORIZONTAL = {"N", "1", "NS"}
@@ -165,8 +169,21 @@ class ComponentGroup:
         """The horizontal components, H1 first."""
         return [record for label, record in self.components.items() if label.startswith("H")]
 
-    def aligned(self) -> dict:
-        """The components cut to the time window they share: label -> Record with equal start, step and length.
+    def aligned(self, cut: bool = False) -> dict:
+        """The components over the time window they share: label -> Record with equal start, step and length.
+
+        Components of one station rarely end on the same sample (the shipped CSMIP files differ by up to 2.6 s
+        at their ends). Cutting them to the shared window is harmless when every component keeps its peak
+        (PGA) and at least ``KEPT_ARIAS`` of its Arias intensity: then the cut is made and stated in each
+        record's processing provenance (``stats.processing``: its window, the samples removed, the PGA kept).
+        Otherwise the window is no longer the record (a vertical holding only its first 10 s would cut the
+        horizontals to pre-event noise): that is an error naming the file, the channels and what the cut would
+        do to their PGA, unless ``cut`` asks for it anyway; then the provenance states the PGA it changed.
+
+        Parameters
+        ----------
+        cut : bool, optional
+            Cut to the shared window even where a component loses its peak or its strong motion (default False).
 
         Returns
         -------
@@ -176,19 +193,19 @@ class ComponentGroup:
         Raises
         ------
         RecordError
-            The components have different time steps, or share no time window.
+            The components have different time steps, share no time window, or (without ``cut``) the shared
+            window leaves out a component's peak or more than 1% of its Arias intensity.
         """
         records = list(self.components.values())
+        where = records[0].metadata.get("file") or records[0].id
         steps = {round(record.dt, 9) for record in records}
         if len(steps) > 1:
-            raise RecordError(records[0].metadata.get("file") or records[0].id,
-                              f"components of {self.station} have different time steps ({sorted(steps)} s); "
+            raise RecordError(where, f"components of {self.station} have different time steps ({sorted(steps)} s); "
                               "resample them first")
         start = max(record.trace.stats.starttime for record in records)
         end = min(record.trace.stats.endtime for record in records)
         if end <= start:
-            raise RecordError(records[0].metadata.get("file") or records[0].id,
-                              f"components of {self.station} share no time window")
+            raise RecordError(where, f"components of {self.station} share no time window ({self._windows()})")
         aligned = {}
         for label, record in self.components.items():
             trace = record.trace.slice(start, end, nearest_sample=True).copy()
@@ -196,7 +213,50 @@ class ComponentGroup:
         length = min(record.trace.stats.npts for record in aligned.values())
         for record in aligned.values():
             record.trace.data = record.trace.data[:length]
+        effects = {label: _cut_effect(self.components[label], aligned[label]) for label in aligned}
+        if all(removed == 0 for removed, *_ in effects.values()):
+            return aligned
+        harmful = {label: effect for label, effect in effects.items()
+                   if effect[2] < effect[1] or effect[3] < KEPT_ARIAS}
+        if harmful and not cut:
+            damage = "; ".join(f"{self._channel(label)}'s PGA {before:.3g} g -> {after:.3g} g, Arias intensity "
+                               f"{kept:.0%} kept" for label, (_, before, after, kept) in harmful.items())
+            raise RecordError(where, f"components of {self.station} differ in length ({self._windows()}); cut to "
+                              f"the {float(end - start):.3g} s they share: {damage}. They are not cut without a word: "
+                              "give the components over one time window")
+        for label, record in aligned.items():
+            removed, before, after, kept = effects[label]
+            trace = record.trace
+            trace.stats.processing = [*trace.stats.get("processing", []),
+                                      f"rockfrag {__version__}: cut_to_shared_window(start={start}, end={end}, "
+                                      f"samples_removed={removed}, pga_g={before:.4g}->{after:.4g}, "
+                                      f"arias_kept={kept:.4f})"]
         return aligned
+
+    def _channel(self, label: str) -> str:
+        """``H1 (HNE)``: a component's label and channel code."""
+        code = self.components[label].metadata.get("channel_code") or self.components[label].trace.stats.channel
+        return f"{label} ({code})" if code else label
+
+    def _windows(self) -> str:
+        """Each component's channel, length [s] and samples, for the messages."""
+        return ", ".join(f"{self._channel(label)} {record.duration:.4g} s from {record.trace.stats.starttime}, "
+                         f"{record.trace.stats.npts} samples" for label, record in self.components.items())
+
+
+KEPT_ARIAS = 0.99
+"""A cut to the components' shared window is made only where each keeps its PGA and this fraction of its Arias
+intensity (of the demeaned samples); the shipped three-component records keep 99.99% or more."""
+
+
+def _cut_effect(whole, cut) -> tuple[int, float, float, float]:
+    """(samples removed, PGA before and after [g], fraction of the Arias intensity kept) of one component's cut."""
+    mean = float(np.mean(whole.acceleration))
+    before, after = whole.acceleration - mean, cut.acceleration - mean
+    energy = float(np.sum(before ** 2))
+    kept = float(np.sum(after ** 2)) / energy if energy > 0 else 1.0
+    return (whole.trace.stats.npts - cut.trace.stats.npts, float(np.max(np.abs(whole.acceleration))) / STANDARD_GRAVITY,
+            float(np.max(np.abs(cut.acceleration))) / STANDARD_GRAVITY if cut.trace.stats.npts else 0.0, kept)
 
 
 def group_key(record) -> tuple[str, str, str]:
