@@ -302,8 +302,8 @@ def command_fragility(args) -> int:
                                             loaded=loaded)
     else:  # not None: the report would read an applicability.nc an earlier run left in the folder
         applicability = xr.Dataset()
-        _log("rockfrag: applicability sweep not run (a study file's default); --applicability or the study's "
-             "[applicability] run = true runs it")
+        _log("rockfrag: the applicability sweep (where Housner's rigid base is good enough; minutes) was not run: "
+             "for a study file it runs with --applicability or the study's [applicability] run = true")
     results_s = time.perf_counter() - started  # the run time the report states: one number, here and there
     pdf, pngs = report_stage(config, cube, ida, fragility, risk, output, results_s, applicability,
                              progress=not args.no_progress, workers=args.workers, run=stats)

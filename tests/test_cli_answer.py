@@ -192,7 +192,7 @@ def test_fragility_ends_with_the_answer_and_skips_the_sweep_of_a_study_file(tiny
     planned, workers = [], []
     monkeypatch.setattr("rockfrag.report.report_stage", _planned_not_rendered(planned, workers))
     captured, calls = _run(study, output, capsys, monkeypatch)
-    assert not calls and "applicability sweep not run" in captured.err and "--applicability" in captured.err
+    assert not calls and "good enough; minutes) was not run" in captured.err and "--applicability" in captured.err
     assert workers == [1]  # --serial: the report's figures are drawn in this process too, no forked worker
     answer = captured.out[captured.out.index("Overturning, model recommended"):].splitlines()
     table = pd.read_csv(output / "fragility.csv")
@@ -213,7 +213,7 @@ def test_quiet_hides_the_answer_and_the_flag_runs_the_sweep(tiny_run, capsys, mo
     # the flags are what is tested here: the report (planned by the test above) is not made again
     monkeypatch.setattr("rockfrag.report.report_stage", lambda *args, **kwargs: (output / "report.pdf", []))
     captured, calls = _run(study, output, capsys, monkeypatch, "--quiet", "--applicability")
-    assert len(calls) == 1 and "Overturning" not in captured.out and "sweep not run" not in captured.err
+    assert len(calls) == 1 and "Overturning" not in captured.out and "was not run" not in captured.err
 
 
 # ---------------------------------------------------------------- the shipped examples
