@@ -90,11 +90,11 @@ def test_the_command_skips_a_bad_knet_file_with_one_line_and_runs_the_rest(tmp_p
 def test_an_empty_file_is_called_empty(tmp_path, capsys):
     path = tmp_path / "record.csv"
     path.write_bytes(b"")
-    with pytest.raises(RecordError, match="empty file \\(0 bytes\\)"):
+    with pytest.raises(RecordError, match="file is empty \\(0 bytes\\)"):
         read_record(path)
     status = main(["records", "--set", str(path), "--output", str(tmp_path / "out"), "--no-progress"])
     error = capsys.readouterr().err
-    assert status == 2 and "empty file" in error and "Unknown format" not in error
+    assert status == 2 and "file is empty" in error and "Unknown format" not in error
 
 
 def test_an_unknown_format_says_which_formats_are_read(tmp_path):

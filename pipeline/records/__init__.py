@@ -155,7 +155,7 @@ def read_stream(path: str | Path, format: str | None = None, units: str | None =
     if not path.is_file():
         raise RecordError(path, "file not found")
     if path.stat().st_size == 0:
-        raise RecordError(path, "empty file (0 bytes); expected a record")
+        raise RecordError(path, "file is empty (0 bytes); expected a record")
     name = format if format in FORMATS else (None if format else detect_format(path))
     if name is None and format is None and path.suffix.lower() == ".at2":
         name = "PEER_AT2"  # not recognised, but named as AT2: the reader says what is wrong with it
