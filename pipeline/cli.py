@@ -455,7 +455,10 @@ def command_study(args) -> int:
             print(f"{key:<{width}}  {value or '-'} | {default or '-'} | {allowed}" + (f" | {note}" if note else ""))
         print("NAME: a table name of your own, e.g. [blocks.cabinet]; units SI unless stated (levels of PGA/Sa in g)")
         return 0
-    check_record_selection(config.record_sets, "study.record_sets", config.source)
+    if args.record_set:  # the selection came from the command line, not the study file
+        check_record_selection(config.record_sets, "--set", "command line")
+    else:
+        check_record_selection(config.record_sets, "study.record_sets", config.source)
     print(f"study '{config.name}' ({config.source}) is valid: {len(config.blocks)} blocks, {len(config.soils)} soils, "
           f"{len(config.models)} models, record sets {', '.join(config.record_sets)} (found; the records themselves "
           f"are read by rockfrag records); output {output}. rockfrag study --keys lists every key.")

@@ -80,7 +80,7 @@ def test_command_line_paths_stay_relative_to_the_working_folder(tmp_path, monkey
     assert main(["study", str(study), "--set", "here"]) == 0, capsys.readouterr().err
     assert main(["study", str(study), "--set", "mine"]) == 2  # the study's folder 'mine' is not the command's
     error = capsys.readouterr().err
-    assert "'mine' not found" in error and error.count("\n") == 1
+    assert "command line: --set: 'mine' not found" in error and error.count("\n") == 1
 
 
 def test_a_missing_input_is_named_where_it_was_looked_for(tmp_path, monkeypatch, capsys):
