@@ -15,6 +15,7 @@ import pytest
 from matplotlib.container import BarContainer
 from matplotlib.transforms import Bbox
 
+from tests.test_report_client import tool_syntax
 from tests.test_report_legibility import _shown_texts, off_page, overprinted
 
 EDGE = 1.5
@@ -196,6 +197,7 @@ def test_lines_drawn_on_the_frame_do_not_fill_a_panel():
 
 @pytest.mark.slow
 def test_every_figure_of_the_small_study_is_free_of_layout_defects(small_pipeline):
+    """Every figure page as the report draws it (the footer included), and its words: no tool syntax either."""
     import xarray as xr
 
     from rockfrag.config import load_study
@@ -217,6 +219,8 @@ def test_every_figure_of_the_small_study_is_free_of_layout_defects(small_pipelin
         try:
             add_footer(figure, "a report title", number, len(planned))
             defects = layout_defects(figure)
+            words = " ".join(text.get_text() for text in figure.findobj(plt.Text))
+            defects += [f"tool syntax: {found}" for found in tool_syntax(f"{words} {page.caption}")]
             if defects:
                 found[page.name] = defects
         finally:

@@ -249,12 +249,15 @@ def plan(results: Results) -> list[Page]:
             with results.facts.writing(f"Answer: {name}"):
                 answers.append((f"answer-{answer.block}", f"Answer: {name}", f"Answer: {name}",
                                 answer_items(results, answer)))
+    with results.facts.writing("Fitted curves"):
+        fitted = fitted_items(results)
+    with results.facts.writing("Limitations"):
+        limitations = limitations_items(results)
     planned += _packed_pages([  # one run of text: a section starts where the one before ends (no near-empty page)
         *answers,
-        ("fitted", "Fitted curves", "Fitted fragility functions", fitted_items(results)),
+        ("fitted", "Fitted curves", "Fitted fragility functions", fitted),
         ("methods", "Methods", "Methods and assumptions", methods_items(results)),
-        ("limitations", "Limitations", "Limitations: where the models are outside their validity",
-         limitations_items(results)),
+        ("limitations", "Limitations", "Limitations: where the models are outside their validity", limitations),
         ("records-table", "Records", "Intensity measures of the processed records",
          [*records_items(results), note("PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) "
                                         "after processing.")])])

@@ -471,7 +471,9 @@ def fitted_items(results: Results) -> list[Item]:
                     if np.isfinite(median) and median > largest:
                         mark += "†"
                     marks.update(mark)
-                    row.append(f"{_g(median)}{mark} / {_beta(beta)}")
+                    shown = results.facts.say("fitted median", (block, model.name, str(picked.soil.values), state),
+                                              _g(median))
+                    row.append(f"{shown}{mark} / {_beta(beta)}")
                 rows.append(row)
     items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β), the answering model "
                        "first. A rigid-base model has one row per block (soil '(any)') unless base friction lets "
@@ -868,9 +870,10 @@ def limitations_items(results: Results) -> list[Item]:
     else:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
-            "lognormal fit beyond the levels that were run (the summary marks them * for the states it shows)."))
+            "lognormal fit beyond the levels that were run (the table of fitted functions marks them * for the "
+            "states it shows)."))
         every_model = [short_label(m) for m in models_of(fragility)]
-        rows = []
+        rows, said = [], []
         for row in outside.itertuples():
             levels = block_levels(fragility, row.block) * scale
             median = row.median * scale
@@ -879,7 +882,11 @@ def limitations_items(results: Results) -> list[Item]:
                          short_states.get(row.damage_state) or labels.get(row.damage_state, row.damage_state),
                          _g(median), f"{levels.min():.2g} to {levels.max():.2g}",
                          OUTSIDE["below" if median < levels.min() else "above"]])
+            said.append(((row.block, row.model, row.soil, row.damage_state), _g(median)))
         rows = _merged(rows, 1, every_model)
+        if len(rows) <= EXTRAPOLATION_ROWS:  # every median is printed: the ledger has them
+            for key, shown in said:
+                results.facts.say("fitted median", key, shown)
         items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
                             "median lies"], rows[:EXTRAPOLATION_ROWS]))
         if len(rows) > EXTRAPOLATION_ROWS:
