@@ -160,16 +160,18 @@ STATION_NAMES = ("Stations are named as the records' source catalogue spells the
 
 
 CAPTIONS = {
-    "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled, the bold "
-               "lines the 16, 50 and 84% fractiles. The study scales every record to each intensity level.",
+    "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled; the 16% "
+               "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
+               "intensity level.",
     "showcase-processing": "Read that processing keeps the record and removes only the drift: raw (grey) and "
                            "processed (blue); the processed displacement ends at rest.",
     "showcase-response": "Read how the soil changes the rocking under one real record, unscaled: θ (left, one scale "
                          "for all panels) and the vertical displacement of the foundation (right, up +); grey: the "
                          "strong-motion window (5-95% Arias). As in the paper's Figs. 4, 7 and 10.",
-    "ida": "Read at which intensity the block starts to rock and where it overturns: thin lines, one record each; "
-           "bold, the 16/50/84% fractiles of θmax/α. Overturning is drawn at the right edge. Dotted: the site's "
-           "return-period intensities; shaded: beyond the largest recorded intensity (extrapolation by scaling). "
+    "ida": "Read at which intensity the block starts to rock and where it overturns: thin grey lines, one record "
+           "each; the 16% (blue dashed), 50% (black) and 84% (red dotted) fractiles of θmax/α. Overturning is drawn "
+           "at the right edge. Dotted: the site's return-period intensities (the legend names them); shaded: "
+           "beyond the largest recorded intensity (extrapolation by scaling). "
            "A block that slides instead of rocking stays at θmax/α = 0. Curves are not smoothed: a record may "
            "overturn at one level and survive a higher one (resurrection).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "

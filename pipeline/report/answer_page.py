@@ -254,8 +254,10 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                         for i in range(len(periods))) for soil in answer.soils)]
             for index, state in enumerate(short)]
     items.append(table(header, rows))
-    counts = [[short[state], *(_joined(_records_cell(soil.states[index], i) for i in range(len(periods)))
-                               for soil in answer.soils)] for index, state in enumerate(short)]
+    counts = [[short[state], *(_joined(results.facts.say("records reaching", (answer.block, soil.soil, state, t),
+                                                         _records_cell(soil.states[index], i))
+                                       for i, t in enumerate(periods)) for soil in answer.soils)]
+              for index, state in enumerate(short)]
     n = int(fragility["n_records"]) if "n_records" in fragility else None
     if any(cell.strip(" /-") for row in counts for cell in row[1:]):
         items.append(paragraph(f"Records that reached each state at those levels{f' (of {n})' if n else ''}:"))

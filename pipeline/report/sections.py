@@ -592,7 +592,9 @@ def methods_items(results: Results) -> list[Item]:
     items.append(table(header, rows))
     items.append(note("b, h: half-width and half-height; E_b: the block's Young's modulus, which with the soil's "
                       "modulus sets the interface stiffness k (the paper's eq. 19); uplift: the ground acceleration "
-                      "at which the block starts to rock on a rigid base."))
+                      "at which the block starts to rock on a rigid base. Each block is a rigid solid block of "
+                      "uniform mass; its description (on its answer page) states the density its mass assumes. Its "
+                      "base friction is the soil's, whatever the block's own base (see 'Reading the answer pages')."))
 
     pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"

@@ -170,6 +170,8 @@ def reason(results, answer, soil) -> str:
         return f"fitted tail only: no record below {first}"
     if row.records and row.records[-1][0] >= 0:
         reached, total, level = row.records[-1]
+        results.facts.say("records reaching", (answer.block, soil.soil, row.state, answer.return_periods[-1]),
+                          str(reached))
         return f"{numbers.count(reached, total)} records reach it at {numbers.intensity(level, unit)}"
     return "from the fitted curve"
 

@@ -171,9 +171,10 @@ GLOSSARY = (
                     "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
     ("record sets", "the earthquake records the study runs; the far-field and near-field sets (with and without a "
                     "velocity pulse) are those of FEMA P695."),
-    ("flies, free flight", "the ground drops faster than gravity (g + a_v < 0 under the vertical component) and "
-                           "the block leaves it: the pivot models stop there, the Winkler bed follows the block "
-                           "through the air until it lands."),
+    ("flies, free flight", "the whole base leaves the ground, a corner at least the uplift size: after an "
+                           "impact on a bed (the block bounces), or in free flight, where the ground drops faster "
+                           "than gravity (g + a_v < 0 under the vertical component); the pivot models stop at free "
+                           "flight, the Winkler bed follows the block through the air until it lands."),
     ("pulse period, pulse acceleration", "of a record's dominant velocity pulse, taken as one full sine cycle: "
                                          "its period T_p and its acceleration amplitude a_p = 2π·PGV/T_p; the "
                                          "efficiency page tests whether the capacity still "
