@@ -167,14 +167,14 @@ def _motions(runs, lifted) -> np.ndarray:
     return np.where(outcome == int(Outcome.FAILED), -1, worst)
 
 
-def motion_counts(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
-    """What the records make the block do at each intensity: how many records enter each motion.
+def motion_tallies(cube, block: str, model: str, soil: str, intensities, scale: float) -> list:
+    """How many records enter each motion at each intensity: a dict motion -> count per intensity.
 
-    "at rest 34, tilts on the bed 6, rocks 4 (of 44)": each record counted once, at its most severe motion
-    (``MOTIONS``), at the level run nearest at or below each intensity (in the answer's unit, ``scale`` times the
-    cube's), the level whose records the probability table counts; ``NO_LEVEL`` where no level lies that low. The
-    records that lift off (rocks, slides and rocks, flies, overturns) are the uplift count of that table. From
-    the runs of ``model`` (the recommended curve's: the restitution band's centre).
+    Each record is counted once, at its most severe motion (``MOTIONS``), at the level run nearest at or below
+    each intensity (in the answer's unit, ``scale`` times the cube's), the level whose records the probability
+    table counts; ``NO_LEVEL`` where no level lies that low, "-" where nothing is known. The records that lift off
+    (rocks, slides and rocks, flies, overturns) are the uplift count of that table. From the runs of ``model``
+    (the recommended curve's: the restitution band's centre).
     """
     if cube is None or "intensity" not in cube:
         return ["-"] * len(intensities)
@@ -197,9 +197,33 @@ def motion_counts(cube, block: str, model: str, soil: str, intensities, scale: f
         if not worst.size:
             out.append("-")
             continue
-        counts = [(MOTIONS[m], int(np.sum(worst == m))) for m in range(len(MOTIONS))]
-        out.append(", ".join(f"{words} {n}" for words, n in counts if n) + f" (of {worst.size})")
+        out.append({MOTIONS[m]: int(np.sum(worst == m)) for m in range(len(MOTIONS))})
     return out
+
+
+def motion_counts(cube, block: str, model: str, soil: str, intensities, scale: float) -> list[str]:
+    """``motion_tallies`` in words: "at rest 34, tilts on the bed 6, rocks 4 (of 44)" per intensity."""
+    return [tally if isinstance(tally, str) else
+            ", ".join(f"{words} {n}" for words, n in tally.items() if n) + f" (of {sum(tally.values())})"
+            for tally in motion_tallies(cube, block, model, soil, intensities, scale)]
+
+
+def motion_table(cube, answer, scale: float) -> Item | None:
+    """The motions of the records per soil: a column per motion any record enters, the return periods in a cell.
+
+    "25 / 14 / 3": at rest in 25, 14 and 3 records at the three return periods' levels (short cells: the table fits
+    the page whatever the counts). None when nothing is known.
+    """
+    tallies = {soil.soil: motion_tallies(cube, answer.block, answer.model, soil.soil, soil_intensities(answer, soil),
+                                         scale) for soil in answer.soils}
+    known = [tally for row in tallies.values() for tally in row if isinstance(tally, dict)]
+    if not known:
+        return None
+    shown = [motion for motion in MOTIONS if any(tally[motion] for tally in known)]
+    total = max(sum(tally.values()) for tally in known)
+    rows = [[soil, *(_joined(str(tally[motion]) if isinstance(tally, dict) else "-" for tally in row)
+                     for motion in shown)] for soil, row in tallies.items()]
+    return table([f"soil (of {total} records)", *shown], rows)
 
 
 def answer_items(results, answer: BlockAnswer) -> list[Item]:
@@ -264,11 +288,11 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(table(header, counts))
     scale = display_scale(cube.intensity.attrs.get("units", ""))[0] if cube is not None and "intensity" in cube \
         else 1.0
-    modes = [[soil.soil, *motion_counts(cube, answer.block, answer.model, soil.soil, soil_intensities(answer, soil),
-                                        scale)] for soil in answer.soils]
-    if any(cell != "-" for row in modes for cell in row[1:]):
-        items.append(paragraph("What the records make the block do at those levels:"))
-        items.append(table(["soil", *map(numbers.years, periods)], modes))
+    motions = motion_table(cube, answer, scale)
+    if motions is not None:
+        items.append(paragraph("What the records make the block do at those levels, each record at its most severe "
+                               "motion:"))
+        items.append(motions)
     sliding = sliding_rows(cube, answer, scale)
     if any(cell not in ("-", NO_LEVEL) for row in sliding for cell in row[1:]):
         items.append(paragraph("Records whose tied base would slide (it needs more friction than the soil "
