@@ -8,7 +8,7 @@ The precision policy, applied here and nowhere else:
 
 - a probability (or a share of records or runs) to two significant figures, "< 0.1%" below 0.1%, "0%" for
   none, "100%" for all, "> 99%" just below all (two figures would round it to a certainty);
-- a computed intensity to two significant figures ("0.54 g");
+- a computed intensity to two significant figures ("0.54 g"); a dispersion β to two decimals ("0.50");
 - an input as the study states it (``as_stated``: "0.35", "50 years");
 - a calibrated model parameter (the bed's damping ratio fitted to a restitution) is not printed for the client.
 """
@@ -70,6 +70,13 @@ def intensity(value, unit: str) -> str:
     return f"{float(value):.2g} {unit}".strip()
 
 
+def dispersion(value) -> str:
+    """A lognormal dispersion β to two decimals ("0.50"); "-" when unknown."""
+    if value is None or not math.isfinite(float(value)):
+        return "-"
+    return f"{float(value):.2f}"
+
+
 def count(reached: int, total: int) -> str:
     """How many records of how many: "10 of 44"."""
     return f"{int(reached)} of {int(total)}"
@@ -123,4 +130,4 @@ class Facts:
         return found
 
 
-__all__ = ["FLOOR", "Facts", "as_stated", "bound", "count", "intensity", "probability", "years"]
+__all__ = ["FLOOR", "Facts", "as_stated", "bound", "count", "dispersion", "intensity", "probability", "years"]

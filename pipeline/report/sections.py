@@ -503,7 +503,7 @@ def _hazard_words(results: Results) -> str:
 
 
 def _beta(value: float) -> str:
-    return f"{value:.2f}" if np.isfinite(value) else "-"
+    return numbers.dispersion(value)
 
 
 STEP_WORDS = {

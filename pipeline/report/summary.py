@@ -134,7 +134,7 @@ def beta_words(results, answer, soil: str, state: str) -> str:
     present = {name for name, _ in BETA_PARTS if name in row and np.isfinite(float(row[name]))}
     parts = [(float(row[name]), words) for name, words in BETA_PARTS if name in present
              and not (name == "beta_model" and {"beta_parameters", "beta_form"} & present)]
-    text = numbers.intensity(total, "").strip()
+    text = numbers.dispersion(total)
     if parts:
         largest, words = max(parts)
         if largest > 0:
