@@ -392,7 +392,21 @@ def verdict_settings(results: Results) -> list[list[str]]:
              "the block itself: its slenderness and size set when it rocks and overturns"],
             ["[damage_states.NAME] edp, threshold", "the shipped damage states",
              "which outcomes are judged, and at what size"]]
+    for table_name, key, what in OPTIONAL_SETTINGS:  # the keys this version of the study has, with their value
+        values = raw.get(table_name) or {}
+        if isinstance(values, dict) and key in values:
+            rows.append([f"[{table_name}] {key}", _toml(values[key]), what])
     return rows
+
+
+OPTIONAL_SETTINGS = (
+    ("hazard", "reference_vs30", "the Vs30 of the hazard file's site: each soil's site hazard is amplified from it"),
+    ("hazard", "vs30", "a soil's site Vs30: the site hazard its probabilities use"),
+    ("intensity", "credible_max", "the credible cap on the intensity: no level, fit or median above it, and the "
+                                  "hazard's exceedance of it a stated bound"),
+    ("intensity", "component", "which horizontal component the intensity is of: it must be the hazard's"),
+)
+"""Settings that change a verdict where the study has them: (table, key, what it changes)."""
 
 
 def reproduce_items(results: Results) -> list[Item]:
