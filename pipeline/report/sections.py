@@ -903,8 +903,8 @@ def limitations_items(results: Results) -> list[Item]:
         if len(rows) <= EXTRAPOLATION_ROWS:  # every median is printed: the ledger has them
             for key, shown in said:
                 results.facts.say("fitted median", key, shown)
-        items.append(table(["block", "model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
-                            "median lies"], rows[:EXTRAPOLATION_ROWS]))
+        items.append(table(["model", "soil", "damage state", f"median [{unit}]", f"studied range [{unit}]",
+                            "median lies"], by_block(rows[:EXTRAPOLATION_ROWS])))
         if len(rows) > EXTRAPOLATION_ROWS:
             items.append(note(f"... and {len(rows) - EXTRAPOLATION_ROWS} more: in the result tables (see 'How to "
                               "reproduce this report')."))
@@ -920,8 +920,8 @@ def limitations_items(results: Results) -> list[Item]:
         items.append(paragraph(f"{len(unfitted)} curves have no median. The records that reached the state at the "
                                "lowest and the highest level of the block say why; a state no record reached at any "
                                "level is one row per block and state, naming its models and soils:"))
-        items.append(table(["block", "model", "soil", "damage state", "records reaching it: lowest, highest level",
-                            "why no median"], rows))
+        items.append(table(["model", "soil", "damage state", "records reaching it: lowest, highest level",
+                            "why no median"], by_block(rows)))
 
     items += free_flight_items(cube, models)
     items.append(heading("Solver"))
@@ -973,6 +973,21 @@ def _soils_words(names, every_soil) -> str:
         return "every soil"
     missing = [soil for soil in every_soil if soil not in names]
     return f"every soil but {', '.join(missing)}" if len(missing) < len(names) else ", ".join(names)
+
+
+def by_block(rows: list[list[str]]) -> list[list[str]]:
+    """Rows whose first cell names the block, as a group heading per block and the rows without it.
+
+    The heading is a row across the table: a block's long name is read once, and the table keeps one row per curve
+    within the page's width.
+    """
+    grouped, last = [], None
+    for block, *rest in rows:
+        if block != last:
+            grouped.append([block] + [""] * len(rest))
+            last = block
+        grouped.append(rest)
+    return grouped
 
 
 def _no_median_rows(fragility, config, unfitted, rigid, short_states, n_records) -> list[list[str]]:
