@@ -65,6 +65,11 @@ BAND = "band"
 FRICTION_MODES = ("where-it-matters", "all", "none")
 """``[solver] friction``: which housner and winkler cells slide (rockfrag.study.cell_friction)."""
 
+COMPONENTS = ("rotd50", "single")
+"""``[intensity] component``: how a record's intensity is defined (rockfrag.study.record_intensities):
+"rotd50" scales the two horizontal components of a station together by their pair's RotD50 (Boore 2010; a
+record without a partner keeps its own component), "single" scales each component by its own measure."""
+
 LEVEL_REFERENCES = ("", "uplift")
 """``relative_to`` of ``[intensity] levels``: "" = absolute levels, "uplift" = multiples of each block's
 uplift intensity."""
@@ -113,7 +118,8 @@ SCHEMA = Table({
                      "units": TEXT, "dt": Number(0, 1, low_open=True, unit="s"), "vertical": Flag(),
                      # report metadata, read by rockfrag.report
                      "title": TEXT, "project": TEXT, "author": TEXT}),
-    "intensity": _table({"measure": Text(scaling_measures()), "period": Number(0.01, 20.0, unit="s"),
+    "intensity": _table({"measure": Text(scaling_measures()), "component": Text(COMPONENTS),
+                         "period": Number(0.01, 20.0, unit="s"),
                          "damping": Number(0.0, 0.5),
                          "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True),
                                            "a list of levels or { start, stop, count, spacing }"),
@@ -241,6 +247,10 @@ class StudyConfig:
     measure, period, damping : str, float, float
         The intensity measure (``pga``, ``pgv``, ``sa``, ...), the oscillator period [s] and damping
         ratio [-] of Sa.
+    component : str
+        ``[intensity] component``: "rotd50" (each station's two horizontal components scaled together by the
+        pair's RotD50, Boore 2010; a record without a partner by its own component) or "single" (each
+        component by its own measure; ``COMPONENTS``).
     levels : tuple of float
         Intensity levels in the measure's display unit (g or m/s), or multiples of each block's uplift
         intensity when ``levels_relative_to`` is ``"uplift"`` (SI values: ``levels_si``).
@@ -337,6 +347,7 @@ class StudyConfig:
     reference_vs30: float = REFERENCE_VS30  # Vs30 of the hazard curve's site [m/s]
     vs30_sigma: float = VS30_SIGMA  # standard deviation of ln Vs30 of each soil's site [-]
     scenario: tuple[float, float] = SCENARIO  # (magnitude, Joyner-Boore distance [km]) of the rock-PGA ratio
+    component: str = "rotd50"  # the records' intensity: rotd50 (pairs) | single (each component its own)
 
     @property
     def calibrates_bed(self) -> bool:
@@ -626,6 +637,10 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     hazard = data.get("hazard", {})
     fragility = data.get("fragility", {})
     measure = intensity.get("measure", "pga")
+    component = intensity.get("component", "rotd50")
+    if component == "rotd50" and not MEASURES[measure].rotatable:
+        raise ConfigError("intensity.component", f"\"rotd50\": {measure} has no RotD50 form (it is defined per "
+                          "component); use \"single\"", source)
 
     custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
     soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
@@ -650,7 +665,8 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     config = StudyConfig(
         name=study.get("name", "study"), record_sets=tuple(study.get("record_sets", ["far-field"])),
         processing=study.get("processing", ""), output=Path(study.get("output", "reports")),
-        measure=measure, period=float(intensity.get("period", 1.0)), damping=float(intensity.get("damping", 0.05)),
+        measure=measure, component=component, period=float(intensity.get("period", 1.0)),
+        damping=float(intensity.get("damping", 0.05)),
         levels=levels, levels_relative_to=relative_to,
         capacity_resolution=float(intensity.get("capacity_resolution", 0.02)),
         period_range=_period_range(intensity.get("period_range")),

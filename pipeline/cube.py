@@ -45,6 +45,31 @@ VERTICAL_APPLIED, VERTICAL_NOT_APPLIED = "applied", "not applied"
 
 DIMS = ("record", "im_level", "soil", "block", "model")
 
+COMPONENT_ROTD50, COMPONENT_SINGLE = "RotD50", "single component"
+"""Values of a cube's per-record ``record_intensity_component`` and of its ``intensity_component`` attribute (which
+is "mixed" when both occur): what the record's intensity, and so its scale factors, is the measure of."""
+COMPONENT_MIXED = "mixed"
+COMPONENT_DEFINITIONS = {
+    COMPONENT_ROTD50: "RotD50 (Boore 2010, BSSA 100(4)): the median over rotation angles 0-179 deg (1 deg apart) of "
+                      "the peak of the rotated horizontal component a1 cos(theta) + a2 sin(theta) of the record's "
+                      "station pair (for Sa the oscillator responses rotated); both components of a pair have one "
+                      "scale factor, and both run",
+    COMPONENT_SINGLE: "the record's own horizontal component, as recorded (each component scaled by its own measure)",
+}
+"""What each component definition means (the cube's and fragility.nc's ``intensity_component_definition``)."""
+
+
+def component_attributes(flags) -> dict:
+    """The global attributes that state the intensity's component definition, from the per-record flags."""
+    kinds = list(dict.fromkeys(str(flag) for flag in flags))
+    if kinds == [COMPONENT_ROTD50] or kinds == [COMPONENT_SINGLE]:
+        return {"intensity_component": kinds[0], "intensity_component_definition": COMPONENT_DEFINITIONS[kinds[0]]}
+    single = sum(str(flag) == COMPONENT_SINGLE for flag in flags)
+    return {"intensity_component": COMPONENT_MIXED,
+            "intensity_component_definition": f"{COMPONENT_DEFINITIONS[COMPONENT_ROTD50]}; {single} of {len(flags)} "
+                                              "records without a partner: "
+                                              f"{COMPONENT_DEFINITIONS[COMPONENT_SINGLE]} (record_intensity_component)"}
+
 
 def _always(model):
     return True
@@ -128,7 +153,8 @@ DERIVED_ATTRIBUTES = {
 
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
                intensity=None, capacities=None, capacity_stats=None, verticals=None,
-               vertical_applied=False, calibration=None, friction=None) -> xr.Dataset:
+               vertical_applied=False, calibration=None, friction=None, partners=None,
+               component_im=None) -> xr.Dataset:
     """Assemble the labelled cube.
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
@@ -142,7 +168,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     study takes no verticals; vertical_applied : whether the runs applied those verticals (the cube's
     ``vertical_applied`` flag per record, and its ``vertical`` attribute); friction : (2, n_soil, n_block,
     n_model) each cell's base friction (mu_s, mu_k) [-], NaN where tied (rockfrag.study.friction_grid; None:
-    every base tied): the cube's ``friction_static``/``friction_kinetic`` and where ``SLIP_VARIABLES`` apply.
+    every base tied): the cube's ``friction_static``/``friction_kinetic`` and where ``SLIP_VARIABLES`` apply;
+    partners : the record id of each record's partner in RotD50 scaling ("" or None: scaled by its own
+    component; None for all: no pairs); component_im : (n_record, n_block) each record's own component's
+    measure [SI] (default: ``record_im``).
 
     Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
     with ``levels.relative_to = "uplift"``, else the levels in the measure's display unit. The physical
@@ -165,6 +194,9 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     scale_factors = np.asarray(scale_factors, float)
     if scale_factors.ndim == 2:
         scale_factors = np.repeat(scale_factors[:, :, None], n_block, axis=2)
+    partners = [str(p or "") for p in (partners if partners is not None else [""] * len(records))]
+    flags = [COMPONENT_ROTD50 if p else COMPONENT_SINGLE for p in partners]
+    component_im = record_im if component_im is None else np.asarray(component_im, float).reshape(record_im.shape)
     if intensity is None:
         intensity = np.broadcast_to(config.levels_si, (n_block, len(config.levels)))
     intensity = np.asarray(intensity, float)
@@ -209,7 +241,17 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                        {"long_name": "PGA of the processed record", "units": acceleration_units}),
         **vertical_coords,
         "record_im": (("record", "block"), record_im / measure.display_factor,
-                      {"long_name": f"{measure_name} of the processed record", "units": measure.cf_units()}),
+                      {"long_name": f"{measure_name} of the processed record as the study scales it (its pair's "
+                                    "RotD50 where record_intensity_component says so, else its own component)",
+                       "units": measure.cf_units()}),
+        "record_component_im": (("record", "block"), component_im / measure.display_factor,
+                                {"long_name": f"{measure_name} of the processed record's own component",
+                                 "units": measure.cf_units()}),
+        "record_intensity_component": ("record", flags, {
+            "long_name": "what record_im and the scale factors are the measure of: RotD50 of the station's pair of "
+                         "horizontal components, or the single component"}),
+        "record_partner": ("record", partners, {
+            "long_name": "record id of the other horizontal component of the record's pair (empty: none)"}),
         "soil_shear_modulus": ("soil", [s.shear_modulus for s in config.soils],
                                {"long_name": "soil shear modulus G_s", "units": "Pa"}),
         "soil_constrained_modulus": ("soil", [s.constrained_modulus for s in config.soils],
@@ -241,6 +283,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "rockfrag_version": __version__,
         "intensity_measure": config.measure,
         "intensity_measure_long_name": measure_name,
+        **component_attributes(flags),
         "levels_relative_to": config.levels_relative_to,
         **{key: value for key, value in (capacity_stats or {}).items()},
         "study_config": config.as_json(),
@@ -319,7 +362,8 @@ def _level_coordinates(config, measure_name, intensity) -> dict:
                   "units": "1"})
         uplift = intensity[:, 0] / float(config.levels[0])
         extra = {"block_uplift_intensity": ("block", uplift / measure.display_factor, {
-            "long_name": f"{measure_name} at which the block starts to rock (rockfrag.study.uplift_intensity)",
+            "long_name": f"{measure_name} at which the block starts to rock (rockfrag.study.uplift_intensity; "
+                         "exact g tan(alpha) only under each component's own PGA, else the records' median)",
             "units": units})}
     else:
         level = ("im_level", np.asarray(config.levels, float),

@@ -18,8 +18,10 @@ pelicun file, the risk and the report carry them. For overturning the refined ca
 ``ida.nc`` (the first overturning transition bisected to ``capacity_resolution``) are also fitted, a
 censored lognormal MLE (``capacity_median``, ``capacity_beta``; ``CAPACITY_FIT``) that checks the
 stripe fit. Every row says what it is (``STATUS``):
-- uplift under PGA scaling of a model whose uplift is the rigid-body threshold is the exact step
-  g tan(alpha) (``deterministic-threshold``, beta = 0), not a fit;
+- uplift under each component's own PGA of a model whose uplift is the rigid-body threshold is the exact
+  step g tan(alpha) (``deterministic-threshold``, beta = 0), not a fit; under RotD50 scaling (the cube's
+  ``intensity_component``) a component lifts at g tan(alpha) of its own PGA, which is 0.7-1.4 times its
+  pair's RotD50, so that row is fitted like any other;
 - perfectly separated counts have no lognormal MLE: a step between the two bracketing levels,
   beta = 0, status ``separated`` and a warning (never a silent small beta);
 - a median outside the studied range is flagged ``extrapolated``; a state no record reached is
@@ -46,6 +48,8 @@ from tqdm.auto import tqdm
 
 from rockfrag.config import StudyConfig
 from rockfrag.cube import (
+    COMPONENT_DEFINITIONS,
+    COMPONENT_SINGLE,
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
     OUTCOME_NO_UPLIFT,
@@ -96,7 +100,7 @@ STATUS = {
     "not-reached": "no record reached the state at any level; no curve",
     "below-range": "most records reached the state already at the lowest level: the median is below the range",
     "above-range": "a few records reached the state, only at the highest level: the median is above the range",
-    "deterministic-threshold": "an exact step at g tan(alpha) (uplift under PGA scaling), beta = 0",
+    "deterministic-threshold": "an exact step at g tan(alpha) (uplift under each component's own PGA), beta = 0",
     "separated": "perfectly separated counts: a step between two levels, beta = 0 (not identifiable)",
     NOT_APPLICABLE: "a slip state of a cell whose base is tied (no friction, no sliding: [solver] friction); "
                       "no curve",
@@ -212,6 +216,19 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     levels = cube.im_level.values.astype(float)
     values, units = in_display(levels, cube.im_level.attrs.get("units", ""))
     return np.broadcast_to(values, (n_block, n_level)).copy(), units
+
+
+def scaled_by_own_component(cube: xr.Dataset) -> bool:
+    """Whether every record of the cube is scaled by its own component (a cube from before pairs: yes)."""
+    return cube.attrs.get("intensity_component", COMPONENT_SINGLE) == COMPONENT_SINGLE
+
+
+def component_attributes(cube: xr.Dataset) -> dict:
+    """The cube's statement of the intensity's component definition, for fragility.nc (an older cube: single)."""
+    kind = cube.attrs.get("intensity_component", COMPONENT_SINGLE)
+    return {"intensity_component": kind,
+            "intensity_component_definition": cube.attrs.get("intensity_component_definition",
+                                                             COMPONENT_DEFINITIONS.get(kind, ""))}
 
 
 def uplift_is_rigid_threshold(model_name: str) -> bool:
@@ -500,7 +517,8 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     states = states or list(DAMAGE_STATES.values())
     intensity, unit = intensity_levels(cube)
     measure = cube.attrs.get("intensity_measure", "")
-    thresholds = uplift_threshold(cube, unit) if measure == "pga" else None
+    # g tan(alpha) is exact in the study's own intensity only when each record is scaled by its own PGA
+    thresholds = uplift_threshold(cube, unit) if measure == "pga" and scaled_by_own_component(cube) else None
     group_dims = ("soil", "block", "model")
     models = [str(m) for m in cube.model.values]
     rigid = {m: uplift_is_rigid_threshold(m) for m in models}
@@ -601,6 +619,7 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag lognormal fragility functions",
                      "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", ""),
                      "intensity_measure": measure, "intensity_unit": unit, "intensity_unit_label": label,
+                     **component_attributes(cube),
                      "overturning_convention": OVERTURNING_CONVENTION,
                      "capacity_fit": CAPACITY_FIT if capacities is not None else
                      "capacity_median/capacity_beta: none (no refined capacities: capacity_resolution = 0 or no "

@@ -12,6 +12,12 @@ one ``Measure``: name, function, SI and display unit, long name, short label, pe
 OpenQuake IMT. Every stage reads these (the study file's choices and units, the cube's metadata, the
 report's axes, the hazard readers, the pelicun export): a new measure is one ``@define_measure``
 function at the end of this module.
+Two horizontal components of one station (a pair) have one intensity that does not depend on how the
+instrument was turned: RotD50 and RotD100 (Boore 2010, BSSA 100(4)), the median and the largest over rotation
+angles 0-179 deg (1 deg apart) of the peak of the rotated component a1 cos(theta) + a2 sin(theta). A measure
+that has them says how (``Measure.histories``: the response histories, linear in the ground motion, whose
+peaks make the measure; ``rotated``, ``rotd``): for Sa the oscillator responses of the two components are
+rotated, as pyrotd does, since the oscillator is linear. Hazard curves of NGA-West2 models are in RotD50.
 ``Measure.cf_units``, ``file_units``, ``parse_units`` and ``convert_units`` are the one place for the
 ``units`` strings of result files (as UDUNITS parses them: g is "9.80665 m s-2") and for reading them back.
 
@@ -155,6 +161,43 @@ def _oscillator_peaks(acceleration, phi, gamma0, gamma1, omega, damping):
     return peak_displacement, peak_total_acceleration
 
 
+@njit(cache=True)
+def _oscillator_histories(acceleration, phi, gamma0, gamma1, omega, damping):
+    n_periods = phi.shape[0]
+    history = np.zeros((n_periods, acceleration.size))
+    for j in range(n_periods):
+        u = 0.0
+        v = 0.0
+        history[j, 0] = acceleration[0]  # as _oscillator_peaks: the first sample counts as the ground's
+        for k in range(acceleration.size - 1):
+            ramp = acceleration[k + 1] - acceleration[k]
+            u_next = phi[j, 0, 0] * u + phi[j, 0, 1] * v + gamma0[j, 0] * acceleration[k] + gamma1[j, 0] * ramp
+            v_next = phi[j, 1, 0] * u + phi[j, 1, 1] * v + gamma0[j, 1] * acceleration[k] + gamma1[j, 1] * ramp
+            u = u_next
+            v = v_next
+            history[j, k + 1] = -2.0 * damping * omega[j] * v - omega[j] ** 2 * u
+    return history
+
+
+def _oscillator_arrays(periods, damping, dt):
+    """The recurrence coefficients of every period, stacked: phi (m, 2, 2), gamma0 and gamma1 (m, 2)."""
+    coefficients = [oscillator_coefficients(float(period), float(damping), float(dt)) for period in periods]
+    return (np.array([c[0] for c in coefficients]), np.array([c[1] for c in coefficients]),
+            np.array([c[2] for c in coefficients]))
+
+
+def oscillator_accelerations(acceleration, dt, periods, damping=0.05) -> np.ndarray:
+    """Absolute acceleration histories of linear oscillators under ``acceleration`` [m/s^2], (m, n).
+
+    The same exact recurrence as ``response_spectrum`` (its peaks are the rows' peaks); linear in the ground
+    motion, so the histories of two components rotate as the components do (``rotated``).
+    """
+    periods = np.atleast_1d(np.asarray(periods, dtype=float))
+    phi, gamma0, gamma1 = _oscillator_arrays(periods, damping, dt)
+    return _oscillator_histories(np.ascontiguousarray(acceleration, dtype=np.float64), phi, gamma0, gamma1,
+                                 2.0 * np.pi / periods, float(damping))
+
+
 def response_spectrum(acceleration, dt, periods=DEFAULT_PERIODS, damping=0.05):
     """Elastic response spectrum of a linear SDOF oscillator.
 
@@ -179,10 +222,7 @@ def response_spectrum(acceleration, dt, periods=DEFAULT_PERIODS, damping=0.05):
         raise ValueError("periods must be positive [s]")
     if not 0 <= damping < 1:
         raise ValueError(f"damping ratio {damping} out of range; allowed 0 <= damping < 1")
-    coefficients = [oscillator_coefficients(float(period), float(damping), float(dt)) for period in periods]
-    phi = np.array([c[0] for c in coefficients])
-    gamma0 = np.array([c[1] for c in coefficients])
-    gamma1 = np.array([c[2] for c in coefficients])
+    phi, gamma0, gamma1 = _oscillator_arrays(periods, damping, dt)
     omega = 2.0 * np.pi / periods
     sd, sa = _oscillator_peaks(np.ascontiguousarray(acceleration, dtype=np.float64), phi, gamma0,
                                gamma1, omega, float(damping))
@@ -210,7 +250,11 @@ def intensity_measures(acceleration, dt, sa_periods=(0.2, 1.0, 2.0)) -> dict:
     return measures
 
 
-def average_spectral_acceleration(acceleration, dt, low, high, damping=0.05, count=10) -> float:
+AVGSA_PERIODS = 10
+"""Periods of AvgSa, log-spaced over its range."""
+
+
+def average_spectral_acceleration(acceleration, dt, low, high, damping=0.05, count=AVGSA_PERIODS) -> float:
     """AvgSa [m/s^2]: geometric mean of Sa at ``count`` log-spaced periods from ``low`` to ``high`` [s].
 
     After Eads et al. (2015) and Kohrangi et al. (2016).
@@ -257,6 +301,54 @@ def _zero_crossing(series, i, j, dt) -> float:
     return (i + a / (a - b) * (j - i)) * dt if a != b else i * dt
 
 
+# ------------------------------------------------------------------ two horizontal components: RotD50, RotD100
+
+ROTATION_ANGLES = np.arange(180.0)
+"""Rotation angles of RotD50 and RotD100 [deg]: 0 to 179, 1 deg apart (Boore 2010)."""
+
+_ROTATION_CHUNK = 2_000_000
+"""Most rotated samples held at once (angles x samples), to bound the memory of long records."""
+
+
+def rotated_peaks(first, second, angles=ROTATION_ANGLES) -> np.ndarray:
+    """Peak over time of |first cos(theta) + second sin(theta)| at each rotation angle theta.
+
+    Parameters
+    ----------
+    first, second : array_like, shape (..., n)
+        Histories of the two horizontal components (or of their linear responses), sampled alike.
+    angles : array_like, shape (m,)
+        Rotation angles [deg].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., m)
+        The peak of the rotated history at each angle [the histories' unit].
+    """
+    first, second = np.asarray(first, float), np.asarray(second, float)
+    if first.shape != second.shape:
+        raise ValueError(f"the two components have different shapes {first.shape} and {second.shape}; "
+                         "cut them to the window they share first")
+    radians = np.radians(np.asarray(angles, float))
+    cos, sin = np.cos(radians), np.sin(radians)
+    step = max(1, _ROTATION_CHUNK // max(1, first.shape[-1]))
+    peaks = np.empty((*first.shape[:-1], radians.size))
+    for start in range(0, radians.size, step):
+        part = slice(start, start + step)
+        rotated = cos[part, None] * first[..., None, :] + sin[part, None] * second[..., None, :]
+        peaks[..., part] = np.max(np.abs(rotated), axis=-1)
+    return peaks
+
+
+def rotated(first, second, percentile=50.0, angles=ROTATION_ANGLES) -> np.ndarray:
+    """RotD``percentile`` (Boore 2010) of two histories: that percentile of ``rotated_peaks`` over the angles.
+
+    ``percentile`` 50 is RotD50 (the median, linear interpolation between the two middle angles' peaks), 100 is
+    RotD100 (the largest). Returns shape (...,) for histories (..., n).
+    """
+    return np.percentile(rotated_peaks(first, second, angles), percentile, axis=-1)
+
+
 # ------------------------------------------------------------------ the measure registry
 
 MeasureFunction = Callable[[np.ndarray, float, "Block | None", dict], float]
@@ -280,6 +372,10 @@ class Measure:
     their files (PGV comes in cm/s: 0.01).
     ``scaling_exponent`` n: IM(lambda a) = lambda^n IM(a); a study scales records to measures with
     n = 1 only, and a record's capacity re-expressed in the measure is scale x IM (n = 1).
+    ``histories(acceleration, dt, block, options) -> (n_channel, n)``: the histories, linear in the ground
+    motion, whose peaks make the measure (its value is the geometric mean over the channels of their peaks:
+    one channel for PGA, the oscillator's absolute acceleration at each period for AvgSa); None where the
+    measure has no rotated form (``rotd``).
     """
 
     name: str
@@ -294,6 +390,12 @@ class Measure:
     openquake_factor: float = 1.0
     per_block: bool = False
     scaling_exponent: float = 1.0
+    histories: Callable | None = None
+
+    @property
+    def rotatable(self) -> bool:
+        """Whether the measure has RotD50/RotD100 forms for a pair of horizontal components (``rotd``)."""
+        return self.histories is not None
 
     @property
     def scalable(self) -> bool:
@@ -327,6 +429,47 @@ class Measure:
         if self.per_block and block is None:
             raise ValueError(f"measure {self.name!r} is defined per block; pass the block")
         return float(self.function(acceleration, dt, block, _options(options)))
+
+    def rotd(self, first, second, dt, percentile=50.0, block=None, **options) -> float:
+        """RotD``percentile`` of the measure for a pair of horizontal components (Boore 2010).
+
+        Parameters
+        ----------
+        first, second : array_like
+            The two horizontal components' accelerations [m/s^2], sampled alike over one window.
+        dt : float
+            Time step [s].
+        percentile : float
+            50 for RotD50 (the median over rotation angles 0-179 deg), 100 for RotD100 (the largest).
+        block : rockfrag.blocks.Block, optional
+            The block, required for a per-block measure.
+        **options
+            The study's ``period`` [s], ``damping`` [-] and ``period_range`` ((low, high) [s]).
+
+        Returns
+        -------
+        float
+            The value in the measure's ``si_unit``: for each channel of ``histories`` the percentile over the
+            angles of the rotated pair's peak, then their geometric mean (AvgSa: of RotD50 Sa at its periods).
+
+        Raises
+        ------
+        ValueError
+            The measure has no rotated form, a per-block measure has no block, or the components differ in
+            length.
+        """
+        if self.histories is None:
+            raise ValueError(f"measure {self.name!r} has no RotD form (it is defined per component)")
+        if self.per_block and block is None:
+            raise ValueError(f"measure {self.name!r} is defined per block; pass the block")
+        options = _options(options)
+        first, second = np.asarray(first, float), np.asarray(second, float)
+        if first.shape != second.shape:
+            raise ValueError(f"the two components have {first.size} and {second.size} samples; RotD needs one "
+                             "window")
+        per_channel = rotated(self.histories(first, dt, block, options),
+                              self.histories(second, dt, block, options), percentile)
+        return float(per_channel[0]) if per_channel.size == 1 else float(np.exp(np.mean(np.log(per_channel))))
 
     def cf_units(self, display: bool = True) -> str:
         """The measure's ``units`` attribute in result files, as UDUNITS parses it.
@@ -402,7 +545,8 @@ def register_measure(measure: Measure) -> Measure:
 def define_measure(name: str, *, si_unit: str, long_name: str, label: str, display_unit: str | None = None,
                    display_factor: float = 1.0, pelicun_demand: tuple[str, str] | None = None,
                    openquake_imt: str | None = None, openquake_factor: float = 1.0, per_block: bool = False,
-                   scaling_exponent: float = 1.0) -> Callable[[MeasureFunction], MeasureFunction]:
+                   scaling_exponent: float = 1.0,
+                   histories: Callable | None = None) -> Callable[[MeasureFunction], MeasureFunction]:
     """Decorator: register the decorated ``function(acceleration, dt, block, options)`` as measure ``name``.
 
     Parameters
@@ -416,7 +560,7 @@ def define_measure(name: str, *, si_unit: str, long_name: str, label: str, displ
     long_name, label : str
         Templates (fields ``period``, ``damping``, ``low``, ``high``) of the netCDF long name and of the
         short label for axes and messages.
-    pelicun_demand, openquake_imt, openquake_factor, per_block, scaling_exponent
+    pelicun_demand, openquake_imt, openquake_factor, per_block, scaling_exponent, histories
         See ``Measure``.
 
     Returns
@@ -427,7 +571,7 @@ def define_measure(name: str, *, si_unit: str, long_name: str, label: str, displ
     def register(function: MeasureFunction) -> MeasureFunction:
         register_measure(Measure(name, function, si_unit, si_unit if display_unit is None else display_unit,
                                  display_factor, long_name, label, pelicun_demand, openquake_imt,
-                                 openquake_factor, per_block, scaling_exponent))
+                                 openquake_factor, per_block, scaling_exponent, histories))
         return function
 
     return register
@@ -557,41 +701,67 @@ def unit_label(units: str) -> str:
     return str(units)
 
 
+def _ground_acceleration(acceleration, dt, block, options):
+    return np.asarray(acceleration, float)[None, :]
+
+
+def _ground_velocity(acceleration, dt, block, options):
+    return integrate(np.asarray(acceleration, float), dt)[0][None, :]
+
+
+def _oscillator_at_period(acceleration, dt, block, options):
+    return oscillator_accelerations(acceleration, dt, [options["period"]], options["damping"])
+
+
+def _oscillators_over_range(acceleration, dt, block, options):
+    return oscillator_accelerations(acceleration, dt, np.geomspace(*avgsa_range(options), AVGSA_PERIODS),
+                                    options["damping"])
+
+
+def _acceleration_over_uplift(acceleration, dt, block, options):
+    return _ground_acceleration(acceleration, dt, block, options) / block.uplift_acceleration()
+
+
+def _rocking_velocity(acceleration, dt, block, options):
+    return block.p() * _ground_velocity(acceleration, dt, block, options) / block.uplift_acceleration()
+
+
 @define_measure("pga", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
                 long_name="peak ground acceleration", label="PGA",
-                pelicun_demand=("Peak Ground Acceleration", "g"), openquake_imt="PGA")
+                pelicun_demand=("Peak Ground Acceleration", "g"), openquake_imt="PGA", histories=_ground_acceleration)
 def _pga(acceleration, dt, block, options):
     return pga(acceleration)
 
 
 @define_measure("pgv", si_unit="m/s", long_name="peak ground velocity", label="PGV",
-                pelicun_demand=("Peak Ground Velocity", "mps"), openquake_imt="PGV", openquake_factor=0.01)
+                pelicun_demand=("Peak Ground Velocity", "mps"), openquake_imt="PGV", openquake_factor=0.01,
+                histories=_ground_velocity)
 def _pgv(acceleration, dt, block, options):
     return pgv(acceleration, dt)
 
 
 @define_measure("sa", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
                 long_name="spectral acceleration Sa({period:g} s, {damping:.0%})", label="Sa({period:g} s)",
-                pelicun_demand=("Spectral Acceleration", "g"), openquake_imt="SA(T)")
+                pelicun_demand=("Spectral Acceleration", "g"), openquake_imt="SA(T)", histories=_oscillator_at_period)
 def _sa(acceleration, dt, block, options):
     return spectral_acceleration(acceleration, dt, options["period"], options["damping"])
 
 
 @define_measure("avgsa", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
                 long_name="average spectral acceleration AvgSa({low:g}-{high:g} s, {damping:.0%})",
-                label="AvgSa({low:g}-{high:g} s)")
+                label="AvgSa({low:g}-{high:g} s)", histories=_oscillators_over_range)
 def _avgsa(acceleration, dt, block, options):
     return average_spectral_acceleration(acceleration, dt, *avgsa_range(options), damping=options["damping"])
 
 
 @define_measure("pga_ratio", si_unit="1", long_name="PGA over the block's uplift acceleration, PGA/(g tan alpha)",
-                label="PGA/(g tan alpha)", per_block=True)
+                label="PGA/(g tan alpha)", per_block=True, histories=_acceleration_over_uplift)
 def _rocking_pga(acceleration, dt, block, options):
     return pga(acceleration) / block.uplift_acceleration()
 
 
 @define_measure("pgv_ratio", si_unit="1", long_name="p PGV/(g tan alpha), p = sqrt(3g/4R) (Makris & Vassiliou)",
-                label="p PGV/(g tan alpha)", per_block=True)
+                label="p PGV/(g tan alpha)", per_block=True, histories=_rocking_velocity)
 def _rocking_pgv(acceleration, dt, block, options):
     return block.p() * pgv(acceleration, dt) / block.uplift_acceleration()
 

@@ -63,6 +63,7 @@ from rockfrag.models.variants import BandCalibration, calibrate_models, split_va
 from rockfrag.outputs import write_dataset
 from rockfrag.processing import ProcessingRecipe, load_recipe, process_records
 from rockfrag.records import Record, group_components, load_records, split_vertical
+from rockfrag.records.components import horizontal_partners, pair_window
 from rockfrag.soils import soil_block_stiffness
 
 
@@ -113,11 +114,33 @@ def record_intensity(acceleration, dt, config, block=None) -> float:
     return MEASURES[config.measure](acceleration, dt, block, **config.measure_options)
 
 
-def record_intensities(records, config) -> np.ndarray:
-    """The study's measure of every record for every block, (n_record, n_block) [SI].
+def record_intensities(records, config, partners=None) -> np.ndarray:
+    """The intensity each record is scaled by, for every block, (n_record, n_block) [SI].
 
-    One value per record, repeated over the blocks, unless the measure is defined per block.
+    With ``[intensity] component = "rotd50"`` a record that has a partner (``partners``, from
+    ``rockfrag.records.components.horizontal_partners``) takes its pair's RotD50 of the measure (Boore 2010),
+    computed once over the window the two share, so both components get the same value and the same scale
+    factors. Any other record takes its own component's measure (``component_intensities``). One value per
+    record, repeated over the blocks, unless the measure is defined per block.
     """
+    measure = MEASURES[config.measure]
+    values = component_intensities(records, config)
+    if config.component != "rotd50" or partners is None:
+        return values
+    blocks = config.blocks if measure.per_block else [None]
+    for r, partner in enumerate(partners):
+        if partner is None or partner < r:
+            continue
+        first, second = records[r], records[partner]
+        window = pair_window(first, second)
+        values[r] = values[partner] = [measure.rotd(first.acceleration[window[0]], second.acceleration[window[1]],
+                                                    first.dt, 50.0, block, **config.measure_options)
+                                       for block in blocks]
+    return values
+
+
+def component_intensities(records, config) -> np.ndarray:
+    """The study's measure of every record's own component for every block, (n_record, n_block) [SI]."""
     measure = MEASURES[config.measure]
     values = np.empty((len(records), len(config.blocks)))
     for r, record in enumerate(records):
@@ -128,13 +151,38 @@ def record_intensities(records, config) -> np.ndarray:
     return values
 
 
+def study_partners(records, config, log) -> list:
+    """Each record's partner index for RotD50 scaling (None: scaled by its own component), and one log line.
+
+    ``[intensity] component = "single"``: no partners. Stations whose horizontals cannot be paired are named.
+    """
+    label = MEASURES[config.measure].short_label(**config.measure_options)
+    if config.component != "rotd50":
+        log(f"intensity: each component scaled by its own {label} ([intensity] component = \"single\")")
+        return [None] * len(records)
+    partners, notes = horizontal_partners(records)
+    for note in notes:
+        log(f"rockfrag: {note}")
+    paired = sum(p is not None for p in partners)
+    single = [records[i].id for i, p in enumerate(partners) if p is None]
+    line = (f"intensity: RotD50 of {label} (Boore 2010) for {paired // 2} pairs of horizontal components "
+            f"({paired} records, both components run, one scale factor per pair)")
+    if single:
+        shown = ", ".join(single[:5]) + (f" and {len(single) - 5} more" if len(single) > 5 else "")
+        line += f"; {len(single)} without a partner scaled by their own component: {shown}"
+    log(line)
+    return partners
+
+
 def uplift_intensity(config, record_im, record_pga) -> np.ndarray:
     """Each block's uplift intensity in the study's measure, (n_block,) [SI].
 
-    Under PGA scaling it is exactly g tan(alpha) (Housner's rigid-base threshold; compliant bases
-    uplift at about the same PGA); for PGA/(g tan alpha) it is 1. For any other measure it is the
-    record median of the measure's value when the record is scaled to PGA = g tan(alpha):
-    median_r(IM_r / PGA_r) g tan(alpha) (record_im (n_record, n_block), record_pga (n_record,) [SI]).
+    Under each component's own PGA it is exactly g tan(alpha) (Housner's rigid-base threshold; compliant
+    bases uplift at about the same PGA); for PGA/(g tan alpha) it is 1. For any other measure, and for
+    RotD50 scaling (where a component's PGA is 0.7-1.4 times its pair's RotD50), it is the record median
+    of the intensity at which the record's component reaches PGA = g tan(alpha):
+    median_r(IM_r / PGA_r) g tan(alpha) (record_im (n_record, n_block), record_pga (n_record,) [SI]); the
+    relative levels are then multiples of an approximate uplift intensity.
     """
     uplift_pga = np.array([block.uplift_acceleration() for block in config.blocks])
     return np.median(record_im / np.asarray(record_pga)[:, None], axis=0) * uplift_pga
@@ -605,13 +653,16 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     if config.vertical and verticals is None:
         raise PipelineError("[study] vertical = true, but the records were read without their verticals "
                             "(rockfrag.study.study_records of a horizontal-only study)")
-    record_im = record_intensities(records, config)
-    keep, unscalable = _scalable(records, record_im, warn)
+    keep, unscalable = _scalable(records, component_intensities(records, config), warn)
     failures += unscalable
     if not keep:
         raise PipelineError(f"no record has a positive intensity measure {config.measure}; nothing to run")
-    records, record_im = [records[i] for i in keep], record_im[keep]
+    records = [records[i] for i in keep]
     verticals = [verticals[i] for i in keep] if verticals is not None else None
+    partners = study_partners(records, config, log)
+    record_im = record_intensities(records, config, partners)
+    component_im = component_intensities(records, config)
+    partner_ids = [records[p].id if p is not None else "" for p in partners]
     record_pga = np.array([pga(r.acceleration) for r in records])
     intensity = level_intensities(config, record_im, record_pga)
     scale_factors = study_scale_factors(intensity, record_im)
@@ -678,6 +729,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                                 "finished cells are kept, rerun to continue")
         # the levels stay those of the whole record set (relative levels use its median)
         records, record_im, scale_factors = [records[i] for i in kept], record_im[kept], scale_factors[kept]
+        component_im, partner_ids = component_im[kept], [partner_ids[i] for i in kept]
         verticals = [verticals[i] for i in kept] if verticals is not None else None
         all_cells = {variant: [cells[i] for i in kept] for variant, cells in all_cells.items()}
 
@@ -695,7 +747,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
                                      calibration=calibration, friction=friction_grid(config),
-                                     verticals=verticals, vertical_applied=variant), stats)
+                                     verticals=verticals, vertical_applied=variant, partners=partner_ids,
+                                     component_im=component_im), stats)
     dataset, capacity_stats = cubes[variants[0]]
     if config.vertical:  # the comparison first: a cube.nc on disk always has its comparison beside it
         comparison = cubes[False][0]

@@ -16,7 +16,7 @@ import xarray as xr
 
 from rockfrag.config import load_study, study_from_dict
 from rockfrag.errors import ConfigError
-from rockfrag.measures import spectral_acceleration
+from rockfrag.measures import MEASURES, spectral_acceleration
 from rockfrag.models import simulate
 from rockfrag.processing import process_record
 from rockfrag.records import load_records
@@ -94,8 +94,12 @@ def test_cube_values_match_direct_solver_calls(small_cube):
     _, cube, _ = small_cube
     config = load_study(None, {"study": {"record_sets": ["bolu"]}})
     records, _ = load_records("bolu")
-    record = process_record(records[1])
-    scale = 0.6 * 9.80665 / np.max(np.abs(record.acceleration))
+    record, partner = process_record(records[1]), process_record(records[0])
+    # Bolu's two components are one pair: scaled together to a RotD50 PGA of 0.6 g
+    scale = 0.6 * 9.80665 / MEASURES["pga"].rotd(record.acceleration, partner.acceleration, record.dt)
+    cell = cube.sel(record="DUZCE/BOL090", im_level=0.6, block="slender-cabinet")
+    assert cell.scale_factor.item() == pytest.approx(scale, rel=1e-12)
+    scale = cell.scale_factor.item()  # the study's own float, for bit-equal runs
     block = cube.block.values.tolist().index("slender-cabinet")
     blocks = study_from_dict(tomllib.loads(SMALL)).blocks
     t_end = (record.acceleration.size - 1) * record.dt + 10.0
@@ -105,8 +109,6 @@ def test_cube_values_match_direct_solver_calls(small_cube):
         soil = config.soils[3]  # rock
         ssi = simulate("ssi", record.acceleration * scale, record.dt, blocks[block],
                        k=soil_block_stiffness(soil, blocks[block]), xi=soil.damping_ratio, t_end=t_end)
-    cell = cube.sel(record="DUZCE/BOL090", im_level=0.6, block="slender-cabinet")
-    assert cell.scale_factor.item() == pytest.approx(scale, rel=1e-12)
     # Housner does not depend on the soil: the same value on every soil
     np.testing.assert_array_equal(cell.peak_angle.sel(model="housner").values, housner.peak_angle)
     assert cell.peak_angle.sel(model="ssi", soil="rock").item() == pytest.approx(ssi.peak_angle, rel=1e-12)
@@ -189,12 +191,21 @@ def test_sa_scaling_reaches_the_requested_spectral_acceleration(tmp_path):
                      .replace('models = ["housner", "ssi"]', 'models = ["housner"]'))
     config = load_study(study)
     cube, _ = run_study(config, output=tmp_path / "out", workers=1, progress=False, log=lambda m: None)
-    records, _ = load_records("bolu")
-    for record in records:
-        processed = process_record(record)
-        scales = cube.scale_factor.sel(record=record.id).isel(block=0).values  # absolute levels: any block
-        for level, scale in zip(cube.im_level.values * 9.80665, scales):
-            # Sa is linear in the scale factor: the scaled record has exactly the requested Sa(0.5 s)
-            sa = spectral_acceleration(processed.acceleration * scale, processed.dt, 0.5)
-            assert sa == pytest.approx(level, rel=1e-9)
+    first, second = (process_record(record) for record in load_records("bolu")[0])
+    assert cube.attrs["intensity_component"] == "RotD50"
+    assert list(cube.record_partner.values) == [second.id, first.id]
+    scales = cube.scale_factor.isel(block=0).values  # absolute levels: any block
+    np.testing.assert_array_equal(scales[0], scales[1])  # one factor for both components of the pair
+    for level, scale in zip(cube.im_level.values * 9.80665, scales[0]):
+        # Sa is linear in the scale factor: the scaled pair has exactly the requested RotD50 Sa(0.5 s)...
+        rotd50 = MEASURES["sa"].rotd(first.acceleration * scale, second.acceleration * scale, first.dt,
+                                     period=0.5)
+        assert rotd50 == pytest.approx(level, rel=1e-9)
+        # ...checked by rotating the ground motion itself (not the responses) at the median angles
+        peaks = [spectral_acceleration(np.cos(np.radians(t)) * first.acceleration * scale
+                                       + np.sin(np.radians(t)) * second.acceleration * scale, first.dt, 0.5)
+                 for t in range(180)]
+        assert np.median(peaks) == pytest.approx(level, rel=1e-9)
+    own = cube.record_component_im.isel(block=0).values
+    assert not np.allclose(own, cube.record_im.isel(block=0).values)  # each component's own Sa differs
     assert cube.im_level.attrs["units"] == "9.80665 m s-2" and "Sa(0.5 s" in cube.im_level.attrs["long_name"]

@@ -23,6 +23,7 @@ record_sets = ["bolu"]
 [intensity]
 levels = { values = [0.9, 1.5, 3.0, 6.0], relative_to = "uplift" }
 capacity_resolution = 0.02
+component = "single"  # each component its own PGA: Housner lifts at exactly g tan(alpha) of it
 [solver]
 friction = "none"  # Housner's rigid-base uplift threshold: the squat skid would slide on rock (mu_s 0.7 < b/h 0.75)
 """

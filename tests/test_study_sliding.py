@@ -30,6 +30,7 @@ record_sets = ["bolu"]
 [intensity]
 levels = [0.2, 0.5, 0.9]
 capacity_resolution = 0.0
+component = "single"  # each component its own PGA: a tied rigid base lifts at exactly g tan(alpha)
 [solver]
 bed = "two-spring"
 restitution = ""

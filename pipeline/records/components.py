@@ -5,7 +5,8 @@ Input : read traces (their format's header: CSMIP ``stats.csmip``, ASDF ``stats.
 Output: each record's orientation metadata (``orientation_metadata``), its component label
         (``component_label``: ``H1``, ``H2``, ``Z``, or ``H`` for a horizontal of unstated direction), and
         the records grouped by event and station (``group_components``) into ``ComponentGroup`` objects
-        holding H1, H2 and Z.
+        holding H1, H2 and Z; the two horizontal components of each station (``horizontal_partners``), which a
+        study scales together by their RotD50 (rockfrag.study), and the window they share (``pair_window``).
 
 Orientation, where it comes from:
 - CSMIP Volume 1 and ASDF files state it in their header / StationXML (``orientation_from = "header"``);
@@ -305,6 +306,70 @@ def component_labels(records) -> list[tuple[int, str]]:
         for label, record in group.components.items():
             where[id(record)] = (number, label)
     return [where[id(record)] for record in records]
+
+
+def horizontal_partners(records) -> tuple[list, list[str]]:
+    """The other horizontal component of each record's station, as an index into ``records``, or None.
+
+    Two records are a pair when they are the only two horizontal components of one event, station and record
+    set (``group_components``), the event and station are stated, and they share a time step and a window
+    (``pair_window``). Any other record is a single component: a vertical, a horizontal whose station has no
+    second one, one of a station with three or more, or one whose event or station is unknown.
+
+    Parameters
+    ----------
+    records : list of Record
+        Loaded or processed records.
+
+    Returns
+    -------
+    partners : list of int or None
+        For each record, the index of its partner in ``records`` (pairs point at each other), or None.
+    notes : list of str
+        One line per station whose two horizontals could not be paired, with the reason.
+    """
+    index = {id(record): i for i, record in enumerate(records)}
+    partners: list = [None] * len(records)
+    notes = []
+    for group in group_components(records):
+        horizontals = group.horizontals
+        if len(horizontals) != 2 or not (group.event and group.station):
+            continue
+        first, second = horizontals
+        if pair_window(first, second) is None:
+            notes.append(f"{first.id} and {second.id} ({group.station}) are not paired: they have different time "
+                         "steps or share no window; each is scaled by its own component")
+            continue
+        partners[index[id(first)]], partners[index[id(second)]] = index[id(second)], index[id(first)]
+    return partners, notes
+
+
+def pair_window(first, second) -> tuple[slice, slice] | None:
+    """The samples of two components that cover the same time: a slice of each, or None.
+
+    The components must have one time step (within 1e-9 s); the window runs from the later start to the earlier
+    end (files without a start time, such as PEER AT2, all start at one epoch: their first samples align).
+
+    Parameters
+    ----------
+    first, second : Record
+        Two components of one station.
+
+    Returns
+    -------
+    (slice, slice) or None
+        Equal-length slices of ``first.acceleration`` and ``second.acceleration``; None when the time steps
+        differ or the windows do not overlap.
+    """
+    dt = first.dt
+    if abs(dt - second.dt) > 1e-9:
+        return None
+    offset = int(round((second.trace.stats.starttime - first.trace.stats.starttime) / dt))
+    start_first, start_second = max(0, offset), max(0, -offset)
+    length = min(first.trace.stats.npts - start_first, second.trace.stats.npts - start_second)
+    if length < 2:
+        return None
+    return slice(start_first, start_first + length), slice(start_second, start_second + length)
 
 
 def split_vertical(records) -> tuple[list, list]:
