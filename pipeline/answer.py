@@ -65,6 +65,7 @@ _STATUS_NOTES = {
     "above-range": "reached only at the highest level",
     "not-reached": "no record overturned",
     "below-range": "most records overturn at the lowest level",
+    "censored-at-cap": "median above the credible cap",
 }
 
 
@@ -122,7 +123,9 @@ def answer_rows(fragility: xr.Dataset) -> list[dict]:
     -------
     list of dict
         Keys block, soil, median, median_low, median_high, beta, probability (NaN without a hazard
-        curve), status, studied_min, studied_max; intensities in the unit of ``display_scale``.
+        curve), status, studied_min, studied_max (the highest level at or below the credible cap), and the
+        fraction of records overturned there with its bounds (probability_at_cap, _low, _high; NaN where the
+        file has none); intensities in the unit of ``display_scale``.
     """
     model = answer_model(fragility)
     row = fragility.sel(model=model, damage_state=ANSWER_STATE)
@@ -133,7 +136,9 @@ def answer_rows(fragility: xr.Dataset) -> list[dict]:
             cell = row.sel(block=block, soil=soil)
             value = {name: float(cell[name]) * scale for name in ("median", "median_low", "median_high")}
             probability = float(cell["probability_in_life"]) if "probability_in_life" in cell else np.nan
-            rows.append({"block": str(block), "soil": str(soil), **value, "beta": float(cell["beta"]),
+            at_cap = {name: float(cell[name]) if name in cell else np.nan
+                      for name in ("probability_at_cap", "probability_at_cap_low", "probability_at_cap_high")}
+            rows.append({"block": str(block), "soil": str(soil), **value, **at_cap, "beta": float(cell["beta"]),
                          "probability": probability, "status": str(cell["status"].values),
                          "studied_min": float(fragility.studied_im_min.sel(block=block)) * scale,
                          "studied_max": float(fragility.studied_im_max.sel(block=block)) * scale})
@@ -141,7 +146,7 @@ def answer_rows(fragility: xr.Dataset) -> list[dict]:
 
 
 def _median_cell(row: dict) -> str:
-    if row["status"] in ("not-reached", "above-range"):
+    if row["status"] in ("not-reached", "above-range", "censored-at-cap"):
         return f"> {_number(row['studied_max'])}"
     if row["status"] == "below-range":
         return f"< {_number(row['studied_min'])}"
@@ -184,7 +189,11 @@ def answer_table(fragility: xr.Dataset, outputs: Sequence[Path | str] = ()) -> s
                   if np.isfinite(row["median_low"]) and np.isfinite(row["median_high"]) else "-")
         line = [row["block"], row["soil"], _median_cell(row), bounds, _number(row["beta"])]
         line += [f"{row['probability']:.2g}" if np.isfinite(row["probability"]) else "-"] if with_risk else []
-        line += [_STATUS_NOTES.get(row["status"], "")]
+        note = _STATUS_NOTES.get(row["status"], "")
+        if row["status"] == "censored-at-cap" and np.isfinite(row["probability_at_cap"]):
+            note += (f": {row['probability_at_cap']:.0%} of the records overturned at {_number(row['studied_max'])} "
+                     f"{unit} ({row['probability_at_cap_low']:.0%}-{row['probability_at_cap_high']:.0%})")
+        line += [note]
         table.append(line)
     widths = [max(len(str(cells[i])) for cells in [header, *table]) for i in range(len(header))]
     lines = [f"Overturning, model {model} ({int(fragility.n_records)} records): lognormal median {measure} in "
@@ -194,6 +203,13 @@ def answer_table(fragility: xr.Dataset, outputs: Sequence[Path | str] = ()) -> s
     if with_risk:
         lines.append(f"P: probability of overturning in {life:g} years with the hazard curve {hazard}"
                      + (": set your site's as [hazard] file" if example else ""))
+    cap = fragility.attrs.get("credible_intensity_max")
+    if cap is not None and np.all(np.isfinite(np.atleast_1d(cap))):
+        scale, _ = display_scale(fragility["median"].attrs.get("units", fragility.attrs.get("intensity_unit", "")))
+        shown = ", ".join(dict.fromkeys(_number(float(c) * scale) for c in np.atleast_1d(cap)))
+        lines.append(f"Credible cap: {measure} at most {shown} {unit} "
+                     f"({fragility.attrs.get('credible_intensity_reason', '')}); no level, fit or median above it"
+                     + ("; P adds the hazard's exceedance of the cap as an upper bound" if with_risk else ""))
     if outputs:
         lines.append("Results: " + ", ".join(str(path) for path in outputs))
     return "\n".join(lines)
@@ -304,7 +320,9 @@ class SoilAnswer:
     """One block on one soil: its states, the share of records that would slide, and the verdict.
 
     ``sliding_share`` is read at ``sliding_level`` (shown unit), the level run at or below the decision's
-    return-period intensity (the largest of the study's; NaN where no level lies that low).
+    return-period intensity (the largest of the study's; NaN where no level lies that low). ``tied``: the study
+    did not compute sliding for the answer model on this soil (its slip states are ``not-applicable``: ``[solver]
+    friction`` tied the base), so the verdict does not cover sliding and says so.
     """
 
     soil: str
@@ -313,6 +331,7 @@ class SoilAnswer:
     verdict: str
     sliding_level: float = float("nan")
     intensities: tuple = ()  # the soil's site intensity at each return period (shown unit); its states' P use them
+    tied: bool = False
 
 
 @dataclass(frozen=True)
@@ -561,7 +580,12 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | Mapping[str, Haza
                 verdict = CHECK_SLIDING
             else:
                 verdict = NO_ACTION
-            soils.append(SoilAnswer(soil, tuple(rows), share, verdict, decision_level, at_site))
+            edps = [str(e) for e in fragility.damage_state_edp.values] if "damage_state_edp" in fragility.coords \
+                else ["peak_slip" if state.startswith("slip") else "" for state in states]
+            slip = [str(fragility.status.sel(model=model, block=block, soil=soil, damage_state=state).values)
+                    for state, edp in zip(states, edps) if edp == "peak_slip"] if "status" in fragility else []
+            tied = bool(slip) and all(status == "not-applicable" for status in slip)
+            soils.append(SoilAnswer(soil, tuple(rows), share, verdict, decision_level, at_site, tied))
         example = shown is not None and EXAMPLE_HAZARD in shown.source
         answers.append(BlockAnswer(block, model, periods, intensities, tuple(soils), example, design_life, unit,
                                    float(max_sliding_share)))
@@ -655,13 +679,16 @@ def verdict_sentence(answer: BlockAnswer, name: str, labels: Mapping[str, str] |
                     f"intensity{',' if level else ''} need more base friction than the soil's μ_s, above the "
                     f"{percent(answer.max_sliding_share)} the study allows ([decision] max_sliding_share = "
                     f"{answer.max_sliding_share:g}, the "
-                    "study's choice): the block would slide, and sliding was not computed there (its base was "
-                    'tied); compute it with [solver] friction = "all", whose slip damage states then give the '
-                    "verdict)")
+                    "study's choice): the block would slide, and this study did not compute sliding there (its "
+                    "[solver] friction setting ties that base), so no slip state backs the verdict)")
             rocking = exceeded(soils)
             parts.append(text + (f", and anchor it against rocking there ({rocking})" if rocking else ""))
         else:
             parts.append(f"no action {where}")
+    tied = [s.soil for s in answer.soils if s.tied and s.verdict != CHECK_SLIDING]
+    if tied:
+        parts.append(f"sliding was not computed on {_and(tied)}: the study's [solver] friction setting ties the base "
+                     "there, so these verdicts cover rocking and overturning only")
     lead = (f"With the shipped example hazard curve (not this site's: the study must name the site's curve), the "
             f"verdict for the {name} is: " if answer.example_hazard else f"Verdict for the {name}: ")
     return lead + "; ".join(parts) + "."

@@ -62,7 +62,7 @@ BAND = "band"
 """``[solver] restitution = "band"``: each bed model runs at the edges and centre of ``restitution_band``
 (rockfrag.models.variants)."""
 
-FRICTION_MODES = ("where-it-matters", "all", "none")
+FRICTION_MODES = ("recommended", "where-it-matters", "all", "none")
 """``[solver] friction``: which housner and winkler cells slide (rockfrag.study.cell_friction)."""
 
 COMPONENTS = ("rotd50", "single")
@@ -124,6 +124,11 @@ SCHEMA = Table({
                          "levels": Checked(lambda value, field, source: _levels(value, source, check_only=True),
                                            "a list of levels or { start, stop, count, spacing }"),
                          "capacity_resolution": Number(0.0, 0.5),
+                         "credible_max": Number(0.0, 1e3, low_open=True),
+                         "credible_measure": Text(scaling_measures()),
+                         "credible_reason": TEXT,
+                         "credible_frequency": Number(0.0, 1.0),
+                         "beyond_credible": Flag(),
                          "period_range": Interval(Number(0.01, 20.0, unit="s"))}),
     "solver": _table({"switch": Text(tuple(SWITCH_RULES)), "tail": Number(0.0, 600.0, unit="s"),
                       "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
@@ -247,6 +252,16 @@ class StudyConfig:
     measure, period, damping : str, float, float
         The intensity measure (``pga``, ``pgv``, ``sa``, ...), the oscillator period [s] and damping
         ratio [-] of Sa.
+    credible_max, credible_measure, credible_reason, credible_frequency : float, str, str, float
+        The credible cap on the intensity (``[intensity] credible_*``; rockfrag.study.credible_cap): at most
+        ``credible_max`` in ``credible_measure``'s display unit (3 g PGA by default; for another study measure its
+        equivalent over the records), raised to the site hazard's intensity at ``credible_frequency`` [1/yr] (0:
+        not) when that is higher, with the reason stated ("" for the shipped one).
+    beyond_credible : bool
+        Run the level grid past the cap as given (IDA to overturning, for research); fits, risk and exchange
+        files still use only the levels at or below it.
+    level_range : (float, float, int, str) or None
+        ``levels = { start, stop, count, spacing }``: the grid the cap re-spaces per block (None: listed levels).
     component : str
         ``[intensity] component``: "rotd50" (each station's two horizontal components scaled together by the
         pair's RotD50, Boore 2010; a record without a partner by its own component) or "single" (each
@@ -267,8 +282,9 @@ class StudyConfig:
         The band's edges as multiples of Housner's restitution (each capped at 0.99).
     friction : str
         ``[solver] friction``, which housner and winkler cells run with Coulomb friction at the base (each
-        soil's ``friction_static``/``friction_kinetic``): "where-it-matters" (where the soil's mu_s is below the
-        block's b/h), "all" or "none" (every base tied). ssi is always tied (rockfrag.study.cell_friction).
+        soil's ``friction_static``/``friction_kinetic``): "recommended" (every winkler cell, and housner where the
+        soil's mu_s is below the block's b/h), "where-it-matters" (both only there), "all" or "none" (every
+        base tied). ssi is always tied (rockfrag.study.cell_friction).
     tail : float
         Free vibration simulated after the record [s].
     overturn_angle : float
@@ -343,11 +359,17 @@ class StudyConfig:
     hazard_site: tuple[float, float] | None = None  # [lon, lat] [degrees]; picks a multi-site file's nearest site
     restitution: str | float = ""  # bed models' restitution target: "band", "housner", a number, "" (none)
     restitution_band: tuple[float, float] = DEFAULT_BAND  # edges as multiples of Housner's r
-    friction: str = "where-it-matters"  # which cells slide: where-it-matters | all | none
+    friction: str = "recommended"  # which cells slide: recommended | where-it-matters | all | none
     reference_vs30: float = REFERENCE_VS30  # Vs30 of the hazard curve's site [m/s]
     vs30_sigma: float = VS30_SIGMA  # standard deviation of ln Vs30 of each soil's site [-]
     scenario: tuple[float, float] = SCENARIO  # (magnitude, Joyner-Boore distance [km]) of the rock-PGA ratio
     component: str = "rotd50"  # the records' intensity: rotd50 (pairs) | single (each component its own)
+    credible_max: float = 3.0  # in credible_measure's display unit
+    credible_measure: str = "pga"
+    credible_reason: str = ""  # "" = the shipped reason (rockfrag.study.DEFAULT_CREDIBLE_REASON)
+    credible_frequency: float = 1e-5  # [1/yr]; 0 = the hazard does not raise the cap
+    beyond_credible: bool = False
+    level_range: tuple | None = None  # (start, stop, count, spacing) of a { start, stop, count } grid
 
     @property
     def calibrates_bed(self) -> bool:
@@ -421,10 +443,12 @@ def _levels(spec, source, check_only=False):
 
     Levels are in g or m/s, or multiples of each block's uplift intensity with ``relative_to = "uplift"``.
 
-    Returns (levels, relative_to); with ``check_only`` the spec unchanged.
+    Returns (levels, relative_to, level_range), level_range (start, stop, count, spacing) of a range spec
+    (None for listed values); with ``check_only`` the spec unchanged.
     """
     where = "intensity.levels"
     relative_to = ""
+    level_range = None
     if isinstance(spec, list):
         if not spec:
             raise ConfigError(where, "empty list; give at least one level", source)
@@ -443,6 +467,7 @@ def _levels(spec, source, check_only=False):
                 raise ConfigError(where, f"stop {stop:g} must exceed start {start:g}", source)
             spacing = spec.get("spacing", "log")
             values = (np.geomspace if spacing == "log" else np.linspace)(start, stop, count).tolist()
+            level_range = (start, stop, count, spacing)
     else:
         raise ConfigError(where, f"{_shown(spec)}; must be a list of levels or "
                           "{ start, stop, count, spacing }", source)
@@ -450,7 +475,7 @@ def _levels(spec, source, check_only=False):
         raise ConfigError(where, "levels must increase strictly", source)
     if check_only:
         return spec
-    return tuple(float(v) for v in values), relative_to
+    return tuple(float(v) for v in values), relative_to, level_range
 
 
 def _block(table, name, data, source) -> Block:
@@ -657,7 +682,12 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         raise ConfigError("blocks", "no block defined; add [blocks.NAME] tables", source)
     blocks = _select("blocks", data["blocks"], library, source)
     check_study(blocks, soils, data.get("checks", {}).get("plausibility", "error"), source)
-    levels, relative_to = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}), source)
+    levels, relative_to, level_range = _levels(intensity.get("levels", {"start": 0.05, "stop": 3.0, "count": 40}),
+                                               source)
+    credible_measure = intensity.get("credible_measure", "pga")
+    if credible_measure not in ("pga", measure):
+        raise ConfigError("intensity.credible_measure", f"{credible_measure!r}: the cap is stated in the study's "
+                          f"measure ({measure!r}) or in PGA (converted over the records)", source)
     _check_damage_states(data, source)
     site = check_site(hazard["site"], "hazard.site", source) if "site" in hazard else None
     sweep = data.get("applicability", {})
@@ -667,13 +697,17 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         processing=study.get("processing", ""), output=Path(study.get("output", "reports")),
         measure=measure, component=component, period=float(intensity.get("period", 1.0)),
         damping=float(intensity.get("damping", 0.05)),
-        levels=levels, levels_relative_to=relative_to,
+        levels=levels, levels_relative_to=relative_to, level_range=level_range,
+        credible_max=float(intensity.get("credible_max", 3.0)), credible_measure=credible_measure,
+        credible_reason=intensity.get("credible_reason", ""),
+        credible_frequency=float(intensity.get("credible_frequency", 1e-5)),
+        beyond_credible=bool(intensity.get("beyond_credible", False)),
         capacity_resolution=float(intensity.get("capacity_resolution", 0.02)),
         period_range=_period_range(intensity.get("period_range")),
         soils=soils, blocks=blocks, models=models,
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
         restitution=restitution, restitution_band=tuple(solver.get("restitution_band", DEFAULT_BAND)),
-        friction=solver.get("friction", "where-it-matters"),
+        friction=solver.get("friction", "recommended"),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
         hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)), hazard_site=site,
         reference_vs30=float(hazard.get("reference_vs30", REFERENCE_VS30)),

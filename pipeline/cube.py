@@ -59,6 +59,15 @@ COMPONENT_DEFINITIONS = {
 """What each component definition means (the cube's and fragility.nc's ``intensity_component_definition``)."""
 
 
+def credible_attributes(cap, reason, beyond=False) -> dict:
+    """The global attributes stating the credible cap: one value when every block has it, else one per block."""
+    cap = np.asarray(cap, float)
+    return {"credible_intensity_max": float(cap[0]) if np.allclose(cap, cap[0], rtol=1e-12) else cap,
+            "credible_intensity_reason": str(reason),
+            "beyond_credible": "levels above the cap ran (research), not fitted" if beyond
+            else "no levels above the cap"}
+
+
 def component_attributes(flags) -> dict:
     """The global attributes that state the intensity's component definition, from the per-record flags."""
     kinds = list(dict.fromkeys(str(flag) for flag in flags))
@@ -154,7 +163,7 @@ DERIVED_ATTRIBUTES = {
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
                intensity=None, capacities=None, capacity_stats=None, verticals=None,
                vertical_applied=False, calibration=None, friction=None, partners=None,
-               component_im=None) -> xr.Dataset:
+               component_im=None, uplift=None, credible=None) -> xr.Dataset:
     """Assemble the labelled cube.
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
@@ -171,7 +180,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     every base tied): the cube's ``friction_static``/``friction_kinetic`` and where ``SLIP_VARIABLES`` apply;
     partners : the record id of each record's partner in RotD50 scaling ("" or None: scaled by its own
     component; None for all: no pairs); component_im : (n_record, n_block) each record's own component's
-    measure [SI] (default: ``record_im``).
+    measure [SI] (default: ``record_im``); uplift : (n_block,) each block's uplift intensity [SI] of relative
+    levels (rockfrag.study.uplift_intensity; default: the lowest level over its multiple); credible : (cap
+    (n_block,) [SI], reason, beyond) the credible cap on the intensity (rockfrag.study.credible_cap), its reason
+    and whether levels run beyond it, or None (no cap: a cube made by hand).
 
     Layout: ``im_level`` is the level index: multiples of each block's uplift intensity (units "1")
     with ``levels.relative_to = "uplift"``, else the levels in the measure's display unit. The physical
@@ -224,11 +236,24 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
                                         {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
     data_vars.update(_calibration_variables(calibration, model_names, stiffness.shape))
+    credible_attrs = {}
+    if credible is not None:
+        cap, reason, beyond = credible
+        cap = np.asarray(cap, float) / measure.display_factor
+        data_vars["credible_intensity_max"] = ("block", cap, {
+            "long_name": f"credible cap on the {measure_name}: the fits, risk and exchange files use only the levels "
+                         f"at or below it ({reason})", "units": measure.cf_units()})
+        inside = intensity / measure.display_factor <= cap[:, None] * (1 + 1e-9)
+        data_vars["credible_level"] = (("block", "im_level"), inside.astype(np.int8),
+                                       {"long_name": "1 where the level lies at or below the credible cap",
+                                        "units": "1", "flag_values": np.array([0, 1], np.int8),
+                                        "flag_meanings": "beyond_credible credible"})
+        credible_attrs = credible_attributes(cap, reason, beyond)
     for index, (name, long_name) in enumerate(FRICTION_VARIABLES.items()):
         data_vars[name] = (("soil", "block", "model"), friction[index], {"long_name": long_name, "units": "1"})
     coords = {
         "record": ("record", [r.id for r in records], {"long_name": "record id (records/MANIFEST.csv)"}),
-        **_level_coordinates(config, measure_name, intensity),
+        **_level_coordinates(config, measure_name, intensity, uplift),
         "soil": ("soil", [s.name for s in config.soils], {"long_name": "soil class"}),
         "block": ("block", [b.name for b in config.blocks], {"long_name": "block"}),
         "model": ("model", model_names, {"long_name": "rocking model"}),
@@ -284,6 +309,7 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
         "intensity_measure": config.measure,
         "intensity_measure_long_name": measure_name,
         **component_attributes(flags),
+        **credible_attrs,
         "levels_relative_to": config.levels_relative_to,
         **{key: value for key, value in (capacity_stats or {}).items()},
         "study_config": config.as_json(),
@@ -349,26 +375,47 @@ def _vertical_variables(records, verticals, applied, g_factor, acceleration_unit
     }
 
 
-def _level_coordinates(config, measure_name, intensity) -> dict:
+def _shared(values, listed):
+    """The levels every block shares, (n_level,): the study's listed ones where they are those; None if none."""
+    if not np.allclose(values, values[:1], rtol=1e-9):
+        return None
+    if listed.size == values.shape[1] and np.allclose(values[0], listed, rtol=1e-9):
+        return listed
+    return values[0]
+
+
+def _level_coordinates(config, measure_name, intensity, uplift=None) -> dict:
     """``im_level`` and the per-block intensities, in the measure's display unit (``Measure.cf_units``).
 
-    ``im_level`` is an index: multiples of uplift or absolute levels.
+    ``im_level`` holds what the blocks' levels share: the absolute levels when every block has the same, the
+    multiples of each block's uplift intensity when those are the same, else the level's number (1, 2, ...: a
+    grid re-spaced per block up to the credible cap). ``intensity`` (block, im_level) always holds the levels, and
+    with relative levels ``level_multiple`` (block, im_level) their multiples of the block's uplift intensity.
     """
     measure = MEASURES[config.measure]
     units = measure.cf_units()
+    n_level = intensity.shape[1]
+    numbers = ("im_level", np.arange(1.0, n_level + 1.0), {
+        "long_name": f"intensity level number: each block's levels ({measure_name}) are its own, re-spaced up to the "
+                     "credible cap (intensity, level_multiple)", "units": "1"})
+    extra = {}
+    listed = np.asarray(config.levels, float)
     if config.relative_levels:
-        level = ("im_level", np.asarray(config.levels, float),
-                 {"long_name": f"intensity level: multiple of the block's uplift intensity ({measure_name})",
-                  "units": "1"})
-        uplift = intensity[:, 0] / float(config.levels[0])
-        extra = {"block_uplift_intensity": ("block", uplift / measure.display_factor, {
+        uplift = intensity[:, 0] / float(config.levels[0]) if uplift is None else np.asarray(uplift, float)
+        multiples = intensity / uplift[:, None]
+        extra["block_uplift_intensity"] = ("block", uplift / measure.display_factor, {
             "long_name": f"{measure_name} at which the block starts to rock (rockfrag.study.uplift_intensity; "
                          "exact g tan(alpha) only under each component's own PGA, else the records' median)",
-            "units": units})}
+            "units": units})
+        extra["level_multiple"] = (("block", "im_level"), multiples, {
+            "long_name": "the level as a multiple of the block's uplift intensity", "units": "1"})
+        shared = _shared(multiples, listed)
+        level = numbers if shared is None else ("im_level", shared, {
+            "long_name": f"intensity level: multiple of the block's uplift intensity ({measure_name})", "units": "1"})
     else:
-        level = ("im_level", np.asarray(config.levels, float),
-                 {"long_name": f"intensity level: {measure_name}", "units": units})
-        extra = {}
+        shared = _shared(intensity / measure.display_factor, listed)
+        level = numbers if shared is None else ("im_level", shared, {
+            "long_name": f"intensity level: {measure_name}", "units": units})
     return {"im_level": level, **extra,
             "intensity": (("block", "im_level"), intensity / measure.display_factor,
                           {"long_name": f"{measure_name} of the level for the block", "units": units})}

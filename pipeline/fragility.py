@@ -26,6 +26,11 @@ stripe fit. Every row says what it is (``STATUS``):
   beta = 0, status ``separated`` and a warning (never a silent small beta);
 - a median outside the studied range is flagged ``extrapolated``; a state no record reached is
   ``not-reached`` (median NaN).
+Credible intensities: the fits use only the levels at or below the cube's credible cap
+(``credible_intensity_max``, rockfrag.study.credible_cap); a row whose fitted median lies above the cap is
+``censored-at-cap``: no median (NaN), and ``probability_at_cap`` with its bounds (the records that reached the
+state at the highest level at or below the cap) says what the records did. The risk stops at the cap and adds
+the hazard's exceedance of the cap as a stated upper bound (``capped_risk``).
 Ordered states must not cross where the data can tell (from the lowest level at which the more severe
 state has exceedances up to the highest level); states that do are refitted with a shared beta and
 the deviance this costs is reported. Bootstrap bounds resample records and refit each row with the
@@ -37,13 +42,14 @@ from __future__ import annotations
 
 import json
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy.stats import beta as beta_distribution
 from tqdm.auto import tqdm
 
 from rockfrag.config import StudyConfig
@@ -73,6 +79,7 @@ from rockfrag.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exp
     write_exchange_files,
 )
 from rockfrag.exchange import intensity_unit_label as _unit_label
+from rockfrag.hazard import hazard_frequency
 from rockfrag.ida import resurrected
 from rockfrag.lognormal_fit import (  # noqa: F401
     CROSSING_TOLERANCE,
@@ -90,7 +97,7 @@ from rockfrag.measures import MEASURES, convert_units, parse_units, udunits, uni
 from rockfrag.models import MODELS
 from rockfrag.models.variants import BAND_ROLES, RECOMMENDED, split_variant
 from rockfrag.outputs import write_dataset
-from rockfrag.risk import risk_dataset
+from rockfrag.risk import annual_frequency, probability_in_life, risk_dataset
 from rockfrag.site_hazard import site_hazard_dataset, study_site_hazards
 from rockfrag.units import STANDARD_GRAVITY
 
@@ -102,6 +109,8 @@ STATUS = {
     "above-range": "a few records reached the state, only at the highest level: the median is above the range",
     "deterministic-threshold": "an exact step at g tan(alpha) (uplift under each component's own PGA), beta = 0",
     "separated": "perfectly separated counts: a step between two levels, beta = 0 (not identifiable)",
+    "censored-at-cap": "the fitted median lies above the credible cap on the intensity: no median is given; the row "
+                       "gives the probability at the cap (probability_at_cap, with its bounds)",
     NOT_APPLICABLE: "a slip state of a cell whose base is tied (no friction, no sliding: [solver] friction); "
                       "no curve",
 }
@@ -231,6 +240,24 @@ def component_attributes(cube: xr.Dataset) -> dict:
                                                              COMPONENT_DEFINITIONS.get(kind, ""))}
 
 
+def credible_caps(cube: xr.Dataset, unit: str) -> np.ndarray:
+    """The credible cap of each block in ``unit``, (n_block,); inf for a cube without one (every level fitted)."""
+    if "credible_intensity_max" not in cube:
+        return np.full(cube.sizes["block"], np.inf)
+    values = cube["credible_intensity_max"]
+    return np.asarray(convert_units(values.values, values.attrs.get("units", unit), unit), float)
+
+
+def clopper_pearson(reached, total, confidence):
+    """Two-sided ``confidence`` bounds of a binomial fraction (Clopper & Pearson 1934); NaN where total is 0."""
+    reached, total = np.asarray(reached, float), np.asarray(total, float)
+    tail = (1 - confidence) / 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        low = np.where(reached > 0, beta_distribution.ppf(tail, reached, total - reached + 1), 0.0)
+        high = np.where(reached < total, beta_distribution.ppf(1 - tail, reached + 1, total - reached), 1.0)
+    return np.where(total > 0, low, np.nan), np.where(total > 0, high, np.nan)
+
+
 def uplift_is_rigid_threshold(model_name: str) -> bool:
     """Does the model's uplift happen exactly at g tan(alpha) under PGA scaling? Asks the model."""
     model = MODELS.get(model_name)
@@ -313,12 +340,13 @@ def noncrossing_groups(levels, exceed, total, fits, usable):
     return groups, fits
 
 
-def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit=""):
+def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit="", cap=np.inf):
     """Fit every damage state of one cell. exceed, total : (n_state, n_level) counts per level.
 
     threshold : the exact uplift intensity g tan(alpha) when uplift is a rigid threshold under this
-    scaling, else None. Returns (rows, groups): a RowFit per state and the estimator groups (lists of
-    state indices; more than one state = a shared-beta fit), which the bootstrap reuses.
+    scaling, else None. cap : the credible cap [the levels' unit]: the levels are those at or below it, and a
+    median above it is censored (``censored-at-cap``). Returns (rows, groups): a RowFit per state and the
+    estimator groups (lists of state indices; more than one state = a shared-beta fit), which the bootstrap reuses.
     """
     medians, betas = fit_independent(levels, exceed, total)
     rows = []
@@ -373,6 +401,11 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
     grouped = {s for group in groups for s in group}
     groups = [group for group in groups] + [[s] for s in range(len(states)) if s not in grouped]
     for row in rows:
+        if np.isfinite(row.median) and row.median > cap * (1 + 1e-9):  # never a median above the credible cap
+            row.median, row.beta, row.method, row.status = np.nan, np.nan, "censored-at-cap", "censored-at-cap"
+            row.warn(f"the fitted median lies above the credible cap {cap:.3g} {unit}: censored there "
+                     "(probability_at_cap)")
+            continue
         if row.method.startswith("mle") and not levels[0] <= row.median <= levels[-1]:
             row.status = "extrapolated"
             row.warn(f"median {row.median:.3g} {unit} outside the studied range {span} (extrapolated)")
@@ -468,8 +501,8 @@ def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n
     resurrection and for a capacity median outside the stripe fit's bootstrap bounds (when the stripe
     fit has a spread: beta > 0 and distinct bounds).
 
-    capacities : [capacity, censor point] per record [unit] or None; top : the cell's highest level, where
-    a record that never overturned is censored when its own survival is unknown.
+    capacities : [capacity, censor point] per record [unit] or None; top : the cell's highest credible level,
+    where a record that never overturned (or overturned only above it) is censored.
     """
     if n_resurrected:
         row.warn(f"{n_resurrected} of {n_records} records survived a level above their first overturning level "
@@ -477,7 +510,11 @@ def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n
     if capacities is None:
         return
     capacity, censor = capacities
+    beyond = capacity > top * (1 + 1e-9)  # a capacity above the credible cap (runs beyond it) is censored there
+    capacity, censor = np.where(beyond, np.nan, capacity), np.where(beyond, top, censor)
     median, beta = fit_censored_capacities(capacity, np.where(np.isfinite(censor), censor, top))
+    if median > top * (1 + 1e-9):  # never a median above the cap
+        median, beta = np.nan, np.nan
     out["capacity_median"][key], out["capacity_beta"][key] = median, beta
     low, high = out["median_low"][key], out["median_high"][key]
     if row.beta > 0 and np.isfinite(median) and low < high and not low <= median <= high:
@@ -538,20 +575,30 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     weights = record_resamples(n_records, n_bootstrap, seed)
     n_resurrected = resurrected(cube.outcome.transpose("record", *group_dims, "im_level").values).sum(0)
     capacities = refined_capacities(ida, unit)
+    caps = credible_caps(cube, unit)
+    credible = intensity <= caps[:, None] * (1 + 1e-9)  # (block, level): the levels the fits may use
     label = unit_label(unit)
     tail = (1 - confidence) / 2
+    at_cap = {name: np.full(shape, np.nan) for name in ("probability_at_cap", "probability_at_cap_low",
+                                                         "probability_at_cap_high")}
     cells = list(np.ndindex(*shape[:-1]))
     for index in tqdm(cells, desc="fragility fits + bootstrap", unit="cell", disable=not progress):
         soil, block, model = index
-        levels = intensity[block]
-        data = (slice(None), slice(None), *index)
+        levels = intensity[block][credible[block]]
+        data = (slice(None), credible[block], *index)
         exceed = reached[data].sum(0).T  # (state, level)
         total = valid[data].sum(0).T.astype(float)
+        if levels.size:  # the records that reached each state at the highest credible level, with bounds
+            last = total[:, -1]
+            with np.errstate(invalid="ignore"):
+                at_cap["probability_at_cap"][index] = np.where(last > 0, exceed[:, -1] / last, np.nan)
+            at_cap["probability_at_cap_low"][index], at_cap["probability_at_cap_high"][index] = clopper_pearson(
+                exceed[:, -1], last, confidence)
         # the exact step is the rigid base's only where the base is tied: one that slides before it can rock
         # (base friction, Shenton 1996) need not lift at g tan(alpha), so its uplift is fitted from its runs
         threshold = thresholds[block] if thresholds is not None and rigid[models[model]] \
             and not sliding[index] else None
-        rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, label)
+        rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, label, caps[block])
         if n_bootstrap:
             boot_exceed = np.einsum("br,rls->bsl", weights, reached[data])
             boot_total = np.einsum("br,rls->bsl", weights, valid[data].astype(float))
@@ -591,8 +638,19 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     data_vars["fit_warning"] = (dims, text["fit_warning"].astype(str), {"long_name": "warnings about the fit"})
     data_vars["studied_im_min"] = (("block",), intensity[:, 0], {
         "long_name": "lowest intensity level studied for the block", "units": unit})
-    data_vars["studied_im_max"] = (("block",), intensity[:, -1], {
-        "long_name": "highest intensity level studied for the block", "units": unit})
+    highest = np.array([levels[keep][-1] if keep.any() else np.nan for levels, keep in zip(intensity, credible)])
+    data_vars["studied_im_max"] = (("block",), highest, {
+        "long_name": "highest intensity level studied for the block (at or below the credible cap)", "units": unit})
+    data_vars["credible_max"] = (("block",), caps, {
+        "long_name": "credible cap on the intensity: fits, risk and exchange files use only the levels at or below "
+                     "it (inf: none)", "units": unit})
+    for name, long_name in (("probability_at_cap", "fraction of records that reached the state at the highest level "
+                                                   "at or below the credible cap"),
+                            ("probability_at_cap_low", f"lower {confidence:.0%} Clopper-Pearson bound of "
+                                                       "probability_at_cap"),
+                            ("probability_at_cap_high", f"upper {confidence:.0%} Clopper-Pearson bound of "
+                                                        "probability_at_cap")):
+        data_vars[name] = (dims, at_cap[name], {"long_name": long_name, "units": "1"})
     data_vars["n_records"] = ((), n_records, {"long_name": "number of records", "units": "1"})
     data_vars["n_resurrected"] = (group_dims, n_resurrected.astype(np.int32), {
         "long_name": "records that survived a level above their first overturning level (resurrection; counted "
@@ -620,6 +678,9 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
                      "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", ""),
                      "intensity_measure": measure, "intensity_unit": unit, "intensity_unit_label": label,
                      **component_attributes(cube),
+                     "credible_intensity_max": float(caps[0]) if np.allclose(caps, caps[0]) else caps,
+                     "credible_intensity_reason": cube.attrs.get("credible_intensity_reason",
+                                                                 "none: the cube states no credible cap"),
                      "overturning_convention": OVERTURNING_CONVENTION,
                      "capacity_fit": CAPACITY_FIT if capacities is not None else
                      "capacity_median/capacity_beta: none (no refined capacities: capacity_resolution = 0 or no "
@@ -775,23 +836,101 @@ def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
 TABLE_COLUMNS = ["median", "beta", "beta_record_to_record", "beta_model", "status", "extrapolated", "fit_method",
                  "median_low", "median_high", "beta_low",
                  "beta_high", "gof_p_value", "gof_max_error", "noncrossing_deviance_cost", "capacity_median",
-                 "capacity_beta", "fit_warning"]
+                 "capacity_beta", "probability_at_cap", "probability_at_cap_low", "probability_at_cap_high",
+                 "fit_warning"]
 
 
 def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:
     """One row per soil x block x model x damage state, with the studied range of the block."""
     table = dataset[TABLE_COLUMNS].to_dataframe().reset_index()
-    studied = dataset[["studied_im_min", "studied_im_max"]].to_dataframe().reset_index()
+    per_block = ["studied_im_min", "studied_im_max", *(["credible_max"] if "credible_max" in dataset else [])]
+    studied = dataset[per_block].to_dataframe().reset_index()
     table = table.merge(studied.rename(columns={"studied_im_min": "im_lowest", "studied_im_max": "im_highest"}),
                         on="block")
+    if "credible_max" not in table:
+        table["credible_max"] = np.inf
     table["im_units"] = _unit_label(dataset)
     table["n_records"] = int(dataset.n_records)
     resurrections = ["n_resurrected"] if "n_resurrected" in dataset else []
     if resurrections:
         table = table.merge(dataset["n_resurrected"].to_dataframe().reset_index(), on=["soil", "block", "model"])
     keep = ["soil", "block", "model", "damage_state", *TABLE_COLUMNS[:-1], *resurrections, "im_lowest", "im_highest",
-            "im_units", "n_records", "fit_warning"]
+            "credible_max", "im_units", "n_records", "fit_warning"]
     return table[keep]
+
+
+RISK_BOUND = (
+    "annual_frequency integrates P(state | im) over the hazard up to the credible cap (credible_max) and adds the "
+    "hazard's exceedance of the cap, lambda(cap), as if every intensity above it reached the state: an upper bound "
+    "on the part above the cap (annual_frequency_above_cap). A row censored at the cap (no median) integrates the "
+    "records' fractions at the levels below it instead of a fitted curve")
+"""How the risk treats the credible cap (fragility.nc's ``risk_bound`` attribute)."""
+
+
+def capped_frequency(median: float, beta: float, hazard, cap: float, levels=None, fractions=None) -> float:
+    """Lambda of one row [1/yr] up to the credible ``cap`` plus lambda(cap), the stated upper bound above it.
+
+    A row with a curve (finite median and beta): its lognormal integrated up to the cap
+    (``rockfrag.risk.annual_frequency`` with and without ``lower = cap``); a row without one but with the
+    records' ``fractions`` at ``levels`` (a censored row): each fraction held from its level to the next one.
+    NaN without a hazard, or with neither.
+    """
+    if hazard is None:
+        return np.nan
+    above = float(hazard_frequency(hazard, cap)) if np.isfinite(cap) else 0.0
+    if np.isfinite(median) and np.isfinite(beta):
+        whole = annual_frequency(median, beta, hazard)
+        if not np.isfinite(cap):
+            return whole
+        beyond = annual_frequency(median, beta, hazard, lower=cap) if beta > 0 else (whole if median >= cap else 0.0)
+        return whole - beyond + above
+    if levels is None or not np.isfinite(cap):
+        return np.nan
+    known = np.isfinite(fractions)
+    levels, fractions = np.asarray(levels, float)[known], np.asarray(fractions, float)[known]
+    if not levels.size:
+        return np.nan
+    edges = np.append(levels, cap)
+    drops = hazard_frequency(hazard, edges[:-1]) - hazard_frequency(hazard, edges[1:])
+    return float(np.sum(fractions * drops)) + above
+
+
+def capped_risk(fragility: xr.Dataset, risk: xr.Dataset, hazard_of, design_life: float) -> xr.Dataset:
+    """``risk`` (rockfrag.risk.risk_dataset) with every row's integral stopped at its block's credible cap.
+
+    ``hazard_of(soil) -> HazardCurve or None``: the hazard each soil's rows use. Adds
+    ``annual_frequency_above_cap`` [1/yr], the bound lambda(cap) (``RISK_BOUND``); a fragility without a cap
+    (``credible_max`` inf or absent) keeps ``risk`` as it is.
+    """
+    if "credible_max" not in fragility or not np.isfinite(fragility.credible_max.values).any():
+        return risk
+    frequency = risk.annual_frequency.copy()
+    above = xr.full_like(frequency, np.nan)
+    levels = fragility["intensity"] if "intensity" in fragility.variables else None
+    for soil in fragility.soil.values:
+        hazard = hazard_of(str(soil))
+        for block in fragility.block.values:
+            cap = float(fragility.credible_max.sel(block=block))
+            for model in fragility.model.values:
+                for state in fragility.damage_state.values:
+                    where = dict(soil=soil, block=block, model=model, damage_state=state)
+                    row = fragility.sel(**where)
+                    block_levels = levels.sel(block=block).values if levels is not None else None
+                    fractions = row.empirical_fraction.values if "empirical_fraction" in row else None
+                    credible = None if block_levels is None else block_levels <= cap * (1 + 1e-9)
+                    frequency.loc[where] = capped_frequency(
+                        float(row["median"]), float(row["beta"]), hazard, cap,
+                        None if credible is None else block_levels[credible],
+                        None if credible is None or fractions is None else fractions[credible])
+                    above.loc[where] = float(hazard_frequency(hazard, cap)) if hazard is not None else np.nan
+    risk = risk.assign(annual_frequency=frequency.assign_attrs(risk.annual_frequency.attrs),
+                       probability_in_life=(frequency.dims, probability_in_life(frequency.values, design_life),
+                                            risk.probability_in_life.attrs),
+                       annual_frequency_above_cap=above.assign_attrs(
+                           long_name="the hazard's exceedance of the credible cap, added to annual_frequency as an "
+                                     "upper bound on the part above the cap", units="yr-1"))
+    risk.attrs["risk_bound"] = RISK_BOUND
+    return risk
 
 
 def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, output: str | Path,
@@ -839,7 +978,9 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
                                 confidence=config.confidence, progress=progress)
     for line in json.loads(dataset.attrs["fit_warnings"]):
         log(f"fragility warning: {line}")
-    risk = risk_dataset(dataset, hazard, config.design_life)
+    # each soil's risk stops at its block's credible cap and adds the cap's exceedance as a bound (capped_risk)
+    risk = capped_risk(dataset, risk_dataset(dataset, hazard, config.design_life),
+                       lambda soil: hazard[soil] if isinstance(hazard, Mapping) else hazard, config.design_life)
     # the curve each soil's risk used: site_hazard(soil, hazard_intensity)
     sites = site_hazard_dataset(hazard, config.soils, config.measure) if hazard is not None else xr.Dataset()
     combined = dataset.merge(risk).merge(sites)

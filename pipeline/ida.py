@@ -234,7 +234,8 @@ def fill(overturns, lower, upper, tolerance=0.02, max_runs=200):
     return lower, upper, runs
 
 
-def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_runs=200, lower=0.0):
+def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_runs=200, lower=0.0,
+                  limit=math.inf):
     """Adaptive overturning capacity of one record (hunt up, then fill by bisection).
 
     Parameters
@@ -249,21 +250,28 @@ def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_ru
         Relative width of the final bracket [-].
     lower : float
         An intensity known to survive (below ``start``).
+    limit : float
+        The highest intensity the hunt may try (the credible cap): a record that survives it is censored there.
 
     Returns
     -------
     (capacity, lower, upper, runs): capacity is the bracket midpoint of the first overturning
-    intensity found by the hunt (NaN if none within ``max_runs``).
+    intensity found by the hunt (NaN if none within ``max_runs`` or up to ``limit``; ``lower`` is then the
+    highest intensity seen to survive).
     """
     runs = 0
-    im, increment = start, step
+    im, increment = min(start, limit), step
     while runs < max_runs:
+        if im <= lower * (1 + 1e-9):  # the limit lies at (or below) an intensity already seen to survive
+            return math.nan, lower, math.nan, runs
         runs += 1
         if overturns(im):
             upper = im
             break
         lower = im
-        im = im + increment
+        if im >= limit:
+            return math.nan, lower, math.nan, runs
+        im = min(im + increment, limit)
         increment *= growth
     else:
         return math.nan, lower, math.nan, runs
@@ -271,14 +279,15 @@ def hunt_and_fill(overturns, start, step=0.1, growth=1.5, tolerance=0.02, max_ru
     return 0.5 * (lower + upper), lower, upper, runs + fill_runs
 
 
-def capacity_from_stripes(scales, overturned, overturns, tolerance=0.02, max_runs=60):
+def capacity_from_stripes(scales, overturned, overturns, tolerance=0.02, max_runs=60, limit=math.inf):
     """Overturning capacity of one record as a scale factor, refining the study's stripes.
 
     The stripes already ran (``overturned[j]`` at ``scales[j]``, increasing) and are the hunt:
     the first overturning stripe and the stripe below it bracket the first overturning intensity,
     which ``fill`` then bisects to ``tolerance``. A record that survives every stripe is hunted on
     upwards from the top stripe (``hunt_and_fill``); one that overturns at the lowest stripe is
-    bracketed downwards by halving. ``overturns(scale) -> bool`` runs the solver.
+    bracketed downwards by halving. ``overturns(scale) -> bool`` runs the solver. The hunt stops at ``limit``
+    (the credible cap as a scale factor): a record that survives it is censored there (NaN capacity).
 
     Returns (capacity, lower, upper, runs): capacity is the bracket midpoint (NaN if the record
     never overturned within ``max_runs`` extra runs); runs counts the extra solver runs only.
@@ -289,7 +298,7 @@ def capacity_from_stripes(scales, overturned, overturns, tolerance=0.02, max_run
         top = scales[-1]
         step = top * (scales[-1] / scales[-2] - 1.0) if scales.size > 1 else 0.1 * top
         return hunt_and_fill(overturns, top + step, step=step, growth=1.5, tolerance=tolerance,
-                             max_runs=max_runs, lower=top)
+                             max_runs=max_runs, lower=top, limit=limit)
     upper = scales[hits[0]]
     runs = 0
     if hits[0] > 0:

@@ -40,6 +40,7 @@ import hashlib
 import json
 import sys
 import time
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -64,6 +65,7 @@ from rockfrag.outputs import write_dataset
 from rockfrag.processing import ProcessingRecipe, load_recipe, process_records
 from rockfrag.records import Record, group_components, load_records, split_vertical
 from rockfrag.records.components import horizontal_partners, pair_window
+from rockfrag.site_hazard import study_site_hazards
 from rockfrag.soils import soil_block_stiffness
 
 
@@ -94,8 +96,10 @@ def cell_friction(block, soil, model: str, mode: str) -> tuple[float, float] | N
     model : str
         The model's name; only models that slide (housner, winkler) take friction: ssi is always tied.
     mode : str
-        ``[solver] friction``: "where-it-matters" slides where the soil's mu_s < b/h (below it a block at rest
-        slides before it can rock: Shenton 1996), "all" slides every cell of a model that slides, "none" none.
+        ``[solver] friction``: "recommended" slides every cell of the bed model (the recommended fragility's) and a
+        rigid base (a reference) where it matters; "where-it-matters" slides where the soil's mu_s < b/h (below
+        it a block at rest slides before it can rock: Shenton 1996), "all" slides every cell of a model that
+        slides, "none" none.
 
     Returns
     -------
@@ -104,7 +108,8 @@ def cell_friction(block, soil, model: str, mode: str) -> tuple[float, float] | N
     """
     if soil is None or mode == "none" or not get_model(model).slides:
         return None
-    if mode == "all" or soil.friction_static < block.b / block.h:
+    if mode == "all" or (mode == "recommended" and get_model(model).uses_bed) \
+            or soil.friction_static < block.b / block.h:
         return soil.friction
     return None
 
@@ -188,11 +193,102 @@ def uplift_intensity(config, record_im, record_pga) -> np.ndarray:
     return np.median(record_im / np.asarray(record_pga)[:, None], axis=0) * uplift_pga
 
 
-def level_intensities(config, record_im, record_pga) -> np.ndarray:
-    """The physical intensity of every (block, level), (n_block, n_level) [SI]."""
-    if config.relative_levels:
-        return uplift_intensity(config, record_im, record_pga)[:, None] * np.asarray(config.levels)[None, :]
-    return np.broadcast_to(config.levels_si, (len(config.blocks), len(config.levels))).copy()
+DEFAULT_CREDIBLE_REASON = (
+    "3 g PGA: above the largest horizontal PGA recorded, 2.7 g (K-NET MYG004, N-S component, 2011 Tohoku "
+    "earthquake)")
+"""Why the shipped cap is 3 g PGA (``[intensity] credible_max``, ``credible_measure = "pga"``)."""
+
+
+def credible_cap(config, record_im, record_pga, hazard=None) -> tuple[np.ndarray, str]:
+    """The credible cap on each block's intensity [SI], (n_block,), and its reason in words.
+
+    ``[intensity] credible_max`` in ``credible_measure``'s display unit: in the study's own measure it is the cap;
+    stated in PGA for a study of another measure, its equivalent over the records, the median of IM/PGA times it
+    (``uplift_intensity``'s conversion; for PGA/(g tan alpha) exactly 3 g/(g tan alpha) per block). A site hazard
+    for the study's measure (``hazard``, rockfrag.hazard) raises it to the intensity exceeded at
+    ``credible_frequency`` [1/yr] where that is higher ("unless the site's hazard says otherwise").
+
+    Parameters
+    ----------
+    config : rockfrag.config.StudyConfig
+        The study.
+    record_im : numpy.ndarray
+        (n_record, n_block) the intensity each record is scaled by [SI].
+    record_pga : numpy.ndarray
+        (n_record,) each record's own PGA [m/s^2].
+    hazard : rockfrag.hazard.HazardCurve or mapping of soil to HazardCurve, optional
+        The study's hazard curve, or each soil's site curve (rockfrag.site_hazard.study_site_hazards: the largest
+        intensity at the frequency over the soils counts); intensities in the measure's display unit.
+
+    Returns
+    -------
+    cap : numpy.ndarray
+        (n_block,) [SI].
+    reason : str
+        Why, including the equivalent or the hazard when they set it.
+    """
+    measure = MEASURES[config.measure]
+    stated = MEASURES[config.credible_measure]
+    value = config.credible_max * stated.display_factor
+    reason = config.credible_reason or (DEFAULT_CREDIBLE_REASON if (config.credible_measure, config.credible_max)
+                                        == ("pga", 3.0) else "the study's [intensity] credible_max")
+    label = measure.short_label(**config.measure_options)
+    if config.credible_measure == config.measure:
+        cap = np.full(len(config.blocks), value)
+    else:  # stated in PGA: the records' median intensity per unit of their own PGA
+        cap = np.median(np.asarray(record_im) / np.asarray(record_pga)[:, None], axis=0) * value
+        reason += (f"; in {label}, the records' median of {label}/PGA times {config.credible_max:g} "
+                   f"{stated.display_unit}")
+    curves = dict(hazard) if isinstance(hazard, Mapping) else {"": hazard} if hazard is not None else {}
+    if curves and config.credible_frequency > 0:
+        at = {soil: _hazard_intensity_at(curve, config.credible_frequency) * measure.display_factor
+              for soil, curve in curves.items()}
+        soil = max(at, key=at.get)
+        site = at[soil]
+        if np.any(site > cap):
+            where = f" ({soil})" if soil else ""
+            reason = (f"the site hazard's {label}{where} at {config.credible_frequency:g}/yr, "
+                      f"{site / measure.display_factor:.3g} {measure.display_unit}, above {reason}")
+            cap = np.maximum(cap, site)
+    return cap, reason
+
+
+def _hazard_intensity_at(hazard, frequency) -> float:
+    """The intensity [the curve's unit] exceeded at ``frequency`` [1/yr].
+
+    The log-log inverse of the curve, power laws beyond both ends, as rockfrag.answer.intensity_at_frequency reads it.
+    """
+    x, y = np.log(hazard.intensity), np.log(hazard.annual_frequency)
+    target = np.log(frequency)
+    if target < y[-1]:
+        return float(np.exp(x[-1] + (target - y[-1]) * (x[-1] - x[-2]) / (y[-1] - y[-2])))
+    if target > y[0]:
+        return float(np.exp(x[0] + (target - y[0]) * (x[1] - x[0]) / (y[1] - y[0])))
+    return float(np.exp(np.interp(target, y[::-1], x[::-1])))
+
+
+def level_intensities(config, record_im, record_pga, cap=None) -> np.ndarray:
+    """The physical intensity of every (block, level), (n_block, n_level) [SI].
+
+    With a credible ``cap`` [SI] (n_block,) a ``{ start, stop, count }`` grid whose top lies above it is re-spaced
+    per block from its start to the cap, so all ``count`` levels lie in the credible range (``[intensity]
+    beyond_credible = true`` keeps the grid as given). Listed levels stay as listed; those above the cap are
+    beyond credible (the fits leave them out).
+    """
+    base = uplift_intensity(config, record_im, record_pga) if config.relative_levels \
+        else np.ones(len(config.blocks))
+    scale = 1.0 if config.relative_levels else MEASURES[config.measure].display_factor
+    if cap is None or config.level_range is None or config.beyond_credible:
+        return base[:, None] * np.asarray(config.levels_si if not config.relative_levels else config.levels)[None, :]
+    start, stop, count, spacing = config.level_range
+    low, high = start * scale * base, np.minimum(stop * scale * base, cap)
+    if np.any(high <= low):
+        block = config.blocks[int(np.argmax(high <= low))].name
+        raise PipelineError(f"[intensity] levels: block {block}'s lowest level lies at or above the credible cap "
+                            f"({config.credible_max:g} {MEASURES[config.credible_measure].display_unit} "
+                            f"{config.credible_measure}); lower levels.start or raise intensity.credible_max")
+    spaced = np.geomspace if spacing == "log" else np.linspace
+    return np.array([spaced(lo, hi, count) for lo, hi in zip(low, high)])
 
 
 def study_scale_factors(intensity, record_im) -> np.ndarray:
@@ -214,16 +310,31 @@ def refines_capacity(model: str, friction: tuple[float, float] | None = None) ->
     return split_variant(model)[1] not in ("low", "high") and friction is None and not get_model(model).can_pull
 
 
-def capacity_key(key, resolution) -> str:
-    """Checkpoint key of a cell's adaptive overturning capacity."""
-    return f"{key}-capacity-{resolution:g}"
+def capacity_key(key, resolution, limit=np.inf) -> str:
+    """Checkpoint key of a cell's adaptive overturning capacity (``limit``: the scale factor where its hunt stops)."""
+    return f"{key}-capacity-{resolution:g}" + (f"-limit-{float(limit):.12g}" if np.isfinite(limit) else "")
+
+
+def _limit(capacity_limit, record, block) -> float:
+    return np.inf if capacity_limit is None else float(capacity_limit[record, block])
+
+
+def credible_line(config, cap, reason, intensity) -> str:
+    """The run's line on the credible cap and the levels below it."""
+    measure = MEASURES[config.measure]
+    label, unit = measure.short_label(**config.measure_options), measure.display_unit
+    caps = ", ".join(dict.fromkeys(f"{c / measure.display_factor:.3g}" for c in cap))
+    top = intensity[:, -1] > cap * (1 + 1e-9)
+    beyond = f"; levels above it run (beyond credible, not fitted) for {int(top.sum())} blocks" if top.any() else ""
+    return f"credible intensities: {label} at most {caps} {unit} ({reason}){beyond}"
 
 
 class _FreeFlight(Exception):
     """A refining run ended in free flight: whether it would have overturned is unknown."""
 
 
-def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolution, ag_vertical=None):
+def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolution, ag_vertical=None,
+                  limit=np.inf):
     """[capacity, lower, upper, extra runs] of one cell as scale factors (see capacity_from_stripes).
 
     Free flight (a pivot model stopped where g + a_v < 0, ``Outcome.FREE_FLIGHT``) says nothing about
@@ -231,7 +342,9 @@ def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolu
     below it is bracketed as usual, and a refining run that ends in free flight stops the refinement with
     the bracket found so far (``_bracket_so_far``). A record that did not overturn below its first
     free-flight stripe has no capacity (NaN), censored at the highest stripe it survived below it
-    (``lower``; NaN if none). Without free flight this is exactly ``capacity_from_stripes``.
+    (``lower``; NaN if none). Without free flight this is exactly ``capacity_from_stripes``. The hunt stops at the
+    scale factor ``limit`` (the credible cap): stripes above it are left out, and a record that survives it is
+    censored there (NaN capacity, ``lower`` the limit or the highest stripe below it).
     """
     _, model, block, k, xi, friction = job
     seen = []  # (scale, overturned) of each refining run
@@ -245,16 +358,20 @@ def cell_capacity(acceleration, dt, scales, summary, job, options, t_end, resolu
         seen.append((scale, status == int(Outcome.OVERTURNED)))
         return seen[-1][1]
 
-    status = summary["status"].astype(int)
+    credible = np.asarray(scales, float) <= limit * (1 + 1e-9)
+    status = summary["status"].astype(int)[credible]
     overturned = status == int(Outcome.OVERTURNED)
-    scales = np.asarray(scales, float)
+    scales = np.asarray(scales, float)[credible]
+    if not scales.size:
+        return np.array([np.nan, np.nan, np.nan, 0.0])
     flights = np.flatnonzero(status == int(Outcome.FREE_FLIGHT))
     if flights.size:
         scales, overturned = scales[:flights[0]], overturned[:flights[0]]
         if not overturned.any():
             return np.array([np.nan, scales[-1] if scales.size else np.nan, np.nan, 0.0])
     try:
-        return np.array(capacity_from_stripes(scales, overturned, overturns, tolerance=resolution), dtype=float)
+        return np.array(capacity_from_stripes(scales, overturned, overturns, tolerance=resolution, limit=limit),
+                        dtype=float)
     except _FreeFlight:
         return _bracket_so_far(scales, overturned, seen)
 
@@ -421,14 +538,16 @@ def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
     return lines
 
 
-def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0, ag_vertical=None):
+def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0, ag_vertical=None,
+                  capacity_limit=np.inf):
     """Pure task function (runs in a worker): summaries for each job.
 
     jobs : list of (key, model, block, k, xi, friction), friction the base's (mu_s, mu_k) or None (tied);
     options : ``solver_options``; ag_vertical : the record's
     vertical component [m/s^2, up positive], sampled as ``acceleration`` and scaled by the same factors, or None.
     Returns {key: summary records (n_scale,)} and, when ``capacity_resolution`` > 0,
-    {capacity_key(key): [capacity, lower, upper, runs]} (scale factors).
+    {capacity_key(key, ..., capacity_limit): [capacity, lower, upper, runs]} (scale factors; the hunt stops at
+    ``capacity_limit``, the scale factor of the credible cap).
     """
     results = {}
     t_end = (acceleration.size - 1) * dt + tail
@@ -450,8 +569,8 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
             case = (get_model(model).name, block, k, xi, friction)
             if case not in refined:
                 refined[case] = cell_capacity(acceleration, dt, scales, results[key], (key, *case), options, t_end,
-                                              capacity_resolution, ag_vertical)
-            results[capacity_key(key, capacity_resolution)] = refined[case]
+                                              capacity_resolution, ag_vertical, capacity_limit)
+            results[capacity_key(key, capacity_resolution, capacity_limit)] = refined[case]
     return results
 
 
@@ -664,8 +783,15 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     component_im = component_intensities(records, config)
     partner_ids = [records[p].id if p is not None else "" for p in partners]
     record_pga = np.array([pga(r.acceleration) for r in records])
-    intensity = level_intensities(config, record_im, record_pga)
+    cap, cap_reason = credible_cap(config, record_im, record_pga,
+                                   study_site_hazards(config) if config.credible_frequency > 0 else None)
+    intensity = level_intensities(config, record_im, record_pga, cap)
+    uplift = uplift_intensity(config, record_im, record_pga) if config.relative_levels else None
     scale_factors = study_scale_factors(intensity, record_im)
+    # the capacity hunt stops at the cap (records that survive it are censored there), unless runs beyond it
+    # are asked for
+    capacity_limit = np.full(record_im.shape, np.inf) if config.beyond_credible else cap[None, :] / record_im
+    log(credible_line(config, cap, cap_reason, intensity))
     resolution = config.capacity_resolution
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
     calibration = bed_calibration(config, stiffness)
@@ -682,11 +808,14 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     keys = list(dict.fromkeys(c.key for variant in variants for cells in all_cells[variant] for c in cells))
     results = store.load_verified(keys, (n_levels,), SUMMARY_DTYPE)
     if resolution > 0:
-        refining = list(dict.fromkeys(c.key for variant in variants for cells in all_cells[variant] for c in cells
+        refining = list(dict.fromkeys((c.key, r, c.block_index) for variant in variants
+                                      for r, cells in enumerate(all_cells[variant]) for c in cells
                                       if refines_capacity(c.model, c.friction)))
-        results.update(store.load_verified([capacity_key(k, resolution) for k in refining], (4,), np.float64))
+        results.update(store.load_verified([capacity_key(k, resolution, capacity_limit[r, b])
+                                            for k, r, b in refining], (4,), np.float64))
     tasks = [(*task, variant) for variant in variants
-             for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration)]
+             for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration,
+                                     capacity_limit)]
     n_cells = len(keys)
     n_missing = sum(len(task[2]) for task in tasks)
     runs_total = n_missing * n_levels
@@ -709,7 +838,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                              lambda task: (records[task[0]].acceleration, records[task[0]].dt,
                                            scale_factors[task[0], :, task[1]], task[2], solver_options(config),
                                            config.tail, resolution,
-                                           verticals[task[0]].acceleration if task[3] else None),
+                                           verticals[task[0]].acceleration if task[3] else None,
+                                           capacity_limit[task[0], task[1]]),
                              lambda: make_executor(compute_cells, workers, scheduler, dask_workers), keep_result,
                              describe=lambda task: f"record {records[task[0]].id}, block {config.blocks[task[1]].name}"
                                                    f"{', with its vertical' if task[3] else ''}",
@@ -730,6 +860,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         # the levels stay those of the whole record set (relative levels use its median)
         records, record_im, scale_factors = [records[i] for i in kept], record_im[kept], scale_factors[kept]
         component_im, partner_ids = component_im[kept], [partner_ids[i] for i in kept]
+        capacity_limit = capacity_limit[kept]
         verticals = [verticals[i] for i in kept] if verticals is not None else None
         all_cells = {variant: [cells[i] for i in kept] for variant, cells in all_cells.items()}
 
@@ -738,7 +869,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     cubes = {}
     for variant in variants:
         summaries = _gather_summaries(all_cells[variant], results, config, len(records), n_levels)
-        capacities, stats = gather_capacities(all_cells[variant], results, config, intensity, resolution)
+        capacities, stats = gather_capacities(all_cells[variant], results, config, intensity, resolution,
+                                              capacity_limit)
         if stats:
             log(f"capacities to {resolution:.0%}{' without the vertical' if config.vertical and not variant else ''}"
                 f": {stats['capacity_runs']} refining runs over {stats['grid_runs']} stripe runs; uniform stripes "
@@ -748,7 +880,9 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
                                      calibration=calibration, friction=friction_grid(config),
                                      verticals=verticals, vertical_applied=variant, partners=partner_ids,
-                                     component_im=component_im), stats)
+                                     component_im=component_im, uplift=uplift, credible=(cap, cap_reason,
+                                                                                         config.beyond_credible)),
+                        stats)
     dataset, capacity_stats = cubes[variants[0]]
     if config.vertical:  # the comparison first: a cube.nc on disk always has its comparison beside it
         comparison = cubes[False][0]
@@ -779,14 +913,15 @@ def _gather_summaries(all_cells, results, config, n_records, n_levels) -> np.nda
     return summaries
 
 
-def block_tasks(all_cells, available, config, stiffness, resolution, calibration=None) -> list:
+def block_tasks(all_cells, available, config, stiffness, resolution, calibration=None, capacity_limit=None) -> list:
     """(record index, block index, jobs) for every record and block with cells still to run.
 
     Cells still to run are those not in ``available``, the verified checkpoints; a job is
     (key, model, block, k, xi, friction), xi the soil's damping ratio or, for a bed model with a restitution
     target, its calibrated one (``calibration``, a ``BandCalibration``), friction the cell's (mu_s, mu_k) or None
     (``cell_friction``). Grouped by block because scale factors are per block; cells of one key (a tied housner
-    cell on several soils) are one job. A rigid-base model's k and xi are None.
+    cell on several soils) are one job. A rigid-base model's k and xi are None. ``capacity_limit`` (n_record,
+    n_block): the scale factor at the credible cap, where the capacity hunt stops (None: no limit).
     """
     def damping(cell):
         if calibration is not None and cell.model in calibration.variants:
@@ -800,8 +935,9 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
     for index, cells in enumerate(all_cells):
         by_block = {}
         for cell in {c.key: c for c in cells}.values():
+            limit = np.inf if capacity_limit is None else capacity_limit[index, cell.block_index]
             done = cell.key in available and (resolution <= 0 or not refines_capacity(cell.model, cell.friction)
-                                              or capacity_key(cell.key, resolution) in available)
+                                              or capacity_key(cell.key, resolution, limit) in available)
             if not done:
                 by_block.setdefault(cell.block_index, []).append(cell)
         for block_index, missing in by_block.items():
@@ -813,7 +949,7 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
     return tasks
 
 
-def gather_capacities(all_cells, available, config, intensity, resolution):
+def gather_capacities(all_cells, available, config, intensity, resolution, capacity_limit=None):
     """Adaptive capacities as scale factors, and the run accounting.
 
     The capacities are (4, record, soil, block, model): capacity, lower, upper, extra runs. The
@@ -828,14 +964,16 @@ def gather_capacities(all_cells, available, config, intensity, resolution):
         for cell in cells:
             if not refines_capacity(cell.model, cell.friction):
                 continue
-            result = available[capacity_key(cell.key, resolution)]
+            result = available[capacity_key(cell.key, resolution, _limit(capacity_limit, r, cell.block_index))]
             soils = slice(None) if cell.soil_index is None else cell.soil_index
             capacities[:, r, soils, cell.block_index, config.models.index(cell.model)] = result[:, None] \
                 if cell.soil_index is None else result
     # the run accounting counts each computed cell once (a tied housner cell shared by soils is one)
-    unique = [c for cells in all_cells for c in {c.key: c for c in cells}.values()
+    unique = [(r, c) for r, cells in enumerate(all_cells) for c in {c.key: c for c in cells}.values()
               if refines_capacity(c.model, c.friction)]
-    extra = sum(int(available[capacity_key(c.key, resolution)][3]) for c in unique)
+    extra = sum(int(available[capacity_key(c.key, resolution, _limit(capacity_limit, r, c.block_index))][3])
+                for r, c in unique)
+    unique = [c for _, c in unique]
     n_cells = len(unique)
     n_levels = intensity.shape[1]
     uniform = sum(uniform_stripe_runs(intensity[c.block_index, 0], intensity[c.block_index, -1], resolution)
