@@ -294,6 +294,7 @@ class RowFit:
     status: str = "not-reached"
     warnings: tuple = ()
     deviance_cost: float = 0.0
+    step_method: str = ""  # how a step (beta = 0) was placed; "" for a curve
 
     def warn(self, message: str) -> None:
         """Append ``message`` to the row's warnings."""
@@ -340,6 +341,20 @@ def noncrossing_groups(levels, exceed, total, fits, usable):
     return groups, fits
 
 
+def _step_method(levels, exceed, total, unit) -> str:
+    """How a separated row's step was placed: the level where records were mixed, or the bracket's middle."""
+    known = total > 0
+    none = np.flatnonzero(known & (exceed == 0))
+    every = np.flatnonzero(known & (exceed == total))
+    mixed = np.flatnonzero(known & (exceed > 0) & (exceed < total))
+    if mixed.size:
+        return f"the one level where some records were in the state ({levels[mixed[0]]:.3g} {unit})"
+    lower = levels[none[none < every[0]][-1]] if every.size and (none < every[0]).any() else np.nan
+    upper = levels[every[0]] if every.size else np.nan
+    return (f"geometric middle of the bracket {lower:.3g}-{upper:.3g} {unit} (no record in the state at the lower "
+            "level, every record at the upper; not refined by runs between them)")
+
+
 def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit="", cap=np.inf):
     """Fit every damage state of one cell. exceed, total : (n_state, n_level) counts per level.
 
@@ -360,6 +375,7 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
         elif state.edp == "uplifted" and threshold is not None:
             row.median, row.beta, row.method, row.status = float(threshold), 0.0, "exact-g-tan-alpha", \
                 "deterministic-threshold"
+            row.step_method = "exact: g tan(alpha), a rigid base's uplift under each component's own PGA"
             step = (levels > threshold).astype(float)
             clear = has_data & (np.abs(levels / threshold - 1) > 1e-6)
             disagree = int(np.sum(clear & (exceed[s] != step * total[s])))
@@ -377,6 +393,7 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
                      f"{int(total[s][has_data][-1])} records; the median lies above {levels[-1]:.3g} {unit}")
         elif betas[s] == 0:
             row.median, row.beta, row.method, row.status = medians[s], 0.0, "step-between-levels", "separated"
+            row.step_method = _step_method(levels, exceed[s], total[s], unit)
             row.warn("perfectly separated counts: no lognormal MLE exists; reported as a step at "
                      f"{medians[s]:.3g} {unit} with beta = 0")
         else:
@@ -563,7 +580,7 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         else np.zeros(tuple(cube.sizes[d] for d in group_dims), bool)
     shape = tuple(cube.sizes[d] for d in group_dims) + (len(states),)
     out = {name: np.full(shape, np.nan) for name in ROW_VARIABLES}
-    text = {name: np.full(shape, "", dtype=object) for name in ("fit_method", "status", "fit_warning")}
+    text = {name: np.full(shape, "", dtype=object) for name in ("fit_method", "status", "fit_warning", "step_method")}
     extrapolated = np.zeros(shape, np.int8)
     exceed_all = np.stack([exceedance(cube, s).transpose("record", "im_level", *group_dims).values
                            for s in states], axis=-1)  # (record, level, soil, block, model, state)
@@ -608,6 +625,7 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
             out["median"][key], out["beta"][key] = row.median, row.beta
             out["noncrossing_deviance_cost"][key] = row.deviance_cost if np.isfinite(row.median) else np.nan
             text["fit_method"][key], text["status"][key] = row.method, row.status
+            text["step_method"][key] = row.step_method
             extrapolated[key] = row.status == "extrapolated"
             if n_bootstrap and np.isfinite(row.median) and np.isfinite(boot_median[:, s]).any():
                 out["median_low"][key], out["median_high"][key] = np.nanquantile(boot_median[:, s], [tail, 1 - tail])
@@ -636,6 +654,11 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         "long_name": "1 where the fitted median lies outside the studied intensity range of its block",
         "units": "1", "flag_values": np.array([0, 1], np.int8), "flag_meanings": "inside_range extrapolated"})
     data_vars["fit_warning"] = (dims, text["fit_warning"].astype(str), {"long_name": "warnings about the fit"})
+    data_vars["step_position"] = (dims, np.where(text["step_method"] != "", out["median"], np.nan), {
+        "long_name": "intensity of a step row (beta = 0): where the state's threshold is placed (NaN: a curve)",
+        "units": unit})
+    data_vars["step_method"] = (dims, text["step_method"].astype(str), {
+        "long_name": "how the step was placed: exact (g tan alpha) or from the levels that bracket it"})
     data_vars["studied_im_min"] = (("block",), intensity[:, 0], {
         "long_name": "lowest intensity level studied for the block", "units": unit})
     highest = np.array([levels[keep][-1] if keep.any() else np.nan for levels, keep in zip(intensity, credible)])
@@ -837,7 +860,7 @@ TABLE_COLUMNS = ["median", "beta", "beta_record_to_record", "beta_model", "statu
                  "median_low", "median_high", "beta_low",
                  "beta_high", "gof_p_value", "gof_max_error", "noncrossing_deviance_cost", "capacity_median",
                  "capacity_beta", "probability_at_cap", "probability_at_cap_low", "probability_at_cap_high",
-                 "fit_warning"]
+                 "step_position", "step_method", "fit_warning"]
 
 
 def fragility_table(dataset: xr.Dataset) -> pd.DataFrame:

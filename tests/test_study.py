@@ -66,7 +66,11 @@ def test_invalid_study_names_field_and_file(tmp_path, text, field):
 
 def test_default_study_matches_the_issue():
     config = load_study()
-    assert len(config.levels) == 20 and config.measure == "pga"
+    assert len(config.levels) == 14 and config.measure == "pga" and config.component == "rotd50"
+    # the grid runs from half the uplift intensity up to the credible cap, 3 g PGA (re-spaced per block)
+    assert config.level_range == (0.5, 100.0, 14, "log") and config.credible_max == 3.0
+    assert config.credible_measure == "pga" and not config.beyond_credible
+    assert config.friction == "recommended"  # the recommended (bed) model's sliding is always computed
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
     assert config.models == ("housner", "ssi", "winkler-low", "winkler-centre", "winkler-high")
     assert config.restitution == "band" and len(config.blocks) == 3

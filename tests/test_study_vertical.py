@@ -49,6 +49,7 @@ levels = {{ values = [0.8, 2.0, 12.0], relative_to = "uplift" }}
 [solver]
 restitution = ""  # the bed at each soil's xi, as the direct solver calls below run it
 bed = "continuous"
+friction = "none"  # tied, as the direct solver calls below run it (the default slides every winkler cell)
 """
 
 HORIZONTAL_STUDY = """
@@ -63,6 +64,7 @@ levels = { values = [0.8, 2.0, 6.0], relative_to = "uplift" }
 [solver]
 restitution = ""  # the bed at each soil's xi, as the direct solver calls below run it
 bed = "continuous"
+friction = "none"  # tied, as the direct solver calls below run it (the default slides every winkler cell)
 """
 
 QUIET = {"workers": 1, "progress": False, "log": lambda message: None}

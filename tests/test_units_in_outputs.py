@@ -129,8 +129,9 @@ def test_record_pgas_levels_intensities_and_fits_share_one_unit(fragility_run):
                            (fragility, ("intensity", "median", "capacity_median", "studied_im_min"))):
         for name in names:
             assert dataset[name].attrs["units"] == g, name
-    # values are what the units say: the record's PGA x its scale factor is the level, in the same unit
-    scaled = (cube.record_pga * cube.scale_factor).transpose("block", "im_level", "record")
+    # values are what the units say: the record's intensity (its pair's RotD50 PGA) x its scale factor is the
+    # level, in the same unit
+    scaled = (cube.record_im * cube.scale_factor).transpose("block", "im_level", "record")
     np.testing.assert_allclose(scaled, cube.intensity.broadcast_like(scaled), rtol=1e-9)
     np.testing.assert_allclose(cube.im_level.values, [0.1, 0.3, 0.6, 1.0])  # the study's levels [g]
     assert fragility.attrs["intensity_unit"] == g and fragility.attrs["intensity_unit_label"] == "g"
