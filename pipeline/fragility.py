@@ -905,8 +905,9 @@ def capped_frequency(median: float, beta: float, hazard, cap: float, levels=None
         whole = annual_frequency(median, beta, hazard)
         if not np.isfinite(cap):
             return whole
-        beyond = annual_frequency(median, beta, hazard, lower=cap) if beta > 0 else (whole if median >= cap else 0.0)
-        return whole - beyond + above
+        if beta == 0:  # a step: every intensity from its median on reaches the state, the cap's exceedance included
+            return float(hazard_frequency(hazard, min(median, cap)))
+        return whole - annual_frequency(median, beta, hazard, lower=cap) + above
     if levels is None or not np.isfinite(cap):
         return np.nan
     known = np.isfinite(fractions)

@@ -125,6 +125,11 @@ def test_the_risk_stops_at_the_cap_and_adds_its_exceedance(median, beta, cap):
     assert capped_frequency(median, beta, POWER_LAW, cap) >= whole  # an upper bound
 
 
+def test_a_step_below_the_cap_keeps_its_frequency():
+    """A step at m < cap reaches the state at every intensity above m: lambda(m), the cap's exceedance within it."""
+    assert capped_frequency(1.0, 0.0, POWER_LAW, 3.0) == pytest.approx(1e-4, rel=1e-9)
+
+
 def test_a_censored_row_integrates_the_records_below_the_cap():
     levels, fractions = np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.1, 0.2])
     expected = 0.1 * (1e-4 * 2.0 ** -2.5 - 1e-4 * 3.0 ** -2.5) + 1e-4 * 3.0 ** -2.5

@@ -235,19 +235,23 @@ def test_a_non_number_in_a_usgs_response_names_its_line_and_column(tmp_path, tok
 
 # ------------------------------------------------------------------ each soil's risk, by hand
 
-def by_hand_rate(median: float, beta: float, grid: np.ndarray, curve: np.ndarray) -> float:
+def by_hand_rate(median: float, beta: float, grid: np.ndarray, curve: np.ndarray, cap: float = math.inf) -> float:
     """lambda_DS [1/yr] of a lognormal (beta = 0: step) fragility on a tabulated curve, log-log between its points.
 
-    beta > 0: the integral of lambda(z) dP(DS | z) (by parts), by the trapezoid rule over +-7 beta.
+    beta > 0: the integral of lambda(z) dP(DS | z) (by parts), by the trapezoid rule over +-7 beta. With a credible
+    ``cap`` (rockfrag.fragility.capped_risk) the integral stops there and every intensity above it counts as
+    reaching the state: + lambda(cap) (1 - P(DS | cap)).
     """
     def frequency(z):
         return np.exp(np.interp(np.log(z), np.log(grid), np.log(curve)))
 
     if beta == 0:
-        return float(frequency(median))
-    z = np.geomspace(median * math.exp(-7 * beta), median * math.exp(7 * beta), 20001)
+        return float(frequency(min(median, cap)))
+    z = np.geomspace(median * math.exp(-7 * beta), min(median * math.exp(7 * beta), cap), 20001)
     density = np.exp(-0.5 * (np.log(z / median) / beta) ** 2) / (beta * z * math.sqrt(2 * math.pi))
-    return float(np.trapezoid(frequency(z) * density, z))
+    above = 0.0 if not math.isfinite(cap) else \
+        float(frequency(cap)) * (1 - 0.5 * math.erfc(-math.log(cap / median) / (beta * math.sqrt(2))))
+    return float(np.trapezoid(frequency(z) * density, z)) + above
 
 
 def rock_rate(median: float, beta: float) -> float:
@@ -268,10 +272,13 @@ def test_each_soils_probability_is_recomputed_by_hand_from_fragility_nc(small_pi
     rows = fragility[["median", "beta", "probability_in_life"]].to_dataframe().dropna().reset_index()
     assert len(rows) >= 10 and set(rows["soil"]) == {"sand", "rock"}
     for row in rows.itertuples():
-        rate = by_hand_rate(row.median, row.beta, grid, fragility["site_hazard"].sel(soil=row.soil).values)
+        curve = fragility["site_hazard"].sel(soil=row.soil).values
+        cap = float(fragility["credible_max"].sel(block=row.block))  # the risk stops at the credible cap
+        rate = by_hand_rate(row.median, row.beta, grid, curve, cap)
         assert row.probability_in_life == pytest.approx(1 - math.exp(-rate * 50.0), rel=1e-3), row
         if row.soil == "rock":
-            assert rate == pytest.approx(rock_rate(row.median, row.beta), rel=1e-3)
+            assert by_hand_rate(row.median, row.beta, grid, curve) == pytest.approx(rock_rate(row.median, row.beta),
+                                                                                   rel=1e-3)
     same = rows.pivot_table(index=["block", "model", "damage_state"], columns="soil", values=["median", "beta"])
     pairs = rows.pivot_table(index=["block", "model", "damage_state"], columns="soil", values="probability_in_life")
     alike = (same["median"]["sand"] == same["median"]["rock"]) & (same["beta"]["sand"] == same["beta"]["rock"])
