@@ -808,36 +808,49 @@ def with_recommended(dataset: xr.Dataset) -> xr.Dataset:
 
 
 def warning_summary(dataset: xr.Dataset) -> list[str]:
-    """Short lines for the console: how many rows are extrapolated, separated, not reached, small."""
+    """Plain lines for the console: what the fits could not do, and whether the user must act.
+
+    Each line says what happened, what the study did about it, and where the rows are marked; the messages and
+    what to do about each are listed in the documentation (docs/warnings.md).
+    """
     status = dataset.status.values.ravel()
     warnings = dataset.fit_warning.values.ravel()
     total = status.size
     lines = []
-    for name, what in (("extrapolated", "medians outside the studied range (flagged `extrapolated`)"),
-                       ("separated", "perfectly separated states reported as steps with beta = 0"),
-                       ("not-reached", "states no record reached (no curve, 'not reached')"),
-                       ("below-range", "states with the median below the lowest level (no curve)"),
-                       ("above-range", "states reached only at the highest level (median above the range, no curve)")):
+    for name, what in (
+            ("extrapolated", "the median lies outside the studied intensities, so it is extrapolated from the "
+                             "fitted curve (status 'extrapolated'); read those medians as estimates"),
+            ("separated", "every record changed state between the same two levels, so the curve is a step there "
+                          "(dispersion 0; status 'separated'); nothing to do unless the step's position matters"),
+            ("not-reached", "no record reached the state at any level up to the credible cap, so there is no curve "
+                            "(status 'not-reached'); expected for states the shaking cannot cause"),
+            ("below-range", "every record was already in the state at the lowest level, so there is no curve "
+                            "(status 'below-range'); start the intensity levels lower to fit one"),
+            ("above-range", "records reached the state only at the highest level, so the median lies above the "
+                            "levels and there is no curve (status 'above-range')")):
         count = int(np.sum(status == name))
         if count:
             lines.append(f"{count} of {total} fragility rows: {what}")
     small = int(np.sum(["fewer than" in w for w in warnings]))
     if small:
-        lines.append(f"only {int(dataset.n_records)} records (fewer than {SMALL_SAMPLE}): beta and the bounds "
-                     f"of {small} rows are rough")
+        lines.append(f"only {int(dataset.n_records)} records (fewer than {SMALL_SAMPLE}): the dispersion and the "
+                     f"confidence bounds of {small} rows are rough; use more records for a design answer")
     disagree = int(np.sum(["disagree" in w for w in warnings]))
     if disagree:
-        lines.append(f"{disagree} uplift rows: runs disagree with the exact g tan(alpha) step (see fit_warning)")
+        lines.append(f"{disagree} uplift rows: the runs disagree with the closed-form uplift threshold "
+                     "g tan(alpha); check the block's geometry (details in each row's fit_warning)")
     if "n_resurrected" in dataset:
         cells = int(np.sum(dataset.n_resurrected.values > 0))
         if cells:
-            lines.append(f"{cells} of {dataset.n_resurrected.size} cells: {int(dataset.n_resurrected.sum())} records "
-                         "survived a level above their first overturning (resurrection), counted as overturned from "
-                         "their first overturning level on (n_resurrected)")
+            lines.append(f"{cells} of {dataset.n_resurrected.size} block, soil and model combinations: "
+                         f"{int(dataset.n_resurrected.sum())} records overturned at one level but not at a higher "
+                         "one (usual for rocking, whose response is not monotonic in the intensity); each counts as "
+                         "overturned from its first overturning level on, which is conservative; nothing to do")
     outside = int(np.sum(["refined capacities' median" in w for w in warnings]))
     if outside:
-        lines.append(f"{outside} overturning rows: the refined capacities' median lies outside the stripe fit's "
-                     "bounds (see fit_warning)")
+        lines.append(f"{outside} overturning rows: the median of the records' refined overturning intensities lies "
+                     "outside the confidence bounds of the fitted curve; the curve may be a poor fit there "
+                     "(details in each row's fit_warning)")
     return lines
 
 
@@ -1001,7 +1014,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
     dataset = fragility_dataset(cube, states=states, ida=ida, n_bootstrap=config.bootstrap, seed=config.seed,
                                 confidence=config.confidence, progress=progress)
     for line in json.loads(dataset.attrs["fit_warnings"]):
-        log(f"fragility warning: {line}")
+        log(f"fragility note: {line}")
     # each soil's risk stops at its block's credible cap and adds the cap's exceedance as a bound (capped_risk)
     risk = capped_risk(dataset, risk_dataset(dataset, hazard, config.design_life),
                        lambda soil: hazard[soil] if isinstance(hazard, Mapping) else hazard, config.design_life)

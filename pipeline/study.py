@@ -871,11 +871,11 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         summaries = _gather_summaries(all_cells[variant], results, config, len(records), n_levels)
         capacities, stats = gather_capacities(all_cells[variant], results, config, intensity, resolution,
                                               capacity_limit)
-        if stats:
-            log(f"capacities to {resolution:.0%}{' without the vertical' if config.vertical and not variant else ''}"
-                f": {stats['capacity_runs']} refining runs over {stats['grid_runs']} stripe runs; uniform stripes "
-                f"of the same resolution would need {stats['uniform_runs']} runs "
-                f"({stats['runs_saved_fraction']:.0%} saved)")
+        if stats and stats['capacity_runs']:  # no refining run: nothing worth a line
+            log(f"overturning intensities refined to {resolution:.0%}"
+                f"{' without the vertical' if config.vertical and not variant else ''}: "
+                f"{stats['capacity_runs']} extra runs beside the {stats['grid_runs']} runs at the levels (levels as "
+                f"fine would need {stats['uniform_runs']} runs, {stats['runs_saved_fraction']:.0%} more)")
         cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
                                      calibration=calibration, friction=friction_grid(config),
