@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from rockfrag.damage_states import families_of
+from rockfrag.damage_states import DEFAULT_LIMITS, families_of  # limits: the damage-state registry's
 from rockfrag.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency, hazard_of
 from rockfrag.lognormal_fit import lognormal_cdf
 from rockfrag.models.variants import RECOMMENDED
@@ -43,9 +43,6 @@ ANSWER_MODELS = (RECOMMENDED, "winkler-centre", "winkler", "ssi", "ssi-paper", "
 
 DEFAULT_RETURN_PERIODS = (475.0, 975.0, 2475.0)
 """Return periods [years] of the answer pages when the study gives none (10%, 5%, 2% in 50 years)."""
-
-DEFAULT_LIMITS = {"overturning": 0.01, "rocking-0.5": 0.10, "slip-0.30": 0.10}
-"""``[decision] max_probability_in_life`` when the study gives none (pipeline/defaults.toml says why)."""
 
 DEFAULT_SLIDING_SHARE = 0.10
 """``[decision] max_sliding_share`` when the study gives none."""

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from rockfrag.blocks import BLOCK_RANGES, Block
-from rockfrag.damage_states import EDPS, DamageState, damage_states_from_config
+from rockfrag.damage_states import DEFAULT_LIMITS, EDPS, DamageState, damage_states_from_config
 from rockfrag.errors import ConfigError, ManifestError, PipelineError
 from rockfrag.hazard import check_site
 from rockfrag.measures import MEASURES, scaling_measures
@@ -101,7 +101,7 @@ LEVEL_TABLE = _table({"start": LEVEL, "stop": LEVEL, "count": Number(1, 1000, in
 
 
 def _damage_state_table() -> Table:
-    keys = [f.name for f in dataclasses.fields(DamageState) if f.name != "name"]
+    keys = [f.name for f in dataclasses.fields(DamageState) if f.name != "name" and f.metadata.get("study_key", True)]
     kinds = {"threshold": Number(0, low_open=True), "edp": Text(tuple(EDPS))}
     return Table({key: kinds.get(key, TEXT) for key in keys})
 
@@ -780,6 +780,7 @@ def load_study(path: str | Path | None = None, overrides: dict | None = None) ->
         range; the message names the file and the field as written.
     """
     default = tomllib.loads(files("rockfrag").joinpath("defaults.toml").read_text())
+    default.setdefault("decision", {}).setdefault("max_probability_in_life", dict(DEFAULT_LIMITS))  # the registry's
     source = "pipeline/defaults.toml"
     merged = _blocks_as_selector(default)
     if path is not None:

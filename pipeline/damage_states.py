@@ -21,14 +21,20 @@ Slip states (``edp = "peak_slip"``, threshold in metres) are a family of their o
 they apply only to the cells that run with friction at the base (rockfrag.study.cell_friction; elsewhere the
 fits mark them ``not-applicable``), do not nest with the rocking states, and sort after uplift and before the
 rocking states (so the two most severe states stay the rocking ones and overturning).
-A new shipped state is one ``register_damage_state`` call.
+A state may carry the verdict's limit: ``limit``, the largest acceptable probability of reaching it in the design
+life, and ``limit_source``, where that number comes from. The shipped limits (``DEFAULT_LIMITS``, the defaults of
+``[decision] max_probability_in_life``) and the report's "where the numbers come from" read them here, the one place.
+A new shipped state is one ``register_damage_state`` call; an installed package adds one through the entry-point
+group ``rockfrag.damage_states`` (rockfrag.plugins, docs/plugins.md).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
 
 from rockfrag.errors import ConfigError
+from rockfrag.plugins import GROUPS, Registry
 
 SLIP_EDPS = ("peak_slip",)
 NOT_APPLICABLE = "not-applicable"
@@ -46,6 +52,10 @@ class DamageState:
     edp: str  # "uplifted", "overturned", or a cube variable such as "peak_angle_ratio"
     threshold: float
     description: str
+    limit: float | None = field(default=None, metadata={"study_key": False})
+    """Largest acceptable probability of reaching the state in the design life (0-1]; None: reported, not judged."""
+    limit_source: str = field(default="", metadata={"study_key": False})
+    """Where ``limit`` comes from, in the words of the report's sources section."""
 
 
 def severity_order(state: DamageState) -> tuple[float, float]:
@@ -54,16 +64,43 @@ def severity_order(state: DamageState) -> tuple[float, float]:
     return order.get(state.edp, 1.0), state.threshold
 
 
-DAMAGE_STATES: dict[str, DamageState] = {}
-"""The shipped damage states by name, in order of increasing severity."""
+DAMAGE_STATES: Registry = Registry(GROUPS["damage_states"], DamageState, order=severity_order)
+"""The shipped and installed (plugin) damage states by name, in order of increasing severity."""
 
 
 def register_damage_state(state: DamageState) -> None:
     """Add a damage state; the registry is kept in the order of increasing severity (``severity_order``)."""
     DAMAGE_STATES[state.name] = state
-    ordered = sorted(DAMAGE_STATES.values(), key=severity_order)
-    DAMAGE_STATES.clear()
-    DAMAGE_STATES.update((s.name, s) for s in ordered)
+
+
+class _Limits(Mapping):
+    """Damage state name -> its ``limit``, for the registered states that have one, most severe first.
+
+    Read afresh on each use, so the states an installed package adds count.
+    """
+
+    def _limits(self) -> dict[str, float]:
+        most_severe_first = reversed(list(DAMAGE_STATES.values()))
+        return {state.name: state.limit for state in most_severe_first if state.limit is not None}
+
+    def __getitem__(self, name: str) -> float:
+        return self._limits()[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._limits())
+
+    def __len__(self) -> int:
+        return len(self._limits())
+
+    def __repr__(self) -> str:
+        return repr(self._limits())
+
+
+DEFAULT_LIMITS: Mapping[str, float] = _Limits()
+"""``[decision] max_probability_in_life`` when the study gives none: each registered state's ``limit``."""
+
+STUDY_CHOICE = "the study's choice (its study file, else the shipped defaults)"
+"""How the report names a value that is a choice rather than a published fact."""
 
 
 UPLIFT_FRACTION = 0.01
@@ -92,13 +129,20 @@ TILT_WORDS = "tilts on the bed"
 
 register_damage_state(DamageState("uplift", "uplifted", 1.0, f"lift-off: {UPLIFT_WORDS}"))
 register_damage_state(DamageState("rocking-0.2", "peak_angle_ratio", 0.2, "theta_max/alpha >= 0.2"))
-register_damage_state(DamageState("rocking-0.5", "peak_angle_ratio", 0.5, "theta_max/alpha >= 0.5"))
-register_damage_state(DamageState("overturning", "overturned", 1.0, "the block overturns"))
+register_damage_state(DamageState(
+    "rocking-0.5", "peak_angle_ratio", 0.5, "theta_max/alpha >= 0.5", limit=0.10,
+    limit_source="the 10% in 50 years of the design-basis earthquake (475-year return period), applied here to "
+                 "damage short of collapse: " + STUDY_CHOICE))
+register_damage_state(DamageState(
+    "overturning", "overturned", 1.0, "the block overturns", limit=0.01,
+    limit_source="the 1% probability of collapse in 50 years that ASCE 7-22's risk-targeted ground motions aim at "
+                 "(ASCE 7-22)"))
 register_damage_state(DamageState("slip-0.05", "peak_slip", 0.05,
                                   "the base slid 0.05 m or more (cables, pipes and anchors strained)"))
-register_damage_state(DamageState("slip-0.30", "peak_slip", 0.30,
-                                  "the base slid 0.30 m or more: off a plinth whose edge is 0.30 m beyond the base "
-                                  "(a typical edge distance; set your plinth's in the study file)"))
+register_damage_state(DamageState(
+    "slip-0.30", "peak_slip", 0.30, "the base slid 0.30 m or more: off a plinth whose edge is 0.30 m beyond the base "
+    "(a typical edge distance; set your plinth's in the study file)", limit=0.10,
+    limit_source="the 10% in 50 years of the design-basis earthquake, as for θmax/α ≥ 0.5: " + STUDY_CHOICE))
 
 
 def is_slip_state(state: DamageState) -> bool:

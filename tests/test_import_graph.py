@@ -19,8 +19,8 @@ PACKAGE = Path(__file__).resolve().parent.parent / "pipeline"
 LAYERS: list[tuple[str, ...]] = [
     # 0 foundations: the version, exceptions, SI constants, atomic writes, fit numerics on arrays
     ("rockfrag.version", "rockfrag.errors", "rockfrag.units", "rockfrag.outputs", "rockfrag.lognormal_fit"),
-    # 1 plumbing shared by stages: value checks, file locks, checkpoints, worker pools
-    ("rockfrag.validation", "rockfrag.locking", "rockfrag.checkpoints", "rockfrag.executors"),
+    # 1 plumbing shared by stages: value checks, file locks, checkpoints, worker pools, the registries (plugins)
+    ("rockfrag.validation", "rockfrag.locking", "rockfrag.checkpoints", "rockfrag.executors", "rockfrag.plugins"),
     # 2 inputs: record readers and signal processing
     ("rockfrag.records", "rockfrag.records.*", "rockfrag.processing"),
     # 3 facts every stage reads: measures, blocks, soils, damage states, hazard curves and each soil's site hazard

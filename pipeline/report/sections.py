@@ -31,7 +31,7 @@ from rockfrag.answer import (
 from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
 from rockfrag.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
 from rockfrag.config import StudyConfig
-from rockfrag.damage_states import NOT_APPLICABLE
+from rockfrag.damage_states import DAMAGE_STATES, NOT_APPLICABLE, STUDY_CHOICE
 from rockfrag.errors import PipelineError
 from rockfrag.hazard import HazardCurve, study_hazard
 from rockfrag.report import numbers
@@ -669,17 +669,6 @@ def methods_items(results: Results) -> list[Item]:
     return items
 
 
-STUDY_CHOICE = "the study's choice (its study file, else the shipped defaults)"
-LIMIT_SOURCES = {
-    "overturning": "the 1% probability of collapse in 50 years that ASCE 7-22's risk-targeted ground motions aim at "
-                   "(ASCE 7-22)",
-    "rocking-0.5": "the 10% in 50 years of the design-basis earthquake (475-year return period), "
-                   "applied here to damage short of collapse: " + STUDY_CHOICE,
-    "slip-0.30": "the 10% in 50 years of the design-basis earthquake, as for θmax/α ≥ 0.5: " + STUDY_CHOICE,
-}
-"""Where the shipped verdict limits (rockfrag.answer.DEFAULT_LIMITS) come from."""
-
-
 def _kinetic_words(soils) -> str:
     """Kinetic over static friction of the shipped soils, read from rockfrag.soils.
 
@@ -697,7 +686,6 @@ def _kinetic_words(soils) -> str:
 
 def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
-    from rockfrag.answer import DEFAULT_LIMITS as SHIPPED_LIMITS
     from rockfrag.models.variants import DEFAULT_BAND
 
     config, fragility = results.config, results.fragility
@@ -706,9 +694,11 @@ def sources_items(results: Results) -> list[Item]:
     for state, limit in results.decision["max_probability_in_life"].items():
         if state not in labels:  # a limit on a state this study did not compute judges nothing
             continue
-        shipped = SHIPPED_LIMITS.get(state) == limit and state in LIMIT_SOURCES
+        registered = DAMAGE_STATES.get(state)
+        shipped = registered is not None and registered.limit == limit and bool(registered.limit_source)
+        source = registered.limit_source if shipped else "the study file (its own limit)"
         items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', {limit:.0%} in the "
-                            f"design life: {LIMIT_SOURCES[state] if shipped else 'the study file (its own limit)'}."))
+                            f"design life: {source}."))
     life = float(fragility.attrs.get("design_life_years", config.design_life))
     items.append(bullet(f"Design life {life:g} years: {STUDY_CHOICE}; 50 years is the span over which ASCE 7-22 "
                         "and the return periods below are stated."))
