@@ -19,6 +19,7 @@ import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -43,9 +44,12 @@ from rockfrag.models.options import (  # noqa: F401  (the API)
     case_record,
 )
 from rockfrag.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
-from rockfrag.models.variants import BAND_LABELS, split_variant
+from rockfrag.models.variants import BAND_LABELS, DEFAULT_BAND, RECOMMENDED, band_variants, split_variant
 from rockfrag.units import STANDARD_GRAVITY
 from rockfrag.validation import did_you_mean
+
+if TYPE_CHECKING:
+    from rockfrag.soils import SoilClass
 
 MODELS: dict[str, RockingModel] = {}
 
@@ -167,14 +171,22 @@ def _motion(ag, dt, t_end, ag_vertical):
 
 def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical: ArrayLike | None = None,
              k: float | None = None, xi: float | None = None, theta0: float = 0.0, thetadot0: float = 0.0,
-             t_end: float | None = None, **options: float | str | None) -> RockingResult:
+             t_end: float | None = None, soil: str | SoilClass | None = None, scale: float = 1.0,
+             **options: float | str | None) -> RockingResult:
     """Rocking response of ``block`` to ground acceleration ``ag`` [m/s^2] sampled at ``dt`` [s].
 
     Parameters
     ----------
     model : str
         ``housner``, ``ssi`` (the paper's model), ``ssi-paper`` (its printed equations) or ``winkler``
-        (tensionless bed); see ``MODELS``.
+        (tensionless bed); see ``MODELS``. ``recommended`` runs the study's recommended model on ``soil``
+        exactly as the study's central run does (``variants.central_member``: the bed's stiffness from the soil
+        (eq. 19), its damping calibrated to the centre of the restitution band, the soil's friction), and
+        ``winkler-low``/``winkler-centre``/``winkler-high`` the band's positions on ``soil``; these take no
+        ``k``, ``xi``, ``bed``, ``restitution`` or ``friction``. ``winkler`` given neither ``xi`` nor
+        ``restitution`` (nor ``bed``) runs the recommended bed at ``k``: the ``two-spring`` law calibrated to the
+        band's centre, not an arbitrary damping ratio (a named ``bed`` without ``xi``, or a block too squat to have a
+        restitution, Housner's r <= 0, keeps ``DEFAULT_XI``).
     ag : array_like, shape (n,)
         Horizontal ground acceleration [m/s^2]: at least 2 samples, all finite.
     dt : float
@@ -201,6 +213,12 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
     t_end : float, optional
         End time [s], >= 0; zero ground motion after the record, and a t_end inside the record cuts it.
         Default: the record + 10 s (``DEFAULT_TAIL``).
+    soil : str or rockfrag.soils.SoilClass, optional
+        The soil of ``recommended`` and the band's positions: a shipped soil's name or a ``SoilClass``.
+    scale : float
+        Factor [-] on ``ag`` (and ``ag_vertical``), applied inside the solver as the study applies its scale
+        factors: ``simulate(..., ag, ..., scale=s)`` reproduces the study's run at scale factor ``s`` bit for bit
+        (``ag * s`` agrees to rounding only). Default 1.
     **options : float or str or None
         ``SolverOptions`` fields:
         ``switch`` (ssi): the pivot-switch rule, ``consistent`` (default) or ``continuous``;
@@ -247,6 +265,7 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         ssi's foundation spring went into tension (real ground cannot pull): the results past that moment
         are not physical.
     """
+    model, k, xi, options = _resolve_model(model, block, soil, k, xi, options)
     spec = get_model(model)
     settings = SolverOptions(**options)
     samples, n_tail = _motion(ag, dt, t_end, ag_vertical)
@@ -255,9 +274,72 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
     state[0], state[1] = float(theta0), float(thetadot0)
     history = np.empty((1, samples.shape[1] + n_tail, fields.STATE_SIZE))
     impacts = np.empty((1, IMPACT_CAPACITY))
+    if not (math.isfinite(scale) and scale > 0):
+        raise SolverError(f"scale = {scale!r}: the factor on the ground motion must be a finite number > 0")
     summaries = kernels.run_cases(spec.kernel_code, samples, dt, n_tail, table, states, histories=history,
-                                  impact_times=impacts)
+                                  impact_times=impacts, scales=np.array([float(scale)]))
     return _result(spec, block, dt, summaries[0, 0], history[0], impacts[0], table[0])
+
+
+def _resolve_model(model, block, soil, k, xi, options):
+    """(solver model, k, xi, options) of a ``simulate`` call: the recommended model and band positions resolved.
+
+    The recommended model and the band's positions are the study's runs on a soil (one definition:
+    ``variants.band_member``); a plain ``winkler`` call without ``xi`` or ``restitution`` takes the recommended
+    bed at its ``k``. Any other name runs as given.
+    """
+    from rockfrag.models.variants import RECOMMENDED_BED, band_member, band_target, calibrate_to_target
+
+    name, role = ("winkler", "centre") if model == RECOMMENDED else split_variant(model)
+    if name not in MODELS or (role is not None and not MODELS[name].uses_bed):
+        accepted = [*MODELS, RECOMMENDED, *band_variants("winkler")]
+        raise SolverError(f"unknown model {model!r}{did_you_mean(str(model), accepted)}; valid models are: "
+                          f"{', '.join(accepted)}")
+    if role is not None:
+        given = [key for key, value in (("k", k), ("xi", xi)) if value is not None]
+        given += [key for key in ("bed", "restitution", "friction") if options.get(key) is not None]
+        if given:
+            raise SolverError(f"model {model!r} is the study's run on a soil: it takes no {', '.join(given)} "
+                              f"(the soil sets them); run 'winkler' to choose them")
+        if soil is None:
+            raise SolverError(f"model {model!r} needs soil=: a soil name ({', '.join(_soil_names())}) or a "
+                              "rockfrag.soils.SoilClass")
+        member = band_member(block, _soil(soil), role, g=options.get("g", STANDARD_GRAVITY))
+        return member.model, member.k, member.xi, {**options, "bed": member.bed, "friction": member.friction}
+    if soil is not None:
+        raise SolverError(f"soil= is for the study's runs on a soil (models {RECOMMENDED!r}, "
+                          f"{', '.join(band_variants('winkler'))}); model {model!r} takes k (and xi) instead")
+    spec = get_model(model)
+    if spec.uses_bed and xi is None and options.get("restitution") is None and options.get("bed") is None \
+            and k is not None:
+        bed = RECOMMENDED_BED
+        wanted = band_target(block, DEFAULT_BAND, "centre")
+        if not 0 < wanted < 1:  # too squat to rock back (Housner's r <= 0): no target to calibrate to
+            return model, k, DEFAULT_XI, {**options, "bed": bed}
+        from rockfrag.models.restitution import admissible_xi
+        g = options.get("g", STANDARD_GRAVITY)
+        dissipation = calibrate_to_target(block, k, bed, wanted, admissible_xi(block, k, bed, g).reachable,
+                                          movable=True, g=g)
+        return model, k, dissipation.xi, {**options, "bed": calibrated_law(bed)}
+    return model, k, xi, options
+
+
+def _soil_names():
+    from rockfrag.soils import SOILS
+
+    return list(SOILS)
+
+
+def _soil(soil):
+    """A ``SoilClass`` from itself or a shipped soil's name (a ``SolverError`` listing them otherwise)."""
+    from rockfrag.soils import SOILS
+
+    if isinstance(soil, str):
+        if soil not in SOILS:
+            raise SolverError(f"unknown soil {soil!r}{did_you_mean(soil, SOILS)}; shipped soils: "
+                              f"{', '.join(SOILS)} (or pass a rockfrag.soils.SoilClass)")
+        return SOILS[soil]
+    return soil
 
 
 def _result(spec, block, dt, summary, history, impacts, params):

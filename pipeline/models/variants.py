@@ -164,16 +164,10 @@ def calibrate_models(blocks: list[Block], soil_names: list[str], stiffness: np.n
                 wanted = restitution_target(block, restitution) if role is None else band_target(block, band, role)
                 requested[s, b, v] = wanted
                 try:
-                    dissipation = calibrate_dissipation(block, k, bed, wanted, g=g)
+                    dissipation = calibrate_to_target(block, k, bed, wanted, admissible.reachable,
+                                                      movable=role is not None, g=g)
                 except SolverError as error:
-                    low, high = admissible.reachable
-                    if role is None or not math.isfinite(low):
-                        raise SolverError(f"{where}, model {name!r}: {error}") from None
-                    # a band variant runs at the nearest r the admissible xi reach (listed by the study)
-                    try:
-                        dissipation = calibrate_dissipation(block, k, bed, min(max(wanted, low), high), g=g)
-                    except SolverError as error:
-                        raise SolverError(f"{where}, model {name!r}: {error}") from None
+                    raise SolverError(f"{where}, model {name!r}: {error}") from None
                 xi[s, b, v] = dissipation.xi
                 # "dies": the measure cannot resolve r there (NaN); it loses at least about Housner's value
                 target[s, b, v] = dissipation.target if dissipation.decision == "hit" else np.nan
@@ -181,3 +175,125 @@ def calibrate_models(blocks: list[Block], soil_names: list[str], stiffness: np.n
                     notes.append(f"{where}, model {name!r}: {dissipation.note}")
     return BandCalibration(tuple(models), calibrated_law(bed), requested, target, xi, reachable, smallest,
                            tuple(dict.fromkeys(notes)))
+
+
+def calibrate_to_target(block: Block, k: float, bed: str, wanted: float, reachable: tuple[float, float], *,
+                        movable: bool, g: float = STANDARD_GRAVITY):
+    """The calibrated dissipation of one (block, bed) for one restitution target: the one rule of the study.
+
+    A band position (``movable``) the admissible xi cannot reach runs at the nearest r they reach (the study
+    lists it); a plain target is refused (``restitution.calibrate_dissipation``'s error).
+
+    Parameters
+    ----------
+    block : Block
+        The block.
+    k : float
+        The bed's total vertical stiffness [N/m].
+    bed : str
+        The bed law the target is calibrated on (``[solver] bed``).
+    wanted : float
+        The requested effective restitution [-].
+    reachable : (float, float)
+        The range of r the admissible xi reach (``restitution.admissible_xi(...).reachable``).
+    movable : bool
+        True for a band position (moved into reach), False for a plain target (refused out of reach).
+    g : float
+        Gravity [m/s^2].
+
+    Returns
+    -------
+    rockfrag.models.restitution.Dissipation
+        The calibrated damping ratio xi, its decision and the target it hit.
+    """
+    try:
+        return calibrate_dissipation(block, k, bed, wanted, g=g)
+    except SolverError:
+        low, high = reachable
+        if not movable or not math.isfinite(low):
+            raise
+        return calibrate_dissipation(block, k, bed, min(max(wanted, low), high), g=g)
+
+
+RECOMMENDED_BED = "two-spring"
+"""The recommended model's bed law (the study's default ``[solver] bed``; a test checks they agree)."""
+
+
+@dataclass(frozen=True)
+class CentralMember:
+    """The recommended model's run on one (block, soil), as the study's cells and ``simulate`` run it.
+
+    Attributes
+    ----------
+    model : str
+        The solver model it runs (``winkler``, the tensionless bed).
+    k : float
+        The bed's total vertical stiffness [N/m] (eq. 19, the soil's G and the block's modulus).
+    xi : float
+        The bed's damping ratio [-], calibrated to ``restitution_target`` by the study's one rule.
+    bed : str
+        The contact law the bed runs (``restitution.calibrated_law`` of ``RECOMMENDED_BED``).
+    friction : (float, float)
+        The base's (mu_s, mu_k) [-]: the soil's stated friction (the recommended model always slides).
+    restitution_requested : float
+        The centre of the experimental restitution band [-].
+    restitution_target : float
+        The restitution the calibration hit [-]; NaN where free rocking dies below the measure's resolution.
+    """
+
+    model: str
+    k: float
+    xi: float
+    bed: str
+    friction: tuple[float, float]
+    restitution_requested: float
+    restitution_target: float
+
+
+def central_member(block: Block, soil, *, bed: str = RECOMMENDED_BED, band: tuple[float, float] = DEFAULT_BAND,
+                   g: float = STANDARD_GRAVITY) -> CentralMember:
+    """The recommended model's central run of ``block`` on ``soil`` (the band's centre; see ``band_member``)."""
+    return band_member(block, soil, "centre", bed=bed, band=band, g=g)
+
+
+def band_member(block: Block, soil, role: str, *, bed: str = RECOMMENDED_BED,
+                band: tuple[float, float] = DEFAULT_BAND, g: float = STANDARD_GRAVITY) -> CentralMember:
+    """The recommended model's run of ``block`` on ``soil`` at a band position.
+
+    The one definition the study's calibration (``calibrate_models``, through ``calibrate_to_target``) and the API
+    (``simulate("recommended", ...)``) share.
+
+    Parameters
+    ----------
+    block : Block
+        The block.
+    soil : rockfrag.soils.SoilClass
+        The soil (shear modulus, friction).
+    role : str
+        ``low``, ``centre`` (the central run) or ``high``.
+    bed : str
+        The bed law (``[solver] bed``), default the study's.
+    band : (float, float)
+        The restitution band's edges as multiples of Housner's r.
+    g : float
+        Gravity [m/s^2].
+
+    Returns
+    -------
+    CentralMember
+        Its stiffness, calibrated damping, contact law and friction.
+
+    Raises
+    ------
+    SolverError
+        The bed cannot be calibrated on this block (no admissible xi).
+    """
+    from rockfrag.soils import soil_block_stiffness  # soils imports the models' registry
+
+    k = float(soil_block_stiffness(soil, block))
+    wanted = band_target(block, band, role)
+    dissipation = calibrate_to_target(block, k, bed, wanted, admissible_xi(block, k, bed, g).reachable,
+                                      movable=True, g=g)
+    target = dissipation.target if dissipation.decision == "hit" else float("nan")
+    return CentralMember(model="winkler", k=k, xi=float(dissipation.xi), bed=calibrated_law(bed),
+                         friction=tuple(soil.friction), restitution_requested=wanted, restitution_target=target)

@@ -241,8 +241,12 @@ def test_one_calibration_per_cell():
 def test_without_a_target_nothing_changes():
     """No restitution: the given (or default) xi and the named law, as before issue 18."""
     block = block_at(0.25)
-    result = simulate("winkler", np.zeros(2), 0.01, block, k=stiffness(block, 100), thetadot0=-0.3, t_end=1.0)
+    result = simulate("winkler", np.zeros(2), 0.01, block, k=stiffness(block, 100), bed="continuous",
+                      thetadot0=-0.3, t_end=1.0)
     assert result.extra == {"xi": 0.05, "bed": "continuous"}
+    # no bed named either: the recommended bed (two-spring, calibrated to the band's centre; tests/test_api_*)
+    result = simulate("winkler", np.zeros(2), 0.01, block, k=stiffness(block, 100), thetadot0=-0.3, t_end=1.0)
+    assert result.extra["bed"] == "two-spring" and result.extra["xi"] != 0.05
 
 
 # ---- against the scipy reference (slow: the reference needs 1-40 s a case) ------------------------------------
