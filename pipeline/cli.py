@@ -312,9 +312,14 @@ def command_fragility(args) -> int:
           f"the report in {time.perf_counter() - started - results_s:.0f} s)")
     if not args.quiet:
         from rockfrag.answer import answer_table
+        from rockfrag.report import report_results
+        from rockfrag.report.summary import terminal_verdicts
 
         print()
         print(answer_table(fragility, outputs=(pdf, output / "fragility.csv", output / "fragility.nc")))
+        print()  # the verdicts in the report summary's words (one source: rockfrag.report.summary)
+        print(terminal_verdicts(report_results(config, cube, ida, fragility, risk, output, results_s, applicability,
+                                               stats)))
     return EXIT_PARTIAL if stats["failures"] else 0
 
 

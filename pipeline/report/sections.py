@@ -160,6 +160,21 @@ class Results:
         return {str(b): largest_recorded(self.cube, b) * scale for b in self.cube.block.values}
 
     @cached_property
+    def credible_limits(self) -> dict:
+        """Block -> the intensity up to which the study's levels are credible shaking (shown unit).
+
+        The credible cap where the cube has one (``credible_intensity_max``: the levels run to it, and a state no
+        record reached up to it has at most the hazard's exceedance of the cap, as fragility.nc's risk says), else
+        the largest intensity the unscaled records reached.
+        """
+        if "credible_intensity_max" not in self.cube:
+            return self.largest_recorded
+        scale, _ = display_scale(_level_units(self.cube))
+        caps = self.cube["credible_intensity_max"]
+        return {str(b): float(caps.sel(block=b)) * scale if np.isfinite(float(caps.sel(block=b)))
+                else self.largest_recorded[str(b)] for b in self.cube.block.values}
+
+    @cached_property
     def answers(self) -> list[BlockAnswer]:
         """The answer of every block (rockfrag.answer.block_answers) at the study's return periods."""
         hazard, periods = self.hazard, self.return_periods
@@ -173,7 +188,7 @@ class Results:
                        for b in self.cube.block.values for s in self.cube.soil.values}
         decision = self.decision
         return block_answers(self.fragility, self.site_hazards or hazard, periods, decision["max_probability_in_life"],
-                             largest_recorded=self.largest_recorded, sliding=sliding,
+                             largest_recorded=self.credible_limits, sliding=sliding,
                              max_sliding_share=decision["max_sliding_share"])
 
     def marks(self, block) -> CredibleMarks:

@@ -165,6 +165,10 @@ def reason(results, answer, soil) -> str:
     if row.below_lowest is not None:
         level, reached, total = row.below_lowest
         return f"{numbers.count(reached, total)} records already at {numbers.intensity(level, unit)}: a bound"
+    censored = _censored_at_cap(results, answer, soil, row)
+    if censored is not None:
+        return (f"median above the {numbers.intensity(censored, unit)} cap: P is a bound (it adds the hazard's "
+                "exceedance of the cap)")
     if row.tail_only:
         first = numbers.intensity(row.first_reached, unit) if row.first_reached is not None else "any level"
         return f"fitted tail only: no record below {first}"
@@ -174,6 +178,19 @@ def reason(results, answer, soil) -> str:
                           str(reached))
         return f"{numbers.count(reached, total)} records reach it at {numbers.intensity(level, unit)}"
     return "from the fitted curve"
+
+
+def _censored_at_cap(results, answer, soil, row) -> float | None:
+    """The credible cap (shown unit) where the governing row's median lies above it (status censored-at-cap)."""
+    fragility = results.fragility
+    if "status" not in fragility or "credible_limits" not in dir(results):
+        return None
+    try:
+        status = str(fragility.status.sel(model=answer.model, block=answer.block, soil=soil.soil,
+                                          damage_state=row.state).values)
+    except KeyError:
+        return None
+    return results.credible_limits.get(answer.block) if status == "censored-at-cap" else None
 
 
 def hazard_words(results, answer) -> str:
@@ -196,7 +213,6 @@ def summary_items(results) -> list[Item]:
     if not answers:
         return [paragraph("The study has no block, so no verdict.")]
     first = answers[0]
-    short = short_names(results)
     items = []
     if any(answer.example_hazard for answer in answers):
         items.append(strong(EXAMPLE_WARNING))
@@ -207,19 +223,9 @@ def summary_items(results) -> list[Item]:
     rows = []
     for answer in answers:
         rows.append([block_name(results.config, answer.block)] + [""] * (len(header) - 1))
-        for soil in answer.soils:
-            row = governing(soil)
-            if soil.verdict == CHECK_SLIDING:
-                state, at, life_text, beta = "sliding", ["-"] * len(periods), "-", "-"
-            elif row is None:
-                state, at, life_text, beta = "-", ["-"] * len(periods), "-", "-"
-            else:
-                state = short[row.state]
-                at = [say_p_at(results, answer, soil, row, i) for i in range(len(periods))]
-                life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.probability(row.limit)})"
-                beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
-            rows.append([soil.soil, action(soil.verdict, soil), state, *at, life_text, beta,
-                         reason(results, answer, soil)])
+        for line in verdict_rows(results, answer):
+            rows.append([line["soil"], line["action"], line["state"], *line["at"], line["life"], line["beta"],
+                         line["reason"]])
     items.append(paragraph(
         f"Per asset and soil: the action, the damage state that governs it, that state's probability at the site's "
         f"intensity of each return period and in the design life of {life}, with {hazard_words(results, first)}; the "
@@ -235,6 +241,59 @@ def summary_items(results) -> list[Item]:
                       "records, the variability from record to record; model, the model's own uncertainty. The "
                       "answer pages give every damage state and the records behind each number."))
     return items
+
+
+def verdict_rows(results, answer) -> list[dict]:
+    """The summary's facts of one block, a dict per soil: the words every page and the terminal print.
+
+    Keys: ``soil``, ``action``, ``state`` (the governing damage state's short name), ``at`` (its P at each return
+    period), ``life`` (its P in the design life with the limit), ``beta`` and ``reason``.
+    """
+    short = short_names(results)
+    periods = answer.return_periods
+    lines = []
+    for soil in answer.soils:
+        row = governing(soil)
+        if soil.verdict == CHECK_SLIDING:
+            state, at, life_text, beta = "sliding", ["-"] * len(periods), "-", "-"
+        elif row is None:
+            state, at, life_text, beta = "-", ["-"] * len(periods), "-", "-"
+        else:
+            state = short[row.state]
+            at = [say_p_at(results, answer, soil, row, i) for i in range(len(periods))]
+            life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.probability(row.limit)})"
+            beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
+        lines.append({"soil": soil.soil, "action": action(soil.verdict, soil), "state": state, "at": at,
+                      "life": life_text, "beta": beta, "reason": reason(results, answer, soil)})
+    return lines
+
+
+def terminal_verdicts(results) -> str:
+    """The verdict per asset and soil as plain text for the terminal, in the summary page's words.
+
+    One line per block and soil: the action, the governing damage state, its probability in the design life
+    (with the limit) and the reason the summary gives (which says where a bound, the credible cap or the fitted
+    tail decides); a line naming the hazard first. The same functions make the summary page, so the words agree.
+    """
+    answers = results.answers
+    if not answers:
+        return "Verdict: the study has no block, so no verdict."
+    first = answers[0]
+    life = numbers.years(first.design_life)
+    lines = [f"Verdict per asset and soil (probabilities in {life} with {hazard_words(results, first)}):"]
+    if any(answer.example_hazard for answer in answers):
+        lines.append(EXAMPLE_WARNING)
+    header = ["asset", "soil", "action", "governing damage state", f"P in {life} (limit)", "reason"]
+    table = []
+    for answer in answers:
+        name = block_name(results.config, answer.block)
+        for line in verdict_rows(results, answer):
+            table.append([name, line["soil"], line["action"], line["state"], line["life"], line["reason"]])
+            name = ""
+    widths = [max(len(str(cells[i])) for cells in [header, *table]) for i in range(len(header) - 1)]
+    for cells in [header, *table]:
+        lines.append("  ".join(str(cell).ljust(width) for cell, width in zip(cells, widths)) + "  " + cells[-1])
+    return "\n".join(lines)
 
 
 def verdict_items(results, answer) -> list[Item]:
@@ -267,4 +326,4 @@ def _and(words) -> str:
 
 
 __all__ = ["ACTION_WORDS", "action", "beta_words", "governing", "p_at_return_period", "p_in_life", "reason",
-           "summary_items", "verdict_items"]
+           "summary_items", "terminal_verdicts", "verdict_items", "verdict_rows"]
