@@ -201,7 +201,11 @@ def test_fragility_ends_with_the_answer_and_skips_the_sweep_of_a_study_file(tiny
     assert cells[:2] == ["cabinet", "sand"]
     if row.status.iloc[0] in ("fitted", "extrapolated", "separated"):  # a number, as fragility.csv has it
         assert cells[2] == f"{row['median'].iloc[0]:.3g}"
-    assert answer[-1] == f"Results: {output / 'report.pdf'}, {output / 'fragility.csv'}, {output / 'fragility.nc'}"
+    results_line = f"Results: {output / 'report.pdf'}, {output / 'fragility.csv'}, {output / 'fragility.nc'}"
+    assert results_line in answer  # the answer table ends with it; the verdict per asset and soil follows
+    verdicts = answer[answer.index(results_line) + 1:]
+    assert verdicts[0] == "" and verdicts[1].startswith("Verdict per asset and soil")
+    assert any(line.split()[:2] == ["cabinet", "sand"] for line in verdicts)
     assert any(page.name.startswith("fragility-models") for page in planned)
     html = "".join(page.html for page in planned if page.html is not None)
     read_from = html.split("result files read")[1].split("</tr>")[0]  # the provenance table's row

@@ -182,8 +182,8 @@ def reason(results, answer, soil) -> str:
 
 def _censored_at_cap(results, answer, soil, row) -> float | None:
     """The credible cap (shown unit) where the governing row's median lies above it (status censored-at-cap)."""
-    fragility = results.fragility
-    if "status" not in fragility or "credible_limits" not in dir(results):
+    fragility = getattr(results, "fragility", None)
+    if fragility is None or "status" not in fragility or not hasattr(results, "credible_limits"):
         return None
     try:
         status = str(fragility.status.sel(model=answer.model, block=answer.block, soil=soil.soil,
