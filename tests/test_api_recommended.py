@@ -8,6 +8,8 @@ record's processed acceleration and its scale factor from ``cube.nc``: every sum
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -34,6 +36,17 @@ mass = 326197.0
 E_b = 210e9
 footprint_area = 8.0
 soil_depth = 2.0
+[blocks.slender-cabinet]
+b = 0.3
+h = 1.5
+mass = 2000.0
+E_b = 200e9
+footprint_area = 0.48
+soil_depth = 1.0
+[blocks.squat-machinery]
+b = 1.5
+h = 2.0
+mass = 30000.0
 """
 COMPARED = ("peak_angle", "peak_uplift", "peak_slip", "residual_slip", "n_impacts", "time_of_peak",
             "peak_settlement", "peak_friction_demand")
@@ -56,29 +69,29 @@ def study_run(tmp_path_factory):
 
 def test_recommended_reproduces_the_cube_bit_for_bit(study_run):
     config, records, cube = study_run
-    block = config.blocks[0]
-    compared = 0
-    for soil in ("sand", "steel"):
-        for r, record in enumerate(records):
-            for level in range(cube.sizes["im_level"]):
-                scale = float(cube.scale_factor.isel(record=r, im_level=level, block=0))
-                result = simulate("recommended", record.acceleration, record.dt, block, soil=soil, scale=scale)
-                cell = cube.sel(soil=soil, model="winkler-centre").isel(record=r, im_level=level, block=0)
-                for name in COMPARED:
-                    assert getattr(result, name) == pytest.approx(float(cell[name]), rel=0, abs=0,
-                                                                  nan_ok=True), (soil, r, level, name)
-                compared += 1
-    assert compared == 2 * len(records) * cube.sizes["im_level"]
+    cells = list(itertools.product(range(len(config.blocks)), ("sand", "steel"), range(len(records)),
+                                   range(cube.sizes["im_level"])))
+    for b, soil, r, level in cells:  # the paper's block, the slender cabinet and the squat skid
+        block, record = config.blocks[b], records[r]
+        scale = float(cube.scale_factor.isel(record=r, im_level=level, block=b))
+        # the issue's way: the processed record times the cube's scale factor; and scale=
+        scaled = simulate("recommended", record.acceleration * scale, record.dt, block, soil=SOILS[soil])
+        result = simulate("recommended", record.acceleration, record.dt, block, soil=soil, scale=scale)
+        cell = cube.sel(soil=soil, model="winkler-centre").isel(record=r, im_level=level, block=b)
+        for name in COMPARED:
+            for run in (scaled, result):
+                assert getattr(run, name) == pytest.approx(float(cell[name]), rel=0, abs=0, nan_ok=True), \
+                    (block.name, soil, r, level, name)
+    assert len(cells) == 3 * 2 * len(records) * cube.sizes["im_level"]
     # the sand bed slides: the comparison covers the slip
     assert float(cube.peak_slip.sel(soil="sand", model="winkler-centre").max()) > 0
 
 
 def test_the_calibration_is_the_studys(study_run):
     config, _, cube = study_run
-    block = config.blocks[0]
-    for soil in ("sand", "steel"):
+    for (b, block), soil in itertools.product(enumerate(config.blocks), ("sand", "steel")):
         member = central_member(block, SOILS[soil])
-        cell = cube.sel(soil=soil, model="winkler-centre").isel(block=0)
+        cell = cube.sel(soil=soil, model="winkler-centre").isel(block=b)
         assert member.xi == float(cell.damping_ratio_calibrated)
         assert member.k == float(cell.interface_stiffness)
         assert member.friction == (float(cell.friction_static), float(cell.friction_kinetic))

@@ -35,8 +35,8 @@ print(f"{record.id}: PGA {np.abs(ag).max() / 9.80665:.2f} g, {ag.size} samples a
 # ``housner`` needs nothing but the block. ``recommended`` needs the soil: it is the study's recommended run,
 # the tensionless bed with the soil's stiffness (eq. 19) and friction, its damping calibrated so that the
 # block's free rocking loses what experiments measure at each impact (the centre of the restitution band).
-# ``scale`` applies a factor as the study applies its scale factors, so a cell of ``cube.nc`` is reproduced bit
-# for bit with the record, the cell's ``scale_factor`` and its soil.
+# With the processed record times a cell's ``scale_factor`` from ``cube.nc`` (or ``scale=``: the same bits) and
+# the cell's soil, it returns that cell's numbers bit for bit.
 scale = 0.7  # the record scaled to 0.58 g
 housner = rockfrag.simulate("housner", ag, dt, rack, scale=scale)
 recommended = rockfrag.simulate("recommended", ag, dt, rack, soil="sand", scale=scale)

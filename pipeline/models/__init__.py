@@ -216,9 +216,8 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
     soil : str or rockfrag.soils.SoilClass, optional
         The soil of ``recommended`` and the band's positions: a shipped soil's name or a ``SoilClass``.
     scale : float
-        Factor [-] on ``ag`` (and ``ag_vertical``), applied inside the solver as the study applies its scale
-        factors: ``simulate(..., ag, ..., scale=s)`` reproduces the study's run at scale factor ``s`` bit for bit
-        (``ag * s`` agrees to rounding only). Default 1.
+        Factor [-] on ``ag`` (and ``ag_vertical``), applied sample by sample as the study applies its scale
+        factors: ``scale=s`` and ``ag * s`` give the same bits, the study's run at scale factor ``s``. Default 1.
     **options : float or str or None
         ``SolverOptions`` fields:
         ``switch`` (ssi): the pivot-switch rule, ``consistent`` (default) or ``continuous``;
