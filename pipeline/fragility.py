@@ -970,6 +970,27 @@ def capped_risk(fragility: xr.Dataset, risk: xr.Dataset, hazard_of, design_life:
     return risk
 
 
+TEXT_LABELS = {
+    "model": "rocking model whose runs the row fits (housner: rigid base; ssi: the paper's spring-dashpot "
+             "foundation; recommended: the tensionless bed the answer uses)",
+    "model_label": "the model's name in words",
+    "damage_state": "damage state (rockfrag.damage_states: its measure and threshold)",
+    "damage_state_description": "what the damage state means, in words",
+    "outcome_class": "outcome of a run: no_uplift, rocking (lifted, not overturned) or overturned",
+    "fit_warning": "warnings about the fit, in words (empty: none)",
+}
+"""CF long names of fragility.nc's text coordinates and variables (units: none, they are labels)."""
+
+
+def label_text_variables(dataset: xr.Dataset) -> xr.Dataset:
+    """``dataset`` with a CF ``long_name`` on each text coordinate and variable that lacks one (``TEXT_LABELS``)."""
+    labelled = dataset.copy()
+    for name, words in TEXT_LABELS.items():
+        if name in labelled.variables and "long_name" not in labelled[name].attrs:
+            labelled[name].attrs["long_name"] = words
+    return labelled
+
+
 def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, output: str | Path,
                     progress: bool | None = None,
                     log: Callable[[str], object] | None = None) -> tuple[xr.Dataset, xr.Dataset]:
@@ -1024,7 +1045,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
     combined.attrs.update(dataset.attrs)
     combined.attrs.update(risk.attrs)
     combined.attrs.update(sites.attrs)
-    write_dataset(combined, output / "fragility.nc")
+    write_dataset(label_text_variables(combined), output / "fragility.nc")
     table = fragility_table(dataset)
     table = table.merge(risk.to_dataframe().reset_index(), on=["soil", "block", "model", "damage_state"])
     write_csv(table, output / "fragility.csv")

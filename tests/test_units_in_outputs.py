@@ -167,3 +167,12 @@ def test_a_pgv_study_keeps_velocities_and_accelerations_apart(tmp_path):
     assert units["velocity"] == "m s-1" and units["acceleration"] == "9.80665 m s-2"
     assert cube.im_level.attrs["units"] == cube.record_im.attrs["units"] == "m s-1"
     assert cube.record_pga.attrs["units"] == cube.block_uplift_acceleration.attrs["units"]
+
+
+def test_every_variable_of_fragility_nc_has_a_long_name(small_pipeline):
+    """CF: every data variable and coordinate of the fits says what it is (text labels too: model, damage_state)."""
+    import xarray as xr
+
+    with xr.open_dataset(small_pipeline.output / "fragility.nc") as fragility:
+        unnamed = [name for name, variable in fragility.variables.items() if not variable.attrs.get("long_name")]
+    assert not unnamed, f"fragility.nc variables without a long_name: {unnamed}"
