@@ -27,6 +27,11 @@ a second component, ``ID.SLIP``, and its functions go to ``fragility_openquake_s
   KeyError), so a state it needs is written ``deterministic`` with the capacity ``inf``: never reached.
   OpenQuake needs every limit state of a function: a step at twice ``maxIML``.
 
+A file whose consumer has no such intensity measure (pelicun has no demand type for AvgSa, CAV or a plugin's
+measure without ``pelicun_demand``; OpenQuake no IMT without ``openquake_imt``) cannot carry the rows: they are
+left out, with one ``ExchangeWarning`` line for pelicun (the fragility stage says it for OpenQuake), and an
+empty file is not written.
+
 OpenQuake clamps the intensity to [minIML, maxIML]: a function is held at its value at minIML below it and
 at maxIML above it. So minIML and maxIML are not the studied range (which the comment before each function
 gives) but ``TAIL_SIGMAS`` beta beyond every curve of the function and the studied range: OpenQuake then
@@ -36,6 +41,7 @@ evaluates our lognormals wherever they differ from 0 and 1, as pelicun and ``roc
 from __future__ import annotations
 
 import re
+import warnings
 import xml.etree.ElementTree as ElementTree
 from dataclasses import dataclass
 from pathlib import Path
@@ -53,6 +59,12 @@ from rockfrag.outputs import atomic_path
 PELICUN_FILE = "fragility_pelicun.csv"
 OPENQUAKE_FILE = "fragility_openquake.xml"
 OPENQUAKE_SLIP_FILE = "fragility_openquake_slip.xml"
+
+
+
+class ExchangeWarning(UserWarning):
+    """An exchange file cannot carry some rows (its consumer has no such measure): they are left out, said once."""
+
 
 STEP_BETA = 0.001
 """The lognormal dispersion that stands for a step (beta = 0) in OpenQuake's continuous format: the
@@ -269,7 +281,8 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
     -------
     pandas.DataFrame
         One row per component, in pelicun's damage-model column layout (medians in pelicun's unit: g for
-        accelerations, m/s for velocities).
+        accelerations, m/s for velocities); empty, with an ``ExchangeWarning``, when pelicun has no demand type
+        for the measure (``Measure.pelicun_demand`` is None).
 
     Raises
     ------
@@ -278,8 +291,13 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
     """
     name = dataset.attrs.get("intensity_measure", "pga")
     measure = MEASURES.get(name)
-    demand_type, demand_unit = (measure and measure.pelicun_demand) or ("", "")
-    if measure is not None and measure.uses_period and period:
+    if measure is None or measure.pelicun_demand is None:  # pelicun 3.10 refuses an empty Demand-Type
+        count = len(exchange_cells(dataset))
+        warnings.warn(f"{PELICUN_FILE}: pelicun has no demand type for the measure {name!r}; its {count} rows "
+                      "(block x soil x model) left out, no file written", ExchangeWarning, stacklevel=2)
+        return pd.DataFrame()
+    demand_type, demand_unit = measure.pelicun_demand
+    if measure.uses_period and period:
         demand_type = f"{demand_type}|{period:g}"
     unit = intensity_unit_label(dataset)
     rows = []
@@ -516,7 +534,8 @@ def write_exchange_files(dataset: xr.Dataset, output: str | Path, period: float 
     Returns
     -------
     list of pathlib.Path
-        The files written (no OpenQuake file for a measure OpenQuake does not have, e.g. AvgSa).
+        The files written (no OpenQuake file for a measure OpenQuake does not have, e.g. AvgSa; no pelicun file
+        for one pelicun does not have).
 
     Raises
     ------
@@ -524,8 +543,13 @@ def write_exchange_files(dataset: xr.Dataset, output: str | Path, period: float 
         Clashing component IDs or OpenQuake limit-state names.
     """
     output = Path(output)
-    written = [output / PELICUN_FILE]
-    write_csv(pelicun_table(dataset, period), written[0])
+    written = []
+    table = pelicun_table(dataset, period)
+    if table.empty:  # nothing pelicun can read: no file, and no older run's file left to be taken for this one's
+        (output / PELICUN_FILE).unlink(missing_ok=True)
+    else:
+        write_csv(table, output / PELICUN_FILE)
+        written.append(output / PELICUN_FILE)
     if write_openquake(dataset, output / OPENQUAKE_FILE, period):
         written.append(output / OPENQUAKE_FILE)
     if write_openquake(dataset, output / OPENQUAKE_SLIP_FILE, period, SLIP_SUFFIX):

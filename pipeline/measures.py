@@ -41,6 +41,7 @@ import numpy as np
 from numba import njit
 from scipy.linalg import expm
 
+from rockfrag.plugins import GROUPS, Registry
 from rockfrag.processing import integrate
 from rockfrag.units import STANDARD_GRAVITY
 
@@ -234,20 +235,34 @@ def spectral_acceleration(acceleration, dt, period, damping=0.05) -> float:
     return float(response_spectrum(acceleration, dt, [period], damping)["sa"][0])
 
 
-def intensity_measures(acceleration, dt, sa_periods=(0.2, 1.0, 2.0)) -> dict:
-    """All scalar measures of one record as a dict of SI values, keys with units."""
-    spectrum = response_spectrum(acceleration, dt, sa_periods)
-    measures = {
-        "pga_m_s2": pga(acceleration),
-        "pgv_m_s": pgv(acceleration, dt),
-        "pgd_m": pgd(acceleration, dt),
-        "arias_m_s": arias_intensity(acceleration, dt),
-        "cav_m_s": cav(acceleration, dt),
-        "d5_95_s": significant_duration(acceleration, dt),
-    }
-    for period, value in zip(spectrum["period"], spectrum["sa"]):
-        measures[f"sa_{period:g}s_m_s2"] = float(value)
-    return measures
+RECORD_PERIODS = (0.2, 1.0, 2.0)
+"""Periods [s] at which a record's table gives the measures defined at one period (Sa)."""
+
+
+def record_columns(sa_periods=RECORD_PERIODS) -> dict[str, tuple[Measure, dict]]:
+    """The columns of a record's measures: ``name_unit`` (``pga_m_s2``, ``sa_1s_m_s2``) -> (measure, options).
+
+    Every registered measure that needs no block: one defined at the study's period (Sa) at each of
+    ``sa_periods`` [s]; one over a period range (AvgSa) or of a block (PGA/(g tan alpha)) is left out. The
+    registry is the only list: a measure an installed package adds has its column too.
+    """
+    columns = {}
+    for name, measure in MEASURES.items():
+        if measure.per_block or _fields(measure.label) - {"period", "damping"}:
+            continue
+        unit = measure.si_unit.replace("/", "_").replace("^", "")
+        suffix = f"_{unit}" if unit != "1" else ""
+        if measure.uses_period:
+            columns.update({f"{name}_{period:g}s{suffix}": (measure, {"period": float(period)})
+                            for period in sa_periods})
+        else:
+            columns[f"{name}{suffix}"] = (measure, {})
+    return columns
+
+
+def intensity_measures(acceleration, dt, sa_periods=RECORD_PERIODS) -> dict:
+    """Every measure of one record that needs no block (``record_columns``), SI values keyed ``name_unit``."""
+    return {key: measure(acceleration, dt, **options) for key, (measure, options) in record_columns(sa_periods).items()}
 
 
 AVGSA_PERIODS = 10
@@ -376,6 +391,9 @@ class Measure:
     motion, whose peaks make the measure (its value is the geometric mean over the channels of their peaks:
     one channel for PGA, the oscillator's absolute acceleration at each period for AvgSa); None where the
     measure has no rotated form (``rotd``).
+    ``words``: how a page names the measure where its label is a symbol or a formula ("pulse period" for Tp);
+    None: the label. ``normalises``: the measure this one divides by a constant of the block (PGA/(g tan alpha)
+    divides "pga"): within a block the two rank alike, and the efficiency page draws one of them.
     """
 
     name: str
@@ -391,6 +409,8 @@ class Measure:
     per_block: bool = False
     scaling_exponent: float = 1.0
     histories: Callable | None = None
+    words: str | None = None
+    normalises: str | None = None
 
     @property
     def rotatable(self) -> bool:
@@ -532,8 +552,9 @@ def avgsa_range(options) -> tuple[float, float]:
     return 0.2 * options["period"], 3.0 * options["period"]
 
 
-MEASURES: dict[str, Measure] = {}
-"""Registered measures by name (``register_measure``, ``define_measure``), in registration order."""
+MEASURES: Registry = Registry(GROUPS["measures"], Measure)
+"""Registered measures by name (``register_measure``, ``define_measure``), in registration order; then those of
+the installed packages (entry-point group ``rockfrag.measures``, rockfrag.plugins)."""
 
 
 def register_measure(measure: Measure) -> Measure:
@@ -545,8 +566,8 @@ def register_measure(measure: Measure) -> Measure:
 def define_measure(name: str, *, si_unit: str, long_name: str, label: str, display_unit: str | None = None,
                    display_factor: float = 1.0, pelicun_demand: tuple[str, str] | None = None,
                    openquake_imt: str | None = None, openquake_factor: float = 1.0, per_block: bool = False,
-                   scaling_exponent: float = 1.0,
-                   histories: Callable | None = None) -> Callable[[MeasureFunction], MeasureFunction]:
+                   scaling_exponent: float = 1.0, histories: Callable | None = None, words: str | None = None,
+                   normalises: str | None = None) -> Callable[[MeasureFunction], MeasureFunction]:
     """Decorator: register the decorated ``function(acceleration, dt, block, options)`` as measure ``name``.
 
     Parameters
@@ -560,7 +581,7 @@ def define_measure(name: str, *, si_unit: str, long_name: str, label: str, displ
     long_name, label : str
         Templates (fields ``period``, ``damping``, ``low``, ``high``) of the netCDF long name and of the
         short label for axes and messages.
-    pelicun_demand, openquake_imt, openquake_factor, per_block, scaling_exponent, histories
+    pelicun_demand, openquake_imt, openquake_factor, per_block, scaling_exponent, histories, words, normalises
         See ``Measure``.
 
     Returns
@@ -571,7 +592,7 @@ def define_measure(name: str, *, si_unit: str, long_name: str, label: str, displ
     def register(function: MeasureFunction) -> MeasureFunction:
         register_measure(Measure(name, function, si_unit, si_unit if display_unit is None else display_unit,
                                  display_factor, long_name, label, pelicun_demand, openquake_imt,
-                                 openquake_factor, per_block, scaling_exponent, histories))
+                                 openquake_factor, per_block, scaling_exponent, histories, words, normalises))
         return function
 
     return register
@@ -755,25 +776,50 @@ def _avgsa(acceleration, dt, block, options):
 
 
 @define_measure("pga_ratio", si_unit="1", long_name="PGA over the block's uplift acceleration, PGA/(g tan alpha)",
-                label="PGA/(g tan alpha)", per_block=True, histories=_acceleration_over_uplift)
+                label="PGA/(g tan alpha)", per_block=True, histories=_acceleration_over_uplift,
+                words="PGA/(g·tanα)", normalises="pga")
 def _rocking_pga(acceleration, dt, block, options):
     return pga(acceleration) / block.uplift_acceleration()
 
 
 @define_measure("pgv_ratio", si_unit="1", long_name="p PGV/(g tan alpha), p = sqrt(3g/4R) (Makris & Vassiliou)",
-                label="p PGV/(g tan alpha)", per_block=True, histories=_rocking_velocity)
+                label="p PGV/(g tan alpha)", per_block=True, histories=_rocking_velocity,
+                words="PGV·p/(g·tanα)", normalises="pgv")
 def _rocking_pgv(acceleration, dt, block, options):
     return block.p() * pgv(acceleration, dt) / block.uplift_acceleration()
 
 
 @define_measure("pulse_amplitude", si_unit="m/s^2", display_unit="g", display_factor=STANDARD_GRAVITY,
-                long_name="acceleration amplitude a_p = 2 pi PGV/Tp of the dominant velocity pulse", label="a_p")
+                long_name="acceleration amplitude a_p = 2 pi PGV/Tp of the dominant velocity pulse", label="a_p",
+                words="pulse acceleration")
 def _pulse_amplitude(acceleration, dt, block, options):
     return velocity_pulse(acceleration, dt)[2]
 
 
 @define_measure("pulse_period", si_unit="s",
                 long_name="period Tp of the dominant velocity pulse (a record property: does not scale)",
-                label="Tp", scaling_exponent=0.0)
+                label="Tp", scaling_exponent=0.0, words="pulse period")
 def _pulse_period(acceleration, dt, block, options):
     return velocity_pulse(acceleration, dt)[0]
+
+
+@define_measure("pgd", si_unit="m", long_name="peak ground displacement", label="PGD")
+def _pgd(acceleration, dt, block, options):
+    return pgd(acceleration, dt)
+
+
+@define_measure("arias", si_unit="m/s", long_name="Arias intensity", label="Ia", scaling_exponent=2.0,
+                words="Arias intensity")
+def _arias(acceleration, dt, block, options):
+    return arias_intensity(acceleration, dt)
+
+
+@define_measure("cav", si_unit="m/s", long_name="cumulative absolute velocity", label="CAV")
+def _cav(acceleration, dt, block, options):
+    return cav(acceleration, dt)
+
+
+@define_measure("d5_95", si_unit="s", long_name="significant duration D5-95 (a record property: does not scale)",
+                label="D5-95", scaling_exponent=0.0)
+def _significant_duration(acceleration, dt, block, options):
+    return significant_duration(acceleration, dt)

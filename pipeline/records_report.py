@@ -2,7 +2,8 @@
 
 Input : loaded ``Record`` objects and the processing recipe.
 Output: a pandas table of catalogue metadata and intensity measures of the processed records
-        (``reports/records.csv``), and optionally a PNG per record: raw vs processed acceleration,
+        (``reports/records.csv``: every record measure of the registry, an installed plugin's included),
+        and optionally a PNG per record: raw vs processed acceleration,
         velocity and displacement, and the 5%-damped response spectrum, all labelled with units.
 
 Each record is one component: the table's ``group`` numbers the records of one station and event
@@ -21,17 +22,29 @@ import pandas as pd
 from tqdm import tqdm
 
 from rockfrag.errors import RecordError
-from rockfrag.measures import intensity_measures, response_spectrum
+from rockfrag.measures import intensity_measures, record_columns, response_spectrum
 from rockfrag.outputs import atomic_path
 from rockfrag.processing import integrate, process_record
 from rockfrag.records import component_labels
 from rockfrag.units import STANDARD_GRAVITY
 
-TABLE_COLUMNS = {
-    "group": "group", "axis": "axis",
-    "pga_m_s2": "PGA [m/s^2]", "pga_g": "PGA [g]", "pgv_m_s": "PGV [m/s]", "pgd_m": "PGD [m]",
-    "arias_m_s": "Arias intensity [m/s]", "cav_m_s": "CAV [m/s]", "d5_95_s": "D5-95 [s]",
-}
+
+def _table_columns() -> dict[str, str]:
+    """Column -> heading of the table ``rockfrag records`` prints: the group, the axis, then every record measure.
+
+    The measures are the registry's (``rockfrag.measures.record_columns``), headed by their label and SI unit;
+    PGA is given in g too.
+    """
+    columns = {"group": "group", "axis": "axis"}
+    for key, (measure, options) in record_columns().items():
+        columns[key] = f"{measure.words or measure.short_label(**options)} [{measure.si_unit}]"
+        if measure.name == "pga":
+            columns["pga_g"] = "PGA [g]"
+    return columns
+
+
+TABLE_COLUMNS = _table_columns()
+"""Column -> heading of the printed table (the registered measures at the time the module is imported)."""
 
 
 def measures_row(raw, processed, group: int | None = None, axis: str | None = None) -> dict:
@@ -61,7 +74,7 @@ def measures_row(raw, processed, group: int | None = None, axis: str | None = No
     row.update({"npts": processed.trace.stats.npts, "dt_s": processed.dt,
                 "duration_s": processed.duration})
     row.update(measures)
-    row["pga_g"] = measures["pga_m_s2"] / STANDARD_GRAVITY
+    row["pga_g"] = measures["pga_m_s2"] / STANDARD_GRAVITY  # pga is a shipped measure (never a plugin's)
     row["raw_pga_g"] = float(np.max(np.abs(raw.acceleration))) / STANDARD_GRAVITY
     row["qa_flags"] = "; ".join(processed.trace.stats.get("qa", []))
     row["file"] = raw.metadata.get("file")

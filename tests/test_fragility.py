@@ -330,12 +330,22 @@ def test_pelicun_table_follows_its_conventions(fitted):
 @pytest.mark.parametrize("measure, period, demand", [
     ("pga", 1.0, ("Peak Ground Acceleration", "g")), ("pgv", None, ("Peak Ground Velocity", "mps")),
     ("sa", 0.5, ("Spectral Acceleration|0.5", "g")), ("sa", None, ("Spectral Acceleration", "g")),
-    ("avgsa", 1.0, ("", "")),  # pelicun has no such demand: the columns stay empty
 ])
 def test_pelicun_demand_comes_from_the_measure_registry(fitted, measure, period, demand):
     dataset = fitted.assign_attrs(intensity_measure=measure)
     row = pelicun_table(dataset, period).iloc[0]
     assert (row["Demand-Type"], row["Demand-Unit"]) == demand
+
+
+@pytest.mark.parametrize("measure", ["avgsa", "cav", "no-such-measure"])
+def test_pelicun_leaves_out_the_rows_of_a_measure_it_has_no_demand_for(fitted, measure):
+    from rockfrag.exchange import ExchangeWarning
+
+    with pytest.warns(ExchangeWarning) as caught:  # pelicun 3.10 refuses an empty Demand-Type: no row at all
+        table = pelicun_table(fitted.assign_attrs(intensity_measure=measure), 1.0)
+    assert table.empty and len(caught) == 1
+    message = str(caught[0].message)
+    assert "\n" not in message and repr(measure) in message and "left out" in message
 
 
 # ---------------------------------------------------------------- overturning: first-overturn convention

@@ -188,10 +188,15 @@ def test_pgv_is_written_in_centimetres_per_second(tmp_path):
     assert mean / np.sqrt(1 + (stddev / mean) ** 2) == pytest.approx(30.0, rel=1e-9)
 
 
-def test_no_openquake_file_for_a_measure_openquake_does_not_have(tmp_path):
+def test_no_file_for_a_measure_the_consumers_do_not_have(tmp_path):
+    from rockfrag.exchange import ExchangeWarning
+
     (tmp_path / OPENQUAKE_FILE).write_text("an older run's file")
-    written = write_exchange_files(exchange_dataset().assign_attrs(intensity_measure="avgsa"), tmp_path, 1.0)
-    assert written == [tmp_path / "fragility_pelicun.csv"] and not (tmp_path / OPENQUAKE_FILE).exists()
+    (tmp_path / "fragility_pelicun.csv").write_text("an older run's file")
+    with pytest.warns(ExchangeWarning, match="pelicun has no demand type for the measure 'avgsa'"):
+        written = write_exchange_files(exchange_dataset().assign_attrs(intensity_measure="avgsa"), tmp_path, 1.0)
+    assert written == [] and not (tmp_path / OPENQUAKE_FILE).exists()
+    assert not (tmp_path / "fragility_pelicun.csv").exists()
 
 
 def test_damage_states_that_clash_as_openquake_limit_states_are_refused(tmp_path):

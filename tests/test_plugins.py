@@ -2,10 +2,19 @@
 
 from __future__ import annotations
 
+import html
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
 import pytest
 
 from rockfrag.config import load_study
 from rockfrag.damage_states import DAMAGE_STATES, DEFAULT_LIMITS, DamageState, register_damage_state
+from tests.helpers import SMALL_STUDY
 
 
 @pytest.fixture
@@ -44,3 +53,145 @@ def test_a_limit_is_not_a_study_key_of_a_damage_state(tmp_path):
     with pytest.raises(ConfigError) as error:
         load_study(study)
     assert "limit" in error.value.field and "allowed: description, edp, threshold" in str(error.value)
+
+
+# ---------------------------------------------------------------- an installed package adds to the registries
+
+TOY = Path(__file__).resolve().parent / "plugin_toy"
+"""The toy plugin's source (docs/plugins.md's worked example): a measure, a damage state and a record format."""
+
+TOY_STUDY = SMALL_STUDY.replace("[intensity]\nlevels = [0.1, 0.3, 0.6, 1.0]\n", """[intensity]
+measure = "a_rms"
+component = "single"
+levels = [0.02, 0.06, 0.12, 0.2]
+""") + "[fragility]\nbootstrap = 5\n"
+"""The small study scaled to the toy's measure (no RotD form: each component its own; levels of a_rms in g)."""
+
+
+def install(source: Path, folder: Path) -> Path:
+    """Build ``source``'s wheel with its own backend (no isolation, no network) and install it into a folder.
+
+    A pure-Python wheel is installed by unpacking it: the package beside its ``.dist-info`` (whose
+    ``entry_points.txt`` importlib.metadata reads), as pip would put them in site-packages.
+    """
+    work = folder / "build"
+    shutil.copytree(source, work)
+    subprocess.run([sys.executable, "-c", "from setuptools import build_meta; build_meta.build_wheel('../dist')"],
+                   cwd=work, check=True, capture_output=True)
+    site = folder / "site"
+    with zipfile.ZipFile(next((folder / "dist").glob("*.whl"))) as wheel:
+        wheel.extractall(site)
+    return site
+
+
+def rockfrag_with(site: Path, *arguments: str, cwd: Path) -> subprocess.CompletedProcess:
+    """Run ``python *arguments`` with the packages installed in ``site`` importable (a fresh process)."""
+    paths = [str(site), *filter(None, [os.environ.get("PYTHONPATH")])]
+    return subprocess.run([sys.executable, *arguments], cwd=cwd, capture_output=True, text=True, timeout=600,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(paths)})
+
+
+@pytest.fixture(scope="module")
+def toy_site(tmp_path_factory) -> Path:
+    """The toy plugin, built and installed into a folder of its own."""
+    return install(TOY, tmp_path_factory.mktemp("toy"))
+
+
+def test_the_toy_plugin_is_not_installed_here():
+    from rockfrag.measures import MEASURES
+
+    assert "a_rms" not in MEASURES and "rocking-0.8" not in DAMAGE_STATES  # the test below sees it in its process only
+
+
+def test_a_plugin_measure_and_damage_state_run_in_the_small_study(toy_site, tmp_path):
+    import numpy as np
+    import xarray as xr
+
+    from rockfrag.processing import process_record
+    from rockfrag.records import load_records
+    from rockfrag.units import STANDARD_GRAVITY
+
+    (tmp_path / "study.toml").write_text(TOY_STUDY)
+    run = rockfrag_with(toy_site, "-m", "rockfrag", "fragility", "study.toml", "--output", "out", "--no-progress",
+                        "--serial", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    # the study scaled each record to the toy's measure: a_rms of the processed record, computed here by hand
+    cube = xr.open_dataset(tmp_path / "out" / "cube.nc")
+    assert cube.attrs["intensity_measure"] == "a_rms"
+    records, _ = load_records("bolu")
+    by_hand = {r.id: np.sqrt(np.mean(process_record(r).acceleration ** 2)) / STANDARD_GRAVITY for r in records}
+    expected = np.array([by_hand[r] for r in cube.record.values])[:, None]  # every block alike
+    np.testing.assert_allclose(cube.record_im.transpose("record", "block").values,
+                               np.broadcast_to(expected, (cube.sizes["record"], cube.sizes["block"])), rtol=1e-9)
+    # the toy's damage state is fitted between theta_max/alpha >= 0.5 and overturning, with the fits' counts
+    fragility = xr.open_dataset(tmp_path / "out" / "fragility.nc")
+    states = list(fragility.damage_state.values)
+    assert states.index("rocking-0.5") + 1 == states.index("rocking-0.8") == states.index("overturning") - 1
+    reached = (cube.peak_angle_ratio >= 0.8) | (cube.outcome == 2)  # 2: overturned (the cube's flag_meanings)
+    counted = cube.outcome != 3  # 3: the solver failed (not counted)
+    by_count = (reached & counted).sum("record") / counted.sum("record")
+    fraction = fragility.empirical_fraction.sel(damage_state="rocking-0.8")
+    np.testing.assert_allclose(fraction.transpose(*by_count.dims).values, by_count.values, atol=1e-12)
+    assert float(by_count.max()) > 0 and float(by_count.min()) < 1  # the state is reached in some cells only
+    # an exchange file that cannot carry the rows says so in one line and writes none
+    said = [line for line in run.stderr.splitlines() if "pelicun has no demand type" in line]
+    assert len(said) == 1 and "'a_rms'" in said[0] and not (tmp_path / "out" / "fragility_pelicun.csv").exists()
+    # the state's verdict limit and its source reach the report
+    page = html.unescape((tmp_path / "out" / "report.html").read_text())
+    assert "(close to overturning)', 5% in the design life: the toy plugin's own limit" in page
+
+
+def test_a_plugin_record_format_limit_and_records_column(toy_site, tmp_path):
+    import json
+
+    (tmp_path / "quake.toy").write_text("dt = 0.01\n" + "\n".join(f"{0.5 * (-1) ** k:g}" for k in range(400)))
+    script = """
+import json
+from rockfrag.config import load_study
+from rockfrag.measures import intensity_measures
+from rockfrag.records import detect_format, load_records
+(record,), failures = load_records("quake.toy")
+print(json.dumps({"format": detect_format("quake.toy"), "dt": record.dt, "n": len(record.acceleration),
+                  "limit": load_study().raw["decision"]["max_probability_in_life"]["rocking-0.8"],
+                  "a_rms": intensity_measures(record.acceleration, record.dt)["a_rms_m_s2"]}))
+"""
+    run = rockfrag_with(toy_site, "-c", script, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    found = json.loads(run.stdout.splitlines()[-1])
+    assert found["format"] == "TOY" and found["dt"] == 0.01 and found["n"] == 400
+    assert found["limit"] == 0.05 and found["a_rms"] == pytest.approx(0.5, rel=1e-12)  # |a| = 0.5 m/s^2 throughout
+
+
+BROKEN = """[build-system]
+requires = ["setuptools>=61"]
+build-backend = "setuptools.build_meta"
+[project]
+name = "rockfrag-broken"
+version = "0.1"
+[project.entry-points."rockfrag.measures"]
+gone = "rockfrag_gone:MEASURE"
+[project.entry-points."rockfrag.damage_states"]
+gravity = "rockfrag.units:STANDARD_GRAVITY"
+[tool.setuptools]
+packages = []
+"""
+"""A plugin whose measure's module does not exist and whose damage state is a number."""
+
+
+def test_a_broken_plugin_is_one_error_naming_it(tmp_path):
+    source = tmp_path / "broken"
+    source.mkdir()
+    (source / "pyproject.toml").write_text(BROKEN)
+    site = install(source, tmp_path / "installed")
+    (tmp_path / "study.toml").write_text(SMALL_STUDY)
+    run = rockfrag_with(site, "-m", "rockfrag", "fragility", "study.toml", "--output", "out", "--no-progress",
+                        cwd=tmp_path)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("rockfrag: error: package rockfrag-broken 0.1, entry point "
+                                                   "rockfrag.measures: gone = rockfrag_gone:MEASURE: cannot be loaded")
+    assert not (tmp_path / "out" / "cube.nc").exists()
+    run = rockfrag_with(site, "-c", "from rockfrag.damage_states import DAMAGE_STATES; DAMAGE_STATES['uplift']",
+                        cwd=tmp_path)
+    assert "rockfrag.damage_states: gravity = rockfrag.units:STANDARD_GRAVITY: names a float; the group " \
+           "rockfrag.damage_states needs a rockfrag.damage_states.DamageState" in run.stderr

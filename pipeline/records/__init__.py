@@ -7,10 +7,11 @@ Output: ``Record`` objects (an ``obspy.Trace`` of ground acceleration [m/s^2] pl
 
 Formats: rockfrag's own readers (PEER AT2, CSMIP Volume 1, ASDF, text/CSV) sit in
 ``FORMATS[name] = RecordFormat(is_format, read_format)``, registered at the bottom of this module and
-tried in that order; their readers take the user's ``units`` and ``dt``. Every other format goes
+tried in that order, then those of installed packages (entry-point group ``rockfrag.record_formats``,
+rockfrag.plugins); their readers take the user's ``units`` and ``dt``. Every other format goes
 through ``obspy.read``, which detects its built-in formats (MiniSEED, SAC, K-NET/KiK-net, ...) and
-third-party ones through obspy's own entry-point group ``obspy.plugin.waveform``: that is the one
-extension mechanism (the former ``rockfrag.record_formats`` group is gone). Units: from the file where
+third-party ones through obspy's own entry-point group ``obspy.plugin.waveform`` (a reader there gets no
+``units`` or ``dt``: the rockfrag group is for formats that need them). Units: from the file where
 it states them (PEER AT2: g; K-NET/KiK-net: the header's scale factor in gal; CSMIP: the data-start
 line; ASDF: the StationXML response of raw counts; text: a header such as ``acc [g]``), else the user's.
 
@@ -33,6 +34,7 @@ import numpy as np
 import obspy
 
 from rockfrag.errors import ManifestError, RecordError
+from rockfrag.plugins import GROUPS, Registry
 from rockfrag.records import asdf, csmip, knet, peer_at2
 from rockfrag.records import text as text_records
 from rockfrag.records.components import ComponentGroup as ComponentGroup
@@ -61,7 +63,8 @@ class RecordFormat(NamedTuple):
     read_format: Callable  # (path, units=None, dt=None) -> obspy.Stream with acceleration in m/s^2
 
 
-FORMATS: dict[str, RecordFormat] = {}
+FORMATS: Registry = Registry(GROUPS["record_formats"], RecordFormat)
+"""Record formats by name, in the order they are tried: the shipped ones, then the installed packages'."""
 
 
 def register_format(name: str, is_format: Callable, read_format: Callable) -> None:

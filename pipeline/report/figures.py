@@ -717,9 +717,6 @@ def sweep_page(dataset, caption, names: dict | None = None):
 P_FLOOR = 1e-3  # p-values below this are drawn at it: "below 0.001" is all such a number supports
 
 
-MEASURE_WORDS = {"pulse_amplitude": "pulse acceleration", "pulse_period": "pulse period",
-                 "pga_ratio": "PGA/(g·tanα)", "pgv_ratio": "PGV·p/(g·tanα)"}
-"""Intensity measures whose registry label is a symbol (a_p) or a formula, as the efficiency page names them."""
 P_MARKERS = (("p_magnitude", "o", "black", "against magnitude"), ("p_distance", "s", "0.55", "against distance"),
              ("p_pulse_period", "^", "#6a3d9a", "against pulse period"))
 """Sufficiency p-values: marker, colour (none of the blocks' bar colours) and what each tests."""
@@ -727,17 +724,14 @@ P_MARKERS = (("p_magnitude", "o", "black", "against magnitude"), ("p_distance", 
 
 def measure_words(measure: str) -> str:
     """An intensity measure as the efficiency page names it."""
-    if measure in MEASURE_WORDS:
-        return MEASURE_WORDS[measure]
-    return pretty(MEASURES[measure].short_label()) if measure in MEASURES else measure.replace("_", " ")
-
-
-NORMALISED = {"pga_ratio": "pga", "pgv_ratio": "pgv"}
-"""Measures that divide another by a constant of the block (g·tanα; p/(g·tanα)): measure -> the one it divides."""
+    registered = MEASURES.get(measure)
+    if registered is None:
+        return measure.replace("_", " ")
+    return registered.words or pretty(registered.short_label())
 
 
 def efficiency_twins(dataset) -> dict[str, str]:
-    """Normalised measures (``NORMALISED``) whose results repeat their measure's in every cell: measure -> it.
+    """Normalised measures (``Measure.normalises``) whose results repeat their measure's in every cell: measure -> it.
 
     Dividing an intensity by a constant of the block (g·tanα, the uplift acceleration) changes no
     dispersion or p-value within a block, so PGA/(g·tanα) repeats PGA; the page draws one of each pair.
@@ -745,8 +739,9 @@ def efficiency_twins(dataset) -> dict[str, str]:
     """
     measures = [str(m) for m in dataset.measure.values]
     twins = {}
-    for measure, base in NORMALISED.items():
-        if measure in measures and base in measures:
+    normalised = {name: MEASURES[name].normalises for name in measures if name in MEASURES}
+    for measure, base in normalised.items():
+        if base is not None and base in measures:
             values = [np.asarray(dataset.dispersion.sel(measure=m).values, float) for m in (measure, base)]
             if np.allclose(*values, rtol=1e-6, atol=1e-9, equal_nan=True):
                 twins[measure] = base
