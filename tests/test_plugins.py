@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -195,3 +196,14 @@ def test_a_broken_plugin_is_one_error_naming_it(tmp_path):
                         cwd=tmp_path)
     assert "rockfrag.damage_states: gravity = rockfrag.units:STANDARD_GRAVITY: names a float; the group " \
            "rockfrag.damage_states needs a rockfrag.damage_states.DamageState" in run.stderr
+
+
+def test_the_plugins_page_documents_every_group_and_includes_the_toy():
+    from rockfrag.plugins import GROUPS
+
+    root = Path(__file__).resolve().parents[1]
+    page = (root / "docs" / "plugins.md").read_text(encoding="utf-8")
+    assert all(f"`{group}`" in page for group in GROUPS.values())
+    included = re.findall(r"```\{literalinclude\} \.\./(\S+)", page)
+    assert sorted(included) == ["tests/plugin_toy/pyproject.toml", "tests/plugin_toy/rockfrag_toy/__init__.py"]
+    assert "\nplugins\n" in (root / "docs" / "index.md").read_text(encoding="utf-8")  # in the site's toctree
