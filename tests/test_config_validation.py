@@ -23,7 +23,7 @@ BAD_STUDIES = [
     ('[damage_states.tilt]\nedp = "peak_angle_ratio"\nthreshold = -1\n', "damage_states.tilt.threshold", "> 0"),
     ('blocks.x = 5\n', "blocks.x", "must be a table"),
     ('[intensity]\nmeasure = ["pga"]\n', "intensity.measure", "must be a string"),
-    ('[intensity]\nmeasure = "pgd"\n', "intensity.measure", "allowed: 'pga'"),
+    ('[intensity]\nmeasure = "arias"\n', "intensity.measure", "allowed: 'pga'"),
     ('soils = [["sand"]]\n', "soils[0]", "must be a name"),
     ('soils = ["sand", "loam"]\n', "soils", "unknown soil 'loam'"),
     ('[study]\noutput = 5\n', "study.output", "must be a string"),

@@ -42,7 +42,7 @@ def small_cube(small_study, tmp_path_factory):
 
 
 @pytest.mark.parametrize("text, field", [
-    ('[intensity]\nmeasure = "pgd"\n', "intensity.measure"),
+    ('[intensity]\nmeasure = "arias"\n', "intensity.measure"),
     ('[intensity]\nlevels = { start = 1.0, stop = 0.5, count = 4 }\n', "intensity.levels"),
     ('[intensity]\nlevels = [0.1, 0.05]\n', "intensity.levels"),
     ('[intensity]\nperiod = -1.0\n', "intensity.period"),
