@@ -207,3 +207,23 @@ def test_the_plugins_page_documents_every_group_and_includes_the_toy():
     included = re.findall(r"```\{literalinclude\} \.\./(\S+)", page)
     assert sorted(included) == ["tests/plugin_toy/pyproject.toml", "tests/plugin_toy/rockfrag_toy/__init__.py"]
     assert "\nplugins\n" in (root / "docs" / "index.md").read_text(encoding="utf-8")  # in the site's toctree
+
+
+@pytest.mark.parametrize("states, labels", [(6, 2), (7, 1), (9, 1)])
+def test_a_page_of_more_states_than_shipped_labels_its_probability_axis_once(states, labels):
+    """Six states fill two rows, each row labelled; seven (a plugin's state) need three rows, where a row is
+    shorter than the label: then one label, beside the middle row, instead of three running into each other."""
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from rockfrag.report.figures import _grid, _probability_axes
+
+    rows, columns = _grid(states)
+    figure, axes = plt.subplots(rows, columns, squeeze=False, figsize=(11.7, 8.3))
+    _probability_axes(axes, np.array([0.1, 1.0]), "PGA [g]", "probability of the damage state [-]")
+    labelled = [axis for axis in axes.flat if axis.get_ylabel()]
+    assert len(labelled) == labels and all(axis in axes[:, 0] for axis in labelled)
+    renderer = figure.canvas.get_renderer()
+    boxes = [axis.yaxis.label.get_window_extent(renderer) for axis in labelled]
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+    plt.close(figure)

@@ -503,7 +503,10 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
         if not getattr(axis, "rockfrag_empty", False):
             mark_intensities(axis, marks, along="x")
         axis.tick_params(labelbottom=True, labelsize=8)  # every row: a panel is read on its own
-    for axis in axes[:, 0]:
+    rows = axes.shape[0]
+    # up to two rows each row's label fits beside it; from three rows on (seven damage states or more: a plugin's,
+    # or a study's own) the label is longer than a row is high, so one label, beside the middle row, says it
+    for axis in axes[:, 0] if rows < 3 else axes[rows // 2:rows // 2 + 1, 0]:
         axis.set_ylabel(y_label)
     for axis in axes.flat:
         if axis.get_visible():
