@@ -4,11 +4,13 @@ Input : a reference rotation history (a table of time and rotation, e.g. from LS
         test; units from the header or flags), the ground motion that produced it [m/s^2] sampled at
         dt [s], the block and a model that needs a foundation (``ssi`` by default; any registered model
         whose ``needs_foundation`` is true, solver keywords such as winkler's ``bed=`` pass through).
-Output: ``CalibrationResult``: the best grid point and the global optimum (k [N/m], xi [-]) with their
-        profile-likelihood confidence intervals (``fit_intervals``; default 90 %), the paper's eq. 17
-        Pearson correlation between reference and model rotation (model interpolated onto the
-        reference's own time steps), RMS error [rad], peak-angle error, the implied A/H of eq. 19 [m],
-        the correlation surface of the grid; JSON/CSV and PNG writers.
+Output: ``CalibrationResult``: the best grid point, the search's optimum over the whole reference and the
+        estimate (k [N/m], xi [-]) with its confidence intervals (default 90 %) and the window that decided
+        them, or "not identifiable from this reference" with the range of the fits that explain it equally;
+        the paper's eq. 17 Pearson correlation between reference and model rotation (model interpolated onto
+        the reference's own time steps), RMS error [rad], peak-angle error, the implied A/H of eq. 19 [m],
+        the correlation surface of the grid; JSON/CSV and PNG writers. ``fit_intervals``: the profile
+        intervals of one window around a given fit.
 
 Why not a grid and one local search: the correlation surface of a rocking response is a needle field.
 A few impacts after uplift, 1 % in k or 0.0005 in xi moves the impacts enough to drop eq. 17 from 1.0
@@ -32,6 +34,42 @@ it started. The search therefore grows the fitted time window (continuation in t
 The objective is robust to noise and amplitude errors: (1 - correlation) + 0.5 ln(sigma_model /
 sigma_reference)^2 on both signals low-passed at ``smoothing_hz`` (default 10 Hz, zero phase). The
 correlation reported is the paper's eq. 17 on the unsmoothed reference at its own time steps.
+
+The intervals (issue 34: profile-likelihood intervals of the whole record were point-like on chaotic
+references and contained the truth in 0 of 14 cases). A long rocking record is chaotic in k and xi: past a
+horizon a fit 0.05 % from the truth in k misses the reference by far more than its noise, and the set of
+(k, xi) that reproduce it is a field of needles no search finds and no local curvature describes. The
+likelihood is usable only on the windows [0, T] where the fit explains the reference at its noise level and
+is regular at the interval's scale; the data say which (``_decide``; block comments "intervals" and "windows"):
+
+1. Goodness of fit per window: the noise (variance, autocorrelation time) is the residual of the quiet start
+   (before the reference reaches 20 % of its peak), at least ``NOISE_FLOOR`` (0.1 %) of the peak. A window
+   is accepted when its least-squares fit (Gauss-Newton from the search's points) leaves no more than the
+   chi^2 99.9 % quantile of that noise, in all and in the samples it adds. Where longer windows are not
+   explained, the first of them is scanned over the whole search range for other basins and they are fitted
+   again from those (the search may have tracked the wrong basin).
+2. Regularity: the profile likelihood of the longest accepted window, else of the next shorter one: the
+   response smooth at the interval's scale (its Jacobian at a quarter of the step within 30 %), the profiles
+   rising monotonically and leaving the region once. That window decides; its least-squares point is the
+   estimate, whatever the longer windows (the chaotic tail) would pull it to.
+3. The decisive window's likelihood over the whole search range (a 121 x 21 scan, its basins polished):
+   a better basin takes over; other basins that fit as well make the reference "not identifiable", with the
+   range of every fit that explains the window as well as the estimate.
+4. The profile deviance that bounds the intervals: chi^2_1, or the parametric bootstrap's quantile where
+   larger (40 replicates of the fit plus AR(1) noise with the residuals' variance and lag-1 correlation,
+   refitted by batched Gauss-Newton). The intervals are the union of the decisive window's and of the next
+   shorter regular window's: near the horizon the likelihood splits into narrow basins that fit equally well.
+5. Agreement: the estimate must explain every shorter accepted window (chi^2_2 99.9 %) and the two windows'
+   intervals must meet; else "not identifiable", with the range of the fits of the windows that disagree.
+   No regular window at all (a response chaotic from the start of its rocking): the range is the search
+   range.
+
+Why not the alternatives alone: profile likelihood over the whole record is the old method; a parametric
+bootstrap of the whole calibration (resimulate, search again) costs hundreds of searches of ~2,000
+simulations and inherits each search's basin errors; the set of fits within the noise's tolerance over the
+whole range needs a noise estimate that does not come from the fit (here the quiet start) and a search fine
+enough to find needles (here a scan of the one window where they are wide). Each is used where it holds.
+Coverage, measured on 120 references by ``benchmarks/calibration_coverage.py``: docs/theory/calibration.md.
 """
 
 from __future__ import annotations
@@ -122,7 +160,8 @@ class CalibrationResult:
     k_grid, xi_grid, correlation_grid : float
         The coarse grid's best interface stiffness [N/m], damping ratio [-] and eq. 17 correlation [-].
     k, xi, correlation : float
-        The final fit: interface stiffness [N/m], damping ratio [-], eq. 17 correlation [-].
+        The estimate: interface stiffness [N/m], damping ratio [-] (with intervals: the least-squares point of
+        the decisive window) and its eq. 17 correlation over the whole reference [-].
     rms_error : float
         RMS difference of the fitted and the reference rotation [rad].
     peak_error : float
@@ -159,6 +198,19 @@ class CalibrationResult:
         outside its own likelihood region, strongly correlated residuals.
     interval_simulations : int
         Simulations the intervals took (included in ``n_simulations``).
+    identifiable : bool or None
+        False: "not identifiable from this reference": the intervals are the range of the fits that explain it
+        equally (other basins, windows that disagree, or no window with a regular likelihood); None: not computed.
+    decisive_window : float or None
+        End [s] of the window whose fit and likelihood decided (None: none did).
+    windows : list of dict
+        Each window fitted: ``end`` [s], ``k`` [N/m], ``xi`` [-] of its least-squares point, ``accepted`` (its fit
+        explains it at the noise level), ``regular`` (its likelihood's verdict, None if not profiled) and ``reason``.
+    k_search, xi_search : float or None
+        The search's optimum over the whole reference [N/m], [-] (the estimate without intervals).
+    deviance_limits : dict
+        The profile deviance that bounds the interval of ``k`` and of ``xi`` [-]: chi^2_1 at the confidence, or
+        the parametric bootstrap's quantile where that is larger.
     profile_k, profile_k_deviance, profile_xi, profile_xi_deviance : list
         The profiles: k [N/m] and xi [-] values and the profile deviance D [-] at each.
     """
@@ -195,6 +247,12 @@ class CalibrationResult:
     autocorrelation_time: float | None = None
     interval_notes: list = field(default_factory=list)
     interval_simulations: int = 0
+    identifiable: bool | None = None
+    decisive_window: float | None = None
+    windows: list = field(default_factory=list)
+    k_search: float | None = None
+    xi_search: float | None = None
+    deviance_limits: dict = field(default_factory=dict)
     profile_k: list = field(repr=False, default_factory=list)
     profile_k_deviance: list = field(repr=False, default_factory=list)
     profile_xi: list = field(repr=False, default_factory=list)
@@ -213,7 +271,8 @@ class CalibrationResult:
                          "peak_error": "1 (relative)", "area_over_depth": "m", "soil_shear_modulus": "Pa",
                          "block_modulus": "Pa", "seconds": "s", "confidence": "1 (two-sided)", "k_low": "N/m",
                          "k_high": "N/m", "xi_low": "1", "xi_high": "1", "noise_rms": "rad",
-                         "autocorrelation_time": "samples"}
+                         "autocorrelation_time": "samples", "decisive_window": "s", "k_search": "N/m",
+                         "xi_search": "1", "windows": "end s, k N/m, xi 1"}
         return data
 
     def interval_lines(self) -> list[str]:
@@ -224,10 +283,28 @@ class CalibrationResult:
              f"{self.k_high / self.k - 1:+.2%})")
         xi = (f", xi {self.xi_low:.5f} to {self.xi_high:.5f} ({self.xi_low - self.xi:+.5f} / "
               f"{self.xi_high - self.xi:+.5f})" if self.xi_low is not None else ", xi fixed")
-        lines = [f"{self.confidence:.0%} confidence ({self.interval_method}): {k}{xi}",
-                 f"  noise the intervals assume: RMS {self.noise_rms:.3g} rad, residual autocorrelation time "
-                 f"{self.autocorrelation_time:.2g} samples ({self.interval_simulations} simulations)"]
+        if self.identifiable is False:
+            lines = [f"{NOT_IDENTIFIABLE} ({self.confidence:.0%}): the fits that explain it equally span {k}{xi}"]
+        else:
+            lines = [f"{self.confidence:.0%} confidence ({self.interval_method}): {k}{xi}"]
+        lines += self.window_lines()
+        if self.noise_rms is not None:
+            share = f" ({self.noise_rms / self.peak_reference:.2%} of the peak)" if self.peak_reference else ""
+            lines.append(f"  noise the intervals assume: RMS {self.noise_rms:.3g} rad{share}, residual autocorrelation "
+                         f"time {self.autocorrelation_time:.2g} samples ({self.interval_simulations} simulations)")
         return lines + [f"  note: {note}" for note in self.interval_notes]
+
+    def window_lines(self) -> list[str]:
+        """Which window decided the estimate and the intervals, and why not a longer one."""
+        if not self.windows:
+            return []
+        end = self.windows[-1]["end"]
+        refused = next((w for w in self.windows if w["end"] > (self.decisive_window or 0.0) and w["reason"]), None)
+        why = f" (0-{refused['end']:.2f} s: {refused['reason']})" if refused else ""
+        if self.decisive_window is None:
+            return [f"  no window decided: none of the {len(self.windows)} fitted has a regular likelihood{why}"]
+        return [f"  decided by the window 0-{self.decisive_window:.2f} s of 0-{end:.2f} s: the longest whose fit "
+                f"explains the reference at the noise level and whose likelihood is regular{why}"]
 
 
 # ----------------------------------------------------------------------------------------- reading
@@ -519,7 +596,9 @@ def _nelder_mead(cost, start, steps, fixed_xi, evaluations):
 
 
 def _continuation(search, objective, grid, grid_on_times, shape, windows, steps, fixed_xi, log):
-    """Track the optimum through growing windows; returns (point, objective on the whole reference, windows).
+    """Track the optimum through growing windows; returns (point, objective on the whole reference, history).
+
+    ``history`` holds (samples, best point) of each window accepted, shortest first.
 
     Seeds: the survivors of the previous window and the coarse grid's best basins on this window. A
     window whose best objective more than doubles and exceeds three times the noise floor (what the
@@ -528,6 +607,7 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
     """
     pending = list(windows)
     candidates, previous_n, previous_score, extra, number = [], 0, math.inf, 0, 0
+    history = []  # (samples, best point) of every window accepted
     while pending:
         n = pending[0]
         last = len(pending) == 1
@@ -557,28 +637,28 @@ def _continuation(search, objective, grid, grid_on_times, shape, windows, steps,
         points = np.array([point for _, point in refined])
         candidates = _distinct(points, np.array([score for score, _ in refined]), steps, SURVIVORS)
         previous_n, previous_score = n, candidates[0][0]
+        history.append((n, candidates[0][1]))
         if log:
             k_now, xi_now = search.physical(candidates[0][1])
             log(f"window {number} (0-{objective.times[n - 1]:.2f} s, {len(pending)} to go): best k = {k_now:.4g} "
                 f"N/m, xi = {xi_now:.4f}, objective {candidates[0][0]:.4f}")
         steps = np.maximum(steps * 0.7, MIN_STEP)
-    return candidates[0][1], candidates[0][0], number
+    return candidates[0][1], candidates[0][0], history
 
 
 # ----------------------------------------------------------------------------------------- intervals
-# Profile likelihood. The reference is read as the model's rotation plus Gaussian noise of unknown variance:
-# with sigma profiled out, -2 ln(likelihood ratio) is D = n_eff ln(RSS / RSS_min), RSS the sum of squared
-# residuals on the uniform search grid. Wilks: {k : min over xi of D <= chi2_1(confidence)} is the interval of
-# k, and likewise for xi (each a marginal interval, not a joint region). n_eff = n / tau, tau the integrated
-# autocorrelation time of the residuals (1 for white noise): residuals that are smooth (model error, coloured
-# noise) carry fewer independent samples and widen the intervals.
+# Profile likelihood of one window. The reference is read as the model's rotation plus Gaussian noise of unknown
+# variance: with sigma profiled out, -2 ln(likelihood ratio) is D = n_eff ln(RSS / RSS_min), RSS the sum of squared
+# residuals on the uniform search grid plus the floor's n sigma_floor^2. Wilks: {k : min over xi of D <= limit}
+# is the interval of k (limit chi2_1(confidence), or the bootstrap's), and likewise for xi (each a marginal
+# interval, not a joint region). n_eff = n / tau, tau the integrated autocorrelation time of the residuals (1 for
+# white noise): residuals that are smooth (model error, coloured noise) carry fewer independent samples and widen
+# the intervals.
 # k and xi trade off (a stiffer, more damped interface rocks alike): their estimates are correlated beyond
 # 0.99, so the profile follows a narrow diagonal ridge. Every minimisation is therefore Gauss-Newton on the
-# residuals, with finite-difference Jacobians (the response is smooth at the scale of the interval, although
-# chaotic at the scale of the search box): first from the search's optimum to the maximum-likelihood point,
-# then over xi at each profiled k (and over k at each profiled xi), all rows of a profile in one batch.
-# Why not a residual bootstrap: each resample needs the whole chaotic search again (hundreds of resamples x
-# ~2000 simulations), while the profile needs ~500 simulations in a few compiled batch calls around the fit.
+# residuals, with finite-difference Jacobians (the response is smooth at the scale of the interval on a regular
+# window, which ``_profiles_around`` checks): first from the fit to the maximum-likelihood point, then over xi at
+# each profiled k (and over k at each profiled xi), all rows of a profile in one batch.
 
 CONFIDENCE = 0.90
 """Default two-sided confidence level of the intervals of k and xi."""
@@ -626,8 +706,9 @@ def autocorrelation_time(residual: ArrayLike) -> float:
 class _Likelihood:
     """Residuals (model - reference on the uniform grid) of points of the unit box, and the lowest RSS seen."""
 
-    def __init__(self, search, times, reference, t_end):
+    def __init__(self, search, times, reference, t_end, floor=0.0):
         self.search, self.times, self.reference, self.t_end = search, times, reference, t_end
+        self.floor = floor  # added to every RSS: the noise floor's n sigma_floor^2 (rockfrag.calibrate.NOISE_FLOOR)
         self.best_rss, self.best_point = math.inf, None
         self.seen_points, self.seen_rss = [], []  # every evaluation: the region's points bound the intervals
 
@@ -636,7 +717,7 @@ class _Likelihood:
         chunks = np.array_split(points, math.ceil(len(points) / PROFILE_BATCH))
         values = np.concatenate([_interpolate(self.search.histories(chunk, self.t_end), self.search.dt, self.times)
                                  for chunk in chunks]) - self.reference
-        rss = np.sum(values**2, axis=1)
+        rss = np.sum(values**2, axis=1) + self.floor
         self.seen_points.append(points)
         self.seen_rss.append(rss)
         best = int(np.argmin(rss))
@@ -744,50 +825,70 @@ def _first_crossing(offsets, deviance, threshold):
     return float(offsets[i - 1] + fraction * (offsets[i] - offsets[i - 1]))
 
 
-def _profiles_around(likelihood, start, axes, threshold, tau, fixed_xi):
+def _profiles_around(likelihood, start, axes, threshold, tau, fixed_xi, reach=None):
     """Least-squares point from ``start``, then the profile of each free coordinate around it.
 
-    Returns ({axis: (positions, profile RSS)}, notes, tau, n_eff, RSS at the least-squares point).
+    ``reach`` (default ``threshold``) is the deviance the profiles must reach on both sides.
+
+    Returns ({axis: (positions, profile RSS)}, notes, tau, n_eff, RSS at the least-squares point, rough), rough
+    saying why the response is not smooth at the interval's scale (None when it is): the Jacobian at a quarter
+    of the finite-difference step (a quarter of the conditional half-width) or at four times it (across the
+    interval: Wilks needs the response about linear there) differs from it by more than ``ROUGHNESS`` (a jump,
+    a chaotic wiggle, narrow basins side by side), or the interval is at the solver's resolution.
     """
     samples = likelihood.times.size
     mle, steps, jacobian, residual, mle_rss = _maximum_likelihood(likelihood, start, axes, threshold, samples / tau)
-    tau = autocorrelation_time(residual)  # at the least-squares point, where only noise and model error remain
+    # at the least-squares point, where only noise and model error remain (the floor counts as white noise)
+    tau = _floored_tau(residual, likelihood.floor)
     n_eff = samples / tau
+    rough = None
+    norms = np.linalg.norm(jacobian, axis=0)
+    for factor, what in ((0.25, "a quarter of it"), (4.0, "four times it (the interval's half-width)")):
+        other = likelihood.jacobian([mle], np.minimum(steps * factor, 0.25), axes)[2][0]
+        change = np.linalg.norm(other - jacobian, axis=0) / np.maximum(norms, 1e-300)
+        if rough is None and np.any((change > ROUGHNESS) & (norms > 0)):
+            rough = (f"the response is not smooth at the interval's scale (its derivative in "
+                     f"{', '.join(('k', 'xi')[a] for a, c in zip(axes, change) if c > ROUGHNESS)} changes by "
+                     f"{float(np.max(change)):.0%} from a step to {what})")
     # linearised covariance: sigma^2 tau (J^T J)^-1, sigma^2 = RSS/n; its diagonal sets each profile's span,
     # its regression of one coordinate on the other the ridge the inner minimisation starts from
     covariance = np.linalg.pinv(jacobian.T @ jacobian) * mle_rss / n_eff
     profiles, notes = {}, []
     for index, axis in enumerate(axes):
         other = 1 - axis
-        half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5)
+        if not np.any(jacobian[:, index]):  # the window does not depend on this parameter: profile the whole range
+            half_width, covariance[index, index] = 0.5, math.inf
+        else:
+            half_width = min(math.sqrt(threshold * max(covariance[index, index], 0.0)), 0.5)
         if half_width < 4 * RESOLUTION:
-            notes.append(f"the {('k', 'xi')[axis]} interval is at the solver's resolution (the reference has almost "
-                         "no noise): it says how precisely the model reproduces it, not how well k and xi are known")
+            rough = rough or f"the {('k', 'xi')[axis]} interval would be at the solver's resolution"
             half_width = 4 * RESOLUTION
-        ridge = covariance[1 - index, index] / covariance[index, index] if len(axes) == 2 else 0.0
+        ridge = (covariance[1 - index, index] / covariance[index, index]
+                 if len(axes) == 2 and 0 < covariance[index, index] < math.inf else 0.0)
         span = PROFILE_SPAN
         for _ in range(MAX_WIDENINGS + 1):
             positions = np.unique(np.clip(mle[axis] + span * half_width * np.linspace(-1, 1, PROFILE_POINTS), 0, 1))
             starts = np.clip(mle[other] + ridge * (positions - mle[axis]), 0.0, 1.0)
             rss = _profile_rss(likelihood, positions, axis, starts, steps, fixed_xi)
-            low, high = _bounds(positions, n_eff * np.log(rss / likelihood.best_rss), threshold)
+            low, high = _bounds(positions, n_eff * np.log(rss / likelihood.best_rss), reach or threshold)
             if not ((low is None and positions[0] > 0.0) or (high is None and positions[-1] < 1.0)):
                 break
             span *= 2.0  # the profile is flatter than its linearisation: look wider
         profiles[axis] = (positions, rss)
-    return profiles, notes, tau, n_eff, mle_rss
+    return profiles, notes, tau, n_eff, mle_rss, rough
 
 
 def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: ArrayLike, fixed_xi: bool,
-                      confidence: float, t_end: float) -> dict:
-    """Profile-likelihood intervals of k and xi around a fit (see the block comment above).
+                      confidence: float, t_end: float, noise_floor: float = 0.0,
+                      limits: dict | None = None) -> dict:
+    """Profile-likelihood intervals of k and xi around a fit on one window (see the block comment above).
 
     Parameters
     ----------
     search : _Search
         The simulations of the calibration (model, record, block, search box).
     times, reference : ndarray
-        The uniform search grid [s] and the reference rotation on it [rad].
+        The uniform search grid [s] of the window and the reference rotation on it [rad].
     point : array_like
         The fit in the unit box (u = log-k fraction, v = xi fraction).
     fixed_xi : bool
@@ -796,37 +897,49 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
         Two-sided level in (0, 1).
     t_end : float
         End of the simulations [s].
+    noise_floor : float
+        The least noise RMS the intervals assume [rad] (``NOISE_FLOOR`` of the peak in ``calibrate``).
+    limits : dict, optional
+        The profile deviance that bounds each interval, per axis (0: k, 1: xi); default chi^2_1(confidence)
+        (``calibrate`` passes the parametric bootstrap's, ``_bootstrap_limits``).
 
     Returns
     -------
     dict
         ``k_low``, ``k_high`` [N/m], ``xi_low``, ``xi_high`` [-] (None for a fixed xi), ``noise_rms``
         [rad], ``autocorrelation_time`` [samples], ``notes`` (bounds that are the search box's, a fit
-        outside its own region, correlated residuals), and the profiles (``profile_k``,
-        ``profile_k_deviance``, ``profile_xi``, ``profile_xi_deviance``).
+        outside its own region, correlated residuals), the profiles (``profile_k``,
+        ``profile_k_deviance``, ``profile_xi``, ``profile_xi_deviance``), ``point`` (the likelihood's best
+        point in the unit box), ``at_fit`` (the deviance of ``point`` given) and ``irregular`` (why the
+        likelihood is not regular at the interval's scale, or None; ``_irregularity``).
     """
     from scipy.stats import chi2
 
     threshold = float(chi2.ppf(confidence, 1))
     axes = (0,) if fixed_xi else (0, 1)
+    limits = {axis: max(threshold, (limits or {}).get(axis, threshold)) for axis in axes}
     start = np.clip(np.asarray(point, float), 0.0, 1.0)
-    likelihood = _Likelihood(search, times, reference, t_end)
+    likelihood = _Likelihood(search, times, reference, t_end, floor=times.size * noise_floor**2)
     tau = autocorrelation_time(likelihood.residuals([start])[0][0])
     origin = start
     for attempt in range(RESTARTS + 1):
-        profiles, notes, tau, n_eff, mle_rss = _profiles_around(likelihood, origin, axes, threshold, tau, fixed_xi)
+        profiles, notes, tau, n_eff, mle_rss, rough = _profiles_around(likelihood, origin, axes, threshold, tau,
+                                                                       fixed_xi, max(limits.values()))
         # a point better than the least-squares point found: Gauss-Newton stopped short on a nonlinear surface
         if n_eff * math.log(mle_rss / likelihood.best_rss) <= RESTART_DEVIANCE:
             break
         origin = likelihood.best_point
 
     lowest = min(likelihood.best_rss, *(float(np.min(rss)) for _, rss in profiles.values()))
-    out = {"noise_rms": math.sqrt(lowest / times.size), "autocorrelation_time": tau, "notes": notes}
+    out = {"noise_rms": math.sqrt(max(lowest - likelihood.floor, 0.0) / times.size), "autocorrelation_time": tau,
+           "notes": notes, "point": np.array(likelihood.best_point, float)}
+    irregular = [rough] if rough else []
     # min over xi of D at k is at most D at any (k, xi): every evaluated point inside the joint region lies inside
     # both intervals. Where the profiles' local minimisation falls short (a nonlinear surface), this widens them.
     seen = np.concatenate(likelihood.seen_points)
-    inside = seen[n_eff * np.log(np.concatenate(likelihood.seen_rss) / lowest) <= threshold]
+    seen_deviance = n_eff * np.log(np.concatenate(likelihood.seen_rss) / lowest)
     for axis, (positions, rss) in profiles.items():
+        inside = seen[seen_deviance <= limits[axis]]
         name, unit = ("k", " N/m") if axis == 0 else ("xi", "")
 
         def physical(x, axis=axis):
@@ -835,7 +948,10 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
         # against the profile's own minimum: the same as the lowest RSS where the response is smooth, and the
         # only consistent reference where it is not (a noise-free reference at the solver's resolution)
         deviance = n_eff * np.log(rss / float(np.min(rss)))
-        bounds = list(_bounds(positions, deviance, threshold))
+        reason = _irregularity(deviance, threshold)
+        if reason:
+            irregular.append(f"the {name} profile {reason}")
+        bounds = list(_bounds(positions, deviance, limits[axis]))
         for side, edge in enumerate((positions[0], positions[-1])):
             if bounds[side] is None:
                 bounds[side] = edge
@@ -849,13 +965,18 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
                 out["notes"].append(f"the {name} interval is widened by {growth:.0%} to every simulated point inside "
                                     "the likelihood region (the surface is not quadratic at this scale): read its "
                                     "width as a lower bound")
+            if growth > IRREGULAR_WIDENING:
+                irregular.append(f"simulated points inside the likelihood region lie {growth:.0%} beyond the {name} "
+                                 "profile's interval")
             bounds = widened
         out[f"{name}_low"], out[f"{name}_high"] = (float(physical(bound)) for bound in bounds)
+        out[f"{name}_span"] = tuple(float(physical(bound)) for bound in bounds)
         out[f"profile_{name}"] = [float(physical(x)) for x in positions]
         out[f"profile_{name}_deviance"] = [float(v) for v in deviance]
     if fixed_xi:
         out["xi_low"] = out["xi_high"] = None
     at_fit = n_eff * math.log(float(likelihood.residuals([start])[1][0]) / lowest)
+    out["at_fit"] = at_fit
     if at_fit > threshold:
         k_best, xi_best = search.physical(likelihood.best_point)
         out["notes"].append(f"the fit lies outside its own {confidence:.0%} likelihood region (deviance "
@@ -864,7 +985,521 @@ def _profile_intervals(search, times: np.ndarray, reference: np.ndarray, point: 
     if tau > 2.0:
         out["notes"].append(f"the residuals are correlated over {tau:.0f} samples (model error or coloured noise): "
                             f"the intervals count {n_eff:.0f} of {times.size} samples as independent")
+    out["irregular"] = "; ".join(irregular) or None
     return out
+
+
+ROUGHNESS = 0.3  # a Jacobian that changes by more than this fraction from a step to a quarter of it: not smooth
+DIP = 1.0  # a profile that falls by more than this deviance (or DIP_FRACTION of its climb) on its way out is jagged
+DIP_FRACTION = 0.25
+JAGGED_LEVEL = 4.0  # dips count while the profile has climbed no higher than this many thresholds (the region's
+# neighbourhood; further out, another basin above the threshold does not move the interval)
+IRREGULAR_WIDENING = 1.0  # region points beyond the profile's interval by this fraction of its width: not regular
+
+
+def _irregularity(deviance, threshold):
+    """Why a profile deviance is not that of a regular likelihood, or None.
+
+    A regular likelihood rises monotonically away from its minimum along the profile. A chaotic window's
+    profile is jagged (it falls back by more than ``DIP`` or ``DIP_FRACTION`` of what it had climbed) or
+    leaves the region and comes back into it (several basins within the profile's span).
+    """
+    deviance = np.asarray(deviance, float)
+    centre = int(np.argmin(deviance))
+    for side in (deviance[centre:], deviance[:centre + 1][::-1]):
+        climbed, left = 0.0, False
+        for value in side:
+            if left and value < threshold:
+                return "leaves the likelihood region and comes back into it (several basins)"
+            if climbed <= JAGGED_LEVEL * threshold and value < climbed - max(DIP, DIP_FRACTION * climbed):
+                return f"is jagged (falls from {climbed:.3g} to {value:.3g} on its way out)"
+            climbed, left = max(climbed, value), left or value >= threshold
+    return None
+
+
+# ----------------------------------------------------------------------------------------- windows
+# Which window decides. A window's likelihood is usable when the model explains the window at the noise level
+# (goodness of fit) and the likelihood is regular at the interval's scale (the profiles rise monotonically).
+# The windows are walked from the shortest up; each one's least-squares point is found by Gauss-Newton from the
+# search's point on that window and from the previous window's least-squares point. A window is accepted while
+# the growth of its least RSS over the previous accepted window's, ΔRSS, is what the noise explains: ΔRSS /
+# sigma^2 below the chi^2 quantile GOODNESS of (new samples)/tau degrees of freedom (times tau), sigma^2 and tau
+# from the previous accepted window's residuals. Past the point where the response turns chaotic at the noise's
+# scale, the best fit of the longer window no longer follows the reference, ΔRSS jumps, and the walk stops.
+# The last accepted window whose profiles are regular decides: its least-squares point is the estimate, its
+# profile intervals are the intervals.
+
+NOISE_FLOOR = 1e-3
+"""The least noise RMS the intervals assume, as a fraction of the reference's peak |rotation|: no measurement
+or export is read as more precise than this (a noise-free reference would otherwise give intervals at the
+solver's resolution that the fit's own round-off can miss)."""
+MISMATCH = 0.1  # a reference may differ from the model by this fraction of its noise RMS (interpolated, rounded)
+GOODNESS = 0.999  # level of the chi^2 test of a window's fit against the noise (a false alarm only shortens it)
+AGREEMENT = 0.999  # level of the chi^2_2 test that the decisive fit explains the shorter accepted windows
+NOT_IDENTIFIABLE = "not identifiable from this reference"
+
+
+@dataclass
+class _Window:
+    """One fitting window [0, times[n - 1]]: its least-squares point and what the walk decided."""
+
+    n: int
+    end: float  # [s]
+    point: np.ndarray
+    rss: float  # least RSS, floor included [rad^2]
+    tau: float
+    residual: np.ndarray
+    accepted: bool = False
+    reason: str = ""
+
+
+def _window_fit(search, times, reference, n, starts, axes, threshold, floor, dt):
+    """The least-squares point of the window of n samples, Gauss-Newton from the best of ``starts``."""
+    likelihood = _Likelihood(search, times[:n], reference[:n], float(times[n - 1]) + dt, floor=floor)
+    starts = np.clip(np.array(starts, float), 0.0, 1.0)
+    values, rss = likelihood.residuals(starts)
+    best = int(np.argmin(rss))
+    tau = _floored_tau(values[best], floor)
+    point, _, _, residual, rss = _maximum_likelihood(likelihood, starts[best], axes, threshold, n / tau)
+    if likelihood.best_rss < rss:  # a trial point better than where Gauss-Newton stopped
+        point = likelihood.best_point
+        residual = likelihood.residuals([point])[0][0]
+        rss = float(likelihood.best_rss)
+    return _Window(n, float(times[n - 1]), np.array(point, float), float(rss), _floored_tau(residual, floor),
+                   residual)
+
+
+def _floored_tau(residual, floor):
+    """The autocorrelation time of the residuals plus the white noise floor (floor = n sigma_floor^2)."""
+    variance = float(np.mean(residual**2))
+    noise_share = variance / (variance + floor / residual.size) if variance > 0 else 0.0
+    return 1.0 + (autocorrelation_time(residual) - 1.0) * noise_share
+
+
+def _explained(base: _Window, previous: _Window, window: _Window) -> tuple[bool, str]:
+    """(accepted, why not): does ``window``'s fit explain its samples at the noise of ``base``, beyond it and added.
+
+    The noise variance and autocorrelation time tau are the base window's (``_window_walk``), itself a sample:
+    the mean square the fit leaves in the samples beyond the base, and in those beyond the previous accepted
+    window, over the base's, is F-distributed with (samples / tau, base samples / tau) degrees of freedom for
+    a fit that explains them; both must stay below the ``GOODNESS`` quantile, times (1 + ``MISMATCH``)^2.
+    """
+    from scipy.stats import f as fisher
+
+    variance = base.rss / base.n
+    base_dof = max(base.n / base.tau, 1.0)
+    for label, samples, excess in (("beyond the quiet start", window.n - base.n, window.rss - base.rss),
+                                   ("it adds", window.n - previous.n, window.rss - previous.rss)):
+        if samples <= 0 or (label == "it adds" and previous is base):
+            continue
+        ratio = excess / samples / variance
+        limit = float(fisher.ppf(GOODNESS, max(samples / base.tau, 1.0), base_dof)) * (1.0 + MISMATCH) ** 2
+        if ratio > limit:
+            return False, (f"its best fit leaves {ratio:.3g} times the noise variance unexplained in the {samples} "
+                           f"samples {label} (limit {limit:.3g}: F {GOODNESS:.1%} and {MISMATCH:.0%} of the noise "
+                           "for interpolation)")
+    return True, ""
+
+
+def _quiet_samples(reference: np.ndarray, smoothed: np.ndarray) -> int:
+    """Samples before the (smoothed) reference first reaches ``PEAK_FRACTION`` of its peak: the block barely moves."""
+    magnitude = np.abs(smoothed - smoothed[0])
+    return int(np.argmax(magnitude >= PEAK_FRACTION * magnitude.max()))
+
+
+def _window_walk(search, times, reference, history, full_point, axes, threshold, floor_rms, dt, quiet, log):
+    """The windows of the search with their least-squares points, accepted from the shortest up (block comment).
+
+    The base window is the reference before it first reaches ``PEAK_FRACTION`` of its peak (``quiet`` samples;
+    else the search's first window), fitted from every point the search found: its residual variance (with
+    the floor) and its residuals' autocorrelation time are the noise every window is tested against
+    (``_explained``). Gauss-Newton starts from the best of the search's points on this window and the next two
+    (the search's estimate sharpens as its windows grow) and the previous accepted window's least-squares
+    point. A window the noise does not explain is left out. When the longer windows are not explained, the
+    first of them is scanned over the whole search range (``_scan``) and they are fitted again from every
+    basin that fits it better (at most ``RESCANS`` times): the search may have tracked the wrong one.
+
+    Returns
+    -------
+    (list of _Window, dict)
+        The windows, and the scans {samples: _Scan} of the windows scanned.
+    """
+    starts = dict(history)
+    starts[times.size] = full_point
+    ends = sorted(starts)
+    if MIN_BASE_SAMPLES <= quiet < ends[0]:
+        ends = [quiet] + ends
+        starts[quiet] = starts[ends[1]]
+    fitted, scans = {}, {}
+    # the base from every point the search found (its later ones are the best informed, even on the quiet start)
+    base = _window_fit(search, times, reference, ends[0], [starts[m] for m in ends], axes, threshold,
+                       ends[0] * floor_rms**2, dt)
+    base.accepted = True
+    fitted[ends[0]] = previous = base
+    extra_starts = []
+    for attempt in range(RESCANS + 1):
+        for position, n in enumerate(ends):
+            if n <= previous.n:
+                continue
+            candidates = [starts[m] for m in ends[position:position + 3]] + [previous.point] + extra_starts
+            window = _window_fit(search, times, reference, n, candidates, axes, threshold, n * floor_rms**2, dt)
+            window.accepted, window.reason = _explained(base, previous, window)
+            if n not in fitted or window.accepted or window.rss < fitted[n].rss:
+                fitted[n] = window
+            if window.accepted:
+                previous = window
+        if previous.n == ends[-1] or attempt == RESCANS:
+            break
+        # the longer windows are not explained from the basin tracked: scan the first of them for other basins
+        failed = min(n for n in ends if n > previous.n)
+        if failed in scans:
+            break
+        scan = scans[failed] = _scan(search, times, reference, failed, failed * floor_rms**2, dt, axes)
+        others = [point for point, value in sorted(zip(scan.points, scan.rss), key=lambda pair: pair[1])
+                  if value < fitted[failed].rss and np.max(np.abs(point - fitted[failed].point)) > SAME_BASIN]
+        if not others:
+            break
+        extra_starts = others
+    windows = [fitted[n] for n in sorted(fitted)]
+    if log:
+        last = [w for w in windows if w.accepted][-1]
+        log(f"windows: the fits explain the reference at the noise level up to {last.end:.2f} s "
+            f"({sum(w.accepted for w in windows)} of {len(windows)} windows; {len(scans)} scan(s))")
+    return windows, scans
+
+
+def _scan(search, times, reference, n, floor, dt, axes):
+    """The basins of the window of n samples over the whole search range, each polished by Gauss-Newton.
+
+    A dense grid (``SCAN_K`` log-spaced k times ``SCAN_XI`` xi) in compiled batches; its local minima (best
+    first, at most ``SCAN_BASINS``) are the basins. Returns (points in the unit box, least RSS of each).
+    """
+    u = np.linspace(0.0, 1.0, SCAN_K)
+    v = np.linspace(0.0, 1.0, SCAN_XI) if len(axes) == 2 else np.array([0.0])  # a fixed xi is v = 0
+    grid = np.array([(a, b) for a in u for b in v])
+    likelihood = _Likelihood(search, times[:n], reference[:n], float(times[n - 1]) + dt, floor=floor)
+    _, rss = likelihood.residuals(grid)
+    seeds = _grid_basins(rss, u.size, v.size, grid, SCAN_BASINS)
+    threshold = 2.706
+    points, values = [], []
+    for seed in seeds:
+        window = _window_fit(search, times, reference, n, [seed], axes, threshold, floor, dt)
+        if all(np.max(np.abs(window.point - p)) > SAME_BASIN for p in points):
+            points.append(window.point)
+            values.append(window.rss)
+    return _Scan(np.array(points), np.array(values), grid, rss)
+
+
+@dataclass
+class _Scan:
+    """A window's scan: its basins (points in the unit box, least RSS) and the grid's points and RSS."""
+
+    points: np.ndarray
+    rss: np.ndarray
+    grid: np.ndarray
+    grid_rss: np.ndarray
+
+    def region(self, best: float, variance: float, level: float) -> np.ndarray:
+        """Basins and grid points whose deviance against RSS ``best`` is within ``level``."""
+        points = np.concatenate([self.points.reshape(-1, 2), self.grid])
+        rss = np.concatenate([self.rss, self.grid_rss])
+        return points[(rss - best) / variance <= level]
+
+
+MIN_BASE_SAMPLES = 20  # a quiet start shorter than this is no base: the search's first window is
+REFINEMENTS = 5  # windows bisecting the gap past the decisive one
+SECOND_TRIES = 3  # shorter accepted windows profiled for the second regular one (the union of the intervals)
+LINEAR_PROFILES = 6  # irregular windows profiled one by one down the list before bisection takes over
+RESCANS = 2  # scans of the last accepted window for other basins when the longer windows are not explained
+SCAN_K, SCAN_XI = 121, 21  # the scan's grid: k log-spaced (1.8 % apart over 1e8-9e8 N/m) times xi
+SCAN_BASINS = 8  # local minima of the scan polished by Gauss-Newton
+SAME_BASIN = 0.01  # points closer than this in both coordinates of the unit box are one basin
+
+
+def _decide(search, times, reference, history, full_point, fixed_xi, confidence, floor_rms, quiet, log):
+    """The decisive window, its estimate and intervals, or "not identifiable" with the range of fits (block comment).
+
+    Returns
+    -------
+    dict
+        ``point`` (the estimate, unit box), ``end`` [s] of the decisive window (None when no window's likelihood
+        is regular), ``identifiable``, ``range_points`` (fits that explain the decisive window as well as the
+        estimate), the interval fields of ``_profile_intervals`` and ``notes``, and ``windows`` (end [s],
+        k [N/m], xi [-], accepted, regular, reason per window fitted).
+    """
+    from scipy.stats import chi2
+
+    threshold = float(chi2.ppf(confidence, 1))
+    axes = (0,) if fixed_xi else (0, 1)
+    dt = search.dt
+    windows, scans = _window_walk(search, times, reference, history, full_point, axes, threshold, floor_rms, dt,
+                                  quiet, log)
+    accepted = [w for w in windows if w.accepted]
+    base = accepted[0]
+    variance = base.rss / base.n * base.tau
+
+    def profile_of(window):
+        return _profile_intervals(search, times[:window.n], reference[:window.n], window.point, fixed_xi,
+                                  confidence, window.end + dt, floor_rms)
+
+    # the longest accepted window whose profiles are regular: the longest first, then down the list (a window is
+    # regular up to where the response turns chaotic at the interval's scale, mostly); after ``LINEAR_PROFILES``
+    # irregular ones, by bisection of the rest
+    chosen, profile, irregular, profiles = None, None, {}, {}
+    low, high = 0, len(accepted) - 1
+    while low <= high:
+        middle = high if len(profiles) < LINEAR_PROFILES else (low + high + 1) // 2
+        result = profiles[accepted[middle].n] = profile_of(accepted[middle])
+        if result["irregular"] is None:
+            chosen, profile, low = accepted[middle], result, middle + 1
+        else:
+            irregular[accepted[middle].n] = result["irregular"]
+            high = middle - 1
+    # the search's windows end after large peaks and may leave a long gap past the decisive one: bisect it in
+    # time (at most ``REFINEMENTS`` windows, each fitted from the decisive fit, tested and profiled)
+    following = [w for w in windows if chosen is not None and w.n > chosen.n]
+    limit = following[0].n if following else None
+    for _ in range(REFINEMENTS if chosen is not None else 0):
+        if limit is None or limit - chosen.n < 2 * MIN_BASE_SAMPLES:
+            break
+        n = (chosen.n + limit) // 2
+        window = _window_fit(search, times, reference, n, [chosen.point] + [w.point for w in following[:1]], axes,
+                             threshold, n * floor_rms**2, dt)
+        window.accepted, window.reason = _explained(base, chosen, window)
+        windows.append(window)
+        if window.accepted:
+            accepted.append(window)
+            result = profiles[n] = profile_of(window)
+            if result["irregular"] is None:
+                chosen, profile = window, result
+                continue
+            irregular[n] = result["irregular"]
+        limit = n
+    windows.sort(key=lambda w: w.n)
+    accepted.sort(key=lambda w: w.n)
+
+    def table():
+        return [{"end": w.end, "k": search.physical(w.point)[0], "xi": search.physical(w.point)[1],
+                 "accepted": w.accepted, "regular": (w is chosen) if (w is chosen or w.n in irregular) else None,
+                 "reason": w.reason or irregular.get(w.n, "")} for w in windows]
+
+    def scan_of(window):
+        if window.n not in scans:
+            scans[window.n] = _scan(search, times, reference, window.n, window.n * floor_rms**2, dt, axes)
+        return scans[window.n]
+
+    def region_of(window, best=None):
+        """The fits that explain ``window`` as well as its best (chi^2_2 at the confidence): its scan's."""
+        scan = scan_of(window)
+        best = min(window.rss, float(np.min(scan.rss)) if scan.rss.size else math.inf) if best is None else best
+        return scan.region(best, window.rss / window.n * window.tau, chi2.ppf(confidence, len(axes)))
+
+    if chosen is None:
+        # no window's likelihood is regular at its interval's scale: the fits that explain the shortest accepted
+        # window as well as its best are the range
+        profile = profiles[min(profiles)]  # the shortest profiled window's
+        out = {key: value for key, value in profile.items() if key.startswith("profile_") or key in (
+            "noise_rms", "autocorrelation_time")}
+        # the fits found do not locate the truth: where the response is chaotic from the start of the rocking,
+        # the parameters that reproduce it form needles no search finds, anywhere in the range
+        out.update(point=accepted[-1].point, end=None, identifiable=False, windows=table(),
+                   range_points=np.array([[0.0, 0.0], [1.0, 1.0]]),
+                   notes=[f"no window's likelihood is regular at the interval's scale ({profile['irregular']}): "
+                          "the fits found do not locate k and xi; the range is the search range"])
+        return out
+
+    notes, identifiable = list(profile["notes"]), True
+    point = np.array(profile["point"], float)
+    window_rss = float(_Likelihood(search, times[:chosen.n], reference[:chosen.n], chosen.end + dt,
+                                   chosen.n * floor_rms**2).residuals([point])[1][0])
+    # the whole search range on the decisive window: other basins that explain it as well
+    scan = scan_of(chosen)
+    best = min(window_rss, float(np.min(scan.rss))) if scan.rss.size else window_rss
+    if window_rss - best > RESTART_DEVIANCE * variance:
+        # a better basin than the tracked one: it decides (its profile, if regular)
+        better = _Window(chosen.n, chosen.end, scan.points[int(np.argmin(scan.rss))], best, chosen.tau,
+                         chosen.residual)
+        result = profile_of(better)
+        if result["irregular"] is None:
+            profile, point, window_rss = result, np.array(result["point"], float), best
+            notes = list(profile["notes"]) + [f"the scan of 0-{chosen.end:.2f} s found a better basin than the "
+                                              "search's"]
+    # the limits of the profile deviance from a parametric bootstrap of the window (chi^2_1 where it is quadratic)
+    steps = np.array([max((_unit(search, axis, profile[f"{name}_high"]) - _unit(search, axis, profile[f"{name}_low"]))
+                          / 8.0, RESOLUTION) if profile.get(f"{name}_low") is not None else FIRST_STEP
+                      for axis, name in ((0, "k"), (1, "xi"))])
+    limits = _bootstrap_limits(search, times, reference, chosen.n, point, steps, fixed_xi, confidence, floor_rms, dt)
+    if any(limit > threshold * (1 + 1e-9) for limit in limits.values()):
+        bounded = _profile_intervals(search, times[:chosen.n], reference[:chosen.n], point, fixed_xi, confidence,
+                                     chosen.end + dt, floor_rms, limits)
+        profile = dict(bounded, irregular=profile["irregular"])
+        notes = [note for note in notes if note not in profile["notes"]] + list(profile["notes"])
+    profile["limits"] = limits
+    if log:
+        log(f"bootstrap of 0-{chosen.end:.2f} s ({BOOTSTRAP} replicates): profile deviance limits "
+            + ", ".join(f"{('k', 'xi')[axis]} {limit:.3g}" for axis, limit in limits.items())
+            + f" (chi2_1 {threshold:.3g})")
+    region = [p for p, value in zip(scan.points, scan.rss) if (value - best) / variance <= threshold
+              and np.max(np.abs(p - point)) > SAME_BASIN]
+    box = np.array([[_unit(search, axis, profile[f"{name}_low"]), _unit(search, axis, profile[f"{name}_high"])]
+                    if profile.get(f"{name}_low") is not None else [0.0, 1.0] for axis, name in ((0, "k"), (1, "xi"))])
+    width = np.maximum(box[:, 1] - box[:, 0], 1e-9)
+    far = [p for p in region if np.any((p < box[:, 0] - width) | (p > box[:, 1] + width))]
+    range_points = [point] + region
+    if far:
+        identifiable = False
+        k_values = [search.physical(p)[0] for p in far]
+        notes.append(f"{len(far)} other basin(s) of the search range fit 0-{chosen.end:.2f} s as well as the "
+                     f"estimate (k {min(k_values):.4g} to {max(k_values):.4g} N/m): the range holds every fit that "
+                     "explains it as well")
+        range_points += list(region_of(chosen, best))
+    elif region:
+        notes.append(f"the intervals are widened to {len(region)} fit(s) near them that explain 0-{chosen.end:.2f} s "
+                     "as well (the surface is not quadratic at this scale)")
+    # the next shorter regular window: near the chaotic horizon the likelihood splits into narrow basins that
+    # fit equally well (the longest window's may not be the truth's); a shorter window's, before the split, is
+    # wider and holds them. The interval is the union of both; intervals that do not meet disagree.
+    index = accepted.index(chosen)
+    for earlier in reversed(accepted[max(0, index - SECOND_TRIES):index]):
+        second = profiles.get(earlier.n) or profile_of(earlier)
+        if second["irregular"] is not None:
+            continue
+        meet = all(second[f"{name}_low"] is None or (second[f"{name}_low"] <= profile[f"{name}_high"] and
+                                                       profile[f"{name}_low"] <= second[f"{name}_high"])
+                   for name in ("k", "xi"))
+        for name in ("k", "xi"):
+            if second.get(f"{name}_low") is not None:
+                profile[f"{name}_low"] = min(profile[f"{name}_low"], second[f"{name}_low"])
+                profile[f"{name}_high"] = max(profile[f"{name}_high"], second[f"{name}_high"])
+        notes.append(f"the intervals are the union of those of 0-{chosen.end:.2f} s and 0-{earlier.end:.2f} s (the "
+                     "next shorter window whose likelihood is regular)")
+        if not meet:
+            identifiable = False
+            notes.append(f"the windows disagree: the intervals of 0-{chosen.end:.2f} s and 0-{earlier.end:.2f} s do "
+                         "not meet")
+        break
+    # the decisive fit must explain the shorter accepted windows too (nested data: a fit outside their regions
+    # means the windows disagree beyond their intervals)
+    for window in accepted:
+        if window.n >= chosen.n:
+            break
+        value = float(_Likelihood(search, times[:window.n], reference[:window.n], window.end + dt,
+                                  window.n * floor_rms**2).residuals([point])[1][0])
+        deviance = (value - window.rss) / (window.rss / window.n * window.tau)
+        if deviance > chi2.ppf(AGREEMENT, len(axes)):
+            identifiable = False
+            notes.append(f"the windows disagree: the fit of 0-{chosen.end:.2f} s lies outside the likelihood region "
+                         f"of 0-{window.end:.2f} s (deviance {deviance:.3g}); the range holds every fit that explains "
+                         f"0-{window.end:.2f} s as well as its best")
+            range_points += list(region_of(window))
+            break
+    return dict(profile, end=chosen.end, identifiable=identifiable, windows=table(), notes=notes, point=point,
+                range_points=np.array(range_points))
+
+
+def _bootstrap_limits(search, times, reference, n, point, steps, fixed_xi, confidence, floor_rms, dt):
+    """The profile deviances that bound the intervals, per axis: parametric bootstrap of the decisive window.
+
+    The window's fit plus ``BOOTSTRAP`` noise series (AR(1) with the lag-1 autocorrelation and the variance of
+    the fit's residuals; seeded) are refitted by batched Gauss-Newton from the fit, in all coordinates and with
+    each coordinate held at its true (the fit's) value; the ``confidence`` quantile of each profile deviance
+    n/tau ln(RSS_held / RSS_free) is its limit (at least chi^2_1). Where the likelihood is quadratic and the
+    noise AR(1) this is chi^2_1; where the response is barely regular, a fit chases the noise into the
+    response's wiggles and the deviance at the truth is larger, which the limit then carries.
+
+    Returns
+    -------
+    dict
+        {axis: limit} for k (0) and, unless fixed, xi (1).
+    """
+    from scipy.stats import chi2
+
+    axes = (0,) if fixed_xi else (0, 1)
+    floor = n * floor_rms**2
+    t_end = float(times[n - 1]) + dt
+    likelihood = _Likelihood(search, times[:n], reference[:n], t_end, floor=floor)
+    values = likelihood.residuals([point])[0][0]
+    fit = reference[:n] + values
+    residual = -values
+    centred = residual - residual.mean()
+    variance = float(np.mean(centred**2))
+    phi = float(np.clip(np.sum(centred[1:] * centred[:-1]) / max(np.sum(centred**2), 1e-300), 0.0, 0.99))
+    rng = np.random.default_rng(BOOTSTRAP_SEED)
+    shocks = rng.normal(0.0, math.sqrt(variance * (1.0 - phi**2)), (BOOTSTRAP, n))
+    noise = np.empty_like(shocks)
+    noise[:, 0] = rng.normal(0.0, math.sqrt(variance), BOOTSTRAP)
+    for i in range(1, n):
+        noise[:, i] = phi * noise[:, i - 1] + shocks[:, i]
+    data = fit[None, :] + noise
+    start = np.repeat(np.asarray(point, float)[None, :], BOOTSTRAP, axis=0)
+    free, free_rss, free_residual = _batch_gauss_newton(search, times[:n], t_end, data, start, axes, steps, floor,
+                                                        BOOTSTRAP_ITERATIONS)
+    tau = np.array([_floored_tau(r, floor) for r in free_residual])
+    limits = {}
+    for axis in axes:
+        held = [a for a in axes if a != axis]
+        held_rss = (_batch_gauss_newton(search, times[:n], t_end, data, start, tuple(held), steps, floor,
+                                        BOOTSTRAP_ITERATIONS - 1)[1] if held else
+                    np.sum((fit[None, :] - data) ** 2, axis=1) + floor)
+        deviance = n / tau * np.log(np.maximum(held_rss, free_rss) / free_rss)
+        limits[axis] = max(float(chi2.ppf(confidence, 1)), float(np.quantile(deviance, confidence)))
+    return limits
+
+
+def _batch_gauss_newton(search, times, t_end, data, points, axes, steps, floor, iterations):
+    """Gauss-Newton of many replicates at once (replicate b fits ``data[b]``): (points, RSS, residuals).
+
+    Each iteration runs every replicate's finite-difference stencil in one batch and tries the full, half and
+    quarter step; a replicate keeps the best point it has seen.
+    """
+    points = np.array(points, float)
+    count, axes = len(points), list(axes)
+
+    def residuals(batch, rows):
+        chunks = np.array_split(np.clip(batch, 0.0, 1.0), max(1, math.ceil(len(batch) / PROFILE_BATCH)))
+        model = np.concatenate([_interpolate(search.histories(chunk, t_end), search.dt, times) for chunk in chunks])
+        return model - data[rows]
+
+    rows = np.arange(count)
+    values = residuals(points, rows)
+    rss = np.sum(values**2, axis=1) + floor
+    for _ in range(iterations):
+        stencil, shifts = [], []
+        for axis in axes:
+            plus, minus = points.copy(), points.copy()
+            plus[:, axis] = np.minimum(points[:, axis] + steps[axis], 1.0)
+            minus[:, axis] = np.maximum(points[:, axis] - steps[axis], 0.0)
+            stencil += [plus, minus]
+            shifts.append(plus[:, axis] - minus[:, axis])
+        shifted = residuals(np.concatenate(stencil), np.tile(rows, 2 * len(axes)))
+        jacobian = np.stack([(shifted[(2 * i) * count:(2 * i + 1) * count] - shifted[(2 * i + 1) * count:(2 * i + 2) *
+                                                                                     count]) / shift[:, None]
+                             for i, shift in enumerate(shifts)], axis=-1)
+        moves = np.zeros((count, 2))
+        for b in range(count):
+            moves[b, axes] = _gauss_newton_step(values[b], jacobian[b])
+        trials = np.concatenate([np.clip(points + factor * moves, 0.0, 1.0) for factor in (1.0, 0.5, 0.25)])
+        trial_values = residuals(trials, np.tile(rows, 3))
+        trial_rss = np.sum(trial_values**2, axis=1) + floor
+        for factor in range(3):
+            part = slice(factor * count, (factor + 1) * count)
+            better = trial_rss[part] < rss
+            points[better], rss[better] = trials[part][better], trial_rss[part][better]
+            values[better] = trial_values[part][better]
+    return points, rss, values
+
+
+BOOTSTRAP = 40  # replicates of the parametric bootstrap of the decisive window
+BOOTSTRAP_ITERATIONS = 5  # Gauss-Newton iterations per replicate (one fewer with a coordinate held)
+BOOTSTRAP_SEED = 34  # the bootstrap's noise is seeded: the same reference gives the same intervals
+
+
+def _unit(search, axis, value):
+    """A physical k [N/m] (axis 0) or xi [-] (axis 1) in the unit box."""
+    if axis == 0:
+        return (math.log(value) - search.log_k[0]) / (search.log_k[1] - search.log_k[0])
+    low, high = search.xi_range
+    return (value - low) / (high - low) if high > low else 0.0
 
 
 CALIBRATION_OPTIONS = Table({
@@ -980,21 +1615,26 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
 
     steps = np.array([1.0 / (n_k - 1), 1.0 / (n_xi - 1) if n_xi > 1 else 1.0])
     best_point, best_score = grid[grid_best], float(full_scores[grid_best])
-    n_windows = 0
+    history = []
     if local:
-        point, score, n_windows = _continuation(search, objective, grid, grid_on_times, (n_k, n_xi), windows,
-                                                steps, fixed_xi, log)
+        point, score, history = _continuation(search, objective, grid, grid_on_times, (n_k, n_xi), windows,
+                                              steps, fixed_xi, log)
         if score < best_score:
             best_point, best_score = point, score
 
-    k_fit, xi_fit = search.physical(best_point)
+    k_search, xi_search = search.physical(best_point)
     intervals, before = {}, search.count
     if local and confidence is not None:
-        intervals = _profile_intervals(search, times, objective.reference, best_point, fixed_xi, confidence, t_end)
-        intervals.update(confidence=float(confidence), interval_method="profile likelihood",
-                         interval_notes=intervals.pop("notes"), interval_simulations=search.count - before)
+        peak = float(np.max(np.abs(ref_rotation)))
+        decision = _decide(search, times, objective.reference, history, best_point, fixed_xi,
+                           confidence, NOISE_FLOOR * peak,
+                           _quiet_samples(objective.reference, objective.smoothed_reference), log)
+        best_point = decision["point"]
+        intervals = _interval_fields(search, decision, fixed_xi, confidence, peak)
+        intervals["interval_simulations"] = search.count - before
         if log:
-            log(f"intervals: {search.count - before} simulations (profile likelihood, {confidence:.0%})")
+            log(f"intervals: {search.count - before} simulations ({intervals['interval_method']}, {confidence:.0%})")
+    k_fit, xi_fit = search.physical(best_point)
     theta = search.histories([best_point], t_end)
     model_on_reference = _interpolate(theta, dt, ref_time)[0]
     score = correlation(ref_rotation, model_on_reference)
@@ -1011,11 +1651,40 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
         peak_error=(peak_model - peak_reference) / peak_reference, peak_reference=peak_reference,
         peak_model=peak_model, area_over_depth=area_over_depth, soil_shear_modulus=soil_shear_modulus,
         block_modulus=block.E_b, model=model, bed=_bed_of(model, solver_options), objective=best_score,
-        n_simulations=search.count,
-        n_windows=n_windows, seconds=clock.perf_counter() - started,
+        n_simulations=search.count, n_windows=len(history), k_search=float(k_search), xi_search=float(xi_search),
+        seconds=clock.perf_counter() - started,
         surface_k=[search.physical((u, 0))[0] for u in u_grid],
         surface_xi=[search.physical((0, v))[1] for v in v_grid],
         surface=surface.reshape(n_k, n_xi).tolist(), **intervals)
+
+
+def _interval_fields(search, decision, fixed_xi, confidence, peak):
+    """``CalibrationResult`` fields of the intervals from ``_decide``'s decision."""
+    notes = list(decision["notes"])
+    fields = {key: decision.get(key) for key in ("noise_rms", "autocorrelation_time", "profile_k",
+                                                 "profile_k_deviance", "profile_xi", "profile_xi_deviance")}
+    fields = {key: value for key, value in fields.items() if value is not None}
+    noise = fields.get("noise_rms", 0.0)
+    if noise < NOISE_FLOOR * peak:
+        notes.append(f"the reference has almost no noise (residual RMS {noise:.3g} rad, {noise / peak:.2%} of its "
+                     f"peak): the intervals assume {NOISE_FLOOR:.1%} of the peak, {NOISE_FLOOR * peak:.3g} rad, and "
+                     "say how precisely the model reproduces the reference rather than how well k and xi are known")
+    bounds = {}
+    for axis, name in ((0, "k"), (1, "xi")):
+        if axis == 1 and fixed_xi:
+            bounds.update(xi_low=None, xi_high=None)
+            continue
+        values = [search.physical(p)[axis] for p in decision["range_points"]]
+        if decision.get(f"{name}_low") is not None:
+            values += [decision[f"{name}_low"], decision[f"{name}_high"]]
+        bounds[f"{name}_low"], bounds[f"{name}_high"] = float(min(values)), float(max(values))
+    method = "profile likelihood on the decisive window"
+    if not decision["identifiable"]:
+        method = f"{NOT_IDENTIFIABLE}: the range of fits that explain it equally"
+    limits = {("k", "xi")[axis]: float(limit) for axis, limit in decision.get("limits", {}).items()}
+    return dict(fields, **bounds, confidence=float(confidence), interval_method=method, interval_notes=notes,
+                identifiable=bool(decision["identifiable"]), decisive_window=decision["end"],
+                windows=decision["windows"], deviance_limits=limits)
 
 
 def _uniform_times(ref_time, dt):
@@ -1169,7 +1838,7 @@ def _plot_profiles(result: CalibrationResult, path: Path) -> None:
         axis.plot(values, deviance, "k.-", lw=1.0, ms=4, label="profile deviance")
         axis.axhline(threshold, color="C3", lw=0.9, ls="--", label=f"χ²₁ {result.confidence:.0%} = {threshold:.2f}")
         axis.axvspan(low, high, color="C0", alpha=0.15, label=f"{result.confidence:.0%} interval")
-        axis.axvline(fit, color="C3", lw=0.8, label="search's optimum")
+        axis.axvline(fit, color="C3", lw=0.8, label="estimate")
         axis.set_xlabel(xlabel)
         axis.set_ylabel("profile deviance D = n_eff ln(RSS / RSS_min) [-]")
         axis.set_ylim(0, max(3 * threshold, 1.0))

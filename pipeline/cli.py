@@ -413,8 +413,12 @@ def command_calibrate(args) -> int:
     print(f"grid optimum  : k = {result.k_grid:.4g} N/m, xi = {result.xi_grid:.4f}, correlation (eq. 17) "
           f"{result.correlation_grid:.4f}")
     if not args.grid_only:
-        print(f"global optimum: k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation (eq. 17) "
-              f"{result.correlation:.4f} ({result.n_simulations} simulations, {result.seconds:.1f} s)")
+        if result.k_search is not None and (result.k_search, result.xi_search) != (result.k, result.xi):
+            print(f"search optimum: k = {result.k_search:.4g} N/m, xi = {result.xi_search:.4f} (over the whole "
+                  "reference)")
+        window = f", window 0-{result.decisive_window:.2f} s" if result.decisive_window is not None else ""
+        print(f"estimate      : k = {result.k:.4g} N/m, xi = {result.xi:.4f}, correlation (eq. 17) "
+              f"{result.correlation:.4f} ({result.n_simulations} simulations, {result.seconds:.1f} s{window})")
         print("\n".join(result.interval_lines()))
     print(f"RMS error {result.rms_error:.3g} rad; peak angle {result.peak_model:.4g} rad vs reference "
           f"{result.peak_reference:.4g} rad ({result.peak_error:+.1%})")
