@@ -33,7 +33,7 @@ from rockfrag.models import Outcome, get_model, simulate, simulate_batch  # noqa
 from rockfrag.processing import process_record  # noqa: E402
 from rockfrag.records import load_records  # noqa: E402
 from rockfrag.soils import soil_block_stiffness  # noqa: E402
-from rockfrag.study import bed_calibration, solver_options  # noqa: E402
+from rockfrag.study import bed_calibration, model_stiffness, solver_options  # noqa: E402
 from rockfrag.units import STANDARD_GRAVITY  # noqa: E402
 from tests.physics.reference import reference_response  # noqa: E402  (the independent scipy reference)
 
@@ -118,19 +118,20 @@ def per_run_cost(records):
 
 
 def per_run_cost_band(records):
-    """1b with the anchored dissipation: the default study's band variants at their calibrated xi."""
-    print("\n1b'. Per-run cost, one core, anchored dissipation: winkler (two-spring) at the restitution band's")
-    print("     edges and centre, xi calibrated per block and soil (the default study's runs), same records and levels")
+    """1b with the anchored dissipation: the default study's sample members at their calibrated xi."""
+    print("\n1b'. Per-run cost, one core, anchored dissipation: winkler (two-spring), the recommended model's")
+    print("     sample members, xi calibrated per block and soil (the default study's runs), same records and levels")
     config = load_study()
-    stiffness = np.array([[soil_block_stiffness(s, b) for b in config.blocks] for s in config.soils])
+    stiffness = model_stiffness(config)
     calibration = bed_calibration(config, stiffness)
+    stiffness = stiffness[:, :, [config.models.index(v) for v in calibration.variants]]
     options = solver_options(config)
     print(f"   {'model':20} {'block':16}" + "".join(f"{s.name:>22}" for s in config.soils))
     for v, variant in enumerate(calibration.variants):
         for b, block in enumerate(config.blocks):
             cells = []
             for s in range(len(config.soils)):
-                case = [(block, stiffness[s, b], calibration.xi[s, b, v])]
+                case = [(block, stiffness[s, b, v], calibration.xi[s, b, v])]
                 simulate_batch("winkler", records[0].acceleration[:50], records[0].dt, [1.0], case, **options)
                 start = time.perf_counter()
                 runs = steps = 0
@@ -152,13 +153,12 @@ def accuracy_and_chaos(records, anchored=False):
     mark = "'" if anchored else ""
     print(f"\n1c{mark}. Accuracy at the default tolerance (rtol 1e-6) against rtol 1e-10, and how many runs are "
           "chaotic")
-    print("    (winkler, " + ("two-spring bed, xi calibrated to the band centre (the recommended curve's runs)"
+    print("    (winkler, " + ("two-spring bed, xi calibrated to the restitution range's middle (recommended runs)"
                               if anchored else "continuous bed, each soil's xi = 5%") +
           ", default blocks, 4 far-field records at 0.5, 0.9, 1.5, 2.5 x uplift PGA;")
     print("     chaotic: a 1e-7 change of amplitude moves the peak angle by more than 1e-6 at rtol 1e-10)")
     config = load_study()
-    stiffness = np.array([[soil_block_stiffness(s, b) for b in config.blocks] for s in config.soils])
-    calibration = bed_calibration(config, stiffness) if anchored else None
+    calibration = bed_calibration(config, model_stiffness(config)) if anchored else None
     options = solver_options(config) if anchored else {"bed": "continuous"}
     levels = np.array([0.5, 0.9, 1.5, 2.5])
     print(f"   {'soil':8} {'runs':>5} {'chaotic':>8} | error, regular runs: {'median':>8} {'max':>8} | "
@@ -168,7 +168,7 @@ def accuracy_and_chaos(records, anchored=False):
         for b, block in enumerate(config.blocks):
             k = soil_block_stiffness(soil, block)
             xi = soil.damping_ratio if calibration is None else float(
-                calibration.xi[config.soils.index(soil), b, calibration.variants.index("winkler-centre")])
+                calibration.xi[config.soils.index(soil), b, calibration.variants.index("recommended")])
             for record in records[::11]:
                 scales = levels * block.uplift_acceleration() / np.max(np.abs(record.acceleration))
                 window = {"t_end": (record.acceleration.size - 1) * record.dt + 10.0, **options}

@@ -139,7 +139,7 @@ def default_blocks(print=print):
     import time
 
     from rockfrag.config import load_study
-    from rockfrag.models.variants import band_variants, calibrate_models
+    from rockfrag.models.variants import calibrate_models, sample_models
     from rockfrag.soils import soil_block_stiffness
 
     study = load_study()
@@ -155,8 +155,10 @@ def default_blocks(print=print):
         for b, block in enumerate(study.blocks):
             restitution.restitution_grid(block, float(stiffness_table[s, b]), law)
     grids = time.perf_counter() - started
-    calibration = calibrate_models(list(study.blocks), [soil.name for soil in study.soils], stiffness_table,
-                                   band_variants("winkler"), "band", study.restitution_band, study.bed)
+    restitution_runs = sample_models()[:3]  # the centre and the two restitution members (the same K)
+    calibration = calibrate_models(list(study.blocks), [soil.name for soil in study.soils],
+                                   np.repeat(stiffness_table[:, :, None], 3, axis=2), restitution_runs,
+                                   "recommended", study.design, study.bed)
     total = time.perf_counter() - started
     print(f"\n  default study ({study.bed} bed): the xi grids {grids:.2f} s, the whole calibration {total:.2f} s "
           f"(the rule adds {total - grids:.2f} s; one core, load {__import__('os').getloadavg()[0]:.1f})")

@@ -14,8 +14,8 @@ Output: ``answer_table``, a short text table, one row per block and soil, that `
         "no action"); ``verdict_sentence`` says it in words (rockfrag.report draws it).
 
 The answer model is the first of ``ANSWER_MODELS`` the study ran: the ``recommended`` rows (the
-tensionless bed over the experimental restitution band, its model spread in beta) when the fragility
-stage wrote them, else ``winkler``, the admissible tensionless bed. The median is the fragility's own
+central member of the tensionless bed's designed sample, its model dispersion in beta) when the study
+ran them, else ``winkler``, the admissible tensionless bed. The median is the fragility's own
 (the lognormal MLE over the stripes, ``median`` in fragility.nc and fragility.csv). Accelerations are
 shown in g, whatever unit the file states them in; other measures keep their unit.
 """
@@ -38,7 +38,7 @@ from rockfrag.risk import annual_frequency as risk_annual_frequency
 from rockfrag.risk import probability_in_life as risk_probability_in_life
 from rockfrag.units import STANDARD_GRAVITY
 
-ANSWER_MODELS = (RECOMMENDED, "winkler-centre", "winkler", "ssi", "ssi-paper", "housner")
+ANSWER_MODELS = (RECOMMENDED, "winkler", "ssi", "ssi-paper", "housner")
 """Models the answer is given for, in order of preference: the first one the study ran is used."""
 
 DEFAULT_RETURN_PERIODS = (475.0, 975.0, 2475.0)

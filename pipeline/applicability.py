@@ -231,7 +231,7 @@ def applicability_stage(config, output, workers=None, progress=True, log=print,
     loaded = loaded or study_records(config, log)
     records, recipe = loaded.records, loaded.recipe
     sweep = config.applicability  # the study's [applicability] table: one definition for every caller
-    # a restitution band's variants are one model here: the sweep runs each foundation model once, at xi = 0.05
+    # the recommended model's sample members are one model here: the sweep runs each foundation model once, at xi = 0.05
     models = list(dict.fromkeys(get_model(name).name for name in config.models
                                 if not get_model(name).is_rigid_base)) or list(DEFAULT_MODELS)
     models.sort(key=lambda name: get_model(name).can_pull)  # the admissible (tensionless) models first

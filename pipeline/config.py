@@ -37,7 +37,13 @@ from rockfrag.hazard import check_site
 from rockfrag.measures import MEASURES, scaling_measures
 from rockfrag.models import BED_TYPES, MODELS, SWITCH_RULES, get_model
 from rockfrag.models.options import HOUSNER
-from rockfrag.models.variants import DEFAULT_BAND, band_variants
+from rockfrag.models.variants import (
+    DEFAULT_DESIGN,
+    OLD_BAND_NAMES,
+    RECOMMENDED,
+    SampleDesign,
+    sample_models,
+)
 from rockfrag.plausibility import ON_IMPLAUSIBLE, check_study
 from rockfrag.site_amplification import REFERENCE_VS30, SCENARIO, VS30_SIGMA
 from rockfrag.site_hazard import check_site_hazards
@@ -58,9 +64,20 @@ from rockfrag.validation import (
 )
 from rockfrag.validation import shown as _shown
 
-BAND = "band"
-"""``[solver] restitution = "band"``: each bed model runs at the edges and centre of ``restitution_band``
-(rockfrag.models.variants)."""
+SAMPLE = RECOMMENDED
+"""``[solver] restitution = "recommended"``: the bed model runs as the recommended model, its central member
+(``recommended``) and the designed sample over its epistemic parameters (``[uncertainty]``,
+rockfrag.models.variants)."""
+MODEL_QUALITY = ("superior", "good", "fair", "poor")
+"""``[uncertainty] model_quality``: FEMA P-695's rating of the model (rockfrag.fragility.FORM_RATINGS)."""
+
+
+def _removed(new: str):
+    """A schema check that refuses a key the designed sample replaced, naming its replacement."""
+    def refuse(value, field, source):
+        raise ConfigError(field, f"removed: the restitution band gave way to the designed sample; use {new}",
+                          source)
+    return Checked(refuse, f"removed; use {new}")
 
 FRICTION_MODES = ("recommended", "where-it-matters", "all", "none")
 """``[solver] friction``: which housner and winkler cells slide (rockfrag.study.cell_friction)."""
@@ -134,9 +151,13 @@ SCHEMA = Table({
                       "overturn_angle": Number(0.0, math.pi / 2, low_open=True, unit="rad"),
                       "bed": Text(tuple(BED_TYPES)),
                       "restitution": Checked(lambda value, field, source: _restitution(value, field, source),
-                                             f"{BAND!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
-                      "restitution_band": Interval(Number(0.5, 1.5), strict=False),
+                                             f"{SAMPLE!r}, {HOUSNER!r}, \"\" or a number > 0.0 and < 1.0"),
+                      "restitution_band": _removed("[uncertainty] restitution_range"),
                       "friction": Text(FRICTION_MODES)}),
+    "uncertainty": _table({"restitution_range": Interval(Number(0.5, 1.5), strict=False),
+                           "friction_factor": Number(1.0, 3.0, low_open=True),
+                           "stiffness_factor": Number(1.0, 10.0, low_open=True),
+                           "model_quality": Text(MODEL_QUALITY)}),
     "hazard": _table({"file": Checked(lambda value, field, source: _hazard_files(value, field, source),
                                       "a file name, or a table of soil or site class = file name"),
                       "design_life": Number(0.0, 10000.0, low_open=True, unit="years"),
@@ -172,9 +193,13 @@ SCHEMA = Table({
 
 
 def _restitution(value, field, source):
-    """``[solver] restitution``: "band", "housner", "" (the soil's damping ratio) or a number in (0, 1)."""
+    """``[solver] restitution``: "recommended", "housner", "" (the soil's damping ratio) or a number in (0, 1)."""
+    if value == "band":
+        raise ConfigError(field, f"\"band\" was removed: the restitution band gave way to the designed sample; use "
+                          f"{SAMPLE!r} (the recommended model and its sample, set in [uncertainty] "
+                          "restitution_range, friction_factor, stiffness_factor, model_quality)", source)
     if isinstance(value, str):
-        return Text((BAND, HOUSNER, "")).check(value, field, source)
+        return Text((SAMPLE, HOUSNER, "")).check(value, field, source)
     return Number(0.0, 1.0, low_open=True, high_open=True).check(value, field, source)
 
 
@@ -275,11 +300,13 @@ class StudyConfig:
         ssi pivot-switch rule (consistent | continuous) and winkler bed law (two-spring | continuous |
         hunt-crossley).
     restitution : str or float
-        The bed models' restitution target (``[solver] restitution``): "band" (``models`` then holds each bed
-        model's band variants, ``winkler-low``/``-centre``/``-high``), "housner", a number, or "" (no target:
-        the bed's damping ratio is the soil's ``damping_ratio``).
-    restitution_band : (float, float)
-        The band's edges as multiples of Housner's restitution (each capped at 0.99).
+        The bed models' restitution target (``[solver] restitution``): "recommended" (``models`` then holds the
+        bed model's designed sample, ``recommended`` and ``recommended-<member>``), "housner", a number, or ""
+        (no target: the bed's damping ratio is the soil's ``damping_ratio``).
+    design : rockfrag.models.variants.SampleDesign
+        ``[uncertainty]``: the restitution range (multiples of Housner's r), the friction and stiffness factors.
+    model_quality : str
+        ``[uncertainty] model_quality``: FEMA P-695's rating of the model's form (rockfrag.fragility).
     friction : str
         ``[solver] friction``, which housner and winkler cells run with Coulomb friction at the base (each
         soil's ``friction_static``/``friction_kinetic``): "recommended" (every winkler cell, and housner where the
@@ -357,8 +384,9 @@ class StudyConfig:
     applicability: ApplicabilitySettings = ApplicabilitySettings()
     vertical: bool = False  # apply each record's vertical component (and compare with the run without it)
     hazard_site: tuple[float, float] | None = None  # [lon, lat] [degrees]; picks a multi-site file's nearest site
-    restitution: str | float = ""  # bed models' restitution target: "band", "housner", a number, "" (none)
-    restitution_band: tuple[float, float] = DEFAULT_BAND  # edges as multiples of Housner's r
+    restitution: str | float = ""  # bed models' restitution target: "recommended", "housner", a number, "" (none)
+    design: SampleDesign = DEFAULT_DESIGN  # [uncertainty]: the recommended model's sampled ranges
+    model_quality: str = "fair"  # [uncertainty]: FEMA P-695's rating of the model's form
     friction: str = "recommended"  # which cells slide: recommended | where-it-matters | all | none
     reference_vs30: float = REFERENCE_VS30  # Vs30 of the hazard curve's site [m/s]
     vs30_sigma: float = VS30_SIGMA  # standard deviation of ln Vs30 of each soil's site [-]
@@ -661,6 +689,7 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     solver = data.get("solver", {})
     hazard = data.get("hazard", {})
     fragility = data.get("fragility", {})
+    uncertainty = data.get("uncertainty", {})
     measure = intensity.get("measure", "pga")
     component = intensity.get("component", "rotd50")
     if component == "rotd50" and not MEASURES[measure].rotatable:
@@ -670,12 +699,17 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
     custom = {name: _soil(name, spec, source) for name, spec in data.get("soils_custom", {}).items()}
     soils = _select("soils", data.get("soils", list(SOILS)), {**SOILS, **custom}, source)
     soils = _site_vs30(soils, hazard.get("vs30", {}), source)
+    old = [name for name in data.get("models", []) if name in OLD_BAND_NAMES]
+    if old:
+        raise ConfigError("models", f"{old[0]!r} was removed: the restitution band gave way to the designed sample; "
+                          f"list \"winkler\" with [solver] restitution = {SAMPLE!r} (the recommended model, "
+                          f"{RECOMMENDED!r}, and its sample; [uncertainty] sets the ranges)", source)
     models = _select("models", data.get("models", ["housner", "ssi", "winkler"]), {m: m for m in MODELS}, source)
     restitution = solver.get("restitution", "")
     _check_bed_dissipation(data, soils, models, restitution, source)
-    if restitution == BAND:
+    if restitution == SAMPLE:
         models = tuple(variant for name in models
-                       for variant in (band_variants(name) if get_model(name).uses_bed else [name]))
+                       for variant in (sample_models() if get_model(name).uses_bed else [name]))
     library = {name: _block("blocks_custom", name, spec, source)
                for name, spec in data.get("blocks_custom", {}).items()}
     if "blocks" not in data:
@@ -706,7 +740,11 @@ def study_from_dict(data: dict, source="<dict>") -> StudyConfig:
         period_range=_period_range(intensity.get("period_range")),
         soils=soils, blocks=blocks, models=models,
         switch=solver.get("switch", "consistent"), bed=solver.get("bed", "continuous"),
-        restitution=restitution, restitution_band=tuple(solver.get("restitution_band", DEFAULT_BAND)),
+        restitution=restitution, design=SampleDesign(
+            restitution_range=tuple(uncertainty.get("restitution_range", DEFAULT_DESIGN.restitution_range)),
+            friction_factor=float(uncertainty.get("friction_factor", DEFAULT_DESIGN.friction_factor)),
+            stiffness_factor=float(uncertainty.get("stiffness_factor", DEFAULT_DESIGN.stiffness_factor))),
+        model_quality=uncertainty.get("model_quality", "fair"),
         friction=solver.get("friction", "recommended"),
         tail=float(solver.get("tail", 10.0)), overturn_angle=float(solver.get("overturn_angle", math.pi / 2)),
         hazard_file=hazard.get("file", ""), design_life=float(hazard.get("design_life", 50.0)), hazard_site=site,

@@ -15,6 +15,12 @@ Units: one per quantity in the file, as UDUNITS parses it (``rockfrag.measures.f
 acceleration (levels, ``intensity``, ``record_pga``, ``block_uplift_acceleration``, ``record_im`` of an
 acceleration measure) is in multiples of g, written "9.80665 m s-2" (UDUNITS reads "g" as grams);
 velocities in "m s-1"; the rest SI.
+
+The recommended model's designed sample (rockfrag.models.variants): the ``model`` coordinate holds the models
+that answer or serve as references (``housner``, ``ssi``, ``recommended``, the central member); the other
+members of the sample live apart, in a ``member`` dimension: every per-model variable ``X`` of theirs is
+``member_X`` over (..., member) (``members_apart``), and ``member_cube`` puts them back as a cube of their own
+whose ``model`` coordinate is the members' model names (what the fragility stage fits).
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from rockfrag.models import get_model, model_label
 from rockfrag.models.base import Outcome
 from rockfrag.models.fields import FIELDS_BY_NAME, MODE_TIME_FIELDS
 from rockfrag.models.ssi import PAPER_CITATION
+from rockfrag.models.variants import MEMBER_LABELS, member_model, split_variant
 from rockfrag.version import __version__
 
 # Kept for the stages that read outcomes (ida, fragility): the one enum is rockfrag.models.base.Outcome.
@@ -163,7 +170,7 @@ DERIVED_ATTRIBUTES = {
 def build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance, *,
                intensity=None, capacities=None, capacity_stats=None, verticals=None,
                vertical_applied=False, calibration=None, friction=None, partners=None,
-               component_im=None, uplift=None, credible=None) -> xr.Dataset:
+               component_im=None, uplift=None, credible=None, model_stiffness=None) -> xr.Dataset:
     """Assemble the labelled cube.
 
     records : list of Record (metadata); record_im : (n_record, n_block) (or (n_record,)) IM of each
@@ -236,6 +243,10 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
     data_vars["interface_stiffness"] = (("soil", "block"), stiffness,
                                         {"long_name": "interface stiffness k (paper eq. 19)", "units": "N m-1"})
     data_vars.update(_calibration_variables(calibration, model_names, stiffness.shape))
+    if model_stiffness is not None:
+        data_vars["bed_stiffness"] = (("soil", "block", "model"), model_stiffness, {
+            "long_name": "bed stiffness K each model runs (paper eq. 19; a stiffness member's G scaled)",
+            "units": "N m-1"})
     credible_attrs = {}
     if credible is not None:
         cap, reason, beyond = credible
@@ -321,15 +332,58 @@ def build_cube(config, records, record_im, scale_factors, summaries, stiffness, 
                       "tensionless Winkler bed (Psycharis & Jennings 1983; Chopra & Yim 1985)",
         "winkler_bed": config.bed,
         "restitution": str(config.restitution),
-        "restitution_band": json.dumps(list(config.restitution_band)),
+        "restitution_range": json.dumps(list(config.design.restitution_range)),
+        "friction_factor": config.design.friction_factor,
+        "stiffness_factor": config.design.stiffness_factor,
         "vertical": VERTICAL_APPLIED if vertical_applied else VERTICAL_NOT_APPLIED,
         "friction": config.friction,
     }
-    return dataset
+    return members_apart(dataset)
+
+
+def members_apart(dataset: xr.Dataset) -> xr.Dataset:
+    """The cube with the recommended model's sample members (all but the central one) in a ``member`` dimension.
+
+    Every per-model variable ``X`` of the members becomes ``member_X`` over ``member`` instead of ``model``; the
+    ``model`` coordinate keeps the others (``housner``, ``ssi``, ``recommended``). A cube without members is
+    returned as it is.
+    """
+    names = [str(m) for m in dataset.model.values if split_variant(str(m))[1] not in (None, "centre")]
+    if not names:
+        return dataset
+    members = dataset.sel(model=names)
+    out = dataset.drop_sel(model=names)
+    for name, variable in members.data_vars.items():
+        if "model" in variable.dims:
+            out[f"member_{name}"] = variable.drop_vars(["model", "model_label"], errors="ignore").rename(
+                model="member").assign_attrs(long_name=f"sample member: {variable.attrs.get('long_name', name)}")
+    roles = [split_variant(name)[1] for name in names]
+    out = out.assign_coords(
+        member=("member", roles, {"long_name": "member of the recommended model's designed sample (one parameter "
+                                                "at the low or high end of its range, the others central)"}),
+        member_label=("member", [MEMBER_LABELS[role] for role in roles],
+                      {"long_name": "what the member changes from the central member"}))
+    return out
+
+
+def member_cube(cube: xr.Dataset) -> xr.Dataset | None:
+    """The sample members as a cube of their own (``model`` = ``recommended-<member>``); None without members."""
+    if "member" not in cube.dims:
+        return None
+    prefixed = [name for name in cube.data_vars if name.startswith("member_") and "member" in cube[name].dims]
+    plain = [name for name in cube.data_vars if "model" not in cube[name].dims and name not in prefixed]
+    members = cube[plain].drop_vars(["model", "model_label"], errors="ignore").drop_dims("model", errors="ignore")
+    for name in prefixed:
+        variable = cube[name]
+        members[name.removeprefix("member_")] = variable.assign_attrs(
+            long_name=variable.attrs.get("long_name", name).removeprefix("sample member: "))
+    members = members.drop_vars(["member_label"], errors="ignore").rename(member="model")
+    return members.assign_coords(model=[member_model(str(role)) for role in members.model.values])
 
 
 CALIBRATION_VARIABLES = {
-    "restitution_requested": "effective restitution of free rocking asked of the bed (restitution band or target)",
+    "restitution_requested": "effective restitution of free rocking asked of the bed (the sample's restitution "
+                             "range, or the target)",
     "restitution_target": "effective restitution the bed's damping is calibrated to (the requested one, or the "
                           "nearest the bed reaches)",
     "damping_ratio_calibrated": "damping ratio xi of the bed calibrated to the restitution target",

@@ -61,6 +61,7 @@ from rockfrag.cube import (
     OUTCOME_NO_UPLIFT,
     OUTCOME_OVERTURNED,
     OUTCOME_ROCKING,
+    member_cube,
 )
 from rockfrag.damage_states import (
     DAMAGE_STATES,
@@ -95,7 +96,7 @@ from rockfrag.lognormal_fit import (  # noqa: F401
 )
 from rockfrag.measures import MEASURES, convert_units, parse_units, udunits, unit_label
 from rockfrag.models import MODELS
-from rockfrag.models.variants import BAND_ROLES, RECOMMENDED, split_variant
+from rockfrag.models.variants import PARAMETERS, RECOMMENDED, split_variant
 from rockfrag.outputs import write_dataset
 from rockfrag.risk import annual_frequency, probability_in_life, risk_dataset
 from rockfrag.site_hazard import site_hazard_dataset, study_site_hazards
@@ -541,7 +542,7 @@ def overturning_checks(row: RowFit, out: dict, key: tuple, n_resurrected: int, n
 
 def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None, ida: xr.Dataset | None = None,
                       n_bootstrap: int = 100, seed: int = 0, confidence: float = 0.90,
-                      progress: bool = False) -> xr.Dataset:
+                      progress: bool = False, quality: str = "fair") -> xr.Dataset:
     """Fit every soil x block x model x damage state of a cube (the estimators: see the module docstring).
 
     Parameters
@@ -561,6 +562,8 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         Two-sided confidence level of the bounds, in (0, 1).
     progress : bool
         Show a progress bar over the cells.
+    quality : str
+        FEMA P-695's rating of the recommended model's form (``FORM_RATINGS``; ``with_recommended``).
 
     Returns
     -------
@@ -695,7 +698,10 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
                    "outcome_class": ["no_uplift", "rocking", "overturned"],
                    "intensity": (("block", "im_level"), intensity, {
                        "long_name": f"intensity of each level ({measure})", "units": unit})})
-    dataset = with_recommended(xr.Dataset(data_vars, coords=coords))
+    sample = member_cube(cube)  # the recommended model's other members: their medians only (no bootstrap)
+    members = None if sample is None else fragility_dataset(sample, states, n_bootstrap=0, seed=seed,
+                                                            confidence=confidence)
+    dataset = with_recommended(xr.Dataset(data_vars, coords=coords), members, quality)
     warnings = warning_summary(dataset)
     dataset.attrs = {"Conventions": "CF-1.12", "title": "rockfrag lognormal fragility functions",
                      "source": cube.attrs.get("source", ""), "config_hash": cube.attrs.get("config_hash", ""),
@@ -715,96 +721,131 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     return dataset
 
 
-# ---------------------------------------------------------------- the recommended curve
+# ---------------------------------------------------------------- the recommended curve and its model uncertainty
 
-BAND_COMBINATION = (
-    "recommended = the admissible tensionless-bed model over the restitution band (rockfrag.models.variants): "
-    "median and beta_record_to_record are the band centre's fit; beta_model is the spread of the median over "
-    "the band, taken as uniform in ln(median) between the edges' medians: |ln(m_high / m_low)| / (2 sqrt(3)); "
-    "beta = sqrt(beta_record_to_record^2 + beta_model^2) (FEMA P-58's combination of record-to-record and "
-    "modelling dispersions). mixture_gap is the largest difference, over the studied range, between this "
-    "lognormal and the equal-weight mixture of the three variants' curves.")
+FORM_RATINGS = {"superior": 0.10, "good": 0.20, "fair": 0.35, "poor": 0.50}
+"""beta of FEMA P-695's quality rating of a nonlinear model, superior (A) to poor (D): FEMA P-695 (2009)
+Quantification of Building Seismic Performance Factors, Section 5.7 (the model's rating from its accuracy and
+robustness and its representation of the behaviour) and Section 7.3.1 (beta_MDL combined with the others by
+the square root of the sum of squares)."""
+DEFAULT_QUALITY = "fair"
+"""The recommended model's rating (docs/theory/model-uncertainty.md): verified against closed forms and an
+independent reference, calibrated to the experiments' restitution (accuracy medium), but planar and rigid: no
+three-dimensional rocking (wobbling, twisting), no flexible superstructure, no yielding of the bed or the base
+(representation medium): P-695's medium/medium cell is "fair"."""
+MODEL_UNCERTAINTY = (
+    "recommended = the central member of the recommended model's designed sample (rockfrag.models.variants): "
+    "median and beta_record_to_record are its fit. beta_parameters is the spread of the median over the sample: "
+    "each parameter's range (restitution, friction, bed stiffness) read as uniform in ln(median) between its ends' "
+    "medians, sigma_i = |ln(m_high / m_low)| / (2 sqrt 3) (one end missing: twice its distance to the centre), "
+    "beta_parameters = sqrt(sum sigma_i^2). beta_form is FEMA P-695's model-quality rating (Section 5.7; "
+    "superior 0.10, good 0.20, fair 0.35, poor 0.50) for what the sample cannot represent: a planar rigid block, "
+    "no three-dimensional rocking, no flexible superstructure. That rating covers a model's parameters too, so it "
+    "is not added to their sampled spread: beta_model = max(beta_form, beta_parameters) (the rating replaces the "
+    "spread, unless the sample alone shows more). beta = sqrt(beta_record_to_record^2 + beta_model^2) (FEMA P-695 "
+    "Section 7.3.1; FEMA P-58). The references (housner, ssi) carry their fitted beta only (beta_model 0).")
 UNIFORM_SPREAD = 2.0 * np.sqrt(3.0)  # the standard deviation of a uniform variable is its range / (2 sqrt 3)
 
 
-def band_models(models: list[str]) -> dict[str, str] | None:
-    """{role: model name} of the first bed model with all three band variants in ``models``, else None."""
-    by_base = {}
-    for name in models:
-        base, role = split_variant(name)
-        if role is not None:
-            by_base.setdefault(base, {})[role] = name
-    return next((roles for roles in by_base.values() if set(roles) == set(BAND_ROLES)), None)
+def parameter_spread(low: np.ndarray, centre: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """The sigma of ln(median) over one parameter's range, from its ends' medians.
 
-
-def _band_dispersion(low: np.ndarray, centre: np.ndarray, high: np.ndarray) -> np.ndarray:
-    """beta_model from the band's medians: the edges' spread; one edge missing: twice its distance to the centre."""
+    One end missing: twice its distance to the centre; both missing: NaN.
+    """
     with np.errstate(invalid="ignore", divide="ignore"):
         both = np.abs(np.log(high / low)) / UNIFORM_SPREAD
         one = 2.0 * np.abs(np.log(np.where(np.isfinite(low), low, high) / centre)) / UNIFORM_SPREAD
     return np.where(np.isfinite(low) & np.isfinite(high), both, one)
 
 
-def _mixture_gap(dataset: xr.Dataset, band: dict, median, beta) -> np.ndarray:
-    """Max |lognormal(median, beta) - mean of the band's three curves| over each block's studied range."""
-    grid = np.geomspace(dataset.studied_im_min.values, dataset.studied_im_max.values, 200)  # (point, block)
-    x = grid[:, None, :, None]  # (point, soil, block, state)
-    curves = [lognormal_cdf(x, dataset["median"].sel(model=name).values[None],
-                            dataset.beta.sel(model=name).values[None]) for name in band.values()]
-    with np.errstate(invalid="ignore"):
-        gap = np.abs(lognormal_cdf(x, median[None], beta[None]) - np.mean(curves, axis=0))
-    return np.where(np.isfinite(median), np.nanmax(np.where(np.isfinite(gap), gap, -np.inf), axis=0), np.nan)
+def with_recommended(dataset: xr.Dataset, members: xr.Dataset | None = None,
+                     quality: str = DEFAULT_QUALITY) -> xr.Dataset:
+    """Every row with its beta split; the recommended rows with the model uncertainty of the designed sample.
 
+    Every row gains ``beta_record_to_record`` (its fitted beta), ``beta_parameters``, ``beta_form`` and
+    ``beta_model`` (0 on the references). The ``recommended`` rows, given the members' fits, take
+    ``MODEL_UNCERTAINTY``: beta_model = max(beta_form, beta_parameters) and beta = sqrt(beta_rtr^2 + beta_model^2);
+    the dataset gains ``member_median`` (member, soil, block, damage_state), ``median_sensitivity`` (parameter,
+    soil, block, damage_state: each parameter's sigma of ln median) and ``sensitivity_leading_parameter``.
 
-def with_recommended(dataset: xr.Dataset) -> xr.Dataset:
-    """The fits with the recommended rows first (model ``recommended``) and the beta split on every row.
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The fits over (soil, block, model, damage_state).
+    members : xarray.Dataset, optional
+        The members' fits (``model`` = ``recommended-<member>``); None: no sample (beta_model 0 everywhere).
+    quality : str
+        FEMA P-695's rating of the model's form (``FORM_RATINGS``).
 
-    Every row gains ``beta_record_to_record`` and ``beta_model`` (for a single model: its fitted beta and 0);
-    with a restitution band the recommended rows combine its three variants (``BAND_COMBINATION``). Without a
-    band the dataset only gains the two columns.
+    Returns
+    -------
+    xarray.Dataset
+        ``dataset`` with the beta parts.
     """
+    zero = xr.zeros_like(dataset.beta).where(np.isfinite(dataset.beta))
     dataset = dataset.assign(
         beta_record_to_record=dataset.beta.assign_attrs(
             long_name="record-to-record dispersion: the fitted lognormal beta"),
-        beta_model=xr.zeros_like(dataset.beta).where(np.isfinite(dataset.beta)).assign_attrs(
-            long_name="model dispersion over the restitution band (0: a single model)", units="1"))
-    band = band_models([str(m) for m in dataset.model.values])
-    if band is None:
+        beta_parameters=zero.assign_attrs(long_name="dispersion of the median over the designed sample of the "
+                                                    "recommended model's parameters (0: not sampled)", units="1"),
+        beta_form=zero.assign_attrs(long_name="model-form dispersion: FEMA P-695 model-quality rating (0: not "
+                                              "rated, a reference)", units="1"),
+        beta_model=zero.assign_attrs(long_name="model dispersion: max(beta_form, beta_parameters), the rating "
+                                               "replaces the sampled spread (0: a reference)", units="1"))
+    names = [str(m) for m in dataset.model.values]
+    if members is None or RECOMMENDED not in names:
         return dataset
-    per_model = [name for name in dataset.data_vars if "model" in dataset[name].dims]
-    centre = dataset[per_model].sel(model=band["centre"])
-    medians = {role: dataset["median"].sel(model=name).values for role, name in band.items()}
-    beta_model = _band_dispersion(medians["low"], medians["centre"], medians["high"])
-    beta_model = np.where(np.isfinite(medians["centre"]), beta_model, np.nan)
-    beta_rtr = centre.beta.values
-    known = np.isfinite(beta_model)
-    beta = np.where(known, np.sqrt(beta_rtr ** 2 + np.where(known, beta_model, 0.0) ** 2), beta_rtr)
-    warning = np.where(np.isfinite(medians["centre"]) & ~known,
-                       "neither edge of the restitution band reached the state in the studied range: beta_model "
-                       "unknown, beta is the record-to-record part only", "")
-    row = centre.copy()
-    row["beta"] = (centre.beta.dims, beta, dataset.beta.attrs)
-    row["beta_record_to_record"] = (centre.beta.dims, beta_rtr, dataset.beta_record_to_record.attrs)
-    row["beta_model"] = (centre.beta.dims, beta_model, dataset.beta_model.attrs)
-    for name in ("beta_low", "beta_high"):  # the bootstrap bounds are of a single model's beta
-        row[name] = row[name].where(False)
-    row["fit_method"] = row.fit_method.where(~np.isfinite(centre["median"]), "band-centre-p58")
-    row["fit_warning"] = (centre.fit_warning.dims, np.array(
-        ["; ".join(part for part in (str(a), str(b)) if part) for a, b in
-         zip(centre.fit_warning.values.ravel(), warning.ravel())]).reshape(warning.shape))
-    row = row.expand_dims(model=[RECOMMENDED])
-    if "model_label" in dataset.coords:
-        row = row.assign_coords(model_label=("model", ["recommended: tensionless bed over the restitution band"]))
-    combined = xr.concat([row, dataset[per_model]], dim="model", data_vars="all", coords="minimal",
-                         compat="override", join="override")
-    combined = combined.merge(dataset.drop_vars(per_model).drop_dims("model", errors="ignore"), compat="override")
-    gap = np.full(combined.beta.shape, np.nan)
-    gap[0] = _mixture_gap(dataset, band, medians["centre"], beta)
-    combined["mixture_gap"] = (combined.beta.dims, gap, {
-        "long_name": "recommended rows: largest |P(lognormal) - P(mixture of the band's three curves)| over the "
-                     "studied range", "units": "1"})
-    combined.attrs["recommended"] = BAND_COMBINATION
-    return combined
+    centre = dataset["median"].sel(model=RECOMMENDED).transpose("soil", "block", "damage_state").values
+    member_median = members["median"].transpose("model", "soil", "block", "damage_state")
+    roles = [split_variant(str(m))[1] for m in member_median.model.values]
+    median_of = dict(zip(roles, member_median.values))
+    nan = np.full_like(centre, np.nan)
+    spreads = np.stack([np.where(np.isfinite(centre), parameter_spread(
+        median_of.get(f"{p}_low", nan), centre, median_of.get(f"{p}_high", nan)), np.nan) for p in PARAMETERS])
+    known = np.isfinite(spreads)
+    beta_parameters = np.where(np.isfinite(centre), np.sqrt((np.where(known, spreads, 0.0) ** 2).sum(0)), np.nan)
+    beta_form = np.where(np.isfinite(centre), FORM_RATINGS[quality], np.nan)
+    beta_model = np.fmax(beta_form, beta_parameters)
+    beta_rtr = dataset.beta.sel(model=RECOMMENDED).transpose("soil", "block", "damage_state").values
+    beta = np.where(np.isfinite(beta_rtr) & np.isfinite(beta_model), np.hypot(beta_rtr, beta_model), beta_rtr)
+    unknown = np.isfinite(centre) & ~known.all(0)
+    note = np.where(unknown, "a sample member did not reach the state in the studied range: its parameter's "
+                    "spread is left out of beta_parameters", "")
+    m = names.index(RECOMMENDED)
+    for name, values in (("beta", beta), ("beta_parameters", beta_parameters), ("beta_form", beta_form),
+                         ("beta_model", beta_model)):
+        variable = dataset[name].transpose("soil", "block", "model", "damage_state")
+        data = variable.values.copy()
+        data[:, :, m] = values
+        dataset[name] = variable.copy(data=data)
+    warning = dataset.fit_warning.transpose("soil", "block", "model", "damage_state")
+    text = warning.values.astype(object)
+    text[:, :, m] = np.array(["; ".join(part for part in (str(a), str(b)) if part)
+                              for a, b in zip(text[:, :, m].ravel(), note.ravel())], dtype=object).reshape(note.shape)
+    dataset["fit_warning"] = warning.copy(data=text.astype(str))
+    for name in ("beta_low", "beta_high"):  # the bootstrap bounds are of the record-to-record beta alone
+        if name in dataset:
+            dataset[name].attrs["long_name"] += " (record-to-record part; the recommended rows' beta adds beta_model)"
+    dims = ("soil", "block", "damage_state")
+    dataset["member_median"] = (("member", *dims), member_median.values, {
+        "long_name": "median of each member of the recommended model's designed sample",
+        "units": dataset["median"].attrs.get("units", "")})
+    dataset = dataset.assign_coords(member=("member", roles, {
+        "long_name": "member of the recommended model's designed sample (one parameter at an end of its range)"}))
+    dataset["median_sensitivity"] = (("parameter", *dims), spreads, {
+        "long_name": "sensitivity of the recommended median to each sampled parameter: sigma of ln(median) over "
+                     "its range, |ln(m_high / m_low)| / (2 sqrt 3) (NaN: not reached)", "units": "1"})
+    dataset = dataset.assign_coords(parameter=("parameter", list(PARAMETERS), {
+        "long_name": "sampled epistemic parameter of the recommended model"}))
+    moves = np.where(known, spreads, 0.0).max(0) > 0  # no member moved the median: no parameter leads
+    leading = np.where(moves & np.isfinite(centre),
+                       np.array(PARAMETERS, dtype=object)[np.argmax(np.where(known, spreads, -1.0), axis=0)], "")
+    dataset["sensitivity_leading_parameter"] = (dims, leading.astype(str), {
+        "long_name": "the sampled parameter that moves the recommended median most (empty: no median, or no "
+                     "member moved it)"})
+    dataset.attrs["recommended"] = MODEL_UNCERTAINTY
+    dataset.attrs["model_quality"] = f"{quality} (FEMA P-695 Section 5.7: beta_form = {FORM_RATINGS[quality]:g})"
+    return dataset
 
 
 def warning_summary(dataset: xr.Dataset) -> list[str]:
@@ -869,8 +910,8 @@ def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
     return stacked.transpose("outcome_class", "im_level", "soil", "block", "model")
 
 
-TABLE_COLUMNS = ["median", "beta", "beta_record_to_record", "beta_model", "status", "extrapolated", "fit_method",
-                 "median_low", "median_high", "beta_low",
+TABLE_COLUMNS = ["median", "beta", "beta_record_to_record", "beta_parameters", "beta_form", "beta_model", "status",
+                 "extrapolated", "fit_method", "median_low", "median_high", "beta_low",
                  "beta_high", "gof_p_value", "gof_max_error", "noncrossing_deviance_cost", "capacity_median",
                  "capacity_beta", "probability_at_cap", "probability_at_cap_low", "probability_at_cap_high",
                  "step_position", "step_method", "fit_warning"]
@@ -972,7 +1013,7 @@ def capped_risk(fragility: xr.Dataset, risk: xr.Dataset, hazard_of, design_life:
 
 TEXT_LABELS = {
     "model": "rocking model whose runs the row fits (housner: rigid base; ssi: the paper's spring-dashpot "
-             "foundation; recommended: the tensionless bed the answer uses)",
+             "foundation; recommended: the tensionless bed the answer uses, the central member of its sample)",
     "model_label": "the model's name in words",
     "damage_state": "damage state (rockfrag.damage_states: its measure and threshold)",
     "damage_state_description": "what the damage state means, in words",
@@ -1033,7 +1074,7 @@ def fragility_stage(cube: xr.Dataset, ida: xr.Dataset, config: StudyConfig, outp
     hazard = study_site_hazards(config)  # each soil's site curve
     states = damage_states_from_config(config.raw)
     dataset = fragility_dataset(cube, states=states, ida=ida, n_bootstrap=config.bootstrap, seed=config.seed,
-                                confidence=config.confidence, progress=progress)
+                                confidence=config.confidence, progress=progress, quality=config.model_quality)
     for line in json.loads(dataset.attrs["fit_warnings"]):
         log(f"fragility note: {line}")
     # each soil's risk stops at its block's credible cap and adds the cap's exceedance as a bound (capped_risk)

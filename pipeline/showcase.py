@@ -27,7 +27,7 @@ import xarray as xr
 from rockfrag.errors import ConfigError, PipelineError
 from rockfrag.measures import intensity_measures, response_spectrum, significant_window
 from rockfrag.models import get_model, simulate
-from rockfrag.models.variants import calibrate_models
+from rockfrag.models.variants import calibrate_models, split_variant
 from rockfrag.outputs import write_dataset
 from rockfrag.processing import integrate, process_record
 from rockfrag.records import load_records
@@ -116,12 +116,15 @@ def ground_motion_variables(raw, processed) -> dict:
 def response_cases(config, block):
     """(model name, soil or None, friction) for every case of the showcase, as the study runs its cells.
 
-    A rigid-base model runs once (soil None) while its base is tied on every soil; where base friction lets it
-    slide on some soil (``study.cell_friction``) it runs once per soil, as the study does. friction is the
+    The recommended model runs its central member only. A rigid-base model runs once (soil None) while its base is
+    tied on every soil; where base friction lets it slide on some soil (``study.cell_friction``) it runs once per
+    soil, as the study does. friction is the
     base's (mu_s, mu_k) [-] or None (tied).
     """
     cases = []
     for name in config.models:
+        if split_variant(name)[1] not in (None, "centre"):
+            continue  # the recommended model's sample members: the showcase draws its central run
         slides = [cell_friction(block, soil, name, config.friction) for soil in config.soils]
         if is_rigid_base(get_model(name)) and not any(slides):
             cases.append((name, None, None))
@@ -141,8 +144,8 @@ def simulate_cases(config, block, record):
         if not rigid:
             options.update(k=soil_block_stiffness(soil, block), xi=soil.damping_ratio)
         if not rigid and config.calibrates_bed and get_model(name).uses_bed:  # as the study runs it
-            calibration = calibrate_models([block], [soil.name], np.array([[options["k"]]]), [name],
-                                           config.restitution, config.restitution_band, config.bed)
+            calibration = calibrate_models([block], [soil.name], np.array([[[options["k"]]]]), [name],
+                                           config.restitution, config.design, config.bed)
             options.update(xi=float(calibration.xi[0, 0, 0]), bed=calibration.law)
         else:
             options["bed"] = config.bed
@@ -227,7 +230,7 @@ def input_hash(config, records, recipe) -> str:
                "soils": [repr(s) for s in config.soils], "blocks": [repr(b) for b in config.blocks],
                "showcase": [settings.get("showcase_record", ""), settings.get("showcase_block", "")],
                "solver": [config.switch, config.tail, config.overturn_angle, config.bed, str(config.restitution),
-                          list(config.restitution_band), config.friction]}
+                          repr(config.design), config.friction]}
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 

@@ -60,7 +60,14 @@ from rockfrag.measures import MEASURES, pga
 from rockfrag.models import DEFAULT_ATOL, DEFAULT_RTOL, calibrated_law, get_model, simulate_batch
 from rockfrag.models.base import Outcome
 from rockfrag.models.fields import SUMMARY_DTYPE, new_summaries
-from rockfrag.models.variants import BandCalibration, calibrate_models, split_variant
+from rockfrag.models.variants import (
+    DEFAULT_DESIGN,
+    SampleCalibration,
+    calibrate_models,
+    member_friction,
+    member_stiffness,
+    split_variant,
+)
 from rockfrag.outputs import write_dataset
 from rockfrag.processing import ProcessingRecipe, load_recipe, process_records
 from rockfrag.records import Record, group_components, load_records, split_vertical
@@ -84,7 +91,7 @@ class Cell:
     friction: tuple[float, float] | None = None
 
 
-def cell_friction(block, soil, model: str, mode: str) -> tuple[float, float] | None:
+def cell_friction(block, soil, model: str, mode: str, design=None) -> tuple[float, float] | None:
     """Whether, and with which (mu_s, mu_k) [-], a (block, soil, model) cell slides; None: the base is tied.
 
     Parameters
@@ -100,18 +107,28 @@ def cell_friction(block, soil, model: str, mode: str) -> tuple[float, float] | N
         rigid base (a reference) where it matters; "where-it-matters" slides where the soil's mu_s < b/h (below
         it a block at rest slides before it can rock: Shenton 1996), "all" slides every cell of a model that
         slides, "none" none.
+    design : rockfrag.models.variants.SampleDesign or None
+        The study's sample design: a friction member of the recommended model runs the soil's friction times or
+        divided by its factor (``variants.member_friction``). None: the default design.
 
     Returns
     -------
     (float, float) or None
-        The soil's (mu_s, mu_k), or None.
+        The soil's (mu_s, mu_k) (a friction member's own), or None.
     """
     if soil is None or mode == "none" or not get_model(model).slides:
         return None
     if mode == "all" or (mode == "recommended" and get_model(model).uses_bed) \
             or soil.friction_static < block.b / block.h:
-        return soil.friction
+        member = split_variant(model)[1]
+        return soil.friction if member is None else member_friction(soil.friction, design or DEFAULT_DESIGN, member)
     return None
+
+
+def model_stiffness(config) -> np.ndarray:
+    """The bed stiffness K [N/m] every (soil, block, model) runs: eq. 19, a stiffness member's G scaled."""
+    return np.array([[[member_stiffness(soil, block, config.design, split_variant(model)[1] or "centre")
+                       for model in config.models] for block in config.blocks] for soil in config.soils])
 
 
 def record_intensity(acceleration, dt, config, block=None) -> float:
@@ -297,17 +314,17 @@ def study_scale_factors(intensity, record_im) -> np.ndarray:
 
 
 def refines_capacity(model: str, friction: tuple[float, float] | None = None) -> bool:
-    """Whether a cell refines its overturning capacities: not a restitution band's edges, not a sliding base.
+    """Whether a cell refines its overturning capacities: not a sample member beside the centre, not a sliding base.
 
     The refined capacities check the stripe fit of the overturning curve (``capacity_median``). The recommended
-    curve is the band centre's fit; the edges give only its model dispersion (from their stripe fits), so their
-    capacity runs would check a curve no output publishes. A block that slides (mu_s < b/h) overturns, if at
-    all, only far beyond the credible intensities, and its sliding runs there cost 3-4 times a tied run (the
-    squat skid's refining runs were half the default study's time): its stripe fit stands alone. Nor do the
+    curve is the central member's fit; the other members give only its parameter dispersion (from their stripe
+    fits), so their capacity runs would check a curve no output publishes. A block that slides (mu_s < b/h)
+    overturns, if at all, only far beyond the credible intensities, and its sliding runs there cost 3-4 times a tied
+    run (the squat skid's refining runs were half the default study's time): its stripe fit stands alone. Nor do the
     paper's spring models (``can_pull``): references whose runs after the spring pulls are not physical, so
     a 2% capacity would refine a number nobody should read.
     """
-    return split_variant(model)[1] not in ("low", "high") and friction is None and not get_model(model).can_pull
+    return split_variant(model)[1] in (None, "centre") and friction is None and not get_model(model).can_pull
 
 
 def capacity_key(key, resolution, limit=np.inf) -> str:
@@ -425,7 +442,7 @@ def cells_for_record(record, config, recipe, block_scales=None, vertical=None) -
                 continue
             dissipation = restitution_key(config, model)
             for soil_index, soil in enumerate(config.soils):
-                friction = cell_friction(block, soil, model, config.friction)
+                friction = cell_friction(block, soil, model, config.friction, config.design)
                 # the friction enters the key only where the cell slides: a tied cell keeps its old key, and a
                 # tied rigid-base cell the key it shares with every soil
                 slip = {} if friction is None else {"friction": list(friction)}
@@ -463,7 +480,7 @@ def friction_grid(config) -> np.ndarray:
     for s, soil in enumerate(config.soils):
         for b, block in enumerate(config.blocks):
             for m, model in enumerate(config.models):
-                friction = cell_friction(block, soil, model, config.friction)
+                friction = cell_friction(block, soil, model, config.friction, config.design)
                 if friction is not None:
                     grid[:, s, b, m] = friction
     return grid
@@ -485,8 +502,11 @@ def restitution_key(config, model) -> dict:
     """The part of a bed model's checkpoint key that says how its damping is set (empty: the soil's xi)."""
     if not (config.calibrates_bed and get_model(model).uses_bed):
         return {}
-    role = split_variant(model)[1]
-    return {"restitution": config.restitution, "band": list(config.restitution_band) if role else None}
+    member = split_variant(model)[1]
+    design = config.design
+    return {"restitution": config.restitution,
+            "design": None if member is None else [list(design.restitution_range), design.friction_factor,
+                                                   design.stiffness_factor]}
 
 
 def solver_options(config) -> dict:
@@ -499,21 +519,22 @@ def solver_options(config) -> dict:
     return {"switch": config.switch, "bed": bed, "overturn_angle": config.overturn_angle}
 
 
-def bed_calibration(config, stiffness) -> BandCalibration | None:
+def bed_calibration(config, stiffness) -> SampleCalibration | None:
     """The calibrated damping of every bed model on every (soil, block), or None without a restitution target.
 
-    A band variant whose target the bed cannot reach runs at the nearest reachable one; the study lists
-    those (``calibration_lines``) and the cube keeps both (rockfrag.models.variants).
+    ``stiffness`` (soil, block, model): ``model_stiffness``. A sample member whose target the bed cannot reach
+    runs at the nearest reachable one; the study lists those (``calibration_lines``) and the cube keeps both
+    (rockfrag.models.variants).
     """
-    models = [name for name in config.models if get_model(name).uses_bed]
-    if not (config.calibrates_bed and models):
+    indices = [m for m, name in enumerate(config.models) if get_model(name).uses_bed]
+    if not (config.calibrates_bed and indices):
         return None
-    return calibrate_models(list(config.blocks), [soil.name for soil in config.soils], stiffness, models,
-                            config.restitution, config.restitution_band, config.bed)
+    return calibrate_models(list(config.blocks), [soil.name for soil in config.soils], stiffness[:, :, indices],
+                            [config.models[m] for m in indices], config.restitution, config.design, config.bed)
 
 
-def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
-    """One line per (block, variant) whose band target was moved into the bed's reachable range."""
+def calibration_lines(config, calibration: SampleCalibration | None) -> list[str]:
+    """One line per (block, member) whose restitution target was moved into the bed's reachable range."""
     if calibration is None:
         return []
     lines = []
@@ -526,7 +547,7 @@ def calibration_lines(config, calibration: BandCalibration | None) -> list[str]:
             if moved:
                 where = ", ".join(f"{config.soils[s].name} {calibration.target[s, b, v]:.3f}" for s in moved)
                 lines.append(f"rockfrag: {model}, block {block.name}: the bed at its admissible xi (where free "
-                             f"rocking is reproducible) cannot reach the band's r = {wanted:.3f}; it runs at the "
+                             f"rocking is reproducible) cannot reach r = {wanted:.3f}; it runs at the "
                              f"nearest r it reaches ({where})")
             if unmeasurable:
                 at = ", ".join(f"{config.soils[s].name} {calibration.xi[s, b, v]:.3g}" for s in range(len(
@@ -555,7 +576,7 @@ def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolu
     for key, model, block, k, xi, friction in jobs:
         by_model.setdefault((get_model(model).name, friction), []).append((key, block, k, xi))
     for (model, friction), group in by_model.items():
-        # band variants whose targets the bed reaches at the same xi (moved to one end of its range) run once
+        # members whose targets the bed reaches at the same xi (moved to one end of its range) run once
         cases = list(dict.fromkeys((b, k, xi) for _, b, k, xi in group))
         summaries = dict(zip(cases, simulate_batch(model, acceleration, dt, scales, cases, ag_vertical=ag_vertical,
                                                    t_end=t_end, **options, friction=friction)))
@@ -794,7 +815,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
     log(credible_line(config, cap, cap_reason, intensity))
     resolution = config.capacity_resolution
     stiffness = np.array([[soil_block_stiffness(soil, block) for block in config.blocks] for soil in config.soils])
-    calibration = bed_calibration(config, stiffness)
+    stiffness_of_model = model_stiffness(config)
+    calibration = bed_calibration(config, stiffness_of_model)
     for line in calibration_lines(config, calibration):
         warn(line)
 
@@ -814,7 +836,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         results.update(store.load_verified([capacity_key(k, resolution, capacity_limit[r, b])
                                             for k, r, b in refining], (4,), np.float64))
     tasks = [(*task, variant) for variant in variants
-             for task in block_tasks(all_cells[variant], results, config, stiffness, resolution, calibration,
+             for task in block_tasks(all_cells[variant], results, config, stiffness_of_model, resolution, calibration,
                                      capacity_limit)]
     n_cells = len(keys)
     n_missing = sum(len(task[2]) for task in tasks)
@@ -879,6 +901,7 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
                                      calibration=calibration, friction=friction_grid(config),
+                                     model_stiffness=stiffness_of_model,
                                      verticals=verticals, vertical_applied=variant, partners=partner_ids,
                                      component_im=component_im, uplift=uplift, credible=(cap, cap_reason,
                                                                                          config.beyond_credible)),
@@ -918,7 +941,8 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
 
     Cells still to run are those not in ``available``, the verified checkpoints; a job is
     (key, model, block, k, xi, friction), xi the soil's damping ratio or, for a bed model with a restitution
-    target, its calibrated one (``calibration``, a ``BandCalibration``), friction the cell's (mu_s, mu_k) or None
+    target, its calibrated one (``calibration``, a ``SampleCalibration``), k from ``stiffness`` (soil, block,
+    model; ``model_stiffness``), friction the cell's (mu_s, mu_k) or None
     (``cell_friction``). Grouped by block because scale factors are per block; cells of one key (a tied housner
     cell on several soils) are one job. A rigid-base model's k and xi are None. ``capacity_limit`` (n_record,
     n_block): the scale factor at the credible cap, where the capacity hunt stops (None: no limit).
@@ -942,7 +966,7 @@ def block_tasks(all_cells, available, config, stiffness, resolution, calibration
                 by_block.setdefault(cell.block_index, []).append(cell)
         for block_index, missing in by_block.items():
             jobs = [(c.key, c.model, config.blocks[c.block_index],
-                     None if rigid(c) else stiffness[c.soil_index, c.block_index],
+                     None if rigid(c) else stiffness[c.soil_index, c.block_index, config.models.index(c.model)],
                      None if rigid(c) else damping(c), c.friction)
                     for c in missing]
             tasks.append((index, block_index, jobs))

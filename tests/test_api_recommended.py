@@ -1,7 +1,7 @@
 """``simulate("recommended", ...)`` reproduces the study's central recommended run bit for bit (issue 33 item 3).
 
-The study (``rockfrag run``) and the API share one definition of that run (``variants.band_member``): the bed's
-stiffness from the soil (eq. 19), its damping calibrated to the restitution band's centre, the soil's friction.
+The study (``rockfrag run``) and the API share one definition of that run (``variants.sample_member``): the bed's
+stiffness from the soil (eq. 19), its damping calibrated to the middle of the restitution range, the soil's friction.
 The check runs a one-block study on a sliding sand bed and on a stiff steel deck, and calls ``simulate`` with each
 record's processed acceleration and its scale factor from ``cube.nc``: every summary must be the same float.
 """
@@ -18,7 +18,7 @@ from rockfrag.config import load_study
 from rockfrag.errors import SolverError
 from rockfrag.models import simulate
 from rockfrag.models.restitution import calibrate_dissipation
-from rockfrag.models.variants import RECOMMENDED_BED, band_target, central_member
+from rockfrag.models.variants import DEFAULT_DESIGN, RECOMMENDED_BED, central_member, member_restitution
 from rockfrag.soils import SOILS, soil_block_stiffness
 
 STUDY = """
@@ -77,32 +77,32 @@ def test_recommended_reproduces_the_cube_bit_for_bit(study_run):
         # the issue's way: the processed record times the cube's scale factor; and scale=
         scaled = simulate("recommended", record.acceleration * scale, record.dt, block, soil=SOILS[soil])
         result = simulate("recommended", record.acceleration, record.dt, block, soil=soil, scale=scale)
-        cell = cube.sel(soil=soil, model="winkler-centre").isel(record=r, im_level=level, block=b)
+        cell = cube.sel(soil=soil, model="recommended").isel(record=r, im_level=level, block=b)
         for name in COMPARED:
             for run in (scaled, result):
                 assert getattr(run, name) == pytest.approx(float(cell[name]), rel=0, abs=0, nan_ok=True), \
                     (block.name, soil, r, level, name)
     assert len(cells) == 3 * 2 * len(records) * cube.sizes["im_level"]
     # the sand bed slides: the comparison covers the slip
-    assert float(cube.peak_slip.sel(soil="sand", model="winkler-centre").max()) > 0
+    assert float(cube.peak_slip.sel(soil="sand", model="recommended").max()) > 0
 
 
 def test_the_calibration_is_the_studys(study_run):
     config, _, cube = study_run
     for (b, block), soil in itertools.product(enumerate(config.blocks), ("sand", "steel")):
         member = central_member(block, SOILS[soil])
-        cell = cube.sel(soil=soil, model="winkler-centre").isel(block=b)
+        cell = cube.sel(soil=soil, model="recommended").isel(block=b)
         assert member.xi == float(cell.damping_ratio_calibrated)
         assert member.k == float(cell.interface_stiffness)
         assert member.friction == (float(cell.friction_static), float(cell.friction_kinetic))
 
 
 def test_a_target_in_reach_is_the_plain_calibration():
-    """Independent of the band's bookkeeping: where the centre is reachable, its xi is calibrate_dissipation's."""
+    """Independent of the sample's bookkeeping: where the centre is reachable, its xi is calibrate_dissipation's."""
     block = load_study_blocks()[0]
     k = soil_block_stiffness(SOILS["sand"], block)
     member = central_member(block, SOILS["sand"])
-    expected = calibrate_dissipation(block, k, RECOMMENDED_BED, band_target(block, (1.0, 1.05), "centre"))
+    expected = calibrate_dissipation(block, k, RECOMMENDED_BED, member_restitution(block, DEFAULT_DESIGN, "centre"))
     assert member.xi == expected.xi
 
 
@@ -127,7 +127,8 @@ def test_winkler_without_damping_runs_the_recommended_bed():
     assert old.extra["xi"] != default.extra["xi"]
 
 
-@pytest.mark.parametrize("name", ["winkler-centre", "winkler-low", "winkler-high", "recommended"])
+@pytest.mark.parametrize("name", ["recommended", "recommended-restitution_low", "recommended-friction_high",
+                                  "recommended-stiffness_low"])
 def test_every_cube_name_runs_on_a_soil(name):
     block = load_study_blocks()[0]
     t = np.arange(0, 2, 0.01)
@@ -143,6 +144,8 @@ def test_unknown_names_are_refused_with_the_list():
     block = load_study_blocks()[0]
     with pytest.raises(SolverError, match="valid models are: housner, ssi"):
         simulate("winkler-middle", np.zeros(3), 0.01, block, soil="sand")
+    with pytest.raises(SolverError, match="gave way to the designed sample.*'recommended'"):
+        simulate("winkler-centre", np.zeros(3), 0.01, block, soil="sand")
     with pytest.raises(SolverError, match="shipped soils: clay, sand"):
         simulate("recommended", np.zeros(3), 0.01, block, soil="loam")
     with pytest.raises(SolverError, match="takes k"):

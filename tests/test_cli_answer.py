@@ -225,7 +225,7 @@ def test_quiet_hides_the_answer_and_the_flag_runs_the_sweep(tiny_run, capsys, mo
 def test_the_example_study_is_one_user_block_two_soils_ten_records():
     study = load_study(ROOT / "studies" / "example.toml")
     assert [b.name for b in study.blocks] == ["cabinet"] and len(study.soils) == 2
-    assert len(study.record_sets) == 10 and "winkler-centre" in study.models  # the restitution band's variants
+    assert len(study.record_sets) == 10 and "recommended" in study.models  # the recommended model and its sample
     assert str(study.output) == "reports-example"
 
 

@@ -162,7 +162,7 @@ def test_the_study_states_the_limits_and_return_periods(tmp_path):
 def test_the_motion_at_each_return_period_comes_from_the_runs_at_the_level_at_or_below():
     """Issue 19, 36: what the block does at each return-period intensity, each record counted at its most severe
     motion. Mode times where the base slides; the outcome where it is tied (no mode times); the recommended curve
-    reads the band centre's runs; the level is the one at or below the intensity, as the probability table reads
+    reads its central member's runs; the level is the one at or below the intensity, as the probability table reads
     it (issue 20, finding 4)."""
     import xarray as xr
 
@@ -186,7 +186,7 @@ def test_the_motion_at_each_return_period_comes_from_the_runs_at_the_level_at_or
     dims = ("record", "im_level", "soil", "block", "model")
     cube = xr.Dataset({field: (dims, times[..., k]) for k, field in enumerate(MODE_TIME_FIELDS)} |
                       {"outcome": (dims, outcome)},
-                      coords={"soil": ["clay"], "block": ["skid"], "model": ["winkler-centre", "housner"],
+                      coords={"soil": ["clay"], "block": ["skid"], "model": ["recommended", "housner"],
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
     assert motion_counts(cube, "skid", RECOMMENDED, "clay", [0.11, 0.32, 1.1], 1.0) == \
         ["at rest 4 (of 4)", "slides 3, rocks 1 (of 4)", "slides and rocks 4 (of 4)"]
@@ -265,20 +265,41 @@ def test_curves_that_cross_below_the_data_are_read_as_this_state_or_worse():
         assert milder.at_return_periods[1][0] == pytest.approx(lognorm.cdf(im, 0.549, scale=0.974), rel=1e-9)
 
 
-def test_the_answer_says_where_the_bed_could_not_reach_the_band():
-    """The example study's log warned that the bed runs the band's centre and upper edge at a lower r than asked;
-    the answer page must say it too (beta_model there leaves out the less dissipative side)."""
+def _restitution_cube(requested, reached, xi, blocks):
+    """A cube with the central member (model ``recommended``) and the restitution members (``member``).
+
+    The arrays are (block, run), their columns the low end, the centre and the high end; every soil the same.
+    """
+    soils = ["clay", "rock"]
+
+    def central(values):
+        return (("soil", "block", "model"), np.broadcast_to(values[None, :, 1, None], (2, len(blocks), 1)).copy())
+
+    def ends(values):
+        return (("soil", "block", "member"), np.broadcast_to(values[None, :, [0, 2]], (2, len(blocks), 2)).copy())
+
+    data = {}
+    for name, values in (("restitution_requested", requested), ("restitution_target", reached),
+                         ("damping_ratio_calibrated", xi)):
+        data[name], data[f"member_{name}"] = central(values), ends(values)
+    return xr.Dataset(data, coords={"soil": soils, "block": blocks, "model": ["recommended"],
+                                    "member": ["restitution_low", "restitution_high"]})
+
+
+def test_the_answer_says_where_the_bed_could_not_reach_the_range():
+    """The example study's log warned that the bed runs the range's centre and upper end at a lower r than asked;
+    the answer page must say it too (beta_parameters there leaves out the less dissipative side)."""
     from rockfrag.report.answer_page import _band_reach
 
-    dims = ("soil", "block", "model")
-    requested = np.array([[[np.nan, 0.825, 0.845, 0.866]], [[np.nan, 0.825, 0.845, 0.866]]])
-    reached = np.array([[[np.nan, 0.825, 0.836, 0.836]], [[np.nan, 0.825, 0.845, 0.866]]])
-    cube = xr.Dataset({"restitution_requested": (dims, requested), "restitution_target": (dims, reached)},
-                      coords={"soil": ["clay", "rock"], "block": ["cabinet"],
-                              "model": ["housner", "winkler-low", "winkler-centre", "winkler-high"]})
+    requested = np.array([[0.825, 0.845, 0.866]])
+    cube = _restitution_cube(requested, np.array([[0.825, 0.836, 0.836]]), np.array([[0.3, 0.2, 0.2]]), ["cabinet"])
+    cube["restitution_target"].loc[{"soil": "rock"}] = cube.restitution_requested.sel(soil="rock").values
+    cube["member_restitution_target"].loc[{"soil": "rock"}] = cube.member_restitution_requested.sel(
+        soil="rock").values
     text = _band_reach(cube)
     assert "On clay the bed" in text and "clay, rock" not in text and "0.866" in text and "0.836" in text
-    assert _band_reach(cube.assign(restitution_target=cube.restitution_requested)) == ""
+    assert _band_reach(cube.assign(restitution_target=cube.restitution_requested,
+                                   member_restitution_target=cube.member_restitution_requested)) == ""
 
 
 # ---------------------------------------------------------------- verdicts from the fit's tail (issue 20, report)
@@ -418,47 +439,39 @@ def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from
         "10 of 10 records already at 0.1 g: a bound"
 
 
-def test_the_band_paragraph_is_the_blocks_own_and_says_when_the_band_is_one_run():
+def test_the_sample_paragraph_is_the_blocks_own_and_says_when_the_restitution_range_is_one_run():
     """The client read the study-wide β ranges and the cabinet's r on the crane's and the skid's pages, and the skid's
-    page did not say that its band's three runs were one run (beta_model 0 by construction). The β of each row is
+    page did not say that its restitution runs were one run (no spread by construction). The β of each row is
     the summary's now; the calibrated damping ratio is printed nowhere (issue 36's precision policy)."""
     from types import SimpleNamespace
 
     from rockfrag.report.answer_page import curve_reason
 
-    models = ["recommended", "winkler-low", "winkler-centre", "winkler-high"]
-    dims = ("soil", "block", "model")
+    models = ["recommended"]
     requested = np.array([[0.73, 0.75, 0.76], [0.94, 0.97, 0.99], [0.46, 0.47, 0.48]])  # crane, cabinet, skid
     reached = np.array([[0.73, 0.75, 0.76], [0.94, 0.95, 0.95], [np.nan] * 3])
     xi = np.array([[0.5, 0.4, 0.3], [0.4, 0.16, 0.16], [0.15, 0.15, 0.15]])
-
-    def per_cell(values):  # (block, variant) -> (soil, block, model), the recommended row NaN
-        return np.concatenate([np.full((2, 3, 1), np.nan), np.broadcast_to(values, (2, 3, 3))], axis=2)
-
     blocks = ["crane", "cabinet", "skid"]
-    cube = xr.Dataset({"restitution_requested": (dims, per_cell(requested)),
-                       "restitution_target": (dims, per_cell(reached)),
-                       "damping_ratio_calibrated": (dims, per_cell(xi))},
-                      coords={"soil": ["clay", "rock"], "block": blocks, "model": models})
+    cube = _restitution_cube(requested, reached, xi, blocks)
     fdims = ("soil", "block", "model", "damage_state")
-    beta_model = np.zeros((2, 3, 4, 1))
+    beta_model = np.zeros((2, 3, 1, 1))
     beta_model[:, 0], beta_model[:, 1] = 0.3, 0.41
-    r2r = np.broadcast_to(np.array([0.5, 1.17, 0.2])[None, :, None, None], (2, 3, 4, 1))
+    r2r = np.broadcast_to(np.array([0.5, 1.17, 0.2])[None, :, None, None], (2, 3, 1, 1))
     fragility = xr.Dataset({"beta_model": (fdims, beta_model), "beta_record_to_record": (fdims, r2r)},
                            coords={"soil": ["clay", "rock"], "block": blocks, "model": models,
                                    "damage_state": ["overturning"]})
     results = SimpleNamespace(fragility=fragility, cube=cube)
     crane, cabinet, skid = (curve_reason(results, "recommended", b) for b in blocks)
-    assert crane == ""  # the band reached and not collapsed: nothing of its own to say
+    assert crane == ""  # the range reached and not collapsed: nothing of its own to say
     assert "0.990" in cabinet and "0.950" in cabinet and "collapses" not in cabinet
-    assert "On every soil the restitution band collapses to one run" in skid
+    assert "On every soil the restitution range collapses to one run" in skid
     assert "it reaches none of them" in skid and "because there is one run" in skid and "0.990" not in skid
     assert all("ξ" not in text and "0.15" not in text for text in (crane, cabinet, skid))  # no calibrated ξ
 
 
 def _friction_cube():
     """20 records at 0.24/0.31/0.41/0.54 g on gravel (mu_s 0.55): 0, 0, 0 and 9 records need more friction. The
-    band centre is tied on gravel and slides (friction computed) on clay; the low edge is tied on both."""
+    recommended model is tied on gravel and slides (friction computed) on clay; the plain bed is tied on both."""
     levels = np.array([0.24, 0.31, 0.41, 0.54])
     demand = np.full((20, 4, 2, 1, 2), 0.3)
     demand[:9, 3] = 0.8
@@ -467,8 +480,7 @@ def _friction_cube():
     return xr.Dataset({"peak_friction_demand": (dims, demand), "outcome": (dims, np.ones(demand.shape, np.int8)),
                        "friction_static": (("soil", "block", "model"), friction),
                        "soil_friction_static": (("soil",), [0.45, 0.55])},
-                      coords={"soil": ["clay", "gravel"], "block": ["crane"], "model": ["winkler-centre",
-                                                                                        "winkler-low"],
+                      coords={"soil": ["clay", "gravel"], "block": ["crane"], "model": ["recommended", "winkler"],
                               "intensity": (("block", "im_level"), levels[None, :], {"units": "g"})})
 
 
@@ -478,13 +490,13 @@ def test_the_sliding_share_is_the_records_at_the_level_at_or_below_the_intensity
     from rockfrag.report.adapters import sliding_at, sliding_share
 
     cube = _friction_cube()
-    models = ["recommended", "winkler-centre", "winkler-low"]
+    models = ["recommended", "winkler"]
     assert sliding_share(cube, models, "crane", "gravel", None, 0.57) == pytest.approx(0.45)
     assert sliding_at(cube, models, "crane", "gravel", 0.57) == (pytest.approx(0.45), pytest.approx(0.54), False)
     assert sliding_at(cube, models, "crane", "gravel", 0.5)[:2] == (0.0, pytest.approx(0.41))
     assert np.isnan(sliding_at(cube, models, "crane", "gravel", 0.2)[1])  # no level run this low
     share, _, computed = sliding_at(cube, models, "crane", "clay", 0.57)
-    assert computed and np.isnan(share)  # friction computed: the slip states answer, not the low edge's ties
+    assert computed and np.isnan(share)  # friction computed: the slip states answer, not the plain bed's ties
 
 
 def test_check_sliding_names_its_level_its_threshold_and_how_to_compute_the_sliding():

@@ -292,7 +292,7 @@ def test_the_ground_motion_shares_the_time_axis_of_the_response_and_has_one(smal
 def test_the_recommended_curve_has_a_style_of_its_own():
     from rockfrag.report.adapters import model_styles, models_of
 
-    names = ["housner", "recommended", "ssi", "winkler-low", "winkler-centre", "winkler-high"]
+    names = ["housner", "recommended", "ssi", "winkler", "ssi-paper"]
     models = models_of(xr.Dataset(coords={"model": names}))
     styles = model_styles(models)
     keys = {name: (style["color"], str(style["ls"])) for name, style in styles.items()}

@@ -25,7 +25,7 @@ def test_the_registry_states_the_uplift_size():
     assert "1 mm" in description and "1% of the half-width b" in description
 
 
-def _cube(lift_mm, outcome, model="winkler-centre", b=0.3, times=None):
+def _cube(lift_mm, outcome, model="recommended", b=0.3, times=None):
     """One level of a cube: records with a peak corner lift [mm] and an outcome, on one soil, block and model."""
     lift = np.asarray(lift_mm, float)[:, None, None, None, None] / 1000.0
     code = np.asarray(outcome, np.int8)[:, None, None, None, None]
@@ -57,7 +57,7 @@ def test_the_motion_table_says_tilts_below_the_size_and_its_lifting_records_are_
              "time_rocking": [1.0, 0, 1.0, 1.0, 1.0, 0, 0], "time_slide_rocking": [0] * 7,
              "time_in_flight": [0, 0.1, 0, 0, 0, 0, 0]}  # the second record bounces 0.1 mm: not flight
     cube = _cube(lifts, outcomes, times=times)
-    shown = motion_counts(cube, "cabinet", "winkler-centre", "gravel", [0.3], 1.0)[0]
+    shown = motion_counts(cube, "cabinet", "recommended", "gravel", [0.3], 1.0)[0]
     assert shown == f"at rest 1, {TILT_WORDS} 3, slides 1, rocks 1, overturns 1 (of 7)"
     uplifted = int(exceedance(cube, DAMAGE_STATES["uplift"]).sum())
     lifting = sum(int(n) for words, n in (part.rsplit(" ", 1) for part in shown.split(" (of")[0].split(", "))

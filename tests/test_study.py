@@ -18,6 +18,7 @@ from rockfrag.config import load_study, study_from_dict
 from rockfrag.errors import ConfigError
 from rockfrag.measures import MEASURES, spectral_acceleration
 from rockfrag.models import simulate
+from rockfrag.models.variants import sample_models
 from rockfrag.processing import process_record
 from rockfrag.records import load_records
 from rockfrag.soils import SOILS, soil_block_stiffness
@@ -72,8 +73,8 @@ def test_default_study_matches_the_issue():
     assert config.credible_measure == "pga" and not config.beyond_credible
     assert config.friction == "recommended"  # the recommended (bed) model's sliding is always computed
     assert [s.name for s in config.soils] == ["clay", "sand", "gravel", "rock", "steel"]
-    assert config.models == ("housner", "ssi", "winkler-low", "winkler-centre", "winkler-high")
-    assert config.restitution == "band" and len(config.blocks) == 3
+    assert config.models == ("housner", "ssi", *sample_models())  # the recommended model and its sample
+    assert config.restitution == "recommended" and len(config.blocks) == 3
     paper = config.blocks[0]
     assert paper.R == 9.39 and paper.alpha == 0.44
     # levels are multiples of each block's uplift intensity: from below uplift to far above it

@@ -121,7 +121,8 @@ def test_the_shipped_records_are_found_in_a_clone_and_through_the_environment(tm
 LOAM = '[soils_custom.loam]\nshear_modulus = 5e7\ndamping_ratio = 0.20\n'
 
 
-@pytest.mark.parametrize("restitution, shown", [("0.93", "0.93"), ('"band"', "'band'"), ('"housner"', "'housner'")])
+@pytest.mark.parametrize("restitution, shown", [("0.93", "0.93"), ('"recommended"', "'recommended'"),
+                                                ('"housner"', "'housner'")])
 def test_an_explicit_damping_ratio_with_a_restitution_target_is_refused(tmp_path, restitution, shown):
     study = tmp_path / "s.toml"
     study.write_text(f'soils = ["loam"]\nmodels = ["housner", "winkler"]\n[solver]\nrestitution = {restitution}\n'
@@ -133,9 +134,9 @@ def test_an_explicit_damping_ratio_with_a_restitution_target_is_refused(tmp_path
     assert 'restitution = ""' in message and str(study) in message
 
 
-def test_the_default_restitution_band_refuses_it_too_through_the_command(tmp_path, capsys):
+def test_the_default_recommended_model_refuses_it_too_through_the_command(tmp_path, capsys):
     study = tmp_path / "s.toml"
-    study.write_text('soils = ["loam"]\n' + LOAM)  # the shipped [solver] restitution is "band"
+    study.write_text('soils = ["loam"]\n' + LOAM)  # the shipped [solver] restitution is "recommended"
     assert main(["study", str(study)]) == 2
     error = capsys.readouterr().err
     assert error.count("\n") == 1 and "soils_custom.loam.damping_ratio: 0.2 together with" in error

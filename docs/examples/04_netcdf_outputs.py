@@ -68,13 +68,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 ida = xr.open_dataset(output / "ida.nc")
-curves = ida["edp"].sel(soil="my-fill", block="rack", model="winkler-centre")
+curves = ida["edp"].sel(soil="my-fill", block="rack", model="recommended")
 fig, ax = plt.subplots(figsize=(6, 4))
 levels = ida["intensity"].sel(block="rack").values
 for record in curves.record.values:
     response = curves.sel(record=record).values
     ax.plot(np.where(np.isfinite(response), response, np.nan), levels, "o-", lw=1, label=record)
-    capacity = float(ida["capacity"].sel(record=record, soil="my-fill", block="rack", model="winkler-centre"))
+    capacity = float(ida["capacity"].sel(record=record, soil="my-fill", block="rack", model="recommended"))
     ax.axhline(capacity, lw=0.5, ls=":", color=ax.lines[-1].get_color())
 ax.set_xscale("log")
 ax.set_xlabel("peak theta / alpha")

@@ -44,7 +44,7 @@ from rockfrag.models.options import (  # noqa: F401  (the API)
     case_record,
 )
 from rockfrag.models.restitution import calibrate_dissipation, calibrated_law, radiation_damping
-from rockfrag.models.variants import BAND_LABELS, DEFAULT_BAND, RECOMMENDED, band_variants, split_variant
+from rockfrag.models.variants import MEMBER_LABELS, OLD_BAND_NAMES, RECOMMENDED, sample_models, split_variant
 from rockfrag.units import STANDARD_GRAVITY
 from rockfrag.validation import did_you_mean
 
@@ -65,8 +65,8 @@ def register(model: RockingModel) -> None:
 def get_model(name: str) -> RockingModel:
     """The registered model called ``name``; a ``SolverError`` listing the valid names otherwise.
 
-    A band variant of a bed model (``winkler-low``, ``winkler-centre``, ``winkler-high``;
-    rockfrag.models.variants) is that model: the variant only sets its restitution target.
+    The recommended model's central run (``recommended``) and its sample members (``recommended-<member>``;
+    rockfrag.models.variants) are the bed model ``winkler``: a member only sets its parameters.
     """
     model, role = split_variant(name) if isinstance(name, str) else (name, None)
     try:
@@ -75,15 +75,17 @@ def get_model(name: str) -> RockingModel:
         raise SolverError(f"unknown model {name!r}{did_you_mean(name, MODELS)}; valid models are: "
                           f"{', '.join(MODELS)}") from None
     if role is not None and not spec.uses_bed:
-        raise SolverError(f"unknown model {name!r}: only a bed model has restitution-band variants")
+        raise SolverError(f"unknown model {name!r}: only a bed model has sample members")
     return spec
 
 
 def model_label(name: str) -> str:
-    """A model's label for tables and plots; a band variant's says its place in the band."""
+    """A model's label for tables and plots; a sample member's says which member it is."""
     model, role = split_variant(name)
+    if role == "centre":
+        return "recommended: tensionless bed, central member of the designed sample"
     label = get_model(name).label
-    return f"{label}, {BAND_LABELS[role]}" if role else label
+    return f"{label}, {MEMBER_LABELS[role]}" if role else label
 
 
 def parameter_record(model: RockingModel, block: Block, k=None, xi=None, options=SolverOptions()):
@@ -181,12 +183,12 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         ``housner``, ``ssi`` (the paper's model), ``ssi-paper`` (its printed equations) or ``winkler``
         (tensionless bed); see ``MODELS``. ``recommended`` runs the study's recommended model on ``soil``
         exactly as the study's central run does (``variants.central_member``: the bed's stiffness from the soil
-        (eq. 19), its damping calibrated to the centre of the restitution band, the soil's friction), and
-        ``winkler-low``/``winkler-centre``/``winkler-high`` the band's positions on ``soil``; these take no
+        (eq. 19), its damping calibrated to the middle of the restitution range, the soil's friction), and
+        ``recommended-<member>`` the designed sample's members on ``soil`` (rockfrag.models.variants); these take no
         ``k``, ``xi``, ``bed``, ``restitution`` or ``friction``. ``winkler`` given neither ``xi`` nor
         ``restitution`` (nor ``bed``) runs the recommended bed at ``k``: the ``two-spring`` law calibrated to the
-        band's centre, not an arbitrary damping ratio (a named ``bed`` without ``xi``, or a block too squat to have a
-        restitution, Housner's r <= 0, keeps ``DEFAULT_XI``).
+        restitution range's middle, not an arbitrary damping ratio (a named ``bed`` without ``xi``, or a block too
+        squat to have a restitution, Housner's r <= 0, keeps ``DEFAULT_XI``).
     ag : array_like, shape (n,)
         Horizontal ground acceleration [m/s^2]: at least 2 samples, all finite.
     dt : float
@@ -214,7 +216,7 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
         End time [s], >= 0; zero ground motion after the record, and a t_end inside the record cuts it.
         Default: the record + 10 s (``DEFAULT_TAIL``).
     soil : str or rockfrag.soils.SoilClass, optional
-        The soil of ``recommended`` and the band's positions: a shipped soil's name or a ``SoilClass``.
+        The soil of ``recommended`` and its sample members: a shipped soil's name or a ``SoilClass``.
     scale : float
         Factor [-] on ``ag`` (and ``ag_vertical``), applied sample by sample as the study applies its scale
         factors: ``scale=s`` and ``ag * s`` give the same bits, the study's run at scale factor ``s``. Default 1.
@@ -281,17 +283,26 @@ def simulate(model: str, ag: ArrayLike, dt: float, block: Block, *, ag_vertical:
 
 
 def _resolve_model(model, block, soil, k, xi, options):
-    """(solver model, k, xi, options) of a ``simulate`` call: the recommended model and band positions resolved.
+    """(solver model, k, xi, options) of a ``simulate`` call: the recommended model and its members resolved.
 
-    The recommended model and the band's positions are the study's runs on a soil (one definition:
-    ``variants.band_member``); a plain ``winkler`` call without ``xi`` or ``restitution`` takes the recommended
+    The recommended model and its sample members are the study's runs on a soil (one definition:
+    ``variants.sample_member``); a plain ``winkler`` call without ``xi`` or ``restitution`` takes the recommended
     bed at its ``k``. Any other name runs as given.
     """
-    from rockfrag.models.variants import RECOMMENDED_BED, band_member, band_target, calibrate_to_target
+    from rockfrag.models.variants import (
+        DEFAULT_DESIGN,
+        RECOMMENDED_BED,
+        calibrate_to_target,
+        member_restitution,
+        sample_member,
+    )
 
-    name, role = ("winkler", "centre") if model == RECOMMENDED else split_variant(model)
+    name, role = split_variant(model)
+    if model in OLD_BAND_NAMES:
+        raise SolverError(f"model {model!r}: the restitution band gave way to the designed sample; run "
+                          f"{RECOMMENDED!r} or a member: {', '.join(sample_models()[1:])}")
     if name not in MODELS or (role is not None and not MODELS[name].uses_bed):
-        accepted = [*MODELS, RECOMMENDED, *band_variants("winkler")]
+        accepted = [*MODELS, *sample_models()]
         raise SolverError(f"unknown model {model!r}{did_you_mean(str(model), accepted)}; valid models are: "
                           f"{', '.join(accepted)}")
     if role is not None:
@@ -303,16 +314,16 @@ def _resolve_model(model, block, soil, k, xi, options):
         if soil is None:
             raise SolverError(f"model {model!r} needs soil=: a soil name ({', '.join(_soil_names())}) or a "
                               "rockfrag.soils.SoilClass")
-        member = band_member(block, _soil(soil), role, g=options.get("g", STANDARD_GRAVITY))
+        member = sample_member(block, _soil(soil), role, g=options.get("g", STANDARD_GRAVITY))
         return member.model, member.k, member.xi, {**options, "bed": member.bed, "friction": member.friction}
     if soil is not None:
-        raise SolverError(f"soil= is for the study's runs on a soil (models {RECOMMENDED!r}, "
-                          f"{', '.join(band_variants('winkler'))}); model {model!r} takes k (and xi) instead")
+        raise SolverError(f"soil= is for the study's runs on a soil (models {RECOMMENDED!r} and its members "
+                          f"{', '.join(sample_models()[1:])}); model {model!r} takes k (and xi) instead")
     spec = get_model(model)
     if spec.uses_bed and xi is None and options.get("restitution") is None and options.get("bed") is None \
             and k is not None:
         bed = RECOMMENDED_BED
-        wanted = band_target(block, DEFAULT_BAND, "centre")
+        wanted = member_restitution(block, DEFAULT_DESIGN, "centre")
         if not 0 < wanted < 1:  # too squat to rock back (Housner's r <= 0): no target to calibrate to
             return model, k, DEFAULT_XI, {**options, "bed": bed}
         from rockfrag.models.restitution import admissible_xi

@@ -200,6 +200,11 @@ CAPTIONS = {
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
                            "enough; colours: the intensity level; solid concrete block, dashed steel block.",
+    "sensitivity": "Read which uncertain parameter of the recommended model moves its median most on each soil: "
+                   "each bar is the σ of ln median over that parameter's range (restitution, friction, bed "
+                   "stiffness), the others central; the dashed line is the model-form term β_form (FEMA P-695's "
+                   "rating). β_model is the larger of β_form and the bars combined (√ of the sum of squares): the "
+                   "rating covers the parameters, so it replaces their spread, it is not added.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does, and the measure alone is not enough; the test of Luco & Cornell "
@@ -290,6 +295,9 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure(f"fragility-models-{block}", "Fragility", f"Fragility by model: {names[block]}",
                                pages.fragility_by_model_page, fragility, block, extremes,
                                caption=CAPTIONS["fragility-models"], marks=results.marks(block), name=names[block]))
+    if "median_sensitivity" in fragility:
+        planned.append(_figure("sensitivity", "Fragility", "Model uncertainty: sensitivity of the median",
+                               pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names))
     for block in blocks:
         planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
                                pages.outcomes_page, fragility, block, caption=CAPTIONS["outcomes"],

@@ -62,14 +62,16 @@ class ModelInfo:
 def model_info(name: str) -> ModelInfo:
     """Label and role of a model from the registry (a model no longer registered keeps its name).
 
-    ``recommended`` (the fragility stage's combined curve) is labelled in words; a restitution-band variant of
-    a registered model (``winkler-low``, ``winkler-centre``, ``winkler-high``) is that model, labelled with
-    its place in the band (``rockfrag.models.model_label``).
+    ``recommended`` (the central member of the recommended model's designed sample, whose beta carries the model
+    dispersion) is labelled in words; a sample member (``recommended-<member>``) is the bed model, labelled with
+    what it changes (``rockfrag.models.model_label``).
     """
     if name == RECOMMENDED:
-        return ModelInfo(name, "Recommended (tensionless bed, restitution band)", False,
-                         "the tensionless Winkler bed over the experimental range of impact restitution, its spread "
-                         "added to the dispersion", False, True)
+        return ModelInfo(name, "Recommended (tensionless bed with friction, central member)", False,
+                         "the tensionless Winkler bed with friction at the base, at the middle of the experimental "
+                         "range of impact restitution and the soil's stated friction and stiffness; its model "
+                         "dispersion (the designed sample's spread or FEMA P-695's rating) added to beta", False,
+                         True)
     try:
         model = get_model(name)
     except SolverError:  # a model no longer registered
@@ -329,7 +331,7 @@ def scale_factor_summary(cube) -> tuple[float, float]:
 
 def sliding_candidates(cube, model: str) -> list[str]:
     """The models whose runs tell whether a tied base slides, first preferred: the answer's, then the bed's."""
-    return [model, "winkler-centre", "winkler", *[str(m) for m in cube.model.values if str(m).startswith("winkler")]]
+    return [model, RECOMMENDED, "winkler", *[str(m) for m in cube.model.values if str(m).startswith("winkler")]]
 
 
 def sliding_at(cube, models, block, soil, intensity: float, coefficient: float | None = None) -> tuple:

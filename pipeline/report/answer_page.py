@@ -16,12 +16,12 @@ beyond what any record did.
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from rockfrag.answer import ANCHOR, RECOMMENDED, BlockAnswer, display_scale, level_at_or_below
 from rockfrag.damage_states import DAMAGE_STATES, NOT_APPLICABLE, TILT_WORDS
 from rockfrag.fragility import exceedance, first_overturn_outcomes  # the fits' counting rules, in one place
 from rockfrag.models.base import Outcome
-from rockfrag.models.variants import split_variant
 from rockfrag.report import numbers
 from rockfrag.report.adapters import (
     block_description,
@@ -53,66 +53,80 @@ def _years(frequency: float) -> str:
     return f"once in {years:,.0f} years"
 
 
-def _band_reach(cube, block=None) -> str:
-    """A sentence on the cells where the bed could not reach the restitution band's edge (empty when it did).
+def _restitution_runs(cube, name):
+    """(requested, target, xi) of the recommended model's restitution runs (centre and the restitution members)."""
+    parts = []
+    for variable in ("restitution_requested", "restitution_target", "damping_ratio_calibrated"):
+        if variable not in cube or RECOMMENDED not in cube.model.values:
+            return None
+        centre = cube[variable].sel(model=RECOMMENDED).drop_vars(["model", "model_label"], errors="ignore")
+        centre = centre.expand_dims(run=["centre"])
+        member = f"member_{variable}"
+        if member in cube and "member" in cube.dims:
+            ends = [m for m in ("restitution_low", "restitution_high") if m in cube.member.values]
+            ends = cube[member].sel(member=ends).drop_vars("member_label", errors="ignore").rename(member="run")
+            centre = xr.concat([centre, ends], dim="run")
+        parts.append(centre)
+    return parts
 
-    Of one block when ``block`` is given (its answer page), else of the whole study. Restitutions are the band's
-    inputs and targets; the damping ratio calibrated to them is not printed (the precision policy).
+
+def _band_reach(cube, block=None) -> str:
+    """A sentence on the cells where the bed could not reach the restitution range's ends (empty when it did).
+
+    Of one block when ``block`` is given (its answer page), else of the whole study. Restitutions are the
+    sample's inputs and targets; the damping ratio calibrated to them is not printed (the precision policy).
     """
-    if cube is None or "restitution_requested" not in cube or "restitution_target" not in cube:
+    runs = None if cube is None else _restitution_runs(cube, RECOMMENDED)
+    if runs is None:
         return ""
-    requested, target = cube.restitution_requested, cube.restitution_target
+    requested, target, _ = runs
     if block is not None and "block" in requested.dims:
         requested, target = requested.sel(block=block), target.sel(block=block)
-    short = (requested - target) > 5e-4  # the bed ran at a lower r than the band asked for
+    short = (requested - target) > 5e-4  # the bed ran at a lower r than the sample asked for
     if not bool(short.any()):
         return ""
     soils = [str(s) for s in cube.soil.values if bool(short.sel(soil=s).any())]
     asked, reached = float(requested.where(short).max()), float(target.where(short).max())
-    return (f" On {', '.join(soils)} the bed cannot dissipate as little as the restitution band's upper edge asks "
+    return (f" On {', '.join(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
             f"(r up to {asked:.3f}; it reaches {reached:.3f} at most): those runs use the nearest r it reaches, so "
-            "the model part of β there leaves out the less dissipative side of the band, the side on which a block "
-            "rocks more.")
+            "the restitution part of β_parameters there leaves out the less dissipative side of the range, the side "
+            "on which a block rocks more.")
 
 
 def _band_collapse(cube, block) -> str:
-    """A sentence on the soils where the restitution band's three runs of ``block`` are one run ("" where none are).
+    """A sentence on the soils where the restitution runs of ``block`` are one run ("" where none are).
 
-    Where the bed reaches none of the band's targets, all three runs are the same: the model part of β is 0 there
-    because there is one run, not because the model is certain.
+    Where the bed reaches none of the range's targets, the central member and the two restitution members are
+    the same run: restitution moves the median by 0 there because there is one run, not because it is known.
     """
-    if cube is None or "damping_ratio_calibrated" not in cube:
+    runs = None if cube is None else _restitution_runs(cube, RECOMMENDED)
+    if runs is None or runs[2].sizes.get("run", 0) < 2:
         return ""
-    band = [str(m) for m in cube.model.values if split_variant(str(m))[1] is not None]
-    if len(band) < 2:
-        return ""
-    xi = cube.damping_ratio_calibrated.sel(block=block, model=band)
+    requested, target, xi = (run.sel(block=block) for run in runs)
     collapsed = [str(s) for s in cube.soil.values
                  if np.isfinite(values := np.asarray(xi.sel(soil=s).values, float)).all()
                  and np.ptp(values) <= 1e-9 * max(abs(values).max(), 1.0)]
     if not collapsed:
         return ""
-    asked = ""
-    if "restitution_requested" in cube:
-        requested = cube.restitution_requested.sel(block=block, model=band, soil=collapsed)
-        asked = f"r {float(requested.min()):.3f} to {float(requested.max()):.3f} asked"
-        if "restitution_target" in cube:
-            reached = cube.restitution_target.sel(block=block, model=band, soil=collapsed)
-            asked += f"; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any()) \
-                else "; it reaches none of them"
-        asked = f" ({asked})"
+    asked = f"r {float(requested.sel(soil=collapsed).min()):.3f} to {float(requested.sel(soil=collapsed).max()):.3f}"
+    reached = target.sel(soil=collapsed)
+    asked += (f" asked; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any())
+              else " asked; it reaches none of them")
     where = "every soil" if len(collapsed) == cube.soil.size else ", ".join(collapsed)
-    return (f" On {where} the restitution band collapses to one run for this block: the bed cannot tell the band's "
-            f"restitutions apart{asked}, so its three runs are the same; the model part of β there is 0 because "
-            "there is one run, not because the model is certain.")
+    return (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
+            f"restitutions apart ({asked}), so restitution adds nothing to β_parameters there because there is one "
+            "run, not because it is known; β_model there rests on the model-quality rating.")
 
 
 def curve_reason(results, model: str, block=None) -> str:
-    """Which curve answers and why; with ``block``, what the restitution band could not do for that block."""
+    """Which curve answers and why; with ``block``, what the restitution range could not do for that block."""
     if model == RECOMMENDED:
-        text = ("The answers use the recommended curve: the tensionless Winkler bed run over the experimental range "
-                "of impact restitution (the restitution band: its low edge, centre and high edge), the spread of "
-                "the three added to the record-to-record dispersion (FEMA P-58).")
+        text = ("The answers use the recommended curve: the tensionless Winkler bed with friction at the base, at "
+                "the middle of the experimental range of impact restitution and the soil's stated friction and "
+                "stiffness (the central member). Its β adds the model dispersion to the record-to-record one: the "
+                "larger of the spread of its median over a designed sample (restitution, friction and bed stiffness "
+                "each at both ends of its range) and FEMA P-695's rating of the model's form (a planar rigid block: "
+                "no three-dimensional rocking, no flexible superstructure).")
         if block is not None:
             return (_band_reach(getattr(results, "cube", None), block)
                     + _band_collapse(getattr(results, "cube", None), block)).strip()
@@ -174,13 +188,12 @@ def motion_tallies(cube, block: str, model: str, soil: str, intensities, scale: 
     each intensity (in the answer's unit, ``scale`` times the cube's), the level whose records the probability
     table counts; ``NO_LEVEL`` where no level lies that low, "-" where nothing is known. The records that lift off
     (rocks, slides and rocks, flies, overturns) are the uplift count of that table. From the runs of ``model``
-    (the recommended curve's: the restitution band's centre).
+    (the recommended curve's: its central member).
     """
     if cube is None or "intensity" not in cube:
         return ["-"] * len(intensities)
-    centres = [str(m) for m in cube.model.values if split_variant(str(m))[1] == "centre"]
-    name = (centres[0] if centres else None) if model == RECOMMENDED else model
-    if name is None or name not in cube.model.values:
+    name = model
+    if name not in cube.model.values:
         return ["-"] * len(intensities)
     levels = np.asarray(cube.intensity.sel(block=block).values, float) * scale
     cell = cube.sel(block=block, soil=soil, model=name)

@@ -802,3 +802,47 @@ def efficiency_page(dataset, caption, names: dict | None = None):
     bottom.grid(alpha=0.3, axis="y")
     outside_legend(figure, [top, bottom])
     return figure
+
+
+def sensitivity_state(fragility) -> str:
+    """The damage state the sensitivity page draws: overturning where the study has it, else its most severe."""
+    states = [str(s) for s in fragility.damage_state.values]
+    return "overturning" if "overturning" in states else states[-1]
+
+
+def sensitivity_page(fragility, caption, names: dict | None = None):
+    """Which sampled parameter moves the recommended median most, per block and soil (``median_sensitivity``).
+
+    One panel per block: for each soil, a bar per parameter (restitution, friction, bed stiffness) of the sigma of
+    ln(median) over its range, and the model-form term beta_form as a dashed line (beta_model is the larger of it
+    and the parameters' combined spread).
+    """
+    names = names or {}
+    state = sensitivity_state(fragility)
+    blocks = list(map(str, fragility.block.values))
+    figure = new_page(f"Model uncertainty: which parameter moves the recommended median ({state})", caption)
+    rows, columns = _grid(len(blocks))
+    axes = panels(figure, rows, columns, gridspec_kw=dict(hspace=0.55, wspace=0.3)).ravel()
+    parameters = [str(p) for p in fragility.parameter.values]
+    soils = list(map(str, fragility.soil.values))
+    width = 0.8 / max(len(parameters), 1)
+    x = np.arange(len(soils))
+    for axis, block in zip(axes, blocks):
+        spread = fragility.median_sensitivity.sel(block=block, damage_state=state)
+        for index, parameter in enumerate(parameters):
+            values = spread.sel(parameter=parameter, soil=soils).values
+            axis.bar(x + (index - (len(parameters) - 1) / 2) * width, np.nan_to_num(values), width,
+                     label=f"{parameter}", color=f"C{index % 10}")
+        form = fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()
+        if np.isfinite(form):
+            axis.axhline(form, color="k", lw=0.9, ls="--", label=f"beta_form {form:.2f} (FEMA P-695 rating)")
+        if not np.isfinite(spread.values).any():
+            empty_note(axis, "no median: the state was not reached below the credible cap")
+        axis.set_xticks(x, soils, fontsize=8)
+        axis.set_ylabel("σ of ln median [-]", fontsize=9)
+        axis.set_title(names.get(block, block), fontsize=10)
+        axis.grid(alpha=0.3, axis="y")
+    for axis in axes[len(blocks):]:
+        axis.set_visible(False)
+    outside_legend(figure, list(axes[:len(blocks)]))
+    return figure

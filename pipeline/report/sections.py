@@ -701,7 +701,7 @@ def _kinetic_words(soils) -> str:
 
 def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
-    from rockfrag.models.variants import DEFAULT_BAND
+    from rockfrag.models.variants import DEFAULT_DESIGN
 
     config, fragility = results.config, results.fragility
     labels = state_labels(fragility)
@@ -731,12 +731,25 @@ def sources_items(results: Results) -> list[Item]:
                             f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + STUDY_CHOICE + "."))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
-    band = tuple(float(v) for v in config.restitution_band)
+    design = config.design
+    band = tuple(float(v) for v in design.restitution_range)
     if any(not m.rigid_base and m.uses_bed for m in models_of(fragility)):
         source = ("the range experiments on rigid bases support (ElGawady et al. 2011; Kalliontzis et al. 2016; "
-                  "Ther & Kollár 2017)") if band == tuple(DEFAULT_BAND) else "the study file's own range"
-        items.append(bullet(f"Restitution band {band[0]:g} to {band[1]:g} × Housner's r = 1 − 1.5 sin²α, each edge "
-                            f"at most 0.99: {source}."))
+                  "Ther & Kollár 2017)") if band == tuple(DEFAULT_DESIGN.restitution_range) \
+            else "the study file's own range"
+        items.append(bullet(f"Restitution range of the recommended model's sample {band[0]:g} to {band[1]:g} × "
+                            f"Housner's r = 1 − 1.5 sin²α, each end at most 0.99: {source}."))
+        if "member" in fragility.coords:
+            own = design != DEFAULT_DESIGN
+            items.append(bullet(
+                f"Friction range of the sample: each soil's μ_s and μ_k × and ÷ {design.friction_factor:g} "
+                + ("(the study file's own)" if own else "(the widest ratio of the ends of NAVFAC DM-7.02 Table 1's "
+                   "ranges for concrete on soil, 0.55/0.45 on sand)")
+                + f"; bed stiffness: each soil's G × and ÷ {design.stiffness_factor:g} in eq. 19 "
+                + ("(the study file's own)." if own else "(ASCE 4-16 Section 5.1.7: G(1 + C_v) and G/(1 + C_v), "
+                   "C_v = 1 where the soil is not investigated at the site).")))
+            items.append(bullet(f"Model-form dispersion: {fragility.attrs.get('model_quality', '')}, FEMA P-695's "
+                                "rating of a nonlinear model (docs, 'Model uncertainty')."))
     return items
 
 

@@ -27,7 +27,6 @@ FIT_METHODS = {
     "exact-g-tan-alpha": "the exact uplift threshold g·tanα (a step)",
     "step-between-levels": "a step between two levels (every record changed state there)",
     "none": "no fit (the state was not reached, or reached by most records at the lowest level)",
-    "band-centre-p58": "the restitution band's centre, its dispersion widened by the band's spread (FEMA P-58)",
 }
 """``fit_method`` of fragility.nc in words."""
 
@@ -146,8 +145,9 @@ GLOSSARY = (
                        "adds it."),
     ("confidence bounds", "the bounds of a fitted curve's median from fitting it again with the records "
                           "resampled (bootstrap); drawn as shading around the curve."),
-    ("restitution band", "the range of impact restitution the recommended curve runs: its low edge, centre and "
-                         "high edge (the word 'band' means only this)."),
+    ("designed sample", "the runs of the recommended model with one uncertain parameter (restitution, friction, "
+                        "bed stiffness) at the low or high end of its range, the others central; the spread of "
+                        "their medians is β_parameters."),
     ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
                                "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, the "
                                "integral of the squared acceleration), D5-95 (the time between 5% and 95% of Ia)."),
