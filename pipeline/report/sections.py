@@ -21,6 +21,7 @@ from rockfrag.answer import (
     DEFAULT_LIMITS,
     DEFAULT_RETURN_PERIODS,
     DEFAULT_SLIDING_SHARE,
+    RECOMMENDED,
     BlockAnswer,
     answer_model,
     block_answers,
@@ -34,6 +35,7 @@ from rockfrag.config import StudyConfig
 from rockfrag.damage_states import DAMAGE_STATES, NOT_APPLICABLE, STUDY_CHOICE
 from rockfrag.errors import PipelineError
 from rockfrag.hazard import HazardCurve, study_hazard
+from rockfrag.models.variants import split_variant
 from rockfrag.report import numbers
 from rockfrag.report.adapters import (
     OUTCOME_FAILED,
@@ -57,6 +59,7 @@ from rockfrag.report.adapters import (
     soils_of,
     state_labels,
     tension_flag,
+    tied,
     vertical_applied,
 )
 from rockfrag.report.layout import pretty
@@ -588,17 +591,22 @@ def methods_items(results: Results) -> list[Item]:
     items = [heading("Models and their assumptions"),
              paragraph(f"'The paper' on these pages is the seed paper of this project: {PAPER_CITATION}")]
     bed = (config.raw.get("solver", {}) or {}).get("bed", "continuous")
+    described: dict[str, list[str]] = {}  # models described alike (the restitution band's runs): one bullet
     for model in models_of(cube):
         if model.rigid_base:
-            role = "rigid base: the result does not depend on the soil; computed once per block"
+            role = ("the soil enters only through its base friction where the base slides (Limitations, "
+                    "'Sliding'); with a tied base, computed once per block")
         else:
             rule = f"the bed: {plain(bed)}" if model.uses_bed else plain(config.switch)
             role = f"on a foundation of interface stiffness k (the paper's eq. 19) and the soil's damping ratio; {rule}"
-        items.append(bullet(pretty(f"{model.label}: {model.description}; {role}.")))
+        described.setdefault(f"{model.description}; {role}.", []).append(short_label(model))
+    every_model = [short_label(m) for m in models_of(cube)]
+    for text, labels in described.items():
+        items.append(bullet(pretty(f"{_models_words(labels, every_model)}: {text}")))
     items.append(paragraph(
         f"All models: planar rocking of a rigid block; the base does not slide unless the study's friction runs "
         "let it (a block whose base friction coefficient is below its width over height slides before it can "
-        "rock: Shenton 1996); "
+        "rock: Shenton 1996; the limitations' 'Sliding' says which runs include base friction); "
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
         f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
         f"failed integration (excluded from the fits){_vertical_outcome(cube)}."))
@@ -817,6 +825,64 @@ def _merged(rows, models_at, every_model) -> list[list[str]]:
     return out
 
 
+def _cells_words(config, cells, blocks, soils) -> str:
+    """The (block, soil) cells of a model in the fewest words: "every block on every soil", or per block."""
+    if len(cells) == len(blocks) * len(soils):
+        return "every block on every soil"
+    parts = []
+    for block in blocks:
+        on = [soil for soil in soils if (block, soil) in cells]
+        if on:
+            parts.append(f"the {block_name(config, block)} on {_soils_words(on, soils)}")
+    return "; ".join(parts)
+
+
+def friction_runs_words(results: Results) -> list[str]:
+    """Which runs of each model include base friction (they slide where they must), and which tie the base.
+
+    One sentence per group of models with the same cells (from the cube's ``friction_static``: finite where the
+    runs slide); a tied run whose friction demand the cube does not hold is said to be unchecked for sliding.
+    """
+    cube, config = results.cube, results.config
+    blocks, soils = list(map(str, cube.block.values)), list(map(str, cube.soil.values))
+    every_model = [short_label(m) for m in models_of(cube)]
+    ties = tied(cube)
+    demand = cube.peak_friction_demand if "peak_friction_demand" in cube else None
+    friction = {soil.name: soil.friction_static for soil in config.soils} if config is not None else {}
+    answer = answer_model(results.fragility) if results.fragility is not None else None
+    answering_models = {str(m) for m in cube.model.values  # the recommended curve's runs: the band's members
+                        if str(m) == answer or (answer == RECOMMENDED and split_variant(str(m))[1] is not None)}
+    groups: dict[tuple, list[str]] = {}
+    for model in models_of(cube):
+        sliding = frozenset((b, s) for b in blocks for s in soils
+                            if ties is not True and not bool(ties.sel(model=model.name, block=b, soil=s)))
+        tied_cells = [(b, s) for b in blocks for s in soils if (b, s) not in sliding]
+        checked = demand is not None and all(
+            bool(demand.sel(model=model.name, block=b, soil=s).notnull().any()) for b, s in tied_cells)
+        rocks_first = all(friction.get(s, -1.0) >= float(cube.block_b.sel(block=b) / cube.block_h.sel(block=b))
+                          for b, s in tied_cells)
+        key = (sliding, bool(tied_cells), checked, rocks_first, model.name in answering_models)
+        groups.setdefault(key, []).append(short_label(model))
+    texts = []
+    for (sliding, some_tied, checked, rocks_first, answering), labels in groups.items():
+        who = _models_words(labels, every_model)
+        who = who[0].upper() + who[1:]
+        if not sliding:
+            text = f"{who}: the base is tied (no sliding computed) for every block on every soil"
+        else:
+            text = (f"{who}: runs with base friction (the block slides where the friction is exceeded; its slip is "
+                    f"computed and the slip damage states judge it) for {_cells_words(config, sliding, blocks, soils)}")
+            if some_tied:
+                text += "; elsewhere the base is tied" + (
+                    " (there the soil's μ_s is at least the block's b/h: a block at rest rocks before it slides, "
+                    "Shenton 1996)" if rocks_first else "")
+        if some_tied and not checked:
+            text += ("; the tied runs do not record the friction they need, so whether their base would slide is not "
+                     "checked" + ("" if answering else ": they are references, not the answers"))
+        texts.append(text + ".")
+    return texts
+
+
 def limitations_items(results: Results) -> list[Item]:
     """The limitations pages: foundation tension, sliding, extrapolated medians, solver failures (from the results)."""
     cube, fragility, config = results.cube, results.fragility, results.config
@@ -824,14 +890,14 @@ def limitations_items(results: Results) -> list[Item]:
     items = [heading("Foundation tension")]
     flag = tension_flag(cube)
     found = False
+    tensionless = []  # said once for every model whose foundation cannot pull
     for model in models:
         if model.rigid_base or flag is None:
             continue
         fraction = run_fraction(cube, flag, model)
         if fraction is None:
             if not model.can_pull:
-                items.append(paragraph(f"{model.label}: the foundation cannot pull (tensionless); the block "
-                                       "lifts off instead."))
+                tensionless.append(short_label(model))
             continue
         found = True
         overall = float(fraction.mean())
@@ -845,6 +911,9 @@ def limitations_items(results: Results) -> list[Item]:
             f"({_percent(float(fraction.max()))}). A soil cannot pull: after the first tension these runs are not "
             "physical, and the model is outside its validity there. Fraction of runs with tension:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
+    if tensionless:
+        items.insert(1, paragraph(f"{_models_words(tensionless, [short_label(m) for m in models])}: the foundation "
+                                  "cannot pull (tensionless); the block lifts off instead."))
     if not found and any(not m.rigid_base and m.can_pull for m in models):
         items.append(paragraph("No model of this study reports the support force; tension was not checked."))
     elif not found:
@@ -860,13 +929,12 @@ def limitations_items(results: Results) -> list[Item]:
     items.append(heading("Sliding"))
     items.append(paragraph("Each soil's base friction and where it comes from: the page 'Reading the answer pages' "
                            "and the methods. It is the soil class's, not the block's own base."))
+    items += [paragraph(text) for text in friction_runs_words(results)]
     flag = friction_flag(cube)
-    found = False
     for model in models:
         fraction = None if flag is None else run_fraction(cube, flag, model)
         if fraction is None:
             continue
-        found = True
         if float(fraction.max()) == 0:
             items.append(paragraph(f"{model.label}, runs with a tied base: the friction needed to hold the base "
                                    f"never exceeded {coefficient}."))
@@ -879,9 +947,6 @@ def limitations_items(results: Results) -> list[Item]:
             "answer pages count the records at the level run at or below each return-period intensity. Fraction of "
             "runs above μ_s over all levels:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
-    if not found:
-        items.append(paragraph("No model of this study reports the friction demand (|H|/N at the base); every model "
-                               "assumes the base does not slide, which was not checked."))
 
     items.append(heading("Extrapolated fragility medians"))
     status = extrapolation(fragility, results.output)
