@@ -289,7 +289,10 @@ def test_intensity_axes_are_log_and_mark_the_hazard_and_the_extrapolation(small_
                 assert (axis.get_yscale() if along == "y" else axis.get_xscale()) == "log"
                 data = [line.get_ydata() if along == "y" else line.get_xdata() for line in axis.lines]
                 constant = {round(float(d[0]), 6) for d in data if len(d) == 2 and d[0] == d[1]}
-                for value in (*marks.intensities, marks.largest):
+                soil = getattr(axis, "rockfrag_soil", None)  # a panel of one soil marks its own site intensities
+                site = marks.for_soil(soil).intensities if soil is not None or not marks.by_soil else \
+                    [im for _, values in marks.by_soil for im in values]
+                for value in (*site, marks.largest):
                     low, high = axis.get_ylim() if along == "y" else axis.get_xlim()
                     if low <= value <= high:
                         assert round(value, 6) in constant, (figure.texts[0].get_text(), value)

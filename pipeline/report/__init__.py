@@ -35,10 +35,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 import xarray as xr  # noqa: E402
 from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
+from rockfrag.answer import display_scale  # noqa: E402
 from rockfrag.config import StudyConfig  # noqa: E402
 from rockfrag.damage_states import damage_states_from_config  # noqa: E402
 from rockfrag.outputs import atomic_path  # noqa: E402
@@ -150,7 +152,27 @@ def records_items(results: Results) -> list[Item]:
     else:
         header = ["record", "event", "station", "PGA [g]"]
         rows = [[*m, f"{pga:.2f}"] for m, pga in zip(meta, record_pga_g(cube))]
+    scaled = scaled_intensities(cube)
+    if scaled is not None:  # the intensity the study scales by, where it is not the component's own PGA
+        values, unit = scaled
+        header = [*header[:4], f"scaled by: RotD50 PGA of the pair [{unit}]", *header[4:]]
+        rows = [[*row[:4], f"{value:.2f}", *row[4:]] for row, value in zip(rows, values)]
     return [table(header, rows), note(STATION_NAMES)]
+
+
+def scaled_intensities(cube) -> tuple[np.ndarray, str] | None:
+    """Each record's unscaled intensity as the study scales it (``record_im``) and its unit, or None.
+
+    Only where it is the pair's RotD50 PGA: it differs from the component's PGA the records table lists.
+    """
+    if "record_im" not in cube.variables or str(cube.attrs.get("intensity_measure", "")).lower() != "pga" \
+            or str(cube.attrs.get("intensity_component", "")).upper() != "ROTD50":
+        return None
+    values = cube.record_im
+    if "block" in values.dims:  # PGA needs no block: every block's column is the same
+        values = values.isel(block=0)
+    scale, unit = display_scale(str(values.attrs.get("units", "")))
+    return np.asarray(values.values, float) * scale, unit
 
 
 STATION_NAMES = ("Stations are named as the records' source catalogue spells them (FEMA P695 Table A-4, from PEER's "
@@ -267,7 +289,10 @@ def plan(results: Results) -> list[Page]:
         ("limitations", "Limitations", "Limitations: where the models are outside their validity", limitations),
         ("records-table", "Records", "Intensity measures of the processed records",
          [*records_items(results), note("PGA, PGV, Arias intensity, significant duration and 5%-damped Sa(1 s) "
-                                        "after processing.")])])
+                                        "of each component after processing" + (
+                                            "; 'scaled by': the intensity the study scales the record by, the "
+                                            "RotD50 PGA of its station's pair (Methods), one value per pair"
+                                            if scaled_intensities(cube) is not None else "") + ".")])])
     if showcase is not None and "record_spectrum" in showcase:
         planned.append(_figure("spectra", "Records", "Response spectra of the record set", pages.spectra_page,
                                showcase, caption=CAPTIONS["spectra"]))

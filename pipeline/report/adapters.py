@@ -165,6 +165,18 @@ def measure_label(dataset) -> str:
     return f"{measure_short_label(measure, long_name)} [{unit}]"  # the registry's label (rockfrag.measures)
 
 
+def intensity_name(dataset) -> str:
+    """What the study's intensities are, in a few words: "the pair's RotD50 PGA" or "the component's PGA".
+
+    The methods define it in full (``rockfrag.report.sections.intensity_definition``); pages that print an
+    intensity beside a component's peak name it with these words.
+    """
+    measure = measure_label(dataset).split(" [")[0]
+    if str(dataset.attrs.get("intensity_component", "")).upper() == "ROTD50":
+        return f"the pair's RotD50 {measure}"
+    return f"the component's {measure}"
+
+
 def state_title(label: str) -> str:
     """A damage state's label shortened for a panel title: up to its first colon or parenthesis."""
     return re.split(r":| \(", label, maxsplit=1)[0].strip()
@@ -414,8 +426,17 @@ class CredibleMarks:
         The site's intensity at each return period.
     largest : float or None
         The largest intensity the unscaled records reached; beyond it, extrapolation by scaling.
+    by_soil : tuple of (str, tuple of float)
+        Each soil's own site intensity at each return period (its site hazard), where the soils differ; empty
+        when one hazard serves every soil (then ``intensities`` are every soil's).
     """
 
     return_periods: tuple = ()
     intensities: tuple = ()
     largest: float | None = None
+    by_soil: tuple = ()
+
+    def for_soil(self, soil) -> CredibleMarks:
+        """The marks of a panel of one soil: that soil's own site intensities (unchanged for an unknown soil)."""
+        own = dict(self.by_soil).get(None if soil is None else str(soil))
+        return self if own is None else CredibleMarks(self.return_periods, tuple(own), self.largest)

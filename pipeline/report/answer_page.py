@@ -26,6 +26,7 @@ from rockfrag.report import numbers
 from rockfrag.report.adapters import (
     block_description,
     block_name,
+    intensity_name,
     measure_label,
     model_info,
     sliding_at,
@@ -277,7 +278,9 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     largest = results.largest_recorded.get(answer.block)
     periods = answer.return_periods
     items.append(heading(f"At the site's intensity of each return period ({' / '.join(map(numbers.years, periods))})"))
-    items.append(paragraph(f"The largest {measure} of the records, unscaled: {numbers.intensity(largest, unit)}."))
+    named = intensity_name(cube) if cube is not None else measure
+    items.append(paragraph(f"The largest intensity of the records, unscaled ({named}, as every intensity on these "
+                           f"pages; Methods): {numbers.intensity(largest, unit)}."))
     sites = [[soil.soil, " / ".join(results.facts.say("site intensity", (answer.block, soil.soil, t),
                                                       numbers.intensity(im, unit))
                                     for t, im in zip(periods, soil_intensities(answer, soil))),

@@ -97,16 +97,22 @@ HAZARD_LABEL = "dotted: the site's intensity at each return period"
 """The legend's entry for the return-period lines (each is named on the axis, outside the data, or in the caption)."""
 
 
-def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> None:
+def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x", soil=None) -> None:
     """Mark the site's return-period intensities and the extrapolation by scaling on an intensity axis.
 
     Dotted lines at the return-period intensities; beyond the largest recorded intensity, a shade; ``along`` is
     the intensity axis ("x" or "y"). On an x axis the return periods are named above the panel, outside the data,
     each over its own line (close lines share a label: ``mark_groups``); on a y axis (IDA panels) the lines are
     named in the legend, from the lowest up. Call it after the axis limits and scale are set: the shading runs to
-    the axis end.
+    the axis end. Where each soil has its own site hazard, a panel of one ``soil`` marks that soil's intensities;
+    a panel of every soil (``soil`` None) marks each soil's in the soil's colour (``soil_marks``).
     """
     if marks is None:
+        return
+    if soil is not None:
+        marks = marks.for_soil(soil)
+    elif marks.by_soil:
+        soil_marks(axis, marks, along)
         return
     low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
     line = axis.axvline if along == "x" else axis.axhline
@@ -134,12 +140,47 @@ def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x") -> Non
         top.spines["top"].set_visible(False)
 
 
+SOIL_HAZARD_LABEL = "dotted, in each soil's colour: that soil's site intensity at each return period"
+"""The legend's entry for the return-period lines of a panel of every soil, where each soil has its own hazard."""
+
+
+def soil_marks(axis, marks: CredibleMarks, along: str = "x") -> None:
+    """Each soil's own return-period intensities on a panel of every soil: dotted lines in the soil's colour.
+
+    The extrapolation shade as ``mark_intensities``; the return periods are named once each (above the panel on
+    an x axis, at the geometric mean of the soils' intensities; on a y axis in the legend).
+    """
+    low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
+    line = axis.axvline if along == "x" else axis.axhline
+    mark_intensities(axis, CredibleMarks(largest=marks.largest), along)  # the shade and the largest recorded
+    periods = ", ".join(f"{float(t):,.0f}" for t in sorted(marks.return_periods)) + " years"
+    for index, (soil, intensities) in enumerate(marks.by_soil):
+        for intensity in intensities:
+            if low <= intensity <= high:
+                line(intensity, color=soil_colour(soil, index), lw=0.8, ls=":", alpha=0.9)
+    line(np.nan, color="0.3", lw=0.9, ls=":", label=f"{SOIL_HAZARD_LABEL}: {periods}")  # the legend's entry
+    if along != "x":
+        return
+    names = CredibleMarks(marks.return_periods, tuple(
+        float(np.exp(np.mean(np.log([values[i] for _, values in marks.by_soil]))))
+        for i in range(len(marks.return_periods))), None)
+    groups = mark_groups(axis, names, along)
+    if groups:
+        centres = [float(np.exp(np.mean(np.log(intensities)))) for intensities, _ in groups]
+        top = axis.secondary_xaxis("top")
+        top.set_xticks(centres, [text for _, text in groups])
+        top.minorticks_off()
+        top.tick_params(labelsize=MARK_SIZE, colors=MARK_COLOUR, length=2, pad=1)
+        top.spines["top"].set_visible(False)
+
+
 def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
     """The intensity range of a block's axes: its levels, widened to show the return-period intensities."""
     low, high = float(levels[0]), float(levels[-1])
-    if marks is not None and marks.intensities:
-        low = min(low, 0.9 * min(marks.intensities))
-        high = max(high, 1.1 * max(marks.intensities))
+    shown = [] if marks is None else [*marks.intensities, *(im for _, values in marks.by_soil for im in values)]
+    if shown:
+        low = min(low, 0.9 * min(shown))
+        high = max(high, 1.1 * max(shown))
     return low, high
 
 
@@ -341,6 +382,7 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
                 axis.set_visible(False)
                 continue
             model, soil = cells[column]
+            axis.rockfrag_soil = soil  # its soil's own site intensities are marked on it (None: every soil's)
             drawn.append(axis)
             picked = cell(ida, model, block, soil)
             edp = np.asarray(picked.edp.values, float)
@@ -371,7 +413,7 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
         log_y_axis(axis, span)
     for axis in drawn:
         if not getattr(axis, "rockfrag_empty", False):  # an empty panel's note stays clear of the marks
-            mark_intensities(axis, marks, along="y")
+            mark_intensities(axis, marks, along="y", soil=axis.rockfrag_soil)
     drawn[0].plot([], [], color="0.65", lw=0.5, label="one record")
     drawn[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at θmax/α = {IDA_CAP})")
     outside_legend(figure, drawn)  # every panel: an empty first one has no marks
@@ -500,8 +542,8 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
         log_axis(axis, span)
         axis.set_ylim(-0.02, 1.02)
         axis.grid(alpha=0.3, which="both")
-        if not getattr(axis, "rockfrag_empty", False):
-            mark_intensities(axis, marks, along="x")
+        if not getattr(axis, "rockfrag_empty", False):  # a panel of one soil: that soil's site intensities
+            mark_intensities(axis, marks, along="x", soil=getattr(axis, "rockfrag_soil", None))
         axis.tick_params(labelbottom=True, labelsize=8)  # every row: a panel is read on its own
     rows = axes.shape[0]
     # up to two rows each row's label fits beside it; from three rows on (seven damage states or more: a plugin's,
@@ -561,6 +603,7 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
         for column, state in enumerate(states):
             # one soil: _state_axes lays the states out on a grid, not in one row
             axis = axes[row, column] if len(soils) > 1 else axes.flat[column]
+            axis.rockfrag_soil = soil
             reasons = [_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
                                          styles[model.name], short_label(model), span) for model in models]
             title = f"{state_title(labels[state])} on {soil}"

@@ -200,7 +200,11 @@ class Results:
         answer = next((a for a in self.answers if a.block == str(block)), None)
         periods = answer.return_periods if answer is not None else ()
         intensities = tuple(im / scale for im in answer.intensities) if answer is not None else ()
-        return CredibleMarks(periods, intensities, self.largest_recorded[str(block)] / scale)
+        by_soil = tuple((soil.soil, tuple(im / scale for im in soil.intensities)) for soil in answer.soils
+                        if soil.intensities) if answer is not None else ()
+        if len({values for _, values in by_soil}) == 1:  # one site hazard for every soil: one set of marks
+            intensities, by_soil = by_soil[0][1], ()
+        return CredibleMarks(periods, intensities, self.largest_recorded[str(block)] / scale, by_soil)
 
 
 def _level_units(dataset) -> str:
@@ -585,6 +589,32 @@ def _vertical_records(cube) -> str:
             "records without it are compared on the pages 'Vertical component'. ")
 
 
+def intensity_definition(cube) -> str:
+    """The study's intensity measure defined once, in words: what every intensity of the report is.
+
+    For RotD50 (``intensity_component``): the median over horizontal directions of the pair's rotated motion
+    (Boore 2010), which differs from the peak of either component that the records table also lists.
+    """
+    measure = measure_label(cube).split(" [")[0]
+    long_name = str(cube.attrs.get("intensity_measure_long_name", "")) or measure
+    if str(cube.attrs.get("intensity_component", "")).upper() == "ROTD50":
+        return (f"Every intensity in this report (levels, fragility medians, the site's intensities, the largest "
+                f"recorded) is the {measure} of a station's pair of horizontal components as RotD50 (Boore 2010): "
+                f"the two components are combined into the motion along each horizontal direction, its {long_name} "
+                "is taken in every direction, and RotD50 is the median over the directions. It is not the peak of "
+                "either recorded component (the records table lists each component's peak and its pair's RotD50). "
+                "Both components of a pair are scaled by the same factor, and both are run.")
+    return (f"Every intensity in this report is the {long_name} ({measure}) of the record's own horizontal "
+            "component.")
+
+
+def _weakest_intensity(cube) -> float:
+    """The smallest unscaled intensity of a record [the cube's unit] (the largest scale factor's denominator)."""
+    if "record_im" not in cube.variables:
+        return float("nan")
+    return float(np.nanmin(np.asarray(cube.record_im.values, float)))
+
+
 def methods_items(results: Results) -> list[Item]:
     """The methods pages: models, soils and blocks, records and processing, scaling, fits, hazard and risk."""
     config, cube, fragility = results.config, results.cube, results.fragility
@@ -637,8 +667,8 @@ def methods_items(results: Results) -> list[Item]:
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
     items += [heading("Record set and processing"),
               paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
-                        f"from {events} earthquake{'s' if events != 1 else ''}; PGA of the processed records "
-                        f"{pga.min():.2g} to {pga.max():.2g} g. {_vertical_records(cube)}"
+                        f"from {events} earthquake{'s' if events != 1 else ''}; peak ground acceleration of each "
+                        f"processed component {pga.min():.2g} to {pga.max():.2g} g. {_vertical_records(cube)}"
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
                         "files and each record's processing steps are stored with the results.")]
 
@@ -650,14 +680,26 @@ def methods_items(results: Results) -> list[Item]:
     median_factor, largest_factor = scale_factor_summary(cube)
     relative = cube.im_level.attrs.get("units") == "1"
     scale, unit = display_scale(_level_units(cube))
-    text = (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure}, "
-            f"{levels.min():.3g} to {levels.max():.3g}"
-            f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}. Scale factors: "
-            f"median {median_factor:.2g}, largest {largest_factor:.3g}.")
-    if "intensity" in cube.variables and "block" in cube["intensity"].dims:
-        ranges = "; ".join(f"{block_name(config, b)} {block_levels(cube, b).min() * scale:.2g} to "
-                           f"{block_levels(cube, b).max() * scale:.2g} {unit}" for b in cube.block.values)
-        text += f" Each block has its own levels ({ranges})."
+    text = intensity_definition(cube) + " "
+    per_block = "intensity" in cube.variables and "block" in cube["intensity"].dims
+    if relative and per_block and "level_multiple" in cube.variables:  # each block's own multiples of its uplift
+        ranges = "; ".join(f"{block_name(config, b)} {row.min():.2g} to {row.max():.3g} times, "
+                           f"{block_levels(cube, b).min() * scale:.2g} to {block_levels(cube, b).max() * scale:.2g} "
+                           f"{unit}" for b, row in zip(cube.block.values, levels))
+        text += (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure} per block, "
+                 f"spacing {spacing}, from a multiple of the block's uplift intensity up ({ranges}).")
+    else:
+        text += (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure}, "
+                 f"{levels.min():.3g} to {levels.max():.3g}"
+                 f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}.")
+        if per_block:
+            ranges = "; ".join(f"{block_name(config, b)} {block_levels(cube, b).min() * scale:.2g} to "
+                               f"{block_levels(cube, b).max() * scale:.2g} {unit}" for b in cube.block.values)
+            text += f" Each block has its own levels ({ranges})."
+    weakest = _weakest_intensity(cube) * scale
+    text += (f" Scale factors (a level over the record's own unscaled intensity): median {median_factor:.2g}, "
+             f"largest {largest_factor:.3g}" + (f" (the highest level over the weakest record's intensity, "
+                                                 f"{weakest:.2g} {unit})" if np.isfinite(weakest) else "") + ".")
     largest = ", ".join(f"{v:.2g} {unit}" for v in dict.fromkeys(results.largest_recorded.values()))
     text += (f" The largest intensity of the unscaled records is {largest}: above it every result is an "
              "extrapolation by scaling (shaded on the figures), kept because the analysis must reach overturning; "
