@@ -179,3 +179,56 @@ def xr_array(values, cube):
     import xarray as xr
 
     return xr.DataArray(np.asarray(values, float), coords={"block": cube.block.values}, dims="block")
+
+
+def test_contents_numbers_a_section_by_the_page_its_heading_is_on():
+    """Finding 23: a section that starts part-way down a page (Methods after the fitted-functions table) was
+    numbered by the next page, where its text continues ("Methods 14", its heading on p. 13)."""
+    from rockfrag.report import contents_rows
+    from rockfrag.report.layout import Page
+
+    def page(section, heading, also=()):
+        return Page(section.lower(), section, heading, lambda: None, "", also=also, heading=heading)
+
+    planned = [page("Title", "Title"), page("Fitted curves", "Fitted fragility functions", also=("Methods",)),
+               page("Methods", "Methods and assumptions"), page("Methods", "Methods and assumptions"),
+               page("Limitations", "Limitations: where the models are outside their validity")]
+    rows = contents_rows(planned, position=2)  # the contents is page 2: the fitted table is page 3
+    assert ("section", "Methods", 3) in rows and ("page", "Methods and assumptions", 3) in rows
+    assert [row for row in rows if row[2] in (4, 5)] == []  # Methods' own pages are not listed again
+    assert ("section", "Limitations", 6) in rows
+
+
+def test_every_contents_row_names_a_title_on_its_page(small_pipeline):
+    """The contents of the small pipeline's report: each row's page holds its section (as the page's own or one
+    starting part-way down it) or its heading."""
+    from rockfrag.report import build_plan, contents_rows, plan
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    planned = plan(results)
+    pages = build_plan(results)
+    position = next(i for i, p in enumerate(pages, start=1) if p.name == "contents")
+    first_heading = {}
+    for p in planned:
+        first_heading.setdefault(p.section, p.heading or p.title)
+    for kind, text, number in contents_rows(planned, position):
+        page = pages[number - 1]
+        if kind == "section":
+            assert text == page.section or text in page.also, (text, number)
+        else:
+            assert text == (page.heading or page.title) or text in [first_heading[s] for s in page.also], \
+                (text, number)
+
+
+def test_the_example_hazard_is_said_once_and_referred_to(small_pipeline):
+    """Findings 15/22: "not a site's hazard" was said about ten times in different words (and once garbled:
+    "amplified from the shipped example hazard, which is no site's to the soil's site class"). The summary says it
+    in full, once; every other page before the appendix refers to it in the same few words."""
+    from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, EXAMPLE_WARNING
+
+    html = (small_pipeline.output / "report.html").read_text()
+    text = _visible_text(html[:html.index("id='section-how-to-reproduce-this-report'")])
+    assert text.count(EXAMPLE_WARNING) == 1
+    assert text.count("no verdict in this report applies to a real site") == 1
+    assert "shipped example" not in text and "which is no site's" not in text
+    assert text.count(EXAMPLE_HAZARD_WORDS) >= 3  # the title page, the answer pages, the methods

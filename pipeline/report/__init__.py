@@ -363,11 +363,15 @@ CONTENTS_LINES = 36  # lines per column of the contents page
 CONTENTS_WIDTH = 62  # characters per line of a contents column (two columns); longer titles wrap, never cut
 
 
-def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
-    """The contents: every section and page title with its page number (the contents itself is page ``position``).
+def contents_rows(planned: list[Page], position: int = 2) -> list[tuple[str, str, int]]:
+    """The contents' rows: ("section" or "page", title, the number of the page it starts on).
 
-    Titles are wrapped, never cut; the HTML links every page and every section.
+    The contents itself is page ``position``. A section that starts part-way down a page (``Page.also``) is
+    listed with that page, its title too: not with the next page, where its text continues.
     """
+    first_heading = {}  # a section's title: the heading of its first own page
+    for page in planned:
+        first_heading.setdefault(page.section, page.heading or page.title)
     rows, last, listed = [], None, None
     for number, page in enumerate(planned, start=1):
         shown = number + (1 if number >= position else 0)  # the contents is inserted at ``position``
@@ -380,7 +384,18 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
         listed = heading
         for section in page.also:  # a section that starts part-way down this page
             rows.append(("section", section, shown))
-            last, listed = section, section
+            last, listed = section, first_heading.get(section, section)
+            if listed != section:
+                rows.append(("page", listed, shown))
+    return rows
+
+
+def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
+    """The contents: every section and page title with its page number (the contents itself is page ``position``).
+
+    Titles are wrapped, never cut; the HTML links every page and every section.
+    """
+    rows = contents_rows(planned, position)
     lines = []
     for index, (kind, text, number) in enumerate(rows):
         if kind == "section" and index + 1 < len(rows) and rows[index + 1][0] == "page":

@@ -63,6 +63,7 @@ from rockfrag.report.adapters import (
     vertical_applied,
 )
 from rockfrag.report.layout import pretty
+from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
@@ -339,8 +340,8 @@ def title_items(results: Results) -> list[Item]:
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
         *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
-        *([strong("The hazard is the shipped example, not a site's: the verdicts apply to no real site.")]
-          if any(answer.example_hazard for answer in results.answers) else []),
+        *([strong(f"Hazard: {EXAMPLE_HAZARD_WORDS}.")] if any(answer.example_hazard for answer in results.answers)
+          else []),
         paragraph("The next page is the summary: the action for each block on each soil, and why. Then the "
                   "contents, one answer page per block (at the site's return periods, how likely each damage state "
                   "is, how likely in the design life, and what the records did), the fragility of each block on each "
@@ -534,7 +535,7 @@ def _hazard_words(results: Results) -> str:
     if results.hazard is None:
         return "none for the study's intensity measure"
     if EXAMPLE_HAZARD in results.hazard.source:
-        return "the shipped example curve, which is no site's: its verdicts do not apply to a real site"
+        return EXAMPLE_HAZARD_WORDS
     return "the site's curve given with the study (its file is named in 'How to reproduce this report')"
 
 

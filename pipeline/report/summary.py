@@ -30,10 +30,14 @@ BETA_PARTS = (("beta_record_to_record", "records"),
 """The parts of a fitted row's total dispersion β that fragility.nc may hold, and their words. ``beta_model`` is
 the whole model part: it is named only when the file does not split it into parameters and form."""
 
-EXAMPLE_WARNING = ("The hazard of this report is the shipped example curve, not a site's: no verdict in this "
-                   "report applies to a real site. The probabilities show how the method reads a hazard; a site's own "
-                   "hazard curve gives the verdicts.")
-"""The summary's first line when the hazard is the shipped example."""
+EXAMPLE_WARNING = ("The hazard of this report is the example hazard curve that comes with the tool, not a site's: "
+                   "no verdict in this report applies to a real site. The probabilities show how the method reads a "
+                   "hazard; a site's own hazard curve gives the verdicts. The other pages say this once more only as "
+                   "'the example hazard (not a site's: see the summary)'.")
+"""The summary's first line when the hazard is the shipped example: the report's one full statement of it."""
+
+EXAMPLE_HAZARD_WORDS = "the example hazard (not a site's: see the summary)"
+"""How every other page names the shipped example hazard: a reference to ``EXAMPLE_WARNING``, not a repeat."""
 
 
 def action(verdict: str, soil=None) -> str:
@@ -197,13 +201,13 @@ def hazard_words(results, answer) -> str:
     """The hazard the probabilities come from, named: the shipped example or the site's, per soil or not."""
     if not answer.return_periods:
         return "no hazard curve"
-    source = "the shipped example hazard, which is no site's" if answer.example_hazard else "the site's hazard"
+    source = EXAMPLE_HAZARD_WORDS if answer.example_hazard else "the site's hazard"
     sites = getattr(results, "site_hazards", None)
     if sites is None or len(sites) < 2:
         return source
     if sites.reference is not None:
-        return f"each soil's site hazard, amplified from {source} to the soil's site class"
-    return "each soil's own site hazard, as the study gives it" + (" (the shipped example)"
+        return f"each soil's site hazard: {source}, carried to the soil's site class"
+    return "each soil's own site hazard, as the study gives it" + (f" ({EXAMPLE_HAZARD_WORDS})"
                                                                   if answer.example_hazard else "")
 
 
@@ -302,8 +306,7 @@ def verdict_items(results, answer) -> list[Item]:
     groups: dict[str, list] = {}
     for soil in answer.soils:
         groups.setdefault(soil.verdict, []).append(soil)
-    lead = (f"With the shipped example hazard (not a site's, so no verdict for a real site), the {name}: "
-            if answer.example_hazard else f"Verdict for the {name}: ")
+    lead = (f"With {EXAMPLE_HAZARD_WORDS}, the {name}: " if answer.example_hazard else f"Verdict for the {name}: ")
     parts = []
     for verdict, soils in groups.items():
         where = _and([soil.soil for soil in soils])

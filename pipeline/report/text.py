@@ -163,9 +163,14 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
                 queue.insert(0, tail)
             continue
         if used + need > capacity and current:
-            if current[-1].kind == "heading":  # keep a heading with what follows it
-                pages.append(current[:-1])
-                current, used = [current[-1]], _lines(current[-1])
+            if current[-1].kind == "heading":  # keep the headings (a section's, then its first) with what follows
+                kept = 1
+                while kept < len(current) and current[-1 - kept].kind == "heading":
+                    kept += 1
+                if kept < len(current):  # a page of headings only stays as it is
+                    pages.append(current[:-kept])
+                    current = current[-kept:]
+                    used = sum(_lines(c) for c in current)
             else:
                 pages.append(current)
                 current, used = [], 0

@@ -74,6 +74,9 @@ REFERENCES = {
     "ElGawady et al. 2011": "ElGawady, M. A., Ma, Q., Butterworth, J. W., Ingham, J. (2011). Effects of interface "
                             "material on the performance of free rocking blocks. Earthquake Engineering & "
                             "Structural Dynamics 40(4), 375-392.",
+    "Boore 2010": "Boore, D. M. (2010). Orientation-independent, nongeometric-mean measures of seismic intensity "
+                  "from two horizontal components of motion. Bulletin of the Seismological Society of America "
+                  "100(4), 1830-1835, doi:10.1785/0120090400.",
     "Baker 2015": "Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural "
                   "analysis. Earthquake Spectra 31(1), 579-599.",
     "Vamvatsikos & Cornell 2002": "Vamvatsikos, D., Cornell, C. A. (2002). Incremental dynamic analysis. "
