@@ -279,8 +279,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     periods = answer.return_periods
     items.append(heading(f"At the site's intensity of each return period ({' / '.join(map(numbers.years, periods))})"))
     named = intensity_name(cube) if cube is not None else measure
-    items.append(paragraph(f"The largest intensity of the records, unscaled ({named}, as every intensity on these "
-                           f"pages; Methods): {numbers.intensity(largest, unit)}."))
+    items.append(paragraph(f"The largest intensity of the records, unscaled ({named}): "
+                           f"{numbers.intensity(largest, unit)}."))  # short: it stands on every answer page
     sites = [[soil.soil, " / ".join(results.facts.say("site intensity", (answer.block, soil.soil, t),
                                                       numbers.intensity(im, unit))
                                     for t, im in zip(periods, soil_intensities(answer, soil))),
