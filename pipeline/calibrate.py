@@ -1532,7 +1532,7 @@ def _validate(model, ref_time, ref_rotation, ag, dt, k_range, xi_range, n_k, n_x
 
 
 def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: float, block: Block, *,
-              model: str = "ssi", k_range: tuple[float, float] = (1e8, 9e8),
+              model: str = "ssi", k_range: tuple[float, float] = (1e8, 1e9),
               xi_range: tuple[float, float] = (0.01, 0.07), n_k: int = 25, n_xi: int = 7,
               soil_shear_modulus: float | None = None, switch: str = "consistent", local: bool = True,
               smoothing_hz: float | None = SMOOTHING_HZ, log: Callable[[str], object] | None = None,

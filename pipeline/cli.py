@@ -559,8 +559,9 @@ def build_parser() -> argparse.ArgumentParser:
     calibrate.add_argument("--soil", default=None, help="soil of the study, for the implied A/H of eq. 19")
     calibrate.add_argument("--soil-g", type=POSITIVE, default=None, metavar="PA",
                            help="soil shear modulus G_s [Pa] for the implied A/H (overrides --soil)")
-    calibrate.add_argument("--k-range", type=POSITIVE, nargs=2, default=(1e8, 9e8), metavar=("MIN", "MAX"),
-                           help="stiffness grid [N/m] (default 1e8 9e8 = the paper's 1e5-9e5 kN/m)")
+    calibrate.add_argument("--k-range", type=POSITIVE, nargs=2, default=(1e8, 1e9), metavar=("MIN", "MAX"),
+                           help="stiffness search range [N/m] (default 1e8 1e9: the paper's 1e5-9e5 kN/m and up to "
+                                "the coverage benchmark's 1e9)")
     calibrate.add_argument("--xi-range", type=_number_type(0, high=1, high_open=True), nargs=2,
                            default=(0.01, 0.07), metavar=("MIN", "MAX"),
                            help="damping-ratio grid [-] (default 0.01 0.07)")
