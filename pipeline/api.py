@@ -44,7 +44,7 @@ def run_study(config: StudyConfig, *, output: str | Path | None = None, workers:
     Returns
     -------
     cube : xarray.Dataset
-        The study cube (record x im_level x soil x block x model; README, "Outputs"), as written to ``cube.nc``.
+        The study cube (record x im_level x soil x block x model; docs/reference/outputs.md), as written to ``cube.nc``.
     statistics : dict
         The run's counts and timings: ``cells``, ``cells_reused``, ``runs_computed``, ``seconds``, ``failures``
         (the records skipped, each with its reason), ...

@@ -75,7 +75,7 @@ TAIL_SIGMAS = 6.0
 both are set this many beta beyond every curve of the function (and beyond the studied range): there a
 lognormal is within Phi(-6) = 1e-9 of 0 or 1. With minIML at the lowest level studied, a curve with P = 0.001
 there would keep P = 0.001 down to zero intensity, and a classical damage calculation on a hazard curve that
-starts at 0.005 g would find hundreds of times our annual frequency (README, exchange files)."""
+starts at 0.005 g would find hundreds of times our annual frequency (docs/guide/exchange.md)."""
 
 NRML_NAMESPACE = "http://openquake.org/xmlns/nrml/0.5"
 

@@ -91,7 +91,7 @@ FRICTION_SOURCES = (
     "steel faying surfaces (AISC 360-16 Specification for Structural Steel Buildings, J3.8, class B surfaces), "
     "below the 0.74 of clean dry mild steel in the laboratory (Marks' Standard Handbook for Mechanical "
     "Engineers, Table 3.2.1); 0.40 kinetic (0.8 x static).")
-"""Where the shipped soils' friction coefficients come from (README, "The models")."""
+"""Where the shipped soils' friction coefficients come from (docs/theory/sliding.md)."""
 
 
 @dataclass(frozen=True)

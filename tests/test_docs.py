@@ -26,14 +26,28 @@ pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("docs")]
 
 PAGES = {
     "getting-started.html": "Getting started",
+    "guide/index.html": "User guide",
+    "guide/command-line.html": "The command line",
+    "guide/studies.html": "Study files",
+    "guide/records.html": "Records and their processing",
+    "guide/report.html": "How to read the report",
+    "guide/exchange.html": "Exchange files",
+    "guide/calibration.html": "Calibrating the interface",
+    "default-study.html": "The default study and its answer",
     "tutorials/index.html": "Tutorials",
     "theory/index.html": "Theory",
+    "theory/intensity.html": "Intensity",
+    "theory/site.html": "The site",
+    "theory/references.html": "References",
     "verification.html": "Verification",
     "reference/index.html": "Reference",
     "reference/cli.html": "Command line",
     "reference/study-keys.html": "Study keys",
     "reference/outputs.html": "Output variables",
     "reference/api.html": "API",
+    "development/index.html": "Development",
+    "development/performance.html": "Performance",
+    "development/extending.html": "Extending rockfrag",
 }
 """Pages the site must have, with the title each must carry."""
 
@@ -69,6 +83,17 @@ def test_the_site_builds_from_docs_only_with_pages_in_the_toctree(site):
     index = (site / "index.html").read_text(encoding="utf-8")
     for name in PAGES:
         assert f'href="{name}"' in index, f"{name} is not reachable from the front page"
+
+
+def test_the_theory_pages_cite_what_they_rest_on(site):
+    """The site term, the convolution, RotD50 and the credible cap are cited, with full references."""
+    references = text_of(site / "theory" / "references.html")
+    for source in ("Earthquake Spectra 30(3), 1057–1085", "1241–1256", "94(6), 2110–2123", "100(4), 1830–1835",
+                   "Table 20.3-1", "Biometrika 26(4), 404–413", "MYG004"):
+        assert source in references, f"the references lack {source!r}"
+    site_page, intensity = text_of(site / "theory" / "site.html"), text_of(site / "theory" / "intensity.html")
+    assert "Seyhan & Stewart" in site_page and "Bazzurro & Cornell" in site_page
+    assert "Boore 2010" in intensity and "censored-at-cap" in intensity
 
 
 def test_every_tutorial_ran_in_this_build(site):

@@ -104,10 +104,11 @@ def pelicun_expected(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
 
 
 def readme_example(command: str) -> str:
-    """The Python of the README's example run by ``command`` (a shell block ``COMMAND - <<'EOF' ... EOF``)."""
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    found = re.findall(rf"^{re.escape(command)} - <<'EOF'\n(.*?)^EOF$", readme, flags=re.MULTILINE | re.DOTALL)
-    assert len(found) == 1, f"the README has {len(found)} examples run by {command}"
+    """The Python of the documented example run by ``command`` (a shell block ``COMMAND - <<'EOF' ... EOF``) in
+    docs/guide/exchange.md, the page that holds the README's former exchange-file section."""
+    page = (ROOT / "docs" / "guide" / "exchange.md").read_text(encoding="utf-8")
+    found = re.findall(rf"^{re.escape(command)} - <<'EOF'\n(.*?)^EOF$", page, flags=re.MULTILINE | re.DOTALL)
+    assert len(found) == 1, f"docs/guide/exchange.md has {len(found)} examples run by {command}"
     return found[0]
 
 

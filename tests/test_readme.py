@@ -1,6 +1,8 @@
-"""README examples run as printed: the Python blocks execute (on one shipped record), every `rockfrag` line
-parses with the real command-line parser, every `make` target named exists, and the outputs table names what
-`rockfrag fragility` writes, checked on the session's small pipeline run (fixture ``small_pipeline``)."""
+"""The README's and the documentation pages' examples run as printed: the Python blocks execute (on one shipped
+record), every `rockfrag` line parses with the real command-line parser, every `make` target named exists, and the
+outputs table (docs/reference/outputs.md) names what `rockfrag fragility` writes, checked on the session's small
+pipeline run (fixture ``small_pipeline``). The README is the front page; the long sections it held are pages of the
+documentation site (docs/), read here as written (their Markdown sources)."""
 
 from __future__ import annotations
 
@@ -13,11 +15,18 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
-FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.MULTILINE | re.DOTALL)
+PAGES = sorted(path for folder in ("docs", "docs/guide", "docs/theory", "docs/development", "docs/reference")
+               for path in (ROOT / folder).glob("*.md"))
+"""The hand-written pages of the documentation site (not the generated reference, the tutorials or the build)."""
+SOURCES = {"README.md": README, **{str(path.relative_to(ROOT)): path.read_text(encoding="utf-8") for path in PAGES}}
+TEXT = "\n".join(SOURCES.values())
+FENCE = re.compile(r"^```([^\n]*)\n(.*?)^```", re.MULTILINE | re.DOTALL)  # any info string: ```{toctree} too
 
 
-def code_blocks(language):
-    return [body for lang, body in FENCE.findall(README) if lang == language]
+def code_blocks(language, text=None):
+    """The bodies of the fenced blocks in ``language`` ("" for none) of ``text``, else of every source."""
+    texts = [text] if text is not None else SOURCES.values()
+    return [body for source in texts for lang, body in FENCE.findall(source) if lang.strip() == language]
 
 
 def command_lines(program):
@@ -31,8 +40,15 @@ def command_lines(program):
 
 
 def test_readme_has_python_examples_and_commands():
-    assert code_blocks("python"), "the README lost its Python example"
+    assert code_blocks("python", README), "the README lost its Python example"
     assert command_lines("rockfrag") and command_lines("make")
+    assert len(PAGES) >= 15, "the documentation pages are not where this test reads them"
+
+
+def test_readme_is_a_front_page_that_says_where_the_docs_are():
+    assert len(README.splitlines()) <= 250, "the README is a front page of at most 250 lines"
+    for needed in ("make fragility", "make test", "make docs", "docs/_build/html/index.html", "```python"):
+        assert needed in README, f"the front page lost {needed!r}"
 
 
 @pytest.mark.parametrize("number", range(len(code_blocks("python"))))
@@ -41,7 +57,8 @@ def test_python_example_runs_as_printed(number, tmp_path, monkeypatch, capsys):
     namespace = {"__name__": "__readme__"}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # physics warnings (e.g. tension) are fine to print
-        exec(compile(code_blocks("python")[number], f"README.md python block {number + 1}", "exec"), namespace)
+        exec(compile(code_blocks("python")[number], f"python block {number + 1} of the README and docs", "exec"),
+             namespace)
     assert capsys.readouterr().out.strip(), "the example should print what it computed"
 
 
@@ -58,7 +75,7 @@ def test_every_rockfrag_line_parses():
         try:
             parser.parse_args(words)
         except SystemExit as error:
-            pytest.fail(f"README line does not parse: {line!r} (exit {error.code})")
+            pytest.fail(f"documented line does not parse: {line!r} (exit {error.code})")
         checked += 1
     assert checked >= 5
 
@@ -67,9 +84,9 @@ def test_every_make_target_exists():
     makefile = (ROOT / "Makefile").read_text()
     targets = set(re.findall(r"^([a-z][\w-]*):", makefile, re.MULTILINE))
     named = {shlex.split(line)[1] for line in command_lines("make")}
-    named |= set(re.findall(r"`make ([a-z][\w-]*)`", README))
+    named |= set(re.findall(r"`make ([a-z][\w-]*)`", TEXT))
     missing = named - targets
-    assert not missing, f"README names make targets the Makefile lacks: {sorted(missing)}"
+    assert not missing, f"the README or the docs name make targets the Makefile lacks: {sorted(missing)}"
 
 
 def test_readme_says_where_rockfrag_lives():
@@ -77,8 +94,8 @@ def test_readme_says_where_rockfrag_lives():
 
 
 def outputs_table() -> dict[str, str]:
-    """{file cell: written-by cell} of the README's outputs table."""
-    section = README.split("## Outputs", 1)[1].split("\n## ", 1)[0]
+    """{file cell: written-by cell} of the outputs table (docs/reference/outputs.md, "The files")."""
+    section = SOURCES["docs/reference/outputs.md"].split("## The files", 1)[1].split("\n## ", 1)[0]
     rows = {}
     for line in section.splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
@@ -105,14 +122,14 @@ def test_outputs_table_matches_what_fragility_writes(small_pipeline):
     output = small_pipeline.output
     for name in claimed:
         found = list(output.glob(name))
-        assert found and all(p.is_dir() or p.stat().st_size > 0 for p in found), f"README: fragility writes {name}"
+        assert found and all(p.is_dir() or p.stat().st_size > 0 for p in found), f"table: fragility writes {name}"
     for name in not_claimed:
-        assert not list(output.glob(name)), f"README says only another command writes {name}"
+        assert not list(output.glob(name)), f"the outputs table says only another command writes {name}"
     assert not list(output.glob(".*.part"))
 
 
 def runnable_commands() -> list[str]:
-    """The README's `rockfrag` lines that run on shipped inputs in seconds: `rockfrag study` and every line on a
+    """The documented `rockfrag` lines that run on shipped inputs in seconds: `rockfrag study` and every line on a
     shipped file under studies/ (the default-study runs take minutes: CI's clean clone covers those through the
     same commands on the small study; dask lines start a cluster of processes, tested on their own elsewhere)."""
     lines = []
@@ -142,4 +159,4 @@ def test_readme_commands_on_shipped_inputs_run_as_printed(tmp_path, capsys):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             status = main(words)
-        assert status == 0, f"README line failed: rockfrag {command}: {capsys.readouterr().err[-500:]}"
+        assert status == 0, f"documented line failed: rockfrag {command}: {capsys.readouterr().err[-500:]}"

@@ -31,7 +31,7 @@ def test_the_study_is_one_block_of_its_own_on_two_soils_with_its_site_hazard():
     block = config.blocks[0]
     assert (block.b, block.h, block.mass) == (0.6, 1.5, 4500.0)
     assert "solid block" in config.raw["report"]["block_names"][block.name]  # the name the client reads
-    assert Path(config.hazard_file).resolve() == HAZARD.resolve()  # relative to the study file's folder, wherever the command runs
+    assert Path(config.hazard_file).resolve() == HAZARD.resolve()  # relative to the study file, not the working folder
     assert config.reference_vs30 == 760.0 and config.record_sets == ("far-field",)
 
 

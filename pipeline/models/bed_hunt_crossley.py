@@ -21,7 +21,7 @@ about the settled state delta = y_static = g / omega^2 the linearised damping fo
 K y_static c y' = C y' with C = 2 xi sqrt(K m), so c = 2 xi omega / g. The bed at rest damps its
 vertical vibration as the Kelvin-Voigt bed of the same xi; its impacts lose more, because the damping
 is weighted by the penetration and so acts nearer the landing corner (rockfrag.models.restitution
-calibrates xi to a target restitution; the README gives the range it reaches). q(s) is a product of
+calibrates xi to a target restitution; docs/theory/bed.md gives the range it reaches). q(s) is a product of
 two linear functions of s, so the force and its moment are integrated exactly over the loaded length
 (where both factors are positive).
 """

@@ -40,7 +40,7 @@ one ``note`` line, not an error.
 
 Which law a bed is calibrated with (``calibrated_law``): ``two-spring`` its own Kelvin-Voigt xi;
 ``continuous`` and ``hunt-crossley`` the Hunt-Crossley damping (bed_hunt_crossley.py), because the
-continuous Kelvin-Voigt dashpot leaves r at 0.96-0.98 whatever xi (README, "The models").
+continuous Kelvin-Voigt dashpot leaves r at 0.96-0.98 whatever xi (docs/theory/bed.md).
 """
 
 from __future__ import annotations
