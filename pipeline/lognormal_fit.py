@@ -159,12 +159,21 @@ def fit_independent(levels, exceed, total, start=None):
     not_everywhere = ((exceed < total) & (total > 0)).any(-1)
     regular = reached & not_everywhere & ~separated
     if separated.any():
-        # a step between two levels; but a step at the lowest or highest level with data only says
-        # that the median lies outside the range: no estimate (NaN)
+        # a step between two levels, or at the one mixed level. A mixed level at the edge of the data brackets the
+        # median only from its inner side: the lowest level with fewer than half the records in the state (every
+        # record is at the next level up: the median lies between them), the highest with more than half (none
+        # below it). On its outer side (the lowest with half or more, the highest with half or fewer), or with one
+        # level of data, the step only says that the median lies outside the range: no estimate (NaN).
         _, first_some, last_not_all = separation(exceed, total)
         data_index = np.where(total > 0, np.arange(levels.size), -1)
-        at_edge = (first_some == last_not_all) & ((first_some == data_index.max(-1)) | (
-            first_some == np.where(total > 0, np.arange(levels.size), levels.size).min(-1)))
+        lowest = np.where(total > 0, np.arange(levels.size), levels.size).min(-1)
+        highest = data_index.max(-1)
+        mixed = np.clip(first_some, 0, levels.size - 1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fraction = np.take_along_axis(exceed / total, mixed[..., None], -1)[..., 0]
+        at_edge = (first_some == last_not_all) & (
+            (lowest == highest) | ((first_some == lowest) & ~(fraction < 0.5))
+            | ((first_some == highest) & ~(fraction > 0.5)))
         step = separated & ~at_edge
         median[step] = step_median(levels, exceed[step], total[step])
         beta[step] = 0.0

@@ -105,9 +105,22 @@ def test_separated_data_are_a_step_between_the_bracketing_levels_not_a_small_bet
     # two mixed levels: an ordinary MLE with beta > 0
     assert separation(np.array([0, 1, 3, 4.0]), np.full(4, 4.0))[0] == np.False_
     assert fit_binomial(levels, [0, 1, 3, 4], [4, 4, 4, 4])[1] > 0.05
-    # a step at the highest (or lowest) level only says the median lies outside the range: no estimate
+    # a step at the highest (or lowest) level with the median beyond it (at most half the records in the state at
+    # the highest, at least half at the lowest) only says the median lies outside the range: no estimate
     assert np.isnan(fit_binomial(levels, [0, 0, 0, 1], [4, 4, 4, 4])[0])
     assert np.isnan(fit_binomial(levels, [3, 4, 4, 4], [4, 4, 4, 4])[0])
+    assert np.isnan(fit_binomial(levels, [0, 0, 0, 2], [4, 4, 4, 4])[0])
+    assert np.isnan(fit_binomial(levels, [2, 4, 4, 4], [4, 4, 4, 4])[0])
+    assert np.isnan(fit_binomial(levels[:1], [1], [4])[0])  # one level: nothing brackets the median
+    # ...but a mixed edge level on the median's near side brackets it inside the range: the step sits at that level,
+    # as it does at an interior mixed level (1 of 4 at the lowest, 4 of 4 above; 3 of 4 at the highest, none below)
+    assert fit_binomial(levels, [1, 4, 4, 4], [4, 4, 4, 4]) == (pytest.approx(0.1), 0.0)
+    assert fit_binomial(levels, [0, 0, 0, 3], [4, 4, 4, 4]) == (pytest.approx(0.8), 0.0)
+    # the same through the vectorised fit (a stack of data sets, as the bootstrap fits them)
+    stack = np.array([[1, 4, 4, 4], [3, 4, 4, 4], [0, 0, 0, 3.0]])
+    medians, _ = fit_independent(levels, stack, np.full((3, 4), 4.0))
+    np.testing.assert_array_equal(np.isnan(medians), [False, True, False])
+    np.testing.assert_allclose(medians[[0, 2]], [0.1, 0.8])
 
 
 def test_shared_beta_fit_recovers_known_medians_and_common_beta():
