@@ -402,10 +402,10 @@ def reading_items(results) -> list[Item]:
              paragraph("P(damage state) at the site's intensity of each return period, the three return periods in "
                        "one cell (for example 5.6% / 17% / 43%), each read as 'this state or worse', so a milder "
                        "state is never less likely than a more severe one. 'not reached': no record reached the "
-                       "state up to the largest intensity recorded. '≥ X': the fitted median lies below every level "
-                       "run, and the records at the lowest level give a lower bound instead of the fit's tail. Beside "
-                       "it, how many records reached each state at those levels: a probability where none did is the "
-                       "fitted curve's tail alone."),
+                       "state up to the credible cap, the highest intensity the study runs. '≥ X': the fitted median"
+                       " lies below every level run, and the records at the lowest level give a lower bound instead "
+                       "of the fit's tail. Beside it, how many records reached each state at those levels: a "
+                       "probability where none did is the fitted curve's tail alone."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. A smaller "
                        f"lift off a bed is not rocking: the block {TILT_WORDS} (the bed gives under its toe). The "
                        "motion table counts each record once, at its most severe motion; the records that rock, "

@@ -239,8 +239,8 @@ def summary_items(results) -> list[Item]:
                       "stand free. 'Specialist check': the base would slide, and its sliding was not computed. 'No "
                       "action': every judged damage state is within its limit. 'Rocking only': the study did not "
                       "compute this base's sliding, so the verdict covers rocking and overturning only. '< X': no "
-                      "record reached the state up to the largest intensity recorded, so its probability is at most "
-                      "X, that of exceeding it. "
+                      "record reached the state up to the credible cap (the highest intensity the study runs), so its "
+                      "probability is at most X, that of the site's intensity exceeding the cap. "
                       "Reason: the records at the level run at or below the largest return period's intensity. β: "
                       "records, the variability from record to record; model, the model's own uncertainty. The "
                       "answer pages give every damage state and the records behind each number."))

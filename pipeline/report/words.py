@@ -192,8 +192,15 @@ GLOSSARY = (
                                         "(the paper); its spring can pull on the block, which a soil cannot."),
     ("tensionless Winkler bed", "a rigid block on a bed of springs and dashpots that push but never pull: the block "
                                 "lifts off instead (Psycharis & Jennings 1983; Chopra & Yim 1985)."),
-    ("recommended curve", "the tensionless bed run over the experimental range of impact restitution, its spread "
-                          "added to β (FEMA P-58's combination)."),
+    ("recommended curve", "the tensionless bed with the soil's stated friction and stiffness and the centre of the "
+                          "experimental restitution range; its β adds the model's uncertainty (FEMA P-695's "
+                          "model-quality rating, or the designed sample's spread where larger) to the "
+                          "record-to-record part."),
+    ("credible cap", "the highest intensity the study runs (3 g PGA by default, above the largest horizontal PGA "
+                     "ever recorded); no level, fit or median lies above it, and a probability adds the site's "
+                     "chance of exceeding it as an upper bound."),
+    ("RotD50", "the median over all horizontal orientations of a station's two components (Boore 2010), the "
+               "intensity hazard models give; each pair of components is scaled together by it."),
 )
 """The glossary page: term, one line."""
 
