@@ -187,12 +187,12 @@ def study_partners(records, config, log) -> list:
         log(f"rockfrag: {note}")
     paired = sum(p is not None for p in partners)
     single = [records[i].id for i, p in enumerate(partners) if p is None]
-    line = (f"intensity: RotD50 of {label} (Boore 2010) for {paired // 2} pairs of horizontal components "
-            f"({paired} records, both components run, one scale factor per pair)")
+    parts = [f"RotD50 of {label} (Boore 2010) for {paired // 2} pairs of horizontal components ({paired} records, "
+             "both components run, one scale factor per pair)"] if paired else []
     if single:
         shown = ", ".join(single[:5]) + (f" and {len(single) - 5} more" if len(single) > 5 else "")
-        line += f"; {len(single)} without a partner scaled by their own component: {shown}"
-    log(line)
+        parts.append(f"{len(single)} without a partner scaled by their own component: {shown}")
+    log("intensity: " + "; ".join(parts))
     return partners
 
 
@@ -897,7 +897,8 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
             log(f"overturning intensities refined to {resolution:.0%}"
                 f"{' without the vertical' if config.vertical and not variant else ''}: "
                 f"{stats['capacity_runs']} extra runs beside the {stats['grid_runs']} runs at the levels (levels as "
-                f"fine would need {stats['uniform_runs']} runs, {stats['runs_saved_fraction']:.0%} more)")
+                f"fine would need {stats['uniform_runs']} runs: the refinement saves "
+                f"{stats['runs_saved_fraction']:.0%} of them)")
         cubes[variant] = (build_cube(config, records, record_im, scale_factors, summaries, stiffness, provenance,
                                      intensity=intensity, capacities=capacities, capacity_stats=stats,
                                      calibration=calibration, friction=friction_grid(config),
