@@ -194,8 +194,8 @@ GLOSSARY = (
                                 "lifts off instead (Psycharis & Jennings 1983; Chopra & Yim 1985)."),
     ("recommended curve", "the tensionless bed with the soil's stated friction and stiffness and the centre of the "
                           "experimental restitution range; its β adds the model's uncertainty (FEMA P-695's "
-                          "model-quality rating, or the designed sample's spread where larger) to the "
-                          "record-to-record part."),
+                          "model-quality rating, the counterpart of FEMA P-58's modelling dispersion β_q, or the "
+                          "designed sample's spread where larger) to the record-to-record part."),
     ("credible cap", "the highest intensity the study runs (3 g PGA by default, above the largest horizontal PGA "
                      "ever recorded); no level, fit or median lies above it, and a probability adds the site's "
                      "chance of exceeding it as an upper bound."),
