@@ -137,6 +137,14 @@ def oscillator_coefficients(period, damping, dt):
 
 
 @njit(cache=True)
+def _oscillator_step(phi, gamma0, gamma1, j, a_now, a_next, u, v):
+    """One sample of period j's exact recurrence (piecewise-linear ground acceleration): (u, v) at the next."""
+    ramp = a_next - a_now
+    return (phi[j, 0, 0] * u + phi[j, 0, 1] * v + gamma0[j, 0] * a_now + gamma1[j, 0] * ramp,
+            phi[j, 1, 0] * u + phi[j, 1, 1] * v + gamma0[j, 1] * a_now + gamma1[j, 1] * ramp)
+
+
+@njit(cache=True)
 def _oscillator_peaks(acceleration, phi, gamma0, gamma1, omega, damping):
     n_periods = phi.shape[0]
     peak_displacement = np.zeros(n_periods)
@@ -147,11 +155,7 @@ def _oscillator_peaks(acceleration, phi, gamma0, gamma1, omega, damping):
         peak_u = 0.0
         peak_a = abs(acceleration[0])
         for k in range(acceleration.size - 1):
-            ramp = acceleration[k + 1] - acceleration[k]
-            u_next = phi[j, 0, 0] * u + phi[j, 0, 1] * v + gamma0[j, 0] * acceleration[k] + gamma1[j, 0] * ramp
-            v_next = phi[j, 1, 0] * u + phi[j, 1, 1] * v + gamma0[j, 1] * acceleration[k] + gamma1[j, 1] * ramp
-            u = u_next
-            v = v_next
+            u, v = _oscillator_step(phi, gamma0, gamma1, j, acceleration[k], acceleration[k + 1], u, v)
             if abs(u) > peak_u:
                 peak_u = abs(u)
             total = abs(-2.0 * damping * omega[j] * v - omega[j] ** 2 * u)
@@ -171,11 +175,7 @@ def _oscillator_histories(acceleration, phi, gamma0, gamma1, omega, damping):
         v = 0.0
         history[j, 0] = acceleration[0]  # as _oscillator_peaks: the first sample counts as the ground's
         for k in range(acceleration.size - 1):
-            ramp = acceleration[k + 1] - acceleration[k]
-            u_next = phi[j, 0, 0] * u + phi[j, 0, 1] * v + gamma0[j, 0] * acceleration[k] + gamma1[j, 0] * ramp
-            v_next = phi[j, 1, 0] * u + phi[j, 1, 1] * v + gamma0[j, 1] * acceleration[k] + gamma1[j, 1] * ramp
-            u = u_next
-            v = v_next
+            u, v = _oscillator_step(phi, gamma0, gamma1, j, acceleration[k], acceleration[k + 1], u, v)
             history[j, k + 1] = -2.0 * damping * omega[j] * v - omega[j] ** 2 * u
     return history
 

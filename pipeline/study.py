@@ -534,29 +534,68 @@ def bed_calibration(config, stiffness) -> SampleCalibration | None:
 
 
 def calibration_lines(config, calibration: SampleCalibration | None) -> list[str]:
-    """One line per (block, member) whose restitution target was moved into the bed's reachable range."""
+    """At most two lines per block: where the bed cannot reach a restitution target, and where rocking dies.
+
+    The first names the soils where the bed at its admissible xi cannot reach a member's target, the second those
+    where free rocking dies below what the measure resolves; each names the sample members concerned.
+
+    One line per (block, member) repeated the same sentence for every member (19 lines for the default study);
+    the members concerned are named in brackets instead ("every member" where all of them are).
+    """
     if calibration is None:
         return []
+    names = [_member_name(model) for model in calibration.variants]
     lines = []
     for b, block in enumerate(config.blocks):
-        for v, model in enumerate(calibration.variants):
-            moved = [s for s in range(len(config.soils)) if calibration.moved[s, b, v]]
-            unmeasurable = [config.soils[s].name for s in moved if not np.isfinite(calibration.target[s, b, v])]
-            moved = [s for s in moved if np.isfinite(calibration.target[s, b, v])]
-            wanted = calibration.requested[0, b, v]
-            if moved:
-                where = ", ".join(f"{config.soils[s].name} {calibration.target[s, b, v]:.3f}" for s in moved)
-                lines.append(f"rockfrag: {model}, block {block.name}: the bed at its admissible xi (where free "
-                             f"rocking is reproducible) cannot reach r = {wanted:.3f}; it runs at the "
-                             f"nearest r it reaches ({where})")
-            if unmeasurable:
-                at = ", ".join(f"{config.soils[s].name} {calibration.xi[s, b, v]:.3g}" for s in range(len(
-                    config.soils)) if config.soils[s].name in unmeasurable)
-                lines.append(f"rockfrag: {model}, block {block.name}: free rocking on {', '.join(unmeasurable)} loses "
-                             f"more at every admissible xi than the restitution measure resolves (at least about "
-                             f"Housner's r = {block.housner_restitution():.3f}); it runs at the smallest admissible "
-                             f"xi ({at})")
+        moved, dying, reached, targets, xi = {}, {}, [], [], []
+        for s, soil in enumerate(config.soils):
+            for v, name in enumerate(names):
+                if not calibration.moved[s, b, v]:
+                    continue
+                if np.isfinite(calibration.target[s, b, v]):
+                    moved.setdefault(soil.name, []).append(name)
+                    reached.append(calibration.target[s, b, v])
+                    targets.append(calibration.requested[0, b, v])
+                else:
+                    dying.setdefault(soil.name, []).append(name)
+                    xi.append(calibration.xi[s, b, v])
+        if moved:
+            lines.append(f"rockfrag: block {block.name}: at its admissible xi (where free rocking is reproducible) "
+                         f"the bed cannot reach the restitution target ({_span(targets)}) on "
+                         f"{_soils_by_members(moved, names)}; those runs use the nearest r it reaches "
+                         f"({_span(reached)})")
+        if dying:
+            lines.append(f"rockfrag: block {block.name}: free rocking loses more at every admissible xi than the "
+                         f"restitution measure resolves (at least about Housner's r = "
+                         f"{block.housner_restitution():.3f}) on {_soils_by_members(dying, names)}; it runs at the "
+                         f"smallest admissible xi ({_span(xi, '.3g')})")
     return lines
+
+
+def _member_name(model: str) -> str:
+    """A sample member's name as the lines print it: the central member is the recommended model."""
+    member = split_variant(model)[1]
+    return "recommended" if member in (None, "centre") else member
+
+
+def _span(values, spec=".3f") -> str:
+    low, high = min(values), max(values)
+    return f"{low:{spec}}" if f"{low:{spec}}" == f"{high:{spec}}" else f"{low:{spec}}-{high:{spec}}"
+
+
+def _soils_by_members(members_of_soil: dict, every: list) -> str:
+    """'rock, steel (every member but restitution_low); sand (restitution_high)': soils grouped by members."""
+    groups = {}
+    for soil, members in members_of_soil.items():
+        groups.setdefault(tuple(members), []).append(soil)
+
+    def members_words(members):
+        missing = [name for name in every if name not in members]
+        if not missing:
+            return "every member"
+        return f"every member but {', '.join(missing)}" if len(missing) < len(members) else ", ".join(members)
+
+    return "; ".join(f"{', '.join(soils)} ({members_words(members)})" for members, soils in groups.items())
 
 
 def compute_cells(acceleration, dt, scales, jobs, options, tail, capacity_resolution=0.0, ag_vertical=None,

@@ -135,3 +135,21 @@ def pipeline_results(folder: Path, study: Path, **changes):
                   output=folder, showcase=opened["showcase"], efficiency=opened["efficiency"])
     values.update(changes)
     return Results(**values)
+
+
+def run_study_file(folder: Path, text: str):
+    """Write ``text`` as ``study.toml`` in ``folder``, run it as ``rockfrag run --serial`` does and return
+    (config, its processed records, cube.nc loaded): the API tests' shared small study."""
+    import xarray as xr
+
+    from rockfrag.cli import main
+    from rockfrag.config import load_study
+    from rockfrag.study import study_records
+
+    (folder / "study.toml").write_text(text)
+    assert main(["run", str(folder / "study.toml"), "--output", str(folder / "out"), "--no-progress",
+                 "--serial"]) == 0
+    config = load_study(folder / "study.toml")
+    with xr.open_dataset(folder / "out" / "cube.nc") as cube:
+        cube = cube.load()
+    return config, study_records(config, log=lambda line: None).records, cube

@@ -66,3 +66,51 @@ def test_the_capacity_line_counts_what_the_cube_counts(study_lines):
     assert uniform > grid + extra  # the saving is real
     assert saved == round(100 * (1 - (grid + extra) / uniform))
     assert (extra, grid, uniform) == (attrs["capacity_runs"], attrs["grid_runs"], attrs["uniform_runs"])
+
+
+def test_restitution_lines_are_one_per_block_and_name_every_moved_run():
+    """The default study's calibration lines: at most two per block (one per kind), naming exactly the (soil,
+    member) runs the calibration moved or found unmeasurable (19 near-identical lines before)."""
+    import numpy as np
+
+    from rockfrag import study
+    from rockfrag.config import load_study
+
+    config = load_study()
+    calibration = study.bed_calibration(config, study.model_stiffness(config))
+    lines = study.calibration_lines(config, calibration)
+    names = [study._member_name(model) for model in calibration.variants]
+    for b, block in enumerate(config.blocks):
+        own = [line for line in lines if line.startswith(f"rockfrag: block {block.name}:")]
+        assert len(own) <= 2
+        for finite, marker in ((True, "cannot reach"), (False, "loses more")):
+            expected = {}
+            for s, soil in enumerate(config.soils):
+                for v, name in enumerate(names):
+                    if calibration.moved[s, b, v] and np.isfinite(calibration.target[s, b, v]) == finite:
+                        expected.setdefault(soil.name, set()).add(name)
+            line = next((text for text in own if marker in text), None)
+            assert (line is None) == (not expected), (block.name, marker)
+            if line is not None:
+                assert _soils_and_members(line, names) == expected, line
+    assert len(lines) >= 2  # the default study's paper block and cabinet cannot reach the targets on stiff beds
+
+
+def _soils_and_members(line: str, every: list) -> dict:
+    """{soil: members} read back from a line's 'on clay, sand (a, b); rock (every member)' part."""
+    named = {}
+    groups = line.split(") on ", 1)[1].split("; those runs")[0].split("; it runs")[0]
+    for group in groups.split("; "):
+        soils, words = group.split(" (", 1)
+        for soil in soils.split(", "):
+            named[soil] = _members_named(words.rstrip(")"), every)
+    return named
+
+
+def _members_named(words: str, every: list) -> set:
+    """The members a line's brackets name: 'every member', 'every member but a, b' or 'a, b'."""
+    if words == "every member":
+        return set(every)
+    if words.startswith("every member but "):
+        return set(every) - set(words.removeprefix("every member but ").split(", "))
+    return set(words.split(", "))

@@ -12,14 +12,13 @@ import itertools
 
 import numpy as np
 import pytest
-import xarray as xr
 
-from rockfrag.config import load_study
 from rockfrag.errors import SolverError
 from rockfrag.models import simulate
 from rockfrag.models.restitution import calibrate_dissipation
 from rockfrag.models.variants import DEFAULT_DESIGN, RECOMMENDED_BED, central_member, member_restitution
 from rockfrag.soils import SOILS, soil_block_stiffness
+from tests.helpers import run_study_file
 
 STUDY = """
 soils = ["sand", "steel"]
@@ -54,17 +53,8 @@ COMPARED = ("peak_angle", "peak_uplift", "peak_slip", "residual_slip", "n_impact
 
 @pytest.fixture(scope="module")
 def study_run(tmp_path_factory):
-    from rockfrag.cli import main
-    from rockfrag.study import study_records
-
-    folder = tmp_path_factory.mktemp("api-recommended")
-    (folder / "study.toml").write_text(STUDY)
-    assert main(["run", str(folder / "study.toml"), "--output", str(folder / "out"), "--no-progress",
-                 "--serial"]) == 0
-    config = load_study(folder / "study.toml")
-    with xr.open_dataset(folder / "out" / "cube.nc") as cube:
-        cube = cube.load()
-    return config, study_records(config, log=lambda line: None).records, cube
+    config, records, cube = run_study_file(tmp_path_factory.mktemp("api-recommended"), STUDY)
+    return config, records, cube
 
 
 def test_recommended_reproduces_the_cube_bit_for_bit(study_run):

@@ -10,13 +10,12 @@ xi where free rocking is not reproducible (the issue's case) is refused by both,
 from __future__ import annotations
 
 import pytest
-import xarray as xr
 
-from rockfrag.config import load_study
 from rockfrag.errors import SolverError
 from rockfrag.models import simulate
 from rockfrag.models.restitution import admissible_xi
 from rockfrag.soils import SOILS
+from tests.helpers import run_study_file
 
 TARGET = 0.871
 STUDY = f"""
@@ -44,17 +43,8 @@ COMPARED = ("peak_angle", "peak_uplift", "peak_slip", "residual_slip", "n_impact
 
 @pytest.fixture(scope="module")
 def study_run(tmp_path_factory):
-    from rockfrag.cli import main
-    from rockfrag.study import study_records
-
-    folder = tmp_path_factory.mktemp("api-restitution")
-    (folder / "study.toml").write_text(STUDY)
-    assert main(["run", str(folder / "study.toml"), "--output", str(folder / "out"), "--no-progress",
-                 "--serial"]) == 0
-    config = load_study(folder / "study.toml")
-    with xr.open_dataset(folder / "out" / "cube.nc") as cube:
-        cube = cube.sel(soil="clay", model="winkler").isel(block=0).load()
-    return config, study_records(config, log=lambda line: None).records, cube
+    config, records, cube = run_study_file(tmp_path_factory.mktemp("api-restitution"), STUDY)
+    return config, records, cube.sel(soil="clay", model="winkler").isel(block=0)
 
 
 def test_restitution_calibrates_as_the_study_does(study_run):
