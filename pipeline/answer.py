@@ -38,6 +38,9 @@ from rockfrag.risk import annual_frequency as risk_annual_frequency
 from rockfrag.risk import probability_in_life as risk_probability_in_life
 from rockfrag.units import STANDARD_GRAVITY
 
+OVERTURNED_EDP = "overturned"
+"""The EDP of overturning (rockfrag.damage_states): the most severe state of every family."""
+
 ANSWER_MODELS = (RECOMMENDED, "winkler", "ssi", "ssi-paper", "housner")
 """Models the answer is given for, in order of preference: the first one the study ran is used."""
 
@@ -439,10 +442,20 @@ def _lower_bound(levels: np.ndarray, empirical: np.ndarray, im: float) -> tuple:
 
 
 def nested_families(fragility: xr.Dataset) -> list[list[int]]:
-    """Indices of the damage states by family (rocking, slip), each in the dataset's order of severity."""
-    edps = fragility["damage_state_edp"].values if "damage_state_edp" in fragility.coords \
+    """Indices of the damage states by family (rocking, slip), each in the dataset's order of severity.
+
+    Overturning closes the slip family too: the fits count a record that overturns as beyond every state, the
+    slip states included (``rockfrag.fragility``, first-overturn convention), so a slip state reads "slides that
+    far or overturns" and is never less likely than overturning. Sliding and lift-off stay apart: a block can
+    slide without lifting off.
+    """
+    edps = [str(edp) for edp in fragility["damage_state_edp"].values] if "damage_state_edp" in fragility.coords \
         else ["uplifted"] * fragility.damage_state.size
-    return list(families_of(edps).values())
+    families = families_of(edps)
+    overturned = [index for index, edp in enumerate(edps) if edp == OVERTURNED_EDP]
+    if "slip" in families and overturned:
+        families["slip"] = families["slip"] + overturned[-1:]
+    return list(families.values())
 
 
 def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnswer]:
@@ -460,6 +473,9 @@ def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnsw
             milder, severe = rows[family[position]], rows[family[position + 1]]
             if severe.not_reached_below is not None:
                 continue  # its value is an upper bound P(intensity > the limit), not a probability of the state
+            if not np.isfinite(milder.probability_in_life) and not np.isfinite(
+                    np.asarray(milder.at_return_periods, float)).any():
+                continue  # not computed (a slip state of a tied base): unknown stays unknown
             periods = tuple(tuple(np.fmax(np.asarray(a, float), np.asarray(b, float)))
                             for a, b in zip(milder.at_return_periods, severe.at_return_periods))
             frequency = float(np.fmax(milder.annual_frequency, severe.annual_frequency))

@@ -215,8 +215,9 @@ def test_every_contents_row_names_a_title_on_its_page(small_pipeline):
         if kind == "section":
             assert text == page.section or text in page.also, (text, number)
         else:
-            assert text == (page.heading or page.title) or text in [first_heading[s] for s in page.also], \
-                (text, number)
+            # a section that starts part-way down a page and ends on it is no page's own: its heading is in the text
+            assert text == (page.heading or page.title) or text in [first_heading.get(s) for s in page.also] \
+                or text in (page.html or ""), (text, number)
 
 
 def test_the_example_hazard_is_said_once_and_referred_to(small_pipeline):

@@ -45,8 +45,9 @@ from rockfrag.config import StudyConfig  # noqa: E402
 from rockfrag.damage_states import damage_states_from_config  # noqa: E402
 from rockfrag.outputs import atomic_path  # noqa: E402
 from rockfrag.report import figures as pages  # noqa: E402
+from rockfrag.report import numbers  # noqa: E402
 from rockfrag.report.adapters import block_name, models_of, record_pga_g, short_label, soils_of  # noqa: E402
-from rockfrag.report.answer_page import answer_items, reading_items  # noqa: E402
+from rockfrag.report.answer_page import SUFFICIENCY_LEVEL, answer_items, reading_items  # noqa: E402
 from rockfrag.report.layout import Page, add_footer, new_page  # noqa: E402
 from rockfrag.report.sections import (  # noqa: E402
     Results,
@@ -195,7 +196,8 @@ CAPTIONS = {
            "at the right edge. Dotted: the site's return-period intensities (the legend names them); shaded: "
            "beyond the largest recorded intensity (extrapolation by scaling). "
            "A block that slides instead of rocking stays at θmax/α = 0. Curves are not smoothed: a record may "
-           "overturn at one level and survive a higher one (resurrection).",
+           "overturn at one level and survive a higher one (it counts as overturned from its first overturning "
+           "level on).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
                        "the fitted lognormal, one colour per soil; light shading around a line, the confidence "
@@ -217,7 +219,12 @@ CAPTIONS = {
                      "and dashes) for one block (its marker): the median peak angle of the runs between 1.2 and 3 "
                      "times the block's uplift threshold over the rigid base's. Grey shading: within 10% of the "
                      "rigid base. Green shading: 300-1000 MPa, the soil stiffness above which the paper finds the "
-                     "rigid base good enough. Top axis: the study's soils. Lines that coincide hide each other.",
+                     "rigid base good enough. Top axis: the study's soils. Lines that coincide hide each other. "
+                     "These are the study's own runs: the recommended model's base has friction and its bed's "
+                     "restitution is set within the experiments' range, so where its block slides instead of "
+                     "rocking (its kinetic friction below tan α: the limitations' 'Sliding') the ratio falls far "
+                     "below 1, which is sliding, not the bed's stiffness. The next page ties every base and leaves "
+                     "the bed's damping uncalibrated, to isolate stiffness: the two pages differ by design.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
@@ -257,6 +264,71 @@ def _twins_words(efficiency) -> str:
     pairs = "; ".join(f"{pages.measure_words(m)} repeats {pages.measure_words(o)}" for m, o in twins.items())
     return (f" Not drawn ({pairs}): dividing an intensity by a constant of the block (its uplift acceleration "
             "g·tanα) changes nothing within one block, so their bars and p-values are identical by construction.")
+
+
+def sweep_words(applicability) -> str:
+    """The sweep caption's sentences on what its ratio measures: tied bases and an uncalibrated dashpot.
+
+    The sweep runs each foundation model with its base tied and its dashpot at the sweep's damping ratio, not
+    calibrated to Housner's restitution. The tensionless bed so damped keeps more of its rocking speed at an impact
+    than Housner's r (tests/test_report_signable.py checks it for the default blocks on the stiffest ground), so its
+    ratio does not tend to 1 as the ground stiffens; the paper's model, whose dashpot takes out what the corner
+    impact would, does.
+    """
+    xi = numbers.probability(float(applicability.attrs.get("damping_ratio", 0.05)))
+    models = {str(m) for m in applicability.model.values} if "model" in applicability.coords else set()
+    text = (f" Every run here ties the base (no sliding) and gives the foundation's dashpot {xi} of critical "
+            "damping, not calibrated to Housner's restitution: it isolates stiffness, and the page before compares "
+            "the study's own runs.")
+    if "winkler" in models:
+        text += (" The tensionless bed so damped loses less energy at an impact than Housner's r = 1 − 1.5 sin²α, so "
+                 "even on the stiffest ground its ratio stays above 1: it measures the bed's damping as well as its "
+                 "stiffness.")
+    if models & {"ssi", "ssi-paper"}:
+        text += (" The paper's model, whose dashpot takes out what the corner impact would, comes closer to 1 on stiff "
+                 "ground.")
+    return text
+
+
+def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:
+    """The efficiency caption's sentences on why the study's measure is used though another scatters less ("" else).
+
+    Per block, the measure with the smallest dispersion of the overturning capacity (the top bars: median over
+    soils and models) against the study's measure; the study's measure is the hazard's, which the fragility must
+    share to be integrated with it. Where the study's measure fails the sufficiency test (p < 0.05 against the
+    pulse period, magnitude or distance, median over cells as the bottom panel draws it), the curves hold for
+    records like the study's: the bias this leaves for other records is said, not sized.
+    """
+    study = str(efficiency.attrs.get("study_measure", ""))
+    if not study or study not in efficiency.measure.values or "dispersion" not in efficiency:
+        return ""
+    twins = pages.efficiency_twins(efficiency)
+    measures = [str(m) for m in efficiency.measure.values if str(m) not in twins]
+    better = []
+    for block in map(str, efficiency.block.values):
+        middle = efficiency.dispersion.sel(block=block, measure=measures).median(["soil", "model"])
+        values = dict(zip(measures, np.asarray(middle.values, float)))
+        if not np.isfinite(values.get(study, np.nan)):
+            continue
+        best = min((m for m in measures if np.isfinite(values[m])), key=values.get)
+        if best != study:
+            better.append(f"{pages.measure_words(best)} for the {names.get(block, block)} "
+                          f"({numbers.dispersion(values[best])} against {numbers.dispersion(values[study])})")
+    words = pages.measure_words(study)
+    text = (f" The fragility curves are in {words} because the site's hazard is: a curve must be in the hazard's "
+            "measure to be integrated with it." if hazard else f" The fragility curves are in {words}, the study's "
+            "measure.")
+    if better:
+        text += (f" A measure scatters less than {words} for some blocks: {'; '.join(better)}. In {words} their "
+                 "curves are wider (a larger record-to-record β), not shifted.")
+    insufficient = [name for name, _, _, what in pages.P_MARKERS if name in efficiency
+                    and float(efficiency[name].sel(measure=study).median()) < SUFFICIENCY_LEVEL]
+    if insufficient:
+        text += (f" {words} fails the sufficiency test (bottom, below the dashed line): at a given {words} the "
+                 "capacity still depends on the records' character, so the curves hold for records like the "
+                 "study's set and are biased, by an amount this study does not size, for a site whose motions "
+                 "differ (near a fault: long velocity pulses; run records like the site's there).")
+    return text
 
 
 def plan(results: Results) -> list[Page]:
@@ -340,13 +412,15 @@ def plan(results: Results) -> list[Page]:
     if results.applicability is not None and "peak_angle_ratio_to_housner" in results.applicability:
         planned.append(_figure("applicability-sweep", "Applicability", "Rigid-base error against soil stiffness",
                                pages.sweep_page, results.applicability,
-                               caption=CAPTIONS["applicability-sweep"] + f" Median over "
+                               caption=CAPTIONS["applicability-sweep"] + sweep_words(results.applicability)
+                                       + f" Median over "
                                        f"{results.applicability.attrs.get('n_records', '?')} records that survived "
                                        "in both models.", names=names))
     if results.efficiency is not None and "dispersion" in results.efficiency:
         planned.append(_figure("efficiency", "Measure efficiency", "Efficiency of intensity measures",
                                pages.efficiency_page, results.efficiency,
-                               caption=CAPTIONS["efficiency"] + _twins_words(results.efficiency),
+                               caption=CAPTIONS["efficiency"] + _twins_words(results.efficiency)
+                               + measure_choice_words(results.efficiency, names, results.hazard is not None),
                                names=names))
     planned += _packed_pages([("glossary", "Glossary", "Glossary", glossary_items()),
                               ("references", "References", "References", references_items()),

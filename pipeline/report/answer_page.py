@@ -8,9 +8,9 @@ Output: ``reading_items``, what every answer page shares, said once (which curve
         same words as the summary page), the site's intensity at each return period, P(each damage state) there,
         the records behind each number, what the block does, P in the design life and the verdict row.
 
-Where no record reached a state below the largest recorded intensity, the page says "not reached" and bounds
-its probability in the design life by that of exceeding that intensity ("< X"), never a fitted median far
-beyond what any record did.
+Where no record reached a state at any level up to the credible cap, the page says "not reached" and bounds its
+probability in the design life by that of exceeding the cap ("< X"), never a fitted median far beyond what any
+record did.
 """
 
 from __future__ import annotations
@@ -33,9 +33,13 @@ from rockfrag.report.adapters import (
     sliding_candidates,
 )
 from rockfrag.report.summary import (
+    BOUND_POLICY,
+    BOUND_WORDS,
+    SLIP_NESTING,
     beta_words,
     hazard_words,
     labels_of,
+    no_curve_words,
     p_at_return_period,
     say_p_at,
     say_p_in_life,
@@ -90,8 +94,8 @@ def _band_reach(cube, block=None) -> str:
     asked, reached = float(requested.where(short).max()), float(target.where(short).max())
     return (f" On {', '.join(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
             f"(r up to {asked:.3f}; it reaches {reached:.3f} at most): those runs use the nearest r it reaches, so "
-            "the restitution part of β_parameters there leaves out the less dissipative side of the range, the side "
-            "on which a block rocks more.")
+            "the restitution part of the model dispersion there leaves out the less dissipative side of the range, "
+            "the side on which a block rocks more.")
 
 
 def _band_collapse(cube, block) -> str:
@@ -115,8 +119,9 @@ def _band_collapse(cube, block) -> str:
               else " asked; it reaches none of them")
     where = "every soil" if len(collapsed) == cube.soil.size else ", ".join(collapsed)
     return (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
-            f"restitutions apart ({asked}), so restitution adds nothing to β_parameters there because there is one "
-            "run, not because it is known; β_model there rests on the model-quality rating.")
+            f"restitutions apart ({asked}), so restitution adds nothing to the model dispersion there because there "
+            "is one run, not because it is known; the model part of β there rests on FEMA P-695's model-quality "
+            "rating.")
 
 
 def curve_reason(results, model: str, block=None) -> str:
@@ -400,20 +405,20 @@ def reading_items(results) -> list[Item]:
                        "Above the largest intensity of the unscaled records every result comes from records scaled "
                        "up (extrapolation by scaling)."),
              paragraph("P(damage state) at the site's intensity of each return period, the three return periods in "
-                       "one cell (for example 5.6% / 17% / 43%), each read as 'this state or worse', so a milder "
-                       "state is never less likely than a more severe one. 'not reached': no record reached the "
-                       "state up to the credible cap, the highest intensity the study runs. '≥ X': the fitted median"
-                       " lies below every level run, and the records at the lowest level give a lower bound instead "
-                       "of the fit's tail. Beside it, how many records reached each state at those levels: a "
-                       "probability where none did is the fitted curve's tail alone."),
+                       "one cell (for example 5.6% / 17% / 43%), each read as 'this state or worse' within its "
+                       "family: uplift, the rocking angles and overturning; the slip states and overturning. Within "
+                       "a family a milder state is never less likely than a more severe one. "
+                       f"{SLIP_NESTING} 'not reached': no record reached the state at any level up to the credible "
+                       "cap, the highest intensity the study runs. '≥ X': the fitted median lies below every level "
+                       "run, and the records at the lowest level give a lower bound instead of the fit's tail. "
+                       f"{no_curve_words(answers[0])} Beside it, how many records reached each state at those "
+                       "levels: a probability where none did is the fitted curve's tail alone."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. A smaller "
                        f"lift off a bed is not rocking: the block {TILT_WORDS} (the bed gives under its toe). The "
                        "motion table counts each record once, at its most severe motion; the records that rock, "
                        "slide and rock, fly or overturn there are the records that reach uplift."),
              paragraph(f"The probability in the design life of {life} is the fitted curve integrated over the site's "
-                       "hazard, with how often the state happens on average. '< X': no record reached the state up to "
-                       "the largest intensity recorded, so its probability is at most X, that of exceeding that "
-                       "intensity."),
+                       f"hazard, with how often the state happens on average. {BOUND_WORDS} {BOUND_POLICY}"),
              heading("The verdicts"),
              paragraph(f"'Anchor or restrain' where a probability in {life} exceeds the study's limit ({judged}; "
                        "an anchorage holds the block against sliding too). 'Specialist check of sliding' where "

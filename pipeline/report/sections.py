@@ -477,19 +477,23 @@ def _ordered_models(results: Results):
 
 
 def fitted_items(results: Results) -> list[Item]:
-    """Per block, model and soil: median and β of the two most severe states, the answering model first.
+    """Per block, model and soil: median and β of every damage state, the answering model first.
 
-    Medians and dispersions only: a probability in the design life is a fact of the answer pages (and the
-    summary), printed there once, from the answer objects.
+    Every state a verdict or an answer page uses has its curve here; a row with no curve for any state (every
+    cell "-") is left out and the limitations' 'no median' table says why. Medians and dispersions only: a
+    probability in the design life is a fact of the answer pages (and the summary), printed there once.
     """
+    from rockfrag.report.summary import short_names
+
     fragility = results.fragility
     labels = state_labels(fragility)
-    states = [str(s) for s in fragility.damage_state.values if str(s) in labels][-2:]
+    states = [str(s) for s in fragility.damage_state.values if str(s) in labels]
+    short = short_names(results)
     status = extrapolation(fragility, results.output).set_index(["soil", "block", "model", "damage_state"])["status"]
     unit = measure_label(fragility)
     scale, shown_unit = display_scale(_level_units(fragility))
-    header = ["block", "model", "soil"] + [f"{labels[s]}: median / β" for s in states]
-    rows, marks = [], set()
+    header = ["model", "soil", *(short.get(s, labels[s]) for s in states)]
+    rows, marks, dropped = [], set(), 0
     for block in fragility.block.values:
         largest = results.largest_recorded.get(str(block), np.inf)
         for model in _ordered_models(results):
@@ -497,26 +501,34 @@ def fitted_items(results: Results) -> list[Item]:
             soils = ["(any)"] if once else list(fragility.soil.values)
             for soil in soils:
                 picked = cell(fragility, model, block, None if once else soil)
-                row = [block_name(results.config, block), short_label(model), str(soil)]
+                cells, row_marks = [], set()
                 for state in states:
                     median = float(picked["median"].sel(damage_state=state)) * scale
                     beta = float(picked["beta"].sel(damage_state=state))
+                    if not np.isfinite(median):
+                        cells.append("-")
+                        continue
                     flag = status.get((str(picked.soil.values), str(block), model.name, state), "within")
-                    mark = ""
-                    if flag not in ("within", "no fit"):
-                        mark += "*"
-                    if np.isfinite(median) and median > largest:
-                        mark += "†"
-                    marks.update(mark)
+                    mark = ("*" if flag not in ("within", "no fit") else "") + ("†" if median > largest else "")
+                    row_marks.update(mark)
                     shown = results.facts.say("fitted median", (block, model.name, str(picked.soil.values), state),
                                               _g(median))
-                    row.append(f"{shown}{mark} / {_beta(beta)}")
-                rows.append(row)
-    items = [paragraph(f"Fitted lognormal fragility functions (median in {unit}, dispersion β), the answering model "
-                       "first. A rigid-base model has one row per block (soil '(any)') unless base friction lets "
-                       "the block slide on some soils: then one row per soil. '-': no curve (the limitations say "
-                       "why). The probabilities these curves give at the site are on the answer pages."),
-             table(header, rows)]
+                    cells.append(f"{shown}{mark} / {_beta(beta)}")
+                if all(text == "-" for text in cells):
+                    dropped += 1
+                    continue
+                marks |= row_marks
+                rows.append([block_name(results.config, block), short_label(model), str(soil), *cells])
+    dashes = (f" {dropped} curves' rows with no fitted state at all are left out (the limitations say why no "
+              "median)." if dropped else "")
+    items = [paragraph(f"Fitted lognormal fragility functions: each cell is the median in {unit} / the dispersion "
+                       "β, for every damage state the answer pages and verdicts use, the answering model first. A "
+                       "rigid-base model has one row per block (soil '(any)') unless base friction lets the block "
+                       "slide on some soils: then one row per soil. '-': no curve for that state (the limitations "
+                       f"say why).{dashes} These are each curve's own fit; the answer pages print a slip state no "
+                       "less likely than overturning, which it counts too. The probabilities these curves give at "
+                       "the site are on the answer pages."),
+             table(header, by_block(rows)) if rows else paragraph("No curve could be fitted.")]
     if "*" in marks:
         items.append(note("* the median lies outside the studied intensity range (an extrapolation of the fit; see "
                           "Limitations)."))
@@ -714,8 +726,8 @@ def methods_items(results: Results) -> list[Item]:
               paragraph(f"Damage states: {'; '.join(labels.values())}. Each soil × block × model × state is fitted by "
                         "maximum likelihood on the binomial counts per level (Baker 2015). A record counts as "
                         "overturned, and beyond every damage state, from its first overturning level on (Vamvatsikos "
-                        f"& Cornell 2002); {resurrected} record-cells here survived a higher level after overturning "
-                        "(resurrection). The overturning capacities refined between the levels are fitted too, as a "
+                        f"& Cornell 2002); {_survivals(resurrected)} The overturning capacities refined between the "
+                        "levels are fitted too, as a "
                         "check (in the result tables: see 'How to reproduce this report'). "
                         f"Confidence bounds ({config.confidence:.0%}) from "
                         f"{fragility.attrs.get('bootstrap_samples', '?')} "
@@ -733,6 +745,36 @@ def methods_items(results: Results) -> list[Item]:
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
                             f"1 − exp(−λ·years). Return periods of the answer pages: {periods} years.")]
     return items
+
+
+def soil_source_words(names: str, soils) -> str:
+    """Where the shipped soils' moduli and damping come from: the paper's stated values, and what they are not."""
+    damping = sorted({soil.damping_ratio for soil in soils})
+    xi = (f"Damping ratio {_percent(damping[0])} of each: within the range the paper studies (1% to 7% of critical, "
+          "its Fig. 8), not a measured value." if len(damping) == 1 else "")
+    return (f"Soil moduli of {names}: the values the paper states (its Table 1: shear modulus, Poisson's ratio, "
+            "density; clay's E_d = 130 MPa from its Figs. 9-11, Poisson's ratio 0.3 assumed). The paper cites no "
+            "source for them: they are representative values of each class of ground, not measurements, and the "
+            "paper is a preprint (not peer-reviewed). A site investigation's moduli replace them (the appendix "
+            f"names the setting). {xi}").strip()
+
+
+def _survivals(count: int) -> str:
+    """How often a record survived a level above its first overturning level, in words ("" when never)."""
+    if not count:
+        return "no record survived a level above its first overturning level."
+    return (f"{count} times here a record survived a level above its first overturning level, and it counts as "
+            "overturned there all the same.")
+
+
+def client_words(text: str) -> str:
+    """A registry's words with the tool's phrase for a chosen value replaced by the client's (``CHOICE_WORDS``)."""
+    return text.replace(STUDY_CHOICE, CHOICE_WORDS)
+
+
+CHOICE_WORDS = ("the study's choice, not a published value (the appendix 'How to reproduce this report' names its "
+                "setting)")
+"""How the client pages name a value that is a choice rather than a published fact."""
 
 
 def _kinetic_words(soils) -> str:
@@ -762,11 +804,12 @@ def sources_items(results: Results) -> list[Item]:
             continue
         registered = DAMAGE_STATES.get(state)
         shipped = registered is not None and registered.limit == limit and bool(registered.limit_source)
-        source = registered.limit_source if shipped else "the study file (its own limit)"
+        source = client_words(registered.limit_source) if shipped else "the study's own limit (see 'How to " \
+            "reproduce this report')"
         items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', {limit:.0%} in the "
                             f"design life: {source}."))
     life = float(fragility.attrs.get("design_life_years", config.design_life))
-    items.append(bullet(f"Design life {life:g} years: {STUDY_CHOICE}; 50 years is the span over which ASCE 7-22 "
+    items.append(bullet(f"Design life {life:g} years: {CHOICE_WORDS}; 50 years is the span over which ASCE 7-22 "
                         "and the return periods below are stated."))
     items.append(bullet("Return periods 475, 975 and 2,475 years: 10%, 5% and 2% probability of exceedance in 50 "
                         "years, the conventional design levels (ASCE 7-22 uses the 2% level)."))
@@ -774,12 +817,11 @@ def sources_items(results: Results) -> list[Item]:
     own = [soil.name for soil in config.soils if soil not in shipped_soils]
     if shipped_soils:
         names = ", ".join(soil.name for soil in shipped_soils)
-        items.append(bullet(f"Soil moduli of {names}: the paper's Table 1 (shear modulus, Poisson's ratio, "
-                            "density); clay from the paper's text (E_d = 130 MPa, Poisson's ratio 0.3 assumed)."))
+        items.append(bullet(soil_source_words(names, shipped_soils)))
         items.append(bullet(f"Base friction μ_s of {names} ({results.friction_text}): the ultimate friction factor "
                             "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
                             "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
-                            f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + STUDY_CHOICE + "."))
+                            f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + CHOICE_WORDS + "."))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
     design = config.design
@@ -799,9 +841,24 @@ def sources_items(results: Results) -> list[Item]:
                 + f"; bed stiffness: each soil's G × and ÷ {design.stiffness_factor:g} in eq. 19 "
                 + ("(the study file's own)." if own else "(ASCE 4-16 Section 5.1.7: G(1 + C_v) and G/(1 + C_v), "
                    "C_v = 1 where the soil is not investigated at the site).")))
-            items.append(bullet(f"Model-form dispersion: {fragility.attrs.get('model_quality', '')}, FEMA P-695's "
-                                "rating of a nonlinear model (docs, 'Model uncertainty')."))
+            items.append(bullet(model_form_words(config, fragility)))
     return items
+
+
+def model_form_words(config, fragility) -> str:
+    """The model-form dispersion's source: the rating the study gives the model and its β (FEMA P-695 Section 5.7)."""
+    from rockfrag.fragility import FORM_RATINGS
+
+    quality = str(getattr(config, "model_quality", "fair"))
+    values = np.asarray(fragility["beta_form"].values, float) if "beta_form" in fragility else np.array([])
+    rated = values[np.isfinite(values) & (values > 0)]
+    beta = float(rated.max()) if rated.size else FORM_RATINGS.get(quality, float("nan"))
+    choice = "the study's choice" if quality == "fair" else "the study's own rating"
+    ratings = ", ".join(f"{name} {numbers.dispersion(value)}" for name, value in FORM_RATINGS.items())
+    return (f"Model-form dispersion β {numbers.dispersion(beta)}: FEMA P-695's rating '{quality}' of a nonlinear "
+            f"model (Section 5.7: {ratings}), given to the recommended model's "
+            f"form (a planar rigid block on a bed of springs), {choice}; it stands in for FEMA P-58's modelling "
+            "dispersion β_q.")
 
 
 def _fraction_table(fraction, soils, blocks, config=None):
@@ -1012,8 +1069,7 @@ def limitations_items(results: Results) -> list[Item]:
     else:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
-            "lognormal fit beyond the levels that were run (the table of fitted functions marks them * for the "
-            "states it shows)."))
+            "lognormal fit beyond the levels that were run (the table of fitted functions marks them *)."))
         every_model = [short_label(m) for m in models_of(fragility)]
         rows, said = [], []
         for row in outside.itertuples():

@@ -63,14 +63,50 @@ def labels_of(results) -> dict:
 
 
 def short_names(results) -> dict:
-    """Damage state -> its short name for table cells and headers ("overturning", "θmax/α ≥ 0.5")."""
+    """Damage state -> its short name for the answers' table cells and headers ("overturning", "θmax/α ≥ 0.5").
+
+    A slip state reads "slip ≥ 0.30 m or overturning" where the study has overturning: the fits count a record
+    that overturns as beyond every state, and the answers nest overturning under the slip states
+    (rockfrag.answer.nested_families), so the label says what the number is.
+    """
+    from rockfrag.damage_states import DAMAGE_STATES, is_slip_state
     from rockfrag.report.words import state_short_label
 
     fragility = results.fragility
     descriptions = dict(zip(map(str, fragility.damage_state.values),
                             map(str, fragility["damage_state_description"].values))) \
         if "damage_state_description" in fragility.coords else {}
-    return {state: state_short_label(state, descriptions.get(state, "")) for state in labels_of(results)}
+    overturns = "overturning" in descriptions or "overturning" in map(str, fragility.damage_state.values)
+    names = {}
+    for state in labels_of(results):
+        name = state_short_label(state, descriptions.get(state, ""))
+        registered = DAMAGE_STATES.get(state)
+        if overturns and registered is not None and is_slip_state(registered):
+            name += SLIP_OR_OVERTURNING
+        names[state] = name
+    return names
+
+
+SLIP_OR_OVERTURNING = " or overturning"
+"""Said after a slip state's name on the answers: a record that overturns counts as beyond it too."""
+
+SLIP_NESTING = ("A slip state counts a record that overturns too (it is beyond every state), so 'slip ≥ 0.30 m or "
+                "overturning' is never less likely than overturning; where a block overturns before it slides that "
+                "far, the slip state is its overturning. Sliding and rocking are otherwise apart: a block can slide "
+                "without lifting off, so a slip state may be more likely than uplift.")
+"""How the slip states and overturning are ordered, said once on the page 'Reading the answer pages'."""
+
+BOUND_WORDS = ("'< X': no record reached the state at any level up to the credible cap, the highest intensity the "
+               "study runs (Methods), so its probability is at most X, that of the site's intensity exceeding the "
+               "cap.")
+"""What a "< X" cell means, on the summary and the answer pages (rockfrag.answer's not-reached limit)."""
+
+BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a probability ('< X', '≥ X') these pages "
+                "print the bound, and a state is never printed less likely than a more severe one of its family; "
+                "the result tables keep each curve's own fitted value and say where it is extrapolated or censored "
+                "at the cap, so a bound here and a fitted value there are one result read two ways. The verdicts "
+                "use the values printed here.")
+"""How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
 def governing(soil) -> object | None:
@@ -110,12 +146,23 @@ def p_at_return_period(row, index: int, intensities) -> str:
         return "not reached"
     if row.below_lowest is not None:
         return numbers.bound(p, "≥") if np.isfinite(p) else "-"
+    if p == 0 and row.records and row.records[index][0] == 0:  # no curve, no record at the level: say the count
+        return numbers.count(0, row.records[index][1])
     return numbers.probability(p)
 
 
 def say_p_in_life(results, answer, soil, row) -> str:
     """``p_in_life``, recorded in the ledger as this block's, soil's and state's probability in the design life."""
     return results.facts.say("P in the design life", (answer.block, soil.soil, row.state), p_in_life(row))
+
+
+def no_curve_words(answer) -> str:
+    """What a count in a probability cell means ("0 of 44": ``p_at_return_period`` of a state without a curve)."""
+    total = next((record[1] for soil in answer.soils for row in soil.states for record in row.records), None)
+    example = f"'0 of {total}'" if total else "'0 of n'"
+    return (f"{example} in a probability cell: the state has no fitted curve (its median lies above the credible "
+            "cap) and no record reached it at that level, so the records give no probability there, only that it "
+            "is small; the probability in the design life bounds it.")
 
 
 def say_p_at(results, answer, soil, row, index: int) -> str:
@@ -238,10 +285,9 @@ def summary_items(results) -> list[Item]:
     items.append(note("'Anchor or restrain': a probability in the design life is above its limit; the block must not "
                       "stand free. 'Specialist check': the base would slide, and its sliding was not computed. 'No "
                       "action': every judged damage state is within its limit. 'Rocking only': the study did not "
-                      "compute this base's sliding, so the verdict covers rocking and overturning only. '< X': no "
-                      "record reached the state up to the credible cap (the highest intensity the study runs), so its "
-                      "probability is at most X, that of the site's intensity exceeding the cap. "
-                      "Reason: the records at the level run at or below the largest return period's intensity. β: "
+                      "compute this base's sliding, so the verdict covers rocking and overturning only. "
+                      f"{BOUND_WORDS} {no_curve_words(first)} Reason: the records at the level run at or below the "
+                      "largest return period's intensity. β: "
                       "records, the variability from record to record; model, the model's own uncertainty. The "
                       "answer pages give every damage state and the records behind each number."))
     return items

@@ -68,7 +68,8 @@ CODE_IDENTIFIERS = ("exact-g-tan-alpha", "mle-binomial", "pga_ratio", "pgv_ratio
 REFERENCES = {
     "paper": PAPER_CITATION + " The SSI-rocking model this project implements (a rigid block on one vertical "
              "spring-dashpot, derived from the Lagrangian; interface stiffness k of its eq. 19), its soils (Table "
-             "1) and its record (Duzce, Bolu).",
+             "1, representative values it states without a source) and its record (Duzce, Bolu). A preprint: "
+             "Preprints.org posts papers before, and without, peer review.",
     "Housner 1963": "Housner, G. W. (1963). The behavior of inverted pendulum structures during earthquakes. "
                     "Bulletin of the Seismological Society of America 53(2), 403-417.",
     "ElGawady et al. 2011": "ElGawady, M. A., Ma, Q., Butterworth, J. W., Ingham, J. (2011). Effects of interface "
@@ -150,7 +151,7 @@ GLOSSARY = (
                           "resampled (bootstrap); drawn as shading around the curve."),
     ("designed sample", "the runs of the recommended model with one uncertain parameter (restitution, friction, "
                         "bed stiffness) at the low or high end of its range, the others central; the spread of "
-                        "their medians is β_parameters."),
+                        "their medians is the parameters' part of the model dispersion."),
     ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
                                "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, the "
                                "integral of the squared acceleration), D5-95 (the time between 5% and 95% of Ia)."),
@@ -182,8 +183,6 @@ GLOSSARY = (
                                          "its period T_p and its acceleration amplitude a_p = 2π·PGV/T_p; the "
                                          "efficiency page tests whether the capacity still "
                                          "depends on T_p."),
-    ("resurrection", "a record that overturns the block at one level but not at a higher one; counted as "
-                     "overturned from its first overturning level on."),
     ("friction demand", "the base friction coefficient a run needs to rock without sliding; above the assumed one "
                         "the block would slide."),
     ("Housner model", "a rigid block rocking on a rigid base (Housner 1963): the reference; it does not depend on "
