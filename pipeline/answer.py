@@ -30,16 +30,13 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from rockfrag.damage_states import DEFAULT_LIMITS, families_of  # limits: the damage-state registry's
+from rockfrag.damage_states import DEFAULT_LIMITS, nesting_chains  # limits: the damage-state registry's
 from rockfrag.hazard import EXAMPLE_HAZARD, HazardCurve, hazard_frequency, hazard_of
 from rockfrag.lognormal_fit import lognormal_cdf
 from rockfrag.models.variants import RECOMMENDED
 from rockfrag.risk import annual_frequency as risk_annual_frequency
 from rockfrag.risk import probability_in_life as risk_probability_in_life
 from rockfrag.units import STANDARD_GRAVITY
-
-OVERTURNED_EDP = "overturned"
-"""The EDP of overturning (rockfrag.damage_states): the most severe state of every family."""
 
 ANSWER_MODELS = (RECOMMENDED, "winkler", "ssi", "ssi-paper", "housner")
 """Models the answer is given for, in order of preference: the first one the study ran is used."""
@@ -442,27 +439,24 @@ def _lower_bound(levels: np.ndarray, empirical: np.ndarray, im: float) -> tuple:
 
 
 def nested_families(fragility: xr.Dataset) -> list[list[int]]:
-    """Indices of the damage states by family (rocking, slip), each in the dataset's order of severity.
+    """Indices of the damage states that nest, each chain in the dataset's order of severity.
 
-    Overturning closes the slip family too: the fits count a record that overturns as beyond every state, the
-    slip states included (``rockfrag.fragility``, first-overturn convention), so a slip state reads "slides that
-    far or overturns" and is never less likely than overturning. Sliding and lift-off stay apart: a block can
-    slide without lifting off.
+    ``damage_states.nesting_chains``: the rocking states; the slip states followed by overturning. The fits count a
+    record that overturns as beyond every state, the slip states included (``rockfrag.fragility``, first-overturn
+    convention), so a slip state reads "slides that far or overturns" and is never less likely than overturning.
+    Sliding and lift-off stay apart: a block can slide without lifting off.
     """
     edps = [str(edp) for edp in fragility["damage_state_edp"].values] if "damage_state_edp" in fragility.coords \
         else ["uplifted"] * fragility.damage_state.size
-    families = families_of(edps)
-    overturned = [index for index, edp in enumerate(edps) if edp == OVERTURNED_EDP]
-    if "slip" in families and overturned:
-        families["slip"] = families["slip"] + overturned[-1:]
-    return list(families.values())
+    return nesting_chains(edps)
 
 
 def nested(rows: list[StateAnswer], families: list[list[int]]) -> list[StateAnswer]:
     """The states' probabilities made to nest: P(a state) is at least that of every more severe one of its family.
 
-    A block that overturns has also rocked past every angle and uplifted, and one that slid 30 cm has slid 5 cm,
-    so exceeding a state implies exceeding the milder ones. Curves fitted one by one may cross in a tail below
+    A block that overturns has also rocked past every angle and uplifted, and counts in every slip state; one that
+    slid 30 cm has slid 5 cm: exceeding a state implies exceeding the milder ones of its chain.
+    Curves fitted one by one may cross in a tail below
     the data (where the fit keeps them apart only from the first level a severe state is reached,
     ``rockfrag.fragility``); the answer reads each state as "this state or worse", the largest of its own and
     the more severe states' values, as pelicun reads the limit states of one component.

@@ -183,6 +183,32 @@ def families_of(edps) -> dict[str, list[int]]:
     return {family: members for family, members in families.items() if members}
 
 
+def nesting_chains(edps) -> list[list[int]]:
+    """The chains of states that nest, each in order of severity: the rocking states; the slip states, overturning.
+
+    A record that overturned counts as beyond every damage state (``rockfrag.fragility.exceedance``), slip states
+    included, so overturning is the most severe member of both chains: P(slip >= x) is never below P(overturning).
+    The slip and rocking states do not nest with each other. The one rule for the fits' non-crossing groups and the
+    answer's "this state or worse".
+
+    Parameters
+    ----------
+    edps : sequence of str
+        Each state's EDP, in order of severity.
+
+    Returns
+    -------
+    list of list of int
+        The rocking chain first (if any), then the slip chain (if any).
+    """
+    families = families_of(edps)
+    chains = [families["rocking"]] if "rocking" in families else []
+    if "slip" in families:
+        overturning = [index for index, edp in enumerate(edps) if str(edp) == "overturned"]
+        chains.append(families["slip"] + overturning)
+    return chains
+
+
 def damage_states_from_config(raw: dict) -> list[DamageState]:
     """The shipped damage states plus (or replaced by) the study's ``[damage_states.NAME]`` tables.
 

@@ -69,7 +69,7 @@ from rockfrag.damage_states import (
     DamageState,
     damage_states_from_config,
     is_slip_state,
-    state_family,
+    nesting_chains,
     uplift_lift,
 )
 from rockfrag.exchange import (  # noqa: F401 (pelicun_id, pelicun_table: re-exported)
@@ -320,26 +320,39 @@ def _shared_fit(levels, exceed, total, group):
     return [(float(m), float(beta)) for m in medians]
 
 
-def noncrossing_groups(levels, exceed, total, fits, usable):
-    """Merge adjacent fitted states into shared-beta groups until no two curves cross where the data can tell.
+def noncrossing_groups(levels, exceed, total, fits, usable, chains=None):
+    """Merge fitted states into shared-beta groups until no two neighbours of a chain cross where the data can tell.
 
-    Returns (groups, fits) with the refitted (median, beta) of grouped states.
+    ``chains``: lists of state indices in order of severity whose states nest (``damage_states.nesting_chains``:
+    the rocking states; the slip states followed by overturning); default one chain of ``usable``. Overturning ends
+    both chains, so a slip state that crosses it joins its group, and a group can hold states of both families.
+    Returns (groups, fits): the groups (lists of state indices in increasing order) and the refitted (median,
+    beta) of grouped states.
     """
-    groups = [[s] for s in usable]
+    usable = list(usable)
+    chains = [usable] if chains is None else [[s for s in chain if s in usable] for chain in chains]
+    group_of = {s: frozenset([s]) for s in usable}
     fits = dict(fits)
     changed = True
-    while changed and len(groups) > 1:
+    while changed:
         changed = False
-        for g in range(len(groups) - 1):
-            lower, upper = groups[g][-1], groups[g + 1][0]
-            if _crosses_where_data_tell(levels, exceed[upper], fits[lower], fits[upper]):
-                merged = groups[g] + groups[g + 1]
-                for s, fit in zip(merged, _shared_fit(levels, exceed, total, merged)):
+        for chain in chains:
+            for milder, severe in zip(chain, chain[1:]):
+                if group_of[milder] is group_of[severe] or \
+                        not _crosses_where_data_tell(levels, exceed[severe], fits[milder], fits[severe]):
+                    continue
+                merged = group_of[milder] | group_of[severe]
+                members = sorted(merged)
+                for s, fit in zip(members, _shared_fit(levels, exceed, total, members)):
                     fits[s] = fit
-                groups[g:g + 2] = [merged]
+                for s in members:
+                    group_of[s] = merged
                 changed = True
                 break
-    return groups, fits
+            if changed:
+                break
+    groups = sorted({group_of[s] for s in usable}, key=min)
+    return [sorted(group) for group in groups], fits
 
 
 def _step_method(levels, exceed, total, unit) -> str:
@@ -400,13 +413,9 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
         else:
             row.median, row.beta, row.method, row.status = medians[s], betas[s], "mle-binomial", "fitted"
         rows.append(row)
-    groups, fits = [], {}
-    for family in dict.fromkeys(map(state_family, states)):  # slip and rocking states do not nest: each on its own
-        usable = [s for s, row in enumerate(rows) if row.method == "mle-binomial" and state_family(states[s]) == family]
-        family_groups, family_fits = noncrossing_groups(levels, exceed, total,
-                                                        {s: (rows[s].median, rows[s].beta) for s in usable}, usable)
-        groups += family_groups
-        fits.update(family_fits)
+    usable = [s for s, row in enumerate(rows) if row.method == "mle-binomial"]
+    groups, fits = noncrossing_groups(levels, exceed, total, {s: (rows[s].median, rows[s].beta) for s in usable},
+                                      usable, nesting_chains([state.edp for state in states]))
     for group in groups:
         if len(group) < 2:
             continue
