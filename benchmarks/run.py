@@ -6,6 +6,7 @@ Prints a report; never part of the tests.
 from __future__ import annotations
 
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -198,30 +199,29 @@ def run_study_subprocess(args, output):
     command = [sys.executable, "-m", "rockfrag", "run", *args, "--output", str(output), "--no-progress"]
     start = time.perf_counter()
     before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    subprocess.run(command, check=True, capture_output=True, text=True)
+    finished = subprocess.run(command, check=True, capture_output=True, text=True)
     elapsed = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    return elapsed, max(peak, before) / 1024
+    return elapsed, max(peak, before) / 1024, finished.stdout + finished.stderr
 
 
 def study_timing():
     cores = os.cpu_count()
     print(f"\n2. Default study end to end (rockfrag run, {cores} cores, fresh output folder)")
     with tempfile.TemporaryDirectory() as folder:
-        elapsed, peak_mb = run_study_subprocess([], Path(folder) / "default")
-    config = load_study()
-    runs = sum(1 if get_model(m).is_rigid_base else len(config.soils) for m in config.models) \
-        * len(config.blocks) * 44 * len(config.levels)
-    print(f"   {runs} solver runs in {elapsed:.1f} s wall ({runs / elapsed:.0f} runs/s); "
-          f"peak RSS of the largest process {peak_mb:.0f} MB")
+        elapsed, peak_mb, log = run_study_subprocess([], Path(folder) / "default")
+    counted = re.search(r"(\d+) runs to do", log)  # the study's own count: stripes of every model and member
+    runs = int(counted.group(1)) if counted else 0
+    print(f"   {runs} stripe runs in {elapsed:.1f} s wall ({runs / elapsed:.0f} runs/s, refining runs not counted; "
+          f"budget 300 s, issue 32); peak RSS of the largest process {peak_mb:.0f} MB")
     print("\n3. Scaling: 8 far-field records, default levels/soils/blocks/models")
     study = Path(tempfile.mkdtemp()) / "eight.toml"
     records, _ = load_records("far-field")
     ids = ", ".join(f'"{r.id}"' for r in records[:8])
     study.write_text(f"[study]\nname = \"scaling\"\nrecord_sets = [{ids}]\n")
     with tempfile.TemporaryDirectory() as folder:
-        serial, _ = run_study_subprocess([str(study), "--serial"], Path(folder) / "one")
-        parallel, _ = run_study_subprocess([str(study)], Path(folder) / "all")
+        serial = run_study_subprocess([str(study), "--serial"], Path(folder) / "one")[0]
+        parallel = run_study_subprocess([str(study)], Path(folder) / "all")[0]
     print(f"   1 core: {serial:.1f} s   {cores} cores: {parallel:.1f} s   speed-up {serial / parallel:.2f}x "
           f"(efficiency {serial / parallel / cores:.0%})")
 
