@@ -303,6 +303,10 @@ class CalibrationResult:
         why = f" (0-{refused['end']:.2f} s: {refused['reason']})" if refused else ""
         if self.decisive_window is None:
             return [f"  no window decided: none of the {len(self.windows)} fitted has a regular likelihood{why}"]
+        if DIRECT_METHOD in self.interval_method:
+            return [f"  decided by the window 0-{self.decisive_window:.2f} s of 0-{end:.2f} s: none of the "
+                    f"{len(self.windows)} fitted has a regular likelihood, and this one's region is read off a scan "
+                    f"of the search range{why}"]
         return [f"  decided by the window 0-{self.decisive_window:.2f} s of 0-{end:.2f} s: the longest whose fit "
                 f"explains the reference at the noise level and whose likelihood is regular{why}"]
 
@@ -731,18 +735,27 @@ class _Likelihood:
         At an edge of the unit box the difference is one-sided (divided by the shift that remains).
         """
         points = np.clip(np.atleast_2d(np.asarray(points, float)), 0.0, 1.0)
-        stencil, shifts = [points], []
-        for axis in axes:
-            plus, minus = points.copy(), points.copy()
-            plus[:, axis] = np.minimum(points[:, axis] + steps[axis], 1.0)
-            minus[:, axis] = np.maximum(points[:, axis] - steps[axis], 0.0)
-            stencil += [plus, minus]
-            shifts.append(plus[:, axis] - minus[:, axis])
-        values, rss = self.residuals(np.concatenate(stencil))
+        stencil, shifts = _stencil(points, steps, axes)
+        values, rss = self.residuals(np.concatenate([points] + stencil))
         m = len(points)
         jacobian = np.stack([(values[(1 + 2 * i) * m:(2 + 2 * i) * m] - values[(2 + 2 * i) * m:(3 + 2 * i) * m])
                              / shift[:, None] for i, shift in enumerate(shifts)], axis=-1)
         return values[:m], rss[:m], jacobian
+
+
+def _stencil(points, steps, axes):
+    """Central-difference neighbours of ``points``: [plus, minus] per axis, and the shift between them per axis.
+
+    At an edge of the unit box a neighbour stays on the edge (the difference is one-sided, over the shift left).
+    """
+    stencil, shifts = [], []
+    for axis in axes:
+        plus, minus = points.copy(), points.copy()
+        plus[:, axis] = np.minimum(points[:, axis] + steps[axis], 1.0)
+        minus[:, axis] = np.maximum(points[:, axis] - steps[axis], 0.0)
+        stencil += [plus, minus]
+        shifts.append(plus[:, axis] - minus[:, axis])
+    return stencil, shifts
 
 
 def _gauss_newton_step(residual, jacobian):
@@ -1101,10 +1114,10 @@ def _explained(base: _Window, previous: _Window, window: _Window) -> tuple[bool,
     return True, ""
 
 
-def _quiet_samples(reference: np.ndarray, smoothed: np.ndarray) -> int:
-    """Samples before the (smoothed) reference first reaches ``PEAK_FRACTION`` of its peak: the block barely moves."""
+def _quiet_samples(smoothed: np.ndarray, fraction: float = PEAK_FRACTION) -> int:
+    """Samples before the (smoothed) reference first reaches ``fraction`` of its peak: the block barely moves."""
     magnitude = np.abs(smoothed - smoothed[0])
-    return int(np.argmax(magnitude >= PEAK_FRACTION * magnitude.max()))
+    return int(np.argmax(magnitude >= fraction * magnitude.max()))
 
 
 def _window_walk(search, times, reference, history, full_point, axes, threshold, floor_rms, dt, quiet, log):
@@ -1134,6 +1147,14 @@ def _window_walk(search, times, reference, history, full_point, axes, threshold,
     # the base from every point the search found (its later ones are the best informed, even on the quiet start)
     base = _window_fit(search, times, reference, ends[0], [starts[m] for m in ends], axes, threshold,
                        ends[0] * floor_rms**2, dt)
+    # and from every basin of the whole search range that fits it better: a base fit in a wrong basin would read
+    # its misfit as noise, and every window after it would be tested against that inflated noise
+    scan = scans[ends[0]] = _scan(search, times, reference, ends[0], ends[0] * floor_rms**2, dt, axes)
+    better = [point for point, value in zip(scan.points, scan.rss) if value < base.rss]
+    if better:
+        rescanned = _window_fit(search, times, reference, ends[0], better, axes, threshold, ends[0] * floor_rms**2,
+                                dt)
+        base = rescanned if rescanned.rss < base.rss else base
     base.accepted = True
     fitted[ends[0]] = previous = base
     extra_starts = []
@@ -1178,7 +1199,7 @@ def _scan(search, times, reference, n, floor, dt, axes):
     v = np.linspace(0.0, 1.0, SCAN_XI) if len(axes) == 2 else np.array([0.0])  # a fixed xi is v = 0
     grid = np.array([(a, b) for a in u for b in v])
     likelihood = _Likelihood(search, times[:n], reference[:n], float(times[n - 1]) + dt, floor=floor)
-    _, rss = likelihood.residuals(grid)
+    residuals, rss = likelihood.residuals(grid)
     seeds = _grid_basins(rss, u.size, v.size, grid, SCAN_BASINS)
     threshold = 2.706
     points, values = [], []
@@ -1187,7 +1208,7 @@ def _scan(search, times, reference, n, floor, dt, axes):
         if all(np.max(np.abs(window.point - p)) > SAME_BASIN for p in points):
             points.append(window.point)
             values.append(window.rss)
-    return _Scan(np.array(points), np.array(values), grid, rss)
+    return _Scan(np.array(points), np.array(values), grid, rss, residuals.astype(np.float32))
 
 
 @dataclass
@@ -1198,6 +1219,7 @@ class _Scan:
     rss: np.ndarray
     grid: np.ndarray
     grid_rss: np.ndarray
+    grid_residuals: np.ndarray = field(repr=False, default=None)  # (grid points, samples): model - reference
 
     def region(self, best: float, variance: float, level: float) -> np.ndarray:
         """Basins and grid points whose deviance against RSS ``best`` is within ``level``."""
@@ -1208,7 +1230,8 @@ class _Scan:
 
 MIN_BASE_SAMPLES = 20  # a quiet start shorter than this is no base: the search's first window is
 REFINEMENTS = 5  # windows bisecting the gap past the decisive one
-SECOND_TRIES = 3  # shorter accepted windows profiled for the second regular one (the union of the intervals)
+SECOND_TRIES = 6  # shorter accepted windows profiled for the union of the intervals
+UNION_RATIO = 2.0  # the union goes back to a shorter regular window whose interval is this many times as wide
 LINEAR_PROFILES = 6  # irregular windows profiled one by one down the list before bisection takes over
 RESCANS = 2  # scans of the last accepted window for other basins when the longer windows are not explained
 SCAN_K, SCAN_XI = 121, 21  # the scan's grid: k log-spaced (1.8 % apart over 1e8-9e8 N/m) times xi
@@ -1295,17 +1318,21 @@ def _decide(search, times, reference, history, full_point, fixed_xi, confidence,
         return scan.region(best, window.rss / window.n * window.tau, chi2.ppf(confidence, len(axes)))
 
     if chosen is None:
-        # no window's likelihood is regular at its interval's scale: the fits that explain the shortest accepted
-        # window as well as its best are the range
-        profile = profiles[min(profiles)]  # the shortest profiled window's
-        out = {key: value for key, value in profile.items() if key.startswith("profile_") or key in (
-            "noise_rms", "autocorrelation_time")}
-        # the fits found do not locate the truth: where the response is chaotic from the start of the rocking,
-        # the parameters that reproduce it form needles no search finds, anywhere in the range
-        out.update(point=accepted[-1].point, end=None, identifiable=False, windows=table(),
-                   range_points=np.array([[0.0, 0.0], [1.0, 1.0]]),
-                   notes=[f"no window's likelihood is regular at the interval's scale ({profile['irregular']}): "
-                          "the fits found do not locate k and xi; the range is the search range"])
+        # no window's likelihood is regular at its interval's scale: no local curvature describes it, so the
+        # region is read off the likelihood itself over the whole search range, on the shortest accepted window
+        # (the least chaotic), or a longer one where that does not bound k and xi inside the range
+        for window in accepted[:DIRECT_TRIES]:
+            out = _direct_region(search, times, reference, window, scan_of(window), axes, confidence, floor_rms)
+            if not out["whole_range"]:
+                break
+        reason = irregular.get(out["window"].n) or next(iter(irregular.values()))
+        if out["window"].n in profiles:  # the profiles drawn are that window's, although they do not bound it
+            out.update({key: value for key, value in profiles[out["window"].n].items()
+                        if key.startswith("profile_")})
+        out["notes"].insert(0, f"no window's likelihood is regular at the interval's scale ({reason}): the intervals "
+                            f"are its likelihood region on 0-{out['end']:.2f} s by direct evaluation over the search "
+                            "range")
+        out.update(windows=table())
         return out
 
     notes, identifiable = list(profile["notes"]), True
@@ -1356,28 +1383,41 @@ def _decide(search, times, reference, history, full_point, fixed_xi, confidence,
     elif region:
         notes.append(f"the intervals are widened to {len(region)} fit(s) near them that explain 0-{chosen.end:.2f} s "
                      "as well (the surface is not quadratic at this scale)")
-    # the next shorter regular window: near the chaotic horizon the likelihood splits into narrow basins that
-    # fit equally well (the longest window's may not be the truth's); a shorter window's, before the split, is
-    # wider and holds them. The interval is the union of both; intervals that do not meet disagree.
-    index = accepted.index(chosen)
+    # shorter regular windows: near the chaotic horizon the likelihood splits into narrow basins that fit equally
+    # well (the longest window's may not be the truth's; its interval shrinks from one window to the next far
+    # faster than information accrues). A window before the split has an interval at least ``UNION_RATIO`` times
+    # as wide, which holds them: the intervals are the union of the decisive window's and of the shorter regular
+    # windows' back to the first that wide (not one that bounds nothing: the search range). Intervals that do not
+    # meet disagree.
+    def width(result, axis, name):
+        return _unit(search, axis, result[f"{name}_high"]) - _unit(search, axis, result[f"{name}_low"])
+
+    free = [(axis, name) for axis, name in ((0, "k"), (1, "xi")) if profile.get(f"{name}_low") is not None]
+    own = {name: max(width(profile, axis, name), RESOLUTION) for axis, name in free}
+    index, joined = accepted.index(chosen), []
     for earlier in reversed(accepted[max(0, index - SECOND_TRIES):index]):
         second = profiles.get(earlier.n) or profile_of(earlier)
         if second["irregular"] is not None:
             continue
-        meet = all(second[f"{name}_low"] is None or (second[f"{name}_low"] <= profile[f"{name}_high"] and
-                                                       profile[f"{name}_low"] <= second[f"{name}_high"])
-                   for name in ("k", "xi"))
-        for name in ("k", "xi"):
-            if second.get(f"{name}_low") is not None:
-                profile[f"{name}_low"] = min(profile[f"{name}_low"], second[f"{name}_low"])
-                profile[f"{name}_high"] = max(profile[f"{name}_high"], second[f"{name}_high"])
-        notes.append(f"the intervals are the union of those of 0-{chosen.end:.2f} s and 0-{earlier.end:.2f} s (the "
-                     "next shorter window whose likelihood is regular)")
+        if any(width(second, axis, name) >= 1.0 - 1e-9 for axis, name in free):
+            break  # a window that does not bound k or xi inside the search range holds nothing the union needs
+        meet = all(second[f"{name}_low"] <= profile[f"{name}_high"] and profile[f"{name}_low"] <= second[f"{name}_high"]
+                   for _, name in free)
+        for _, name in free:
+            profile[f"{name}_low"] = min(profile[f"{name}_low"], second[f"{name}_low"])
+            profile[f"{name}_high"] = max(profile[f"{name}_high"], second[f"{name}_high"])
+        joined.append(earlier.end)
         if not meet:
             identifiable = False
             notes.append(f"the windows disagree: the intervals of 0-{chosen.end:.2f} s and 0-{earlier.end:.2f} s do "
                          "not meet")
-        break
+        if any(width(second, axis, name) >= UNION_RATIO * own[name] for axis, name in free):
+            break
+    if joined:
+        notes.append(f"the intervals are the union of those of 0-{chosen.end:.2f} s and of the shorter regular "
+                     f"window(s) 0-{', 0-'.join(f'{end:.2f}' for end in joined)} s (back to one whose interval is "
+                     f"{UNION_RATIO:g} times as wide: near the chaotic horizon the likelihood splits into narrow "
+                     "basins)")
     # the decisive fit must explain the shorter accepted windows too (nested data: a fit outside their regions
     # means the windows disagree beyond their intervals)
     for window in accepted:
@@ -1395,6 +1435,86 @@ def _decide(search, times, reference, history, full_point, fixed_xi, confidence,
             break
     return dict(profile, end=chosen.end, identifiable=identifiable, windows=table(), notes=notes, point=point,
                 range_points=np.array(range_points))
+
+
+DIRECT_TRIES = 3  # accepted windows tried, shortest first, for a direct region that bounds k and xi
+DIRECT_METHOD = "likelihood region by direct evaluation (the likelihood is not regular)"
+CLUSTER_GAP = 3  # scan steps between region points that make them separate basins
+DIRECT_BOOTSTRAP = 200  # replicates of the direct region's bootstrap (scored on the scan's grid: no simulations)
+
+
+def _direct_region(search, times, reference, window, scan, axes, confidence, floor_rms):
+    """The likelihood region of one window read off a scan of the whole search range (no local curvature).
+
+    The window's least-squares point f is refitted from its own and from the scan's best basin; sigma^2 tau is
+    that fit's residual variance times their autocorrelation time. The region is every grid point of the scan
+    whose RSS is within ``limit`` sigma^2 tau of the grid's least, with f; each bound moves out by one scan step
+    (the region's edge lies between the last point inside and the first outside). The limit is a parametric
+    bootstrap of exactly that reading: ``DIRECT_BOOTSTRAP`` replicates f + AR(1) noise (the residuals' variance
+    and lag-1 correlation, seeded) are scored against every grid point at once (the grid's histories do not
+    change), and the limit is the ``confidence`` quantile of how far the best of the four grid points around
+    f (the scan cell that holds the truth of the replicate) lies above the replicate's best grid point: where
+    the window is rugged the grid's best point fits the noise better than the truth does, and the limit grows
+    with it (at least chi^2_1). Points that fall apart by more than ``CLUSTER_GAP`` steps are separate basins:
+    "not identifiable", with the range that holds them all.
+
+    Returns
+    -------
+    dict
+        A decision as ``_decide`` returns it: ``point``, ``end`` [s], ``identifiable``, ``range_points`` (the
+        region's box corners in the unit box), ``noise_rms`` [rad], ``autocorrelation_time``, ``notes``,
+        ``limits``, ``method``, and ``window`` and ``whole_range`` (the box spans the search range in k or xi).
+    """
+    from scipy.stats import chi2
+
+    threshold = float(chi2.ppf(confidence, 1))
+    n, floor = window.n, window.n * floor_rms**2
+    starts = [window.point] + ([scan.points[int(np.argmin(scan.rss))]] if scan.rss.size else [])
+    fit = _window_fit(search, times, reference, n, starts, axes, threshold, floor, search.dt)
+    variance = fit.rss / n * fit.tau
+    steps = np.array([1.0 / (SCAN_K - 1), 1.0 / (SCAN_XI - 1) if len(axes) == 2 else 1.0])
+    # replicate b is f + e_b = reference + x_b: its RSS at grid point m is |R_m - x_b|^2, R the scan's residuals
+    replicates = fit.residual[None, :] + _ar1_noise(-fit.residual, DIRECT_BOOTSTRAP, BOOTSTRAP_SEED)
+    grid_residuals = scan.grid_residuals.astype(float)
+    replicate_rss = (np.sum(grid_residuals**2, axis=1)[:, None] - 2.0 * grid_residuals @ replicates.T
+                     + np.sum(replicates**2, axis=1)[None, :])
+    cell = np.all(np.abs(scan.grid - fit.point) <= steps * (1 + 1e-9), axis=1)
+    excess = (replicate_rss[cell].min(axis=0) - replicate_rss.min(axis=0)) / variance
+    limit = max(threshold, float(np.quantile(excess, confidence)))
+    inside = scan.grid[(scan.grid_rss - float(scan.grid_rss.min())) / variance <= limit]
+    region = np.concatenate([inside, fit.point[None, :]])
+    corners = np.array([np.clip(region.min(axis=0) - steps, 0.0, 1.0), np.clip(region.max(axis=0) + steps, 0.0, 1.0)])
+    if len(axes) == 1:
+        corners[:, 1] = fit.point[1]
+    split = [axis for axis in axes if np.any(np.diff(np.unique(region[:, axis])) > CLUSTER_GAP * steps[axis])]
+    notes = [f"the region's deviance limit is {limit:.3g} (chi^2_1 {threshold:.3g}; a bootstrap of {DIRECT_BOOTSTRAP} "
+             "replicates of the scan: the grid's best point fits the noise better than the truth does)"]
+    if split:
+        notes.append(f"the region falls apart into separate basins along {' and '.join(('k', 'xi')[a] for a in split)}"
+                     f" on 0-{window.end:.2f} s: the range holds every fit that explains it as well as the best")
+    if fit.tau > 2.0:
+        notes.append(f"the residuals are correlated over {fit.tau:.0f} samples (model error or coloured noise): the "
+                     f"region counts {n / fit.tau:.0f} of {n} samples as independent")
+    whole = any(corners[0, axis] <= 0.0 and corners[1, axis] >= 1.0 for axis in axes)
+    return {"point": np.array(fit.point, float), "end": window.end, "identifiable": not split,
+            "range_points": corners, "noise_rms": math.sqrt(max(fit.rss - floor, 0.0) / n),
+            "autocorrelation_time": fit.tau, "notes": notes, "limits": {axis: limit for axis in axes},
+            "method": DIRECT_METHOD, "window": window, "whole_range": whole}
+
+
+def _ar1_noise(residual, count, seed):
+    """``count`` series of AR(1) noise with the variance and lag-1 correlation of ``residual`` (seeded)."""
+    centred = residual - residual.mean()
+    n = centred.size
+    variance = float(np.mean(centred**2))
+    phi = float(np.clip(np.sum(centred[1:] * centred[:-1]) / max(np.sum(centred**2), 1e-300), 0.0, 0.99))
+    rng = np.random.default_rng(seed)
+    shocks = rng.normal(0.0, math.sqrt(variance * (1.0 - phi**2)), (count, n))
+    noise = np.empty_like(shocks)
+    noise[:, 0] = rng.normal(0.0, math.sqrt(variance), count)
+    for i in range(1, n):
+        noise[:, i] = phi * noise[:, i - 1] + shocks[:, i]
+    return noise
 
 
 def _bootstrap_limits(search, times, reference, n, point, steps, fixed_xi, confidence, floor_rms, dt):
@@ -1420,17 +1540,7 @@ def _bootstrap_limits(search, times, reference, n, point, steps, fixed_xi, confi
     likelihood = _Likelihood(search, times[:n], reference[:n], t_end, floor=floor)
     values = likelihood.residuals([point])[0][0]
     fit = reference[:n] + values
-    residual = -values
-    centred = residual - residual.mean()
-    variance = float(np.mean(centred**2))
-    phi = float(np.clip(np.sum(centred[1:] * centred[:-1]) / max(np.sum(centred**2), 1e-300), 0.0, 0.99))
-    rng = np.random.default_rng(BOOTSTRAP_SEED)
-    shocks = rng.normal(0.0, math.sqrt(variance * (1.0 - phi**2)), (BOOTSTRAP, n))
-    noise = np.empty_like(shocks)
-    noise[:, 0] = rng.normal(0.0, math.sqrt(variance), BOOTSTRAP)
-    for i in range(1, n):
-        noise[:, i] = phi * noise[:, i - 1] + shocks[:, i]
-    data = fit[None, :] + noise
+    data = fit[None, :] + _ar1_noise(-values, BOOTSTRAP, BOOTSTRAP_SEED)
     start = np.repeat(np.asarray(point, float)[None, :], BOOTSTRAP, axis=0)
     free, free_rss, free_residual = _batch_gauss_newton(search, times[:n], t_end, data, start, axes, steps, floor,
                                                         BOOTSTRAP_ITERATIONS)
@@ -1464,13 +1574,7 @@ def _batch_gauss_newton(search, times, t_end, data, points, axes, steps, floor, 
     values = residuals(points, rows)
     rss = np.sum(values**2, axis=1) + floor
     for _ in range(iterations):
-        stencil, shifts = [], []
-        for axis in axes:
-            plus, minus = points.copy(), points.copy()
-            plus[:, axis] = np.minimum(points[:, axis] + steps[axis], 1.0)
-            minus[:, axis] = np.maximum(points[:, axis] - steps[axis], 0.0)
-            stencil += [plus, minus]
-            shifts.append(plus[:, axis] - minus[:, axis])
+        stencil, shifts = _stencil(points, steps, axes)
         shifted = residuals(np.concatenate(stencil), np.tile(rows, 2 * len(axes)))
         jacobian = np.stack([(shifted[(2 * i) * count:(2 * i + 1) * count] - shifted[(2 * i + 1) * count:(2 * i + 2) *
                                                                                      count]) / shift[:, None]
@@ -1628,7 +1732,7 @@ def calibrate(ref_time: ArrayLike, ref_rotation: ArrayLike, ag: ArrayLike, dt: f
         peak = float(np.max(np.abs(ref_rotation)))
         decision = _decide(search, times, objective.reference, history, best_point, fixed_xi,
                            confidence, NOISE_FLOOR * peak,
-                           _quiet_samples(objective.reference, objective.smoothed_reference), log)
+                           _quiet_samples(objective.smoothed_reference), log)
         best_point = decision["point"]
         intervals = _interval_fields(search, decision, fixed_xi, confidence, peak)
         intervals["interval_simulations"] = search.count - before
@@ -1678,9 +1782,9 @@ def _interval_fields(search, decision, fixed_xi, confidence, peak):
         if decision.get(f"{name}_low") is not None:
             values += [decision[f"{name}_low"], decision[f"{name}_high"]]
         bounds[f"{name}_low"], bounds[f"{name}_high"] = float(min(values)), float(max(values))
-    method = "profile likelihood on the decisive window"
+    method = decision.get("method", "profile likelihood on the decisive window")
     if not decision["identifiable"]:
-        method = f"{NOT_IDENTIFIABLE}: the range of fits that explain it equally"
+        method = f"{NOT_IDENTIFIABLE}: the range of fits that explain it equally ({method})"
     limits = {("k", "xi")[axis]: float(limit) for axis, limit in decision.get("limits", {}).items()}
     return dict(fields, **bounds, confidence=float(confidence), interval_method=method, interval_notes=notes,
                 identifiable=bool(decision["identifiable"]), decisive_window=decision["end"],
