@@ -45,9 +45,10 @@ is regular at the interval's scale; the data say which (``_decide``; block comme
 1. Goodness of fit per window: the noise (variance, autocorrelation time) is the residual of the quiet start
    (before the reference reaches 20 % of its peak), at least ``NOISE_FLOOR`` (0.1 %) of the peak. A window
    is accepted when its least-squares fit (Gauss-Newton from the search's points) leaves no more than the
-   chi^2 99.9 % quantile of that noise, in all and in the samples it adds. Where longer windows are not
-   explained, the first of them is scanned over the whole search range for other basins and they are fitted
-   again from those (the search may have tracked the wrong basin).
+   chi^2 99.9 % quantile of that noise, in all and in the samples it adds. The quiet start itself is scanned
+   over the whole search range first (a base fit in a wrong basin would read its misfit as noise). Where longer
+   windows are not explained, the first of them is scanned for other basins and they are fitted again from
+   those (the search may have tracked the wrong basin).
 2. Regularity: the profile likelihood of the longest accepted window, else of the next shorter one: the
    response smooth at the interval's scale (its Jacobian at a quarter of the step within 30 %), the profiles
    rising monotonically and leaving the region once. That window decides; its least-squares point is the
@@ -57,12 +58,16 @@ is regular at the interval's scale; the data say which (``_decide``; block comme
    range of every fit that explains the window as well as the estimate.
 4. The profile deviance that bounds the intervals: chi^2_1, or the parametric bootstrap's quantile where
    larger (40 replicates of the fit plus AR(1) noise with the residuals' variance and lag-1 correlation,
-   refitted by batched Gauss-Newton). The intervals are the union of the decisive window's and of the next
-   shorter regular window's: near the horizon the likelihood splits into narrow basins that fit equally well.
+   refitted by batched Gauss-Newton). The intervals are the union of the decisive window's and of the shorter
+   regular windows' back to one whose interval is twice as wide: near the horizon the likelihood splits into
+   narrow basins that fit equally well, and the interval of one of them shrinks from window to window far faster
+   than information accrues.
 5. Agreement: the estimate must explain every shorter accepted window (chi^2_2 99.9 %) and the two windows'
    intervals must meet; else "not identifiable", with the range of the fits of the windows that disagree.
-   No regular window at all (a response chaotic from the start of its rocking): the range is the search
-   range.
+6. No regular window at all (a response chaotic from the start of its rocking, e.g. many small impacts): the
+   region is read off the likelihood itself on the shortest accepted window, without local curvature: every
+   point of its 121 x 21 scan within a deviance limit of the scan's best, one scan step beyond, the limit a
+   parametric bootstrap of that reading scored on the scan's grid (``_direct_region``).
 
 Why not the alternatives alone: profile likelihood over the whole record is the old method; a parametric
 bootstrap of the whole calibration (resimulate, search again) costs hundreds of searches of ~2,000
