@@ -28,7 +28,7 @@ The public API is this package's ``__all__``: ``import rockfrag``, then ``rockfr
 ``rockfrag.load_study``, ``rockfrag.run_study``, ... Everything else is internal: its modules may change between
 versions. Each name is imported from its stage on first use (module ``__getattr__``), so ``import rockfrag`` stays
 light for the command line (the version alone, ``rockfrag.version``); ``api`` holds the API's own functions where
-a stage's signature carries internal plumbing.
+a stage's signature carries internal plumbing or a user's step spans stages (``run_fragility``).
 """
 
 from __future__ import annotations
@@ -39,7 +39,8 @@ from rockfrag.version import __version__
 
 TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (a third of the root's import time)
 if TYPE_CHECKING:  # the names as type checkers and readers see them; at run time __getattr__ imports each
-    from rockfrag.api import run_study
+    from rockfrag.answer import answer_table
+    from rockfrag.api import intensity_measures, run_fragility, run_study, shipped_soils
     from rockfrag.blocks import Block
     from rockfrag.config import load_study
     from rockfrag.errors import ConfigError, PipelineError, RecordError, SolverError
@@ -54,10 +55,12 @@ if TYPE_CHECKING:  # the names as type checkers and readers see them; at run tim
 _HOMES = {
     # the model
     "simulate": "rockfrag.models", "Block": "rockfrag.blocks", "SoilClass": "rockfrag.soils",
+    "shipped_soils": "rockfrag.api",
     # the study: definition, inputs, run
     "load_study": "rockfrag.config", "load_records": "rockfrag.records", "load_recipe": "rockfrag.processing",
-    "process_record": "rockfrag.processing", "run_study": "rockfrag.api",
-    # from the cube to the risk
+    "process_record": "rockfrag.processing", "intensity_measures": "rockfrag.api", "run_study": "rockfrag.api",
+    # from the cube to the answer and the risk
+    "run_fragility": "rockfrag.api", "answer_table": "rockfrag.answer",
     "fragility_dataset": "rockfrag.fragility", "load_hazard": "rockfrag.hazard", "risk_dataset": "rockfrag.risk",
     "annual_frequency": "rockfrag.risk", "probability_in_life": "rockfrag.risk",
     # what the functions raise
@@ -68,9 +71,10 @@ _HOMES = {
 
 __all__ = [
     "__version__",
-    "simulate", "Block", "SoilClass",
-    "load_study", "load_records", "load_recipe", "process_record", "run_study",
-    "fragility_dataset", "load_hazard", "risk_dataset", "annual_frequency", "probability_in_life",
+    "simulate", "Block", "SoilClass", "shipped_soils",
+    "load_study", "load_records", "load_recipe", "process_record", "intensity_measures", "run_study",
+    "run_fragility", "answer_table", "fragility_dataset", "load_hazard", "risk_dataset", "annual_frequency",
+    "probability_in_life",
     "PipelineError", "ConfigError", "RecordError", "SolverError",
 ]
 """The public API (tests/test_public_api.py: each name has a home in ``_HOMES``, and each function is typed and

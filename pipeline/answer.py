@@ -156,7 +156,7 @@ def answer_table(fragility: xr.Dataset, outputs: Sequence[Path | str] = ()) -> s
     Parameters
     ----------
     fragility : xarray.Dataset
-        ``fragility.nc`` as written by ``rockfrag.fragility.fragility_stage``.
+        ``fragility.nc``, as ``rockfrag.run_fragility`` returns and writes it.
     outputs : sequence of path
         Files to name at the end (e.g. the report, fragility.csv, fragility.nc).
 

@@ -23,40 +23,37 @@ print(study_file.read_text())
 # %%
 # Check it before anything runs
 # -----------------------------
-# ``rockfrag study`` reads and checks the file and runs nothing. Every command of the ``rockfrag`` program is
-# also a function call: ``rockfrag.cli.main`` takes the words you would type and returns the exit status.
-from rockfrag.cli import main
+# Everything here comes from the package's root, ``import rockfrag``. ``load_study`` reads the file and checks
+# every value against its allowed range before anything runs (on the command line: ``rockfrag study
+# my-site.toml``). The study it returns holds the blocks and soils as objects, in SI units:
+import rockfrag
 
-status = main(["study", str(study_file)])
-print("exit status:", status)
+config = rockfrag.load_study(study_file)
+[rack] = config.blocks
+print(f"block {rack.name}: b = {rack.b} m, h = {rack.h} m, alpha = {rack.alpha:.3f} rad, "
+      f"uplift at g tan(alpha) = {rack.uplift_acceleration() / 9.80665:.2f} g")
+print("soils:", [f"{soil.name} (G = {soil.shear_modulus / 1e6:g} MPa)" for soil in config.soils])
 
 # %%
 # A mistake is one line naming the file, the key and what it must be. Here a copy of the file with a Poisson's
 # ratio of 0.55 (above the 0.5 of an incompressible soil):
 import tempfile
 
-from rockfrag.config import load_study
-from rockfrag.errors import ConfigError
-
 mistaken = Path(tempfile.mkdtemp()) / "my-site-mistaken.toml"
 mistaken.write_text(study_file.read_text().replace("poisson_ratio = 0.40", "poisson_ratio = 0.55"))
 try:
-    load_study(mistaken)
-except ConfigError as error:
+    rockfrag.load_study(mistaken)
+except rockfrag.ConfigError as error:
     print(error)
 
 # %%
 # Run the study
 # -------------
-# The runs go into an output folder (here a temporary one; the study's ``[study] output`` or ``--output``
-# otherwise). ``run_study`` writes ``cube.nc``: every record at every intensity level on every soil for every
-# block and model. A run that is interrupted resumes from its checkpoints.
-from rockfrag.study import run_study, study_records
-
+# The runs go into an output folder (here a temporary one; the study's ``[study] output`` otherwise).
+# ``run_study`` writes ``cube.nc``: every record at every intensity level on every soil for every block and
+# model. A run that is interrupted resumes from its checkpoints.
 output = Path(tempfile.mkdtemp(prefix="my-site-"))
-config = load_study(study_file)
-loaded = study_records(config)
-cube, statistics = run_study(config, output=output, workers=1, progress=False, loaded=loaded)
+cube, statistics = rockfrag.run_study(config, output=output, workers=1)
 print(f"{statistics['runs_computed']} runs in {statistics['seconds']:.1f} s")
 
 # %%
@@ -68,16 +65,13 @@ print(cube.model.values.tolist())
 # %%
 # From the cube to the answer
 # ---------------------------
-# The incremental dynamic analysis (``ida.nc``) and the fragility fits with the risk (``fragility.nc``) follow
-# from the cube without another solver run.
-from rockfrag.fragility import fragility_stage
-from rockfrag.ida import ida_stage
-
-ida = ida_stage(cube, output)
-fragility, risk = fragility_stage(cube, ida, config, output, progress=False, log=print)
+# ``run_fragility`` fits the fragility curves and the risk from the cube, without another solver run, and
+# writes the incremental dynamic analysis (``ida.nc``) and the fits with the risk (``fragility.nc``,
+# ``fragility.csv`` and the exchange files). Its notes go to ``notes`` (stderr by default; here the page):
+fragility = rockfrag.run_fragility(config, cube, output=output, notes=print)
 
 # %%
-# The warnings are part of the answer: with four records the dispersion is rough, and a damage state whose
+# The notes are part of the answer: with four records the dispersion is rough, and a damage state whose
 # records all change at one level is a step (beta = 0), never a made-up small beta.
 #
 # The answer
@@ -85,9 +79,7 @@ fragility, risk = fragility_stage(cube, ida, config, output, progress=False, log
 # One line per block and soil: the median intensity of overturning (PGA in g here) from the recommended model,
 # its bootstrap bounds, the dispersion beta and, with a hazard curve, the probability of overturning in the
 # design life. No ``[hazard] file`` is given here, so the shipped example curve is used and the line says so.
-from rockfrag.answer import answer_table
-
-print(answer_table(fragility))
+print(rockfrag.answer_table(fragility))
 
 # %%
 # Reading the answer

@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rockfrag.records import list_formats, load_records, read_record, read_stream
+import rockfrag
 
-bolu = load_records("DUZCE/BOL090")[0][0]  # a catalogue record: (records, failures)
+[bolu], failures = rockfrag.load_records("DUZCE/BOL090")  # a catalogue record: (records, failures)
 folder = Path(tempfile.mkdtemp(prefix="my-records-"))
 time = np.arange(bolu.trace.stats.npts) * bolu.dt
 in_g = bolu.acceleration / 9.80665
@@ -30,20 +30,21 @@ np.savetxt(folder / "bolu-two-columns.csv", np.column_stack([time, in_g]), delim
            header="time [s], acc [g]", comments="")
 np.savetxt(folder / "bolu-one-column.txt", in_g, fmt="%.6g")  # in g, without a header
 
-two_columns = read_record(folder / "bolu-two-columns.csv")  # units and dt from the file
-one_column = read_record(folder / "bolu-one-column.txt", units="g", dt=0.01)
-for trace in (two_columns, one_column):
-    print(f"{trace.stats.npts} samples at dt = {trace.stats.delta:.4g} s, "
-          f"PGA {np.abs(trace.data).max() / 9.80665:.4f} g")
+# %%
+# ``load_records`` reads a file of one's own as it reads a record set: it returns the records it read and,
+# for each file it could not read, the reason. A two-column file states its units and time step; a one-column
+# file needs them from you.
+[two_columns], _ = rockfrag.load_records(folder / "bolu-two-columns.csv")  # units and dt from the file
+[one_column], _ = rockfrag.load_records(folder / "bolu-one-column.txt", units="g", dt=0.01)
+for record in (two_columns, one_column):
+    print(f"{record.id}: {record.acceleration.size} samples at dt = {record.dt:.4g} s, "
+          f"PGA {np.abs(record.acceleration).max() / 9.80665:.4f} g")
 
 # %%
-# A one-column file without ``units`` or ``dt`` is an error that says what to give, never a guess:
-from rockfrag.errors import RecordError
-
-try:
-    read_record(folder / "bolu-one-column.txt")
-except RecordError as error:
-    print(error)
+# A one-column file without ``units`` or ``dt`` is not read, with a reason that says what to give, never a
+# guess:
+records, failures = rockfrag.load_records(folder / "bolu-one-column.txt")
+print(records, failures[0], sep="\n")
 
 # %%
 # K-NET and KiK-net
@@ -53,43 +54,44 @@ except RecordError as error:
 import obspy
 
 knet_file = Path(obspy.__file__).parent / "io" / "nied" / "tests" / "data" / "test.knet"
-knet = read_record(knet_file)
-print(knet.id, knet.stats.starttime, f"{knet.stats.npts} samples, {knet.stats.sampling_rate} Hz")
-print(f"PGA {np.abs(knet.data).max():.4f} m/s^2")
+[knet], _ = rockfrag.load_records(knet_file)
+print(knet.id, knet.trace.stats.starttime, f"{knet.acceleration.size} samples, {1 / knet.dt:g} Hz")
+print(f"PGA {np.abs(knet.acceleration).max():.4f} m/s^2")
 
 # %%
 # CSMIP Volume 1 and ASDF
 # -----------------------
 # A CSMIP Volume 1 file holds the three channels of a station; an ASDF file (HDF5) holds the raw counts of
-# whole networks with their instrument responses, which rockfrag removes. ``read_stream`` gives every
-# component; each becomes a record of its own, the vertical marked as such. Both files are shipped in
-# ``records/`` (USGS demo data of gmprocess, public domain).
-from rockfrag.records import RECORDS_DIR
+# whole networks with their instrument responses, which rockfrag removes. Each component becomes a record of
+# its own, the vertical marked as such. Both kinds are in the shipped catalogue (USGS demo data of gmprocess,
+# public domain); a record's ``metadata["file"]`` is the file it was read from, which we copy here as if it
+# were one of ours (in a folder of its own: the last section uses the first folder in a study).
+import shutil
 
-csmip = read_stream(RECORDS_DIR / "ridgecrest-2019" / "CICLC.v1")
-print(csmip)
-asdf = read_stream(RECORDS_DIR / "south-napa-2014" / "workspace.h5")
-print(f"{len(asdf)} channels, e.g. {asdf[0].id}: PGA {np.abs(asdf[0].data).max():.3f} m/s^2")
+station_files = Path(tempfile.mkdtemp(prefix="my-stations-"))
 
-# %%
-# The formats rockfrag reads itself are tried first, then obspy's:
-print(list_formats())
+for catalogue_id, name in (("RIDGECREST/CI.CLC.HNE", "CICLC.v1"), ("SOUTHNAPA/CE.68150.HNE", "workspace.h5")):
+    [shipped], _ = rockfrag.load_records(catalogue_id)
+    shutil.copy(shipped.metadata["file"], station_files / name)
+    components, _ = rockfrag.load_records(station_files / name)
+    for record in components:
+        print(f"{name}: {record.id} component {record.component}{' (vertical)' if record.is_vertical else ''}, "
+              f"PGA {np.abs(record.acceleration).max() / 9.80665:.3f} g")
 
 # %%
 # Processing
 # ----------
 # Before any run each record is processed by the shipped recipe (``pipeline/processing.toml``: demean,
 # detrend, taper, zero-padded 4th-order Butterworth band-pass, baseline correction), each step written into
-# the trace's provenance. A recipe of your own is a TOML file of the same layout (``[study] processing``).
+# the trace's provenance. A recipe of your own is a TOML file of the same layout (``[study] processing``;
+# ``rockfrag.load_recipe`` reads one). ``intensity_measures`` gives the measures of the processed record, the
+# columns of ``records.csv``, in SI units.
 import matplotlib.pyplot as plt
 
-from rockfrag.measures import intensity_measures
-from rockfrag.processing import process_record
-
-record = load_records(folder / "bolu-two-columns.csv")[0][0]
-processed = process_record(record)
+record = two_columns
+processed = rockfrag.process_record(record)
 print("\n".join(processed.trace.stats.processing))
-measures = intensity_measures(processed.acceleration, processed.dt)
+measures = rockfrag.intensity_measures(processed)
 print({name: round(value, 4) for name, value in measures.items()})
 
 fig, axes = plt.subplots(2, 1, figsize=(7, 4.5), sharex=True)
@@ -113,7 +115,7 @@ fig.tight_layout()
 # ``dt`` serve the files that do not state them (a file whose header states other units is refused, not
 # converted twice). A file with the same samples as a record read before it is skipped, with the reason: here
 # the two copies of Bolu 090 we wrote, which are the catalogue's Bolu 090.
-records, failures = load_records(["DUZCE/BOL090", str(folder), "KOBE/NIS000"], units="g", dt=0.01)
+records, failures = rockfrag.load_records(["DUZCE/BOL090", str(folder), "KOBE/NIS000"], units="g", dt=0.01)
 print([record.id for record in records])
 for failure in failures:
     print("skipped:", failure)

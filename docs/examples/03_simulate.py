@@ -67,20 +67,20 @@ fig.suptitle("Rack on sand, Bolu 090 x 0.7")
 fig.tight_layout()
 
 # %%
-# Many scale factors at once
-# --------------------------
-# ``simulate_batch`` runs one record at many scale factors in one compiled call (this is how a study runs its
-# stripes) and returns a structured array of the summary fields (``rockfrag.models.fields``). A peak of
-# pi / (2 alpha) = 5.39 alpha is a rack that overturned.
-from rockfrag.models import simulate_batch
-from rockfrag.models.variants import central_member
-from rockfrag.soils import SOILS
+# Many scale factors, and the shipped soils
+# -----------------------------------------
+# A study runs each record at many scale factors; ``simulate`` with ``scale=`` gives the same bits as a study's
+# cell. Here the rack under Bolu 090 at eight scale factors, on each shipped soil (``shipped_soils``: the paper's
+# Table 1 and a steel base). A peak of pi / (2 alpha) = 5.39 alpha is a rack that overturned.
+soils = rockfrag.shipped_soils()
+for name, soil in soils.items():
+    print(f"{name:7s} G = {soil.shear_modulus / 1e6:7.0f} MPa, mu = {soil.friction_static:.2f}: {soil.description}")
 
-member = central_member(rack, SOILS["sand"])  # the recommended run's k, xi, contact law and friction
 scales = np.array([0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1])
-housner_runs = simulate_batch("housner", ag, dt, scales, [(rack, None, None)])
-recommended_runs = simulate_batch(member.model, ag, dt, scales, [(rack, member.k, member.xi)], bed=member.bed,
-                                  friction=member.friction)
-print("scale       ", " ".join(f"{scale:6.2f}" for scale in scales))
-for name, runs in (("housner", housner_runs), ("recommended", recommended_runs)):
-    print(f"{name:12s}", " ".join(f"{ratio:6.3f}" for ratio in runs["peak_angle"][0] / rack.alpha))
+print("\nscale          ", " ".join(f"{scale:6.2f}" for scale in scales))
+runs = {"housner": [rockfrag.simulate("housner", ag, dt, rack, scale=scale) for scale in scales]}
+for name in ("sand", "rock"):
+    runs[f"recommended, {name}"] = [rockfrag.simulate("recommended", ag, dt, rack, soil=soils[name], scale=scale)
+                                    for scale in scales]
+for name, results in runs.items():
+    print(f"{name:17s}", " ".join(f"{result.peak_angle_ratio:6.3f}" for result in results))

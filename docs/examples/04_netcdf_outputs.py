@@ -15,15 +15,12 @@ written beside them. :doc:`/reference/outputs` lists every variable.
 import tempfile
 from pathlib import Path
 
-from rockfrag.config import load_study
-from rockfrag.fragility import fragility_stage
-from rockfrag.ida import ida_stage
-from rockfrag.study import run_study
+import rockfrag
 
 output = Path(tempfile.mkdtemp(prefix="my-site-"))
-config = load_study("my-site.toml")
-cube, _ = run_study(config, output=output, workers=1, progress=False, log=lambda line: None)
-fragility_stage(cube, ida_stage(cube, output), config, output, progress=False, log=lambda line: None)
+config = rockfrag.load_study("my-site.toml")
+cube, _ = rockfrag.run_study(config, output=output, workers=1)
+rockfrag.run_fragility(config, cube, output=output, notes=lambda line: None)  # the notes: see the first tutorial
 print(sorted(path.name for path in output.glob("[!.]*") if path.is_file()))
 
 # %%

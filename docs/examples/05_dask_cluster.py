@@ -4,8 +4,9 @@ Running on a dask cluster
 
 A study is a grid of independent cells (one record on one block, soil and model at every level), so it spreads
 over processes or machines. ``run_study`` runs the cells in this process (``workers=1``), on a pool of local
-processes (``workers=N``), or on dask.distributed: a ``LocalCluster`` it starts (``dask_workers=N``) or a
-cluster that is already running (``scheduler="tcp://host:8786"``). The cube is the same whichever runs it.
+processes (``workers=N``), or on dask.distributed: a ``LocalCluster`` it starts (``scheduler="local"``,
+``workers=N``) or a cluster that is already running (``scheduler="tcp://host:8786"``). The cube is the same
+whichever runs it.
 
 Here a ``LocalCluster`` of two worker processes runs the tiny study of :doc:`01_block_and_site`; on a real
 cluster the scheduler's address is all that changes.
@@ -24,15 +25,14 @@ from pathlib import Path
 import numpy as np
 from dask.distributed import LocalCluster
 
-from rockfrag.config import load_study
-from rockfrag.study import run_study
+import rockfrag
 
 
 def run_on_local_cluster(config, output, n_workers=2):
     """Run a study on a LocalCluster of ``n_workers`` processes; returns the cube and the run's statistics."""
     with LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         print(f"cluster at {cluster.scheduler_address} with {len(cluster.workers)} workers")
-        return run_study(config, output=output, scheduler=cluster.scheduler_address, progress=False)
+        return rockfrag.run_study(config, output=output, scheduler=cluster.scheduler_address)
 
 
 # %%
@@ -41,7 +41,7 @@ def run_on_local_cluster(config, output, n_workers=2):
 # ``scheduler`` is the address of any running scheduler. The records are read and processed here; the cells
 # go to the workers, and their results come back into one cube, written here.
 if __name__ == "__main__":
-    config = load_study("my-site.toml")
+    config = rockfrag.load_study("my-site.toml")
     cube, statistics = run_on_local_cluster(config, Path(tempfile.mkdtemp(prefix="my-site-dask-")))
     print(f"{statistics['runs_computed']} runs on the cluster in {statistics['seconds']:.1f} s")
 
@@ -51,8 +51,7 @@ if __name__ == "__main__":
 # The same study in this process gives the same numbers, bit for bit: a cell does not depend on where or in
 # which order it runs.
 if __name__ == "__main__":
-    here, _ = run_study(config, output=Path(tempfile.mkdtemp(prefix="my-site-here-")), workers=1, progress=False,
-                        log=lambda line: None)
+    here, _ = rockfrag.run_study(config, output=Path(tempfile.mkdtemp(prefix="my-site-here-")), workers=1)
     same = all(np.array_equal(cube[name].values, here[name].values, equal_nan=True)
                for name in ("peak_angle", "outcome", "capacity_scale_factor"))
     print("identical cubes:", same)

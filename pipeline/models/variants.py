@@ -23,8 +23,9 @@ are known only within a range (epistemic uncertainty):
   the soil is not investigated at the site (ASCE 4-16 Seismic Analysis of Safety-Related Nuclear Structures,
   Section 5.1.7; ASCE 4-98 Section 3.3.1.7). This is the bed's stiffness, not the site's Vs30.
 
-The contact law is not sampled: only the two-spring law reaches Housner's restitution on every bed (README,
-"The models"; the continuous bed loses more at every admissible xi), so only one law reaches the range.
+The contact law is not sampled: only the two-spring law reaches Housner's restitution on every bed (docs
+site, theory/bed.md, "Contact laws"; the continuous bed loses more at every admissible xi), so only one law reaches
+the range.
 
 The design: one-at-a-time points at the two ends of each parameter's range, the others at their central
 value (2n + 1 = 7 runs for n = 3 parameters; a point estimate in the manner of Rosenblueth 1981, "Two-point
