@@ -481,10 +481,12 @@ def test_every_reference_is_cited_and_every_citation_listed(small_pipeline):
     html = (small_pipeline.output / "report.html").read_text()
     text = html_module.unescape(re.sub(r"<[^>]+>", " ", re.sub(r"<img[^>]*>", " ", html)))
     references = text.index("The pages cite these works")
-    body = text[:references] + text[text.index("How to reproduce this report", references):]
-    for key in REFERENCES:
-        if key != "paper":
-            assert key in body, f"{key} is listed but never cited"
+    appendix = text.index("How to reproduce this report", references)
+    body = text[:references] + text[appendix:]
+    listed = [key for key in REFERENCES if key != "paper" and f"{key}: " in text[references:appendix]]
+    assert len(listed) >= 10  # the page lists what the pages cite (a study without steel: no AISC 360-16)
+    for key in listed:
+        assert key in body, f"{key} is listed but never cited"
     for cited in set(CITATION.findall(body)):
         assert cited in REFERENCES, f"{cited} is cited but not listed"
 

@@ -229,3 +229,124 @@ def test_no_client_page_or_caption_speaks_the_tools_words(small_pipeline):
         if hits:
             found[page.title] = hits
     assert found == {}
+
+
+def test_the_showcase_draws_the_rise_of_the_base_up_and_names_what_rises(small_pipeline):
+    """Finding 18: the right column said 'vertical displacement Δy from rest (up +, settlement −)' but drew
+    y - y_static, which the models write positive down (a settlement): a block rocking about an edge lifts its base
+    centre, drawn as 50-70 mm of 'settlement' on gravel. The line drawn is -(y - y_static) in mm, and the title and
+    caption say which point it is; the θ title says whether the rigid base differs by soil (finding 20)."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report import CAPTIONS
+    from rockfrag.report.figures import showcase_response_page
+
+    showcase = xr.open_dataset(small_pipeline.output / "showcase.nc")
+    figure = showcase_response_page(showcase, "")
+    drawn = [np.asarray(line.get_ydata(), float) for axis in figure.axes for line in axis.get_lines()
+             if axis.get_ylabel() == "Δy [mm]" and np.asarray(line.get_ydata()).size == showcase.time.size]
+    expected = [-1000 * np.asarray(row, float) for row in showcase.settlement.values if np.isfinite(row).any()]
+    assert drawn and len(drawn) == len(expected)
+    for line in drawn:
+        assert any(np.allclose(line, want, equal_nan=True) for want in expected)
+    titles = " ".join(axis.get_title() for axis in figure.axes)
+    assert "up +" in titles and "base centre" in titles and "settlement −" not in titles
+    rigid = [str(m) for m in showcase.case_model.values if str(m) == "housner"]
+    per_soil = any(str(m) == "housner" and str(s) for m, s in zip(showcase.case_model.values,
+                                                                   showcase.case_soil.values))
+    assert rigid and ("drawn per soil" in titles) == per_soil
+    assert "base's centre" in CAPTIONS["showcase-response"] and "up +" in CAPTIONS["showcase-response"]
+    plt.close(figure)
+
+
+def test_the_methods_say_how_each_soils_site_hazard_is_made(small_pipeline):
+    """Finding 2: the amplification of the example hazard to each soil's site was only an appendix key. The methods
+    name the site term and its references, and tabulate each soil's Vs30 and site class from the study."""
+    from rockfrag.report.sections import site_hazard_items
+    from rockfrag.report.words import REFERENCES
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    items = site_hazard_items(results)
+    text = items[0].text
+    for work in ("Boore et al. 2014", "Seyhan & Stewart 2014", "Bazzurro & Cornell 2004"):
+        assert work in text and work in REFERENCES, work
+    assert f"Vs30 {results.config.reference_vs30:,.0f}" in text
+    rows = {row[0]: row for row in items[1].rows}
+    for soil in results.config.soils:
+        assert rows[soil.name][1] == f"{soil.vs30:,.0f}" and rows[soil.name][2] == soil.site_class
+
+
+def test_the_limitations_give_each_blocks_depth_and_density_and_speak_of_cranes_only_for_one(small_pipeline):
+    """Finding 15: the slender and squat blocks' depth and density were nowhere. The planar-model table gives the
+    depth (footprint area over 2b) and the density of a solid block of that mass, from the study's blocks. A study
+    without a crane-like block (the small study, the user-site study) no longer reads the crane paragraph; a study
+    without a steel base no longer reads the steel slip coefficient."""
+    from rockfrag.report.sections import WHAT_A_CRANE_ADDS, limitations_items, sources_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    items = limitations_items(results)
+    table = next(item for item in items if item.kind == "table" and "density [kg/m^3]" in item.header)
+    for block, row in zip(results.config.blocks, table.rows):
+        area = block.footprint_area
+        assert row[3] == f"{area / (2 * block.b):.3g}"
+        assert row[4] == f"{block.mass / (area * 2 * block.h):,.0f}"
+    assert WHAT_A_CRANE_ADDS not in [item.text for item in items]
+    assert "AISC" not in " ".join(item.text for item in sources_items(results))
+
+
+def test_the_summary_legend_names_only_the_actions_it_uses(small_pipeline):
+    """Finding 27: the legend defined 'Specialist check' and 'Rocking only' where no row used them."""
+    from rockfrag.report.summary import summary_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    items = summary_items(results)
+    table = next(item for item in items if item.kind == "table")
+    legend = items[items.index(table) + 1].text
+    actions = " ".join(row[1] for row in table.rows)
+    for key, words in (("anchor or restrain", "'Anchor or restrain'"), ("specialist check", "'Specialist check'"),
+                       ("no action", "'No action'"), ("rocking only", "'Rocking only'")):
+        assert (words in legend) == (key in actions), key
+
+
+def test_the_default_study_keeps_the_crane_paragraph_and_the_steel_source():
+    """The other side of the rule above: the default study's paper block speaks of a crane portal and it has a
+    steel base, so its limitations name what a crane adds and its methods the steel slip coefficient's source."""
+    from types import SimpleNamespace
+
+    from rockfrag.config import load_study
+    from rockfrag.report.sections import _stands_for_a_crane
+
+    config = load_study(None)
+    assert _stands_for_a_crane(SimpleNamespace(config=config))
+    assert "steel" in [soil.name for soil in config.soils]
+
+
+def test_the_references_list_only_the_works_the_pages_cite():
+    """Without a steel base the pages no longer cite AISC 360-16: the list keeps the paper and what is cited."""
+    from rockfrag.report.words import REFERENCES, references_items
+
+    listed = [item.text for item in references_items("as Housner 1963 found; NAVFAC DM-7.02 Table 1")][1:]
+    assert [text.split(": ")[0] for text in listed] == ["The paper", "Housner 1963", "NAVFAC DM-7.02"]
+    assert len(references_items()) == len(REFERENCES) + 1
+
+
+def test_the_friction_source_names_each_soils_range_and_the_end_taken(small_pipeline):
+    """Read 2, B10 and B5: the methods said 'the lower end of each range' while clay's 0.35 is the upper end of
+    NAVFAC DM-7.02's 0.30-0.35, and steel was 'a concrete base on that soil' on one page and steel on steel on
+    another. Each soil's range and end are named, as rockfrag.soils.FRICTION_SOURCES states them."""
+    import re as regex
+
+    from rockfrag.report.sections import NAVFAC_RANGES, sources_items
+    from rockfrag.soils import FRICTION_SOURCES, SOILS
+
+    for soil, words in NAVFAC_RANGES.items():
+        numbers = regex.findall(r"\d\.\d\d(?:-\d\.\d\d)?", words)[0]
+        assert numbers in FRICTION_SOURCES, soil
+        taken = float(numbers.split("-")[-1 if "high end" in words else 0])
+        assert SOILS[soil].friction_static == taken, soil
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    bullet = next(item.text for item in sources_items(results) if item.text.startswith("Base friction"))
+    assert "lower end of each range" not in bullet
+    for soil in results.config.soils:
+        assert NAVFAC_RANGES[soil.name] in bullet
+    assert "a steel base on steel" not in results.friction_words  # no steel base in this study

@@ -171,7 +171,8 @@ def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline
     from rockfrag.report import figures
 
     showcase = pipeline_results(small_pipeline.output, small_pipeline.study).showcase
-    assert "y - y_static" in showcase.settlement.attrs["long_name"]  # positive up, as the file defines it
+    # y - y_static: the models write y positive down (rockfrag.models.base: a settlement), the page draws it up +
+    assert "y - y_static" in showcase.settlement.attrs["long_name"]
     figure = figures.showcase_response_page(showcase, "")
     try:
         settle = [a for a in figure.axes if a.get_ylabel().startswith("Δy")]
@@ -179,7 +180,8 @@ def test_settlement_axis_says_up_positive_and_draws_the_file_sign(small_pipeline
         assert "down +" not in _figure_text(figure)
         drawn = np.concatenate([line.get_ydata() for axis in settle for line in axis.lines])
         recorded = showcase.settlement.values[showcase.case_soil.values != ""] * 1000
-        assert np.nanmin(drawn) == pytest.approx(np.nanmin(recorded))
+        assert np.nanmin(drawn) == pytest.approx(-np.nanmax(recorded))
+        assert np.nanmax(drawn) == pytest.approx(-np.nanmin(recorded))
     finally:
         plt.close(figure)
 

@@ -189,8 +189,11 @@ CAPTIONS = {
     "showcase-processing": "Read that processing keeps the record and removes only the drift: raw (grey) and "
                            "processed (blue); the processed displacement ends at rest.",
     "showcase-response": "Read how the soil changes the rocking under one real record, unscaled: θ (left, one scale "
-                         "for all panels) and the vertical displacement of the foundation (right, up +); grey: the "
-                         "strong-motion window (5-95% Arias). As in the paper's Figs. 4, 7 and 10.",
+                         "for all panels) and Δy (right), the vertical displacement from rest of the base's centre "
+                         "on the tensionless bed, or of the active pivot in the paper's model, up +: a block rocking "
+                         "about an edge lifts its base centre by about b·θ, so a rise is rocking, and a drop below "
+                         "0 is the bed giving under the block; grey: the strong-motion window (5-95% Arias). As in "
+                         "the paper's Figs. 4, 7 and 10.",
     "ida": "Read at which intensity the block starts to rock and where it overturns: thin grey lines, one record "
            "each; the 16% (blue dashed), 50% (black) and 84% (red dotted) fractiles of θmax/α. Overturning is drawn "
            "at the right edge. Dotted: the site's return-period intensities (the legend names them); shaded: "
@@ -422,10 +425,13 @@ def plan(results: Results) -> list[Page]:
                                caption=CAPTIONS["efficiency"] + _twins_words(results.efficiency)
                                + measure_choice_words(results.efficiency, names, results.hazard is not None),
                                names=names))
-    planned += _packed_pages([("glossary", "Glossary", "Glossary", glossary_items()),
-                              ("references", "References", "References", references_items()),
+    glossary, reproduce = glossary_items(), reproduce_items(results)
+    cited = " ".join([*(f"{page.html or ''} {page.caption or ''}" for page in planned),
+                      *(item.text for item in glossary + reproduce)])
+    planned += _packed_pages([("glossary", "Glossary", "Glossary", glossary),
+                              ("references", "References", "References", references_items(cited)),
                               ("reproduce", "How to reproduce this report", "How to reproduce this report",
-                               reproduce_items(results))])
+                               reproduce)])
     return planned
 
 

@@ -257,7 +257,7 @@ def _time_window(showcase):
 
 
 def showcase_response_page(showcase, caption, name: str | None = None):
-    """Ground motion on top, then per soil theta(t) (left) and the foundation's settlement (right).
+    """Ground motion on top, then per soil theta(t) (left) and the rise of the base centre or pivot, up + (right).
 
     One y-scale per column, time cropped to the strong motion.
     """
@@ -306,8 +306,8 @@ def showcase_response_page(showcase, caption, name: str | None = None):
             index = int(np.flatnonzero(mask)[0])
             theta_axis.plot(showcase.time.values, showcase.theta.values[index] * scale, label=short_label(model),
                             **styles[model.name])
-            if not model.rigid_base:
-                settle_axis.plot(showcase.time.values, showcase.settlement.values[index] * 1000,
+            if not model.rigid_base:  # showcase.nc's y - y_static is positive down (a settlement): drawn up +
+                settle_axis.plot(showcase.time.values, -showcase.settlement.values[index] * 1000,
                                  **styles[model.name])
         theta_axis.set_ylabel(f"θ [{unit}]", fontsize=9)
         settle_axis.set_ylabel("Δy [mm]", fontsize=9)
@@ -318,8 +318,12 @@ def showcase_response_page(showcase, caption, name: str | None = None):
                          color="0.95", zorder=0)
             axis.grid(alpha=0.3)
             axis.tick_params(labelbottom=row == len(soils) - 1)
-    theta_axes[0].set_title("rocking angle θ (the rigid base: the same on every soil)", fontsize=9)
-    settle_axes[0].set_title("vertical displacement Δy from rest (up +, settlement −)", fontsize=9)
+    rigid_per_soil = any(model.rigid_base and bool(((showcase.case_model.values == model.name)
+                                                    & (showcase.case_soil.values != "")).any()) for model in models)
+    theta_axes[0].set_title("rocking angle θ" + (" (the rigid base slides on some soils: drawn per soil)"
+                                                 if rigid_per_soil else " (the rigid base: the same on every soil)"),
+                            fontsize=9)
+    settle_axes[0].set_title("Δy: rise of the base centre (bed) or pivot (paper's model) from rest, up +", fontsize=9)
     theta_axes[-1].set_xlabel("time [s]")
     settle_axes[-1].set_xlabel("time [s]")
     outside_legend(figure, [ground, *theta_axes])

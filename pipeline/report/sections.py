@@ -41,6 +41,7 @@ from rockfrag.report.adapters import (
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
     CredibleMarks,
+    block_description,
     block_levels,
     block_name,
     cell,
@@ -118,8 +119,11 @@ class Results:
                           for soil in self.config.soils)
         shipped = [soil.name for soil in self.config.soils if SOILS.get(soil.name) == soil]
         own = [soil.name for soil in self.config.soils if soil.name not in shipped]
-        sources = ([f"the soil class's default coefficient ({', '.join(shipped)}: a concrete base on that soil)"]
-                   if shipped else []) + ([f"the study file's own value ({', '.join(own)})"] if own else [])
+        soils = [name for name in shipped if name != "steel"]
+        bases = ([f"{', '.join(soils)}: a concrete base on that soil"] if soils else []) \
+            + (["steel: a steel base on steel"] if "steel" in shipped else [])
+        sources = ([f"the soil class's default coefficient ({'; '.join(bases)})"] if shipped else []) \
+            + ([f"the study file's own value ({', '.join(own)})"] if own else [])
         return (f"Base friction: static/kinetic μ_s/μ_k {pairs}, {' and '.join(sources)}, not a value of each "
                 "block's own base: a plinth, a grout bed or a steel shim under the block changes it. The study file "
                 "can give each soil its own coefficients (see 'How to reproduce this report').")
@@ -540,6 +544,40 @@ def fitted_items(results: Results) -> list[Item]:
     return items
 
 
+def site_hazard_items(results: Results) -> list[Item]:
+    """How each soil's site hazard is made from the reference site's curve, with each soil's Vs30 and site class.
+
+    Empty when the study gives no hazard or a curve per soil (then each soil's curve is its own, as given).
+    """
+    sites = results.site_hazards
+    if sites is None or sites.reference is None or len(sites) < 1:
+        return []
+    config = results.config
+    rows, reference = [], []
+    for soil in config.soils:
+        if soil.vs30 is None or soil.vs30 == sites.reference_vs30:
+            reference.append(soil.name)
+            rows.append([soil.name, f"{sites.reference_vs30:,.0f} (the reference site)", "-",
+                         "the reference curve itself"])
+        else:
+            rows.append([soil.name, f"{soil.vs30:,.0f}", soil.site_class, "amplified"])
+    if len(reference) == len(config.soils):
+        return []
+    steel = [name for name in reference if not is_soil(results.cube, name)]
+    text = (f"Each soil's site hazard is the hazard curve of the reference site (Vs30 {sites.reference_vs30:,.0f} "
+            "m/s) carried to the soil's site by the NGA-West2 site term of Boore et al. 2014 (the site amplification "
+            "model of Seyhan & Stewart 2014: linear in ln Vs30 and nonlinear in the rock's PGA), the spread of the "
+            f"soil's Vs30 within its site class (a standard deviation of ln Vs30 of {config.vs30_sigma:g}) "
+            "convolved into the curve (Bazzurro & Cornell 2004). Each soil's Vs30 is the value that stands for its "
+            "site class in the USGS hazard tools (ASCE 7-16 Table 20.3-1's classes), not a measurement: a site's "
+            "measured Vs30 replaces it (the appendix names the setting).")
+    if steel:
+        text += (f" A structural base ({', '.join(steel)}) keeps the reference curve: the block then feels the "
+                 "ground motion of the reference site, not that of a floor or deck above it, which this study "
+                 "does not model.")
+    return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class", "site hazard"], rows)]
+
+
 def _hazard_words(results: Results) -> str:
     """The hazard curve in words: the shipped example (not a site's) or the site's (its file: the appendix)."""
     from rockfrag.hazard import EXAMPLE_HAZARD
@@ -673,8 +711,9 @@ def methods_items(results: Results) -> list[Item]:
     items.append(note("b, h: half-width and half-height; E_b: the block's Young's modulus, which with the soil's "
                       "modulus sets the interface stiffness k (the paper's eq. 19); uplift: the ground acceleration "
                       "at which the block starts to rock on a rigid base. Each block is a rigid solid block of "
-                      "uniform mass; its description (on its answer page) states the density its mass assumes. Its "
-                      "base friction is the soil's, whatever the block's own base (see 'Reading the answer pages')."))
+                      "uniform mass; the limitations' planar-model table gives its depth out of plane and the "
+                      "density its mass implies. Its base friction is the soil's, whatever the block's own base "
+                      "(see 'Reading the answer pages')."))
 
     pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
@@ -738,13 +777,21 @@ def methods_items(results: Results) -> list[Item]:
     items += sources_items(results)
     if "annual_frequency" in fragility:
         periods = ", ".join(f"{t:,.0f}" for t in results.return_periods)
-        items += [heading("Hazard and risk"),
+        items += [heading("Hazard and risk"), *site_hazard_items(results),
                   paragraph(f"Hazard curve: {_hazard_words(results)}. "
                             "Mean annual frequency of each damage state λ = ∫ P(DS | im) |dλ(im)|, the hazard "
                             "interpolated log-log (Cornell et al. 2002); probability in the design life "
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
                             f"1 − exp(−λ·years). Return periods of the answer pages: {periods} years.")]
     return items
+
+
+NAVFAC_RANGES = {"rock": "clean sound rock 0.70",
+                 "gravel": "clean gravel and coarse sand 0.55-0.60, its low end taken",
+                 "sand": "clean fine to medium sand 0.45-0.55, its low end taken",
+                 "clay": "medium stiff and stiff clay 0.30-0.35, its high end taken, below the 0.40-0.50 of very "
+                         "stiff clay"}
+"""The ranges of NAVFAC DM-7.02 Table 1 each shipped soil's μ_s is taken from (rockfrag.soils.FRICTION_SOURCES)."""
 
 
 def soil_source_words(names: str, soils) -> str:
@@ -818,10 +865,13 @@ def sources_items(results: Results) -> list[Item]:
     if shipped_soils:
         names = ", ".join(soil.name for soil in shipped_soils)
         items.append(bullet(soil_source_words(names, shipped_soils)))
+        ranges = "; ".join(NAVFAC_RANGES[soil.name] for soil in shipped_soils if soil.name in NAVFAC_RANGES)
         items.append(bullet(f"Base friction μ_s of {names} ({results.friction_text}): the ultimate friction factor "
-                            "of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1, the lower end of each "
-                            "range; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
-                            f"360-16, J3.8). {_kinetic_words(shipped_soils)}: " + CHOICE_WORDS + "."))
+                            f"of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1 ({ranges})"
+                            + ("; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
+                                       "360-16, J3.8), a value for bolted faying surfaces taken here for a block "
+                                       "bearing on steel" if any(soil.name == "steel" for soil in shipped_soils)
+                                       else "") + f". {_kinetic_words(shipped_soils)}: " + CHOICE_WORDS + "."))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
     design = config.design
@@ -1021,9 +1071,15 @@ def limitations_items(results: Results) -> list[Item]:
 
     items.append(heading("Planar model"))
     items.append(paragraph(PLANAR_WORDS))
-    items.append(table(["block", "rocks across: half-width b [m]", "half-height h [m]"],
+    items.append(table(["block", "rocks across: half-width b [m]", "half-height h [m]", "depth [m]",
+                        "density [kg/m^3]"],
                        [[block_name(config, block), f"{float(cube.block_b.sel(block=block)):.3g}",
-                         f"{float(cube.block_h.sel(block=block)):.3g}"] for block in cube.block.values]))
+                         f"{float(cube.block_h.sel(block=block)):.3g}", *_depth_and_density(config, cube, block)]
+                        for block in cube.block.values]))
+    items.append(note("Depth: the block's size out of the plane it rocks in, its footprint area over its width 2b; "
+                      "density: the mass over the solid block's volume (footprint area × height 2h), the density a "
+                      "solid block of that mass would have. A hollow object of the same mass and size (a cabinet, "
+                      "an enclosure) has its mass elsewhere than this block's: see below."))
     items += what_the_blocks_are_not(results)
     coefficient = f"the soil's μ_s ({results.friction_text})"
     items.append(heading("Sliding"))
@@ -1146,7 +1202,36 @@ def what_the_blocks_are_not(results: Results) -> list[Item]:
             paragraph("Every block of this study is a rigid solid block: its half-width, half-height, mass and "
                       "stiffness are on the methods pages, and nothing else of the object it stands for is "
                       "modelled."),
-            paragraph(WHAT_A_CRANE_ADDS), paragraph(WHAT_EQUIPMENT_ADDS)]
+            *([paragraph(WHAT_A_CRANE_ADDS)] if _stands_for_a_crane(results) else []),
+            paragraph(WHAT_EQUIPMENT_ADDS)]
+
+
+CRANE_WORDS = ("crane", "portal", "ship-loader", "ship loader", "stacker", "reclaimer")
+"""Words of a block's name or description that make it stand for a rail-mounted machine (``WHAT_A_CRANE_ADDS``)."""
+
+
+def _stands_for_a_crane(results: Results) -> bool:
+    """Whether a block's name or description speaks of a crane-like machine: then the limitations say what it adds."""
+    config = results.config
+    for block in getattr(config, "blocks", ()) or ():
+        words = f"{block_name(config, block.name)} {block_description(config, block.name)}".lower()
+        if any(word in words for word in CRANE_WORDS):
+            return True
+    return False
+
+
+def _depth_and_density(config, cube, block) -> list[str]:
+    """The block's out-of-plane depth [m] (footprint area over 2b) and the density its mass implies [kg/m^3].
+
+    The mass itself is printed once, in the methods' table of blocks.
+    """
+    b, h = float(cube.block_b.sel(block=block)), float(cube.block_h.sel(block=block))
+    mass = float(cube.block_mass.sel(block=block))
+    area = next((item.footprint_area for item in getattr(config, "blocks", ()) or () if item.name == str(block)),
+                None)
+    if not area:
+        return ["-", "-"]
+    return [f"{area / (2 * b):.3g}", f"{mass / (area * 2 * h):,.0f}"]
 
 
 def _soils_words(names, every_soil) -> str:

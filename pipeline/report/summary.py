@@ -282,14 +282,21 @@ def summary_items(results) -> list[Item]:
         f"intensity of each return period and in the design life of {life}, with {hazard_words(results, first)}; the "
         "dispersion β of its fragility curve with the part that dominates it; and what the verdict rests on."))
     items.append(table(header, rows))
-    items.append(note("'Anchor or restrain': a probability in the design life is above its limit; the block must not "
-                      "stand free. 'Specialist check': the base would slide, and its sliding was not computed. 'No "
-                      "action': every judged damage state is within its limit. 'Rocking only': the study did not "
-                      "compute this base's sliding, so the verdict covers rocking and overturning only. "
-                      f"{BOUND_WORDS} {no_curve_words(first)} Reason: the records at the level run at or below the "
-                      "largest return period's intensity. β: "
-                      "records, the variability from record to record; model, the model's own uncertainty. The "
-                      "answer pages give every damage state and the records behind each number."))
+    used = {line[1] for line in rows}
+    legend = [("anchor or restrain", "'Anchor or restrain': a probability in the design life is above its limit; the "
+                                     "block must not stand free."),
+              ("specialist check", "'Specialist check': the base would slide, and its sliding was not computed."),
+              ("no action", "'No action': every judged damage state is within its limit."),
+              (ROCKING_ONLY, "'Rocking only': the study did not compute this base's sliding, so the verdict covers "
+                             "rocking and overturning only.")]
+    said = " ".join(words for key, words in legend if any(key in cell for cell in used))
+    cells = " ".join(cell for row in rows for cell in row[3:3 + len(periods) + 1])
+    bounds = " ".join(words for words, shown in ((BOUND_WORDS, "< "), (no_curve_words(first), " of "))
+                      if shown in cells)
+    items.append(note(" ".join(filter(None, [
+        said, bounds, "Reason: the records at the level run at or below the largest return period's intensity. β: "
+        "records, the variability from record to record; model, the model's own uncertainty. The answer pages give "
+        "every damage state and the records behind each number."]))))
     return items
 
 

@@ -78,6 +78,14 @@ REFERENCES = {
     "Boore 2010": "Boore, D. M. (2010). Orientation-independent, nongeometric-mean measures of seismic intensity "
                   "from two horizontal components of motion. Bulletin of the Seismological Society of America "
                   "100(4), 1830-1835, doi:10.1785/0120090400.",
+    "Boore et al. 2014": "Boore, D. M., Stewart, J. P., Seyhan, E., Atkinson, G. M. (2014). NGA-West2 equations "
+                         "for predicting PGA, PGV, and 5% damped PSA for shallow crustal earthquakes. Earthquake "
+                         "Spectra 30(3), 1057-1085 (the site term that carries the reference hazard to each soil).",
+    "Seyhan & Stewart 2014": "Seyhan, E., Stewart, J. P. (2014). Semi-empirical nonlinear site amplification from "
+                             "NGA-West2 data and simulations. Earthquake Spectra 30(3), 1241-1256.",
+    "Bazzurro & Cornell 2004": "Bazzurro, P., Cornell, C. A. (2004). Nonlinear soil-site effects in probabilistic "
+                               "seismic-hazard analysis. Bulletin of the Seismological Society of America 94(6), "
+                               "2110-2123.",
     "Baker 2015": "Baker, J. W. (2015). Efficient analytical fragility function fitting using dynamic structural "
                   "analysis. Earthquake Spectra 31(1), 579-599.",
     "Vamvatsikos & Cornell 2002": "Vamvatsikos, D., Cornell, C. A. (2002). Incremental dynamic analysis. "
@@ -118,10 +126,15 @@ REFERENCES = {
 """The works the report cites, by the short name the pages use."""
 
 
-def references_items() -> list[Item]:
-    """The references page: the seed paper first, then the others in the order of the dict."""
+def references_items(cited: str | None = None) -> list[Item]:
+    """The references page: the seed paper first, then the others in the order of the dict.
+
+    With ``cited`` (the text of the report's other pages), only the works it cites: a study without a steel base
+    does not cite the steel slip coefficient's source, nor one with a curve per soil the site term's.
+    """
     items = [paragraph("The pages cite these works by the short name in bold.")]
-    items += [bullet(f"{'The paper' if key == 'paper' else key}: {text}") for key, text in REFERENCES.items()]
+    items += [bullet(f"{'The paper' if key == 'paper' else key}: {text}") for key, text in REFERENCES.items()
+              if cited is None or key == "paper" or key in cited]
     return items
 
 
