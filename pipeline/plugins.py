@@ -2,7 +2,7 @@
 
 Input : the entry points of the installed distributions (``importlib.metadata``) in the groups of ``GROUPS``.
 Output: ``Registry``, the name -> object mapping every registry of rockfrag is (measures, damage states, record
-        formats); on its first read it loads the entry points of its group once and adds what they name.
+        formats, contact laws); on its first read it loads the entry points of its group once and adds what they name.
 
 A package adds a measure, a damage state or a record format by naming an object in its ``pyproject.toml``::
 
@@ -21,8 +21,13 @@ happens once per process; a plugin that cannot be imported, or names an object o
 ``PluginError`` naming the distribution, the group and the entry point, on every read of that registry (so no
 result is computed with half a registry). docs/plugins.md is the worked example.
 
-Contact laws have the group name ``rockfrag.contact_laws`` reserved but no loader: their hooks are compiled into
-numba dispatchers written out in rockfrag.models.contact, which a package cannot extend at run time.
+A contact law is a module (``NAME`` and four numba-compiled hooks) named in the group ``rockfrag.contact_laws``::
+
+    [project.entry-points."rockfrag.contact_laws"]
+    toy-hertz = "rockfrag_toy.bed_hertz"
+
+rockfrag.models.contact reads that registry when it is imported and calls a plugin's hooks through their addresses
+(its docstring says why and how).
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ from rockfrag.errors import PipelineError
 
 GROUPS = {"measures": "rockfrag.measures", "damage_states": "rockfrag.damage_states",
           "record_formats": "rockfrag.record_formats", "contact_laws": "rockfrag.contact_laws"}
-"""The entry-point group of each registry (``contact_laws`` reserved: see the module docstring)."""
+"""The entry-point group of each registry (``contact_laws``: rockfrag.models.contact.CONTACT_LAWS)."""
 
 
 class PluginError(PipelineError):

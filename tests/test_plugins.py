@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import html
+import json
 import os
 import re
 import shutil
@@ -11,6 +12,7 @@ import sys
 import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rockfrag.config import load_study
@@ -59,7 +61,8 @@ def test_a_limit_is_not_a_study_key_of_a_damage_state(tmp_path):
 # ---------------------------------------------------------------- an installed package adds to the registries
 
 TOY = Path(__file__).resolve().parent / "plugin_toy"
-"""The toy plugin's source (docs/plugins.md's worked example): a measure, a damage state and a record format."""
+"""The toy plugin's source (docs/plugins.md's worked example): a measure, a damage state, a record format and two
+contact laws."""
 
 TOY_STUDY = SMALL_STUDY.replace("[intensity]\nlevels = [0.1, 0.3, 0.6, 1.0]\n", """[intensity]
 measure = "a_rms"
@@ -205,7 +208,8 @@ def test_the_plugins_page_documents_every_group_and_includes_the_toy():
     page = (root / "docs" / "plugins.md").read_text(encoding="utf-8")
     assert all(f"`{group}`" in page for group in GROUPS.values())
     included = re.findall(r"```\{literalinclude\} \.\./(\S+)", page)
-    assert sorted(included) == ["tests/plugin_toy/pyproject.toml", "tests/plugin_toy/rockfrag_toy/__init__.py"]
+    assert sorted(included) == ["tests/plugin_toy/pyproject.toml", "tests/plugin_toy/rockfrag_toy/__init__.py",
+                                "tests/plugin_toy/rockfrag_toy/bed_hertz.py"]
     assert "\nplugins\n" in (root / "docs" / "index.md").read_text(encoding="utf-8")  # in the site's toctree
 
 
@@ -227,3 +231,103 @@ def test_a_page_of_more_states_than_shipped_labels_its_probability_axis_once(sta
     boxes = [axis.yaxis.label.get_window_extent(renderer) for axis in labelled]
     assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
     plt.close(figure)
+
+
+# ---------------------------------------------------------------- a contact law from a plugin
+
+CONTACT_SCRIPT = """
+import json, tempfile
+from pathlib import Path
+import numpy as np
+import rockfrag
+from rockfrag.models import BED_TYPES, contact
+
+report = {"codes": {name: code for name, code in BED_TYPES.items()}}
+block = rockfrag.Block(name="cabinet", b=0.3, h=1.5, mass=2000.0, E_b=200e9, footprint_area=0.48, soil_depth=1.0)
+[record], _ = rockfrag.load_records("DUZCE/BOL090")
+processed = rockfrag.process_record(record)
+k, xi = 5e8, 0.2
+runs = {bed: rockfrag.simulate("winkler", processed.acceleration, processed.dt, block, k=k, xi=xi, bed=bed, scale=0.9)
+        for bed in ("two-spring", "toy-two-spring")}
+shipped, plugin = runs["two-spring"], runs["toy-two-spring"]
+report["histories_equal"] = all(np.array_equal(getattr(shipped, name), getattr(plugin, name))
+                                for name in ("t", "theta", "y"))
+report["impacts"] = [shipped.n_impacts, plugin.n_impacts]
+report["peak_ratio"] = shipped.peak_angle_ratio
+report["plugin_bed"] = plugin.extra["bed"]
+# a small study on each law: the plugin's on a pool of two processes (each compiles the hooks itself)
+cubes = {}
+for bed, workers in (("two-spring", 1), ("toy-two-spring", 2)):
+    Path(f"{bed}.toml").write_text(STUDY.replace("BED", bed))
+    cubes[bed], _ = rockfrag.run_study(rockfrag.load_study(f"{bed}.toml"), output=bed, workers=workers)
+a, b = cubes["two-spring"], cubes["toy-two-spring"]
+report["cube_variables"] = [name for name in a.data_vars if "model" in a[name].dims]
+report["cube_unequal"] = [name for name in report["cube_variables"]
+                          if not np.array_equal(a[name].values, b[name].values, equal_nan=True)]
+report["overturned"] = int((a.outcome == 2).sum())
+# the shipped law's runs stop once settled (a linear bed's test) and add the rest of the tail at rest in one sum;
+# the plugin's run to the end, step by step
+report["rest"] = [a.time_at_rest.values.ravel().tolist(), b.time_at_rest.values.ravel().tolist()]
+# the Hertzian bed: a block left at rest settles where K y^(3/2) / sqrt(b) = m g
+rest = rockfrag.simulate("winkler", np.zeros(300), 0.01, block, k=k, xi=0.3, bed="toy-hertz")
+report["hertz"] = [float(rest.y[-1]), float(np.abs(rest.theta).max())]
+print(json.dumps(report))
+"""
+
+CONTACT_STUDY = """
+soils = ["sand", "rock"]
+models = ["winkler"]
+[study]
+record_sets = ["bolu"]
+[intensity]
+levels = [0.1, 0.3, 0.6, 1.0]
+capacity_resolution = 0.0
+[solver]
+bed = "BED"
+restitution = ""
+[blocks.slender-cabinet]
+b = 0.3
+h = 1.5
+mass = 2000.0
+E_b = 200e9
+footprint_area = 0.48
+soil_depth = 1.0
+"""
+"""Bolu's two components at 4 levels on 2 soils, the tensionless bed alone, on the law BED at each soil's xi."""
+
+
+def test_a_plugin_contact_law_runs_as_a_shipped_one(toy_site, tmp_path):
+    """toy-two-spring is two-spring written out in the plugin: every number equal, bit for bit, which shows the
+    plugin's hooks are called as the shipped law's are (but the time at rest, to rounding: a plugin law's run does not
+    stop once settled); toy-hertz is another law, checked against its closed form."""
+    script = f"STUDY = {CONTACT_STUDY!r}\n" + CONTACT_SCRIPT
+    run = rockfrag_with(toy_site, "-c", script, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    found = json.loads(run.stdout.splitlines()[-1])
+    assert found["codes"]["two-spring"] == 1 and {found["codes"]["toy-hertz"], found["codes"]["toy-two-spring"]} \
+        == {16, 17}  # the registry's order after the shipped codes
+    assert found["histories_equal"] and found["impacts"][0] == found["impacts"][1] > 0
+    assert 0.05 < found["peak_ratio"] < 1 and found["plugin_bed"] == "toy-two-spring"  # it rocked, and not trivially
+    assert "peak_angle" in found["cube_variables"] and set(found["cube_unequal"]) <= {"time_at_rest"}
+    # the one difference: the plugin law's runs do not stop once settled, and sum their time at rest step by step
+    np.testing.assert_allclose(*found["rest"], rtol=1e-12, atol=0)
+    assert found["overturned"] > 0  # the study reaches overturning: the comparison covers the whole outcome range
+    g, b, omega2 = 9.80665, 0.3, 5e8 / 2000.0
+    settled, tilt = found["hertz"]
+    assert settled == pytest.approx((g * np.sqrt(b) / omega2) ** (2 / 3), rel=1e-9) and tilt == 0.0
+    assert abs(settled / (g / omega2) - 1) > 1  # not the linear bed's settlement: the law is another
+
+
+def test_a_contact_law_module_without_its_hooks_is_refused():
+    import types
+
+    from rockfrag.models import contact
+    from rockfrag.plugins import PluginError
+
+    law = types.ModuleType("half_a_law")
+    law.NAME, law.force = "half", lambda x, params, sin_t, cos_t: (0.0, 0.0)
+    with pytest.raises(PluginError, match=r"half = half_a_law: .*missing: indicator, indicators, full_contact"):
+        contact._checked("half", law)
+    law.NAME = "other"
+    with pytest.raises(PluginError, match="needs NAME = 'half' \\(it has 'other'\\)"):
+        contact._checked("half", law)

@@ -66,6 +66,7 @@ PARAMS_DTYPE = np.dtype([
     ("restitution", "f8"),  # factor on theta' at each impact (pivot models)
     ("switch", "f8"),       # SWITCH_* (SSI)
     ("bed", "f8"),          # code of the bed's contact law (winkler; rockfrag.models.contact.BED_LAWS)
+    ("bed_hooks", "f8"),    # a plugin law's compiled hooks in this process (rockfrag.models.contact.attach_hooks)
     ("overturn", "f8"),     # |theta| of overturning [rad]
     ("rtol", "f8"),         # relative error per step [-]
     ("atol", "f8"),         # absolute error per step as a fraction of each state's scale [-]

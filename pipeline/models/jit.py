@@ -32,7 +32,10 @@ COMPILE_NOTICE = ("rockfrag: compiling the solvers (first run after an install o
                   "30 s on 2 cores; later runs load them from the cache)...")
 """The line printed when the solvers compile (not when they load from numba's cache)."""
 
-if os.environ.get("ROCKFRAG_NO_NUMBA", "") not in ("", "0"):
+COMPILED = os.environ.get("ROCKFRAG_NO_NUMBA", "") in ("", "0")
+"""Whether the kernels are compiled by numba (False: plain Python, ROCKFRAG_NO_NUMBA=1)."""
+
+if not COMPILED:
     def njit(*args, **kwargs):
         """Stand-in for numba's ``njit``: returns the function unchanged (``@njit`` and ``@njit(...)``)."""
         if args and callable(args[0]):
@@ -75,4 +78,4 @@ else:
     FIRST_COMPILE = CompileNotice()
     event.register("numba:compile", FIRST_COMPILE)
 
-__all__ = ["kernel", "njit"]
+__all__ = ["COMPILED", "kernel", "njit"]

@@ -44,7 +44,7 @@ from typing import NamedTuple
 import numpy as np
 
 from rockfrag.models.base import Outcome
-from rockfrag.models.contact import N_CONTACT_INDICATORS, contact_indicator, contact_indicators
+from rockfrag.models.contact import N_CONTACT_INDICATORS, attach_hooks, contact_indicator, contact_indicators
 from rockfrag.models.fields import (
     EVENT_CONTACT,
     EVENT_IMPACT,
@@ -1447,6 +1447,7 @@ def run_cases(code, samples, dt, n_tail, params_table, initial_states, scales=No
     histories = np.empty((n_case, 0, STATE_SIZE)) if histories is None else histories
     impact_times = np.empty((n_case, 0)) if impact_times is None else impact_times
     summaries = new_summaries((n_case, scales.size))
+    attach_hooks(params_table)  # a plugin contact law's hooks, compiled in this process (rockfrag.models.contact)
     run_kernel(code, samples, float(dt), n_tail, scales, params_table, initial_states, histories, impact_times,
                summaries)
     return summaries

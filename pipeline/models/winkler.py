@@ -56,7 +56,7 @@ from __future__ import annotations
 import math
 
 from rockfrag.models.base import RockingModel
-from rockfrag.models.contact import bed_force_at, bed_full_contact
+from rockfrag.models.contact import FIRST_PLUGIN, bed_force_at, bed_full_contact
 from rockfrag.models.fields import WINKLER
 from rockfrag.models.jit import kernel
 
@@ -145,6 +145,8 @@ def settled_beyond_reach(x, params, peak_angle):
     bed only dissipates, so the rest of the response cannot change the peak angle, uplift or flights; the
     batch kernels (which keep no history) stop there.
     """
+    if params["bed"] >= FIRST_PLUGIN:
+        return False  # the settled state below is a linear bed's: a plugin's law runs to the end of the record
     b = params["b"]
     h = params["h"]
     g = params["g"]

@@ -1,7 +1,8 @@
 """rockfrag_toy - a toy rockfrag plugin: what an installed package adds through rockfrag's entry points.
 
 Input : nothing at import but rockfrag's own classes.
-Output: three objects its ``pyproject.toml`` names as entry points:
+Output: three objects its ``pyproject.toml`` names as entry points (and two contact laws, the modules
+``bed_linear`` and ``bed_hertz``, which it names too):
 
 - ``A_RMS``, a ``rockfrag.measures.Measure``: the root-mean-square ground acceleration a_rms [m/s^2], shown in
   g; it scales with the record (exponent 1), so a study can scale its records to it; it has no RotD form (a
