@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 
 from rockfrag.answer import StateAnswer, nested, nested_families
-from tests.helpers import pipeline_results
+from tests.helpers import ROOT, pipeline_results
 
 NAN3 = (np.nan, np.nan, np.nan)
 
@@ -152,7 +152,7 @@ def test_the_fitted_functions_table_has_every_state_and_no_row_of_dashes(small_p
                                                    damage_state=state)) * scale
             assert (text == "-") == (not np.isfinite(median)), (row, state)
             if np.isfinite(median):
-                assert text.split(" / ")[0].rstrip("*†") == f"{median:.3g}"
+                assert text.split(" / ")[0].rstrip("*†‡") == f"{median:.3g}"
                 seen += 1
     finite = int(np.isfinite(fragility["median"]).sum())
     assert 0 < seen <= finite
@@ -350,3 +350,133 @@ def test_the_friction_source_names_each_soils_range_and_the_end_taken(small_pipe
     for soil in results.config.soils:
         assert NAVFAC_RANGES[soil.name] in bullet
     assert "a steel base on steel" not in results.friction_words  # no steel base in this study
+
+
+def test_an_illustrative_hazard_file_is_said_so_first_and_the_hazard_is_drawn(small_pipeline, tmp_path):
+    """Read 2, user report A1: the user study's hazard file says in its header that it is 'ILLUSTRATIVE ... not the
+    result of a hazard model', yet its summary gave a bare 'no action' and no page drew the curve. The summary's
+    first line says so, the answer pages' verdicts name it, and a 'Site hazard' page draws each soil's curve with
+    the return periods' frequencies. A file that does not say so gets neither warning."""
+    import shutil
+
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report import build_plan
+    from rockfrag.report.figures import hazard_page
+    from rockfrag.report.summary import (
+        ILLUSTRATIVE_WARNING,
+        ILLUSTRATIVE_WORDS,
+        illustrative_hazard,
+        summary_items,
+        verdict_items,
+    )
+
+    study = tmp_path / "study.toml"
+    hazard = tmp_path / "hazard.csv"
+    shutil.copy(ROOT / "studies" / "user-site-hazard.csv", hazard)
+    text = small_pipeline.study.read_text().replace("[intensity]", '[hazard]\nfile = "hazard.csv"\n'
+                                                    "reference_vs30 = 760.0\nsite = [23.62, 37.94]\n\n[intensity]")
+    study.write_text(text)
+    results = pipeline_results(small_pipeline.output, study)
+    assert illustrative_hazard(results)
+    items = summary_items(results)
+    assert items[0].text == ILLUSTRATIVE_WARNING and items[0].kind == "strong"
+    lead = verdict_items(results, results.answers[0])[0].text
+    assert lead.startswith(f"With {ILLUSTRATIVE_WORDS}")
+    planned = build_plan(results)
+    assert any(page.name == "hazard" for page in planned)
+    figure = hazard_page(results.site_hazards, results.return_periods, "")
+    lines = [line for line in figure.axes[0].get_lines() if np.asarray(line.get_xdata()).size > 2]
+    assert len(lines) == len({id(curve) for curve in results.site_hazards.values()}) + (
+        results.site_hazards.reference is not None and all(curve is not results.site_hazards.reference
+                                                            for curve in results.site_hazards.values()))
+    dotted = sorted(float(line.get_ydata()[0]) for line in figure.axes[0].get_lines() if line.get_linestyle() == ":"
+                    and np.asarray(line.get_ydata()).size == 2)
+    assert np.allclose(dotted, sorted(1.0 / t for t in results.return_periods))
+    plt.close(figure)
+    hazard.write_text(hazard.read_text().replace("hand-written ILLUSTRATIVE curve", "the site's hazard study")
+                      .replace("not the result of a hazard model", "from the site's own model"))
+    results = pipeline_results(small_pipeline.output, study)
+    assert not illustrative_hazard(results)
+    assert ILLUSTRATIVE_WARNING not in [item.text for item in summary_items(results)]
+
+
+def test_the_answer_page_says_where_the_block_slides_before_it_can_rock(small_pipeline):
+    """Cold read 1 finding 4, read 2 user B2: on clay (μ_s 0.35 below the enclosure's b/h 0.40) the block slides
+    instead of rocking, and the report's clay answer rests on that assumed friction without saying so. The answer
+    page names each such soil (with base friction in the answering runs) and b/h; none where μ_s ≥ b/h."""
+    from rockfrag.report.answer_page import slides_first_words
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    cube = results.cube
+    checked = 0
+    for answer in results.answers:
+        b, h = float(cube.block_b.sel(block=answer.block)), float(cube.block_h.sel(block=answer.block))
+        expected = [soil.name for soil in results.config.soils if soil.friction_static < b / h
+                    and np.isfinite(float(cube.friction_static.sel(model=answer.model, block=answer.block,
+                                                                   soil=soil.name)))]
+        words = slides_first_words(results, answer)
+        if not expected:
+            assert words == ""
+            continue
+        checked += 1
+        assert words.startswith(f"On {', '.join(expected)} the soil's base friction") and f"b/h = {b / h:.2f}" in words
+    assert checked == 0  # the small study's answering model (the paper's SSI) ties every base: no sentence
+    friction = cube.friction_static.copy()
+    friction.loc[dict(model=results.answers[0].model)] = 0.45  # as if its runs had base friction
+    results.cube["friction_static"] = friction
+    said = {answer.block: slides_first_words(results, answer) for answer in results.answers}
+    assert said["squat-machinery"].startswith("On sand, rock the soil's base friction (μ_s sand 0.45, rock 0.7) is "
+                                              "below this block's b/h = 0.75")
+    assert said["paper"].startswith("On sand the soil's base friction (μ_s sand 0.45)")
+    assert said["slender-cabinet"] == ""  # b/h = 0.2: every soil grips enough
+
+
+def test_the_sensitivity_page_wraps_its_titles_and_marks_a_soil_without_a_median():
+    """Read 2, default B7: the three block names ran into each other above the sensitivity panels and the first was
+    clipped; a soil with no median was a blank column. Titles wrap within their panel; such a soil is labelled."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report.figures import sensitivity_page
+
+    blocks = ["paper", "slender", "squat"]
+    soils, parameters = ["clay", "sand"], ["restitution", "friction", "stiffness"]
+    spread = np.full((3, 2, 3, 1), 0.05)
+    spread[:, 0, 2, 0] = np.nan  # no median on clay for the squat block
+    fragility = xr.Dataset(
+        {"median_sensitivity": (("parameter", "soil", "block", "damage_state"), spread),
+         "beta_form": (("model", "block", "damage_state"), np.full((1, 3, 1), 0.35)),
+         "median": (("soil", "block", "damage_state"), np.ones((2, 3, 1)))},
+        coords={"parameter": parameters, "soil": soils, "block": blocks, "damage_state": ["overturning"],
+                "model": ["recommended"]})
+    names = {b: f"a long block name for {b} with its size (0.6 m × 3.0 m, 2 t)" for b in blocks}
+    figure = sensitivity_page(fragility, "", names=names)
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    titles = [axis.title.get_window_extent(renderer) for axis in figure.axes if axis.get_visible()]
+    for index, box in enumerate(titles):
+        assert box.x0 >= 0 and box.x1 <= figure.bbox.x1
+        for other in titles[index + 1:]:
+            assert not box.overlaps(other)
+    squat = figure.axes[2]
+    assert [t.get_text() for t in squat.get_xticklabels()][0] == "clay\n(no median)"
+    assert "beta_form" not in " ".join(t.get_text() for axis in figure.axes for t in axis.texts) + " ".join(
+        text.get_text() for legend in figure.legends for text in legend.get_texts())
+    plt.close(figure)
+
+
+def test_the_fitted_table_marks_a_fit_that_fails_its_goodness_of_fit_test(small_pipeline):
+    """Read 2, default B9: the paper block's uplift on steel (gof p 0.0034) fed an answer page unflagged. A fitted
+    cell whose fit fails the test (p < 0.05) is marked ‡ and the note says what it means; none otherwise."""
+    from rockfrag.report.sections import fitted_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    fragility = results.fragility.copy()
+    fragility["gof_p_value"] = xr.full_like(fragility["median"], 0.5)
+    plain = fitted_items(pipeline_results(small_pipeline.output, small_pipeline.study, fragility=fragility))
+    assert "‡" not in " ".join(cell for item in plain if item.kind == "table" for row in item.rows for cell in row)
+    fragility["gof_p_value"] = xr.full_like(fragility["median"], 0.003)
+    items = fitted_items(pipeline_results(small_pipeline.output, small_pipeline.study, fragility=fragility))
+    cells = [cell for item in items if item.kind == "table" for row in item.rows for cell in row[2:] if cell != "-"]
+    assert cells and all("‡" in cell for cell in cells if cell)
+    assert any(item.text.startswith("‡ the fit fails its goodness-of-fit test") for item in items)

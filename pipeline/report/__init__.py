@@ -183,6 +183,10 @@ STATION_NAMES = ("Stations are named as the records' source catalogue spells the
 
 
 CAPTIONS = {
+    "hazard": "Read how often each intensity is exceeded at the site, per year: each soil's curve (its colour) and "
+              "the reference site's it is carried from (black dashed); dotted, the frequencies of the return periods "
+              "(where a curve crosses one, the site's intensity of that return period, as the answer pages print "
+              "it).",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled; the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
                "intensity level.",
@@ -234,9 +238,10 @@ CAPTIONS = {
                            "enough; colours: the intensity level; solid concrete block, dashed steel block.",
     "sensitivity": "Read which uncertain parameter of the recommended model moves its median most on each soil: "
                    "each bar is the σ of ln median over that parameter's range (restitution, friction, bed "
-                   "stiffness), the others central; the dashed line is the model-form term β_form (FEMA P-695's "
-                   "rating). β_model is the larger of β_form and the bars combined (√ of the sum of squares): the "
-                   "rating covers the parameters, so it replaces their spread, it is not added.",
+                   "stiffness), the others central; the dashed line is the model-form β (FEMA P-695's rating). The "
+                   "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
+                   "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
+                   "marked 'no median' has no curve of this state below the credible cap.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does, and the measure alone is not enough; the test of Luco & Cornell "
@@ -269,6 +274,14 @@ def _twins_words(efficiency) -> str:
             "g·tanα) changes nothing within one block, so their bars and p-values are identical by construction.")
 
 
+def hazard_caption(results) -> str:
+    """The hazard page's caption end: whose curve it is, in the summary's words."""
+    from rockfrag.report.summary import hazard_caveat
+
+    caveat = hazard_caveat(results)
+    return f" The curve: {caveat}." if caveat else " The curve: the site's, given with the study (Methods)."
+
+
 def sweep_words(applicability) -> str:
     """The sweep caption's sentences on what its ratio measures: tied bases and an uncalibrated dashpot.
 
@@ -291,6 +304,29 @@ def sweep_words(applicability) -> str:
         text += (" The paper's model, whose dashpot takes out what the corner impact would, comes closer to 1 on stiff "
                  "ground.")
     return text
+
+
+def tested_cells_words(efficiency, measure: str) -> str:
+    """Which cells the bars and p-values rest on: those with enough overturning records (efficiency.nc's finite ones).
+
+    "The bars and p-values rest on 12 of 45 cells (block, soil and model), all Housner (rigid base); the fewest
+    overturning records behind one: 5." ("" when every cell is tested).
+    """
+    if "dispersion" not in efficiency or measure not in efficiency.measure.values:
+        return ""
+    values = efficiency.dispersion.sel(measure=measure)
+    tested = np.isfinite(values)
+    total, count = int(tested.size), int(tested.sum())
+    if count == 0 or count == total:
+        return ""
+    models = [short_label(model) for model in models_of(efficiency)
+              if bool(tested.sel(model=model.name).any())] if "model" in efficiency.dims else []
+    fewest = ""
+    if "n_records" in efficiency:
+        records = efficiency.n_records.sel(measure=measure).where(tested)
+        fewest = f"; the fewest overturning records behind one: {int(records.min())}"
+    return (f" The bars and p-values rest on the {count} of {total} cells (block, soil and model) with enough "
+            f"overturning records ({'; '.join(models)}){fewest}: the others are not tested.")
 
 
 def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:
@@ -324,6 +360,7 @@ def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:
     if better:
         text += (f" A measure scatters less than {words} for some blocks: {'; '.join(better)}. In {words} their "
                  "curves are wider (a larger record-to-record β), not shifted.")
+    text += tested_cells_words(efficiency, study)
     insufficient = [name for name, _, _, what in pages.P_MARKERS if name in efficiency
                     and float(efficiency[name].sel(measure=study).median()) < SUFFICIENCY_LEVEL]
     if insufficient:
@@ -368,6 +405,11 @@ def plan(results: Results) -> list[Page]:
                                             "; 'scaled by': the intensity the study scales the record by, the "
                                             "RotD50 PGA of its station's pair (Methods), one value per pair"
                                             if scaled_intensities(cube) is not None else "") + ".")])])
+    if results.site_hazards is not None and results.answers and results.return_periods:
+        planned.append(_figure("hazard", "Site hazard", "Site hazard: the hazard curve of each soil's site",
+                               pages.hazard_page, results.site_hazards, results.return_periods,
+                               caption=CAPTIONS["hazard"] + hazard_caption(results),
+                               unit=results.answers[0].unit))
     if showcase is not None and "record_spectrum" in showcase:
         planned.append(_figure("spectra", "Records", "Response spectra of the record set", pages.spectra_page,
                                showcase, caption=CAPTIONS["spectra"]))

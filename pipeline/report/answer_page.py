@@ -91,11 +91,22 @@ def _band_reach(cube, block=None) -> str:
     if not bool(short.any()):
         return ""
     soils = [str(s) for s in cube.soil.values if bool(short.sel(soil=s).any())]
-    asked, reached = float(requested.where(short).max()), float(target.where(short).max())
-    return (f" On {', '.join(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
-            f"(r up to {asked:.3f}; it reaches {reached:.3f} at most): those runs use the nearest r it reaches, so "
+    asked = float(requested.where(short).max())
+    reached = ", ".join(f"{soil} {float(target.sel(soil=soil).where(short.sel(soil=soil)).max()):.3f}"
+                        for soil in soils)
+    text = (f" On {', '.join(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
+            f"(r up to {asked:.3f}; at most it reaches {reached}): those runs use the nearest r it reaches, so "
             "the restitution part of the model dispersion there leaves out the less dissipative side of the range, "
             "the side on which a block rocks more.")
+    if "run" in requested.dims and "centre" in requested.run.values:
+        centre_asked, centre_run = requested.sel(run="centre"), target.sel(run="centre")
+        low = [str(s) for s in cube.soil.values
+               if bool(((centre_asked.sel(soil=s) - centre_run.sel(soil=s)) > 5e-4).any())]
+        if low:
+            runs = ", ".join(f"{soil} {float(centre_run.sel(soil=soil).min()):.3f}" for soil in low)
+            text += (f" The answering run itself is below the middle of the range ({float(centre_asked.max()):.3f}) "
+                     f"there: it runs at r {runs}.")
+    return text
 
 
 def _band_collapse(cube, block) -> str:
@@ -151,6 +162,49 @@ def curve_reason(results, model: str, block=None) -> str:
                 "Housner's rigid base and the paper's model are shown as references.")
     return (f"The answers use the {model_info(model).label}: the study did not run the tensionless Winkler bed, "
             "so read them with the limitations, which say where this model is outside its assumptions.")
+
+
+def slides_first_words(results, answer) -> str:
+    """A sentence on the soils where this block slides before it can rock (μ_s below b/h), "" where none.
+
+    Only soils whose answering runs have base friction (cube.nc ``friction_static`` finite): there the block slides
+    at rest instead of rocking (Shenton 1996), so its rocking and overturning rest on the assumed friction. With the
+    designed sample, the overturning median of the high-friction member says what a base that grips more gives.
+    """
+    cube, config = getattr(results, "cube", None), results.config
+    if cube is None or "block_b" not in cube.coords and "block_b" not in cube:
+        return ""
+    b, h = float(cube.block_b.sel(block=answer.block)), float(cube.block_h.sel(block=answer.block))
+    slender = b / h
+    soils = []
+    for soil in config.soils:
+        if soil.friction_static >= slender:
+            continue
+        if "friction_static" in cube and answer.model in cube.model.values:
+            value = cube.friction_static.sel(model=answer.model, block=answer.block, soil=soil.name)
+            if not np.isfinite(float(value)):
+                continue  # a tied base: it cannot slide in these runs
+        soils.append(soil)
+    if not soils:
+        return ""
+    listed = ", ".join(f"{soil.name} {soil.friction_static:g}" for soil in soils)
+    text = (f"On {', '.join(soil.name for soil in soils)} the soil's base friction (μ_s {listed}) is below this "
+            f"block's b/h = {slender:.2f}: at rest it slides before it can rock (Shenton 1996), so its rocking and "
+            "overturning there rest on the assumed friction; a base that grips more (a grout bed, a keyed plinth) "
+            "would rock instead, and overturn more readily.")
+    fragility = results.fragility
+    if "member_median" in fragility and "friction_high" in fragility.member.values \
+            and "overturning" in fragility.damage_state.values:
+        scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+        medians = []
+        for soil in soils:
+            value = float(fragility.member_median.sel(member="friction_high", soil=soil.name, block=answer.block,
+                                                      damage_state="overturning")) * scale
+            medians.append(f"{soil.name} {numbers.intensity(value, answer.unit)}" if np.isfinite(value)
+                           else f"{soil.name} none below the credible cap")
+        text += (" With the friction at the high end of its range (the designed sample), the overturning median is "
+                 f"{'; '.join(medians)}.")
+    return text
 
 
 MOTIONS = ("at rest", TILT_WORDS, "slides", "rocks", "slides and rocks", "flies", "overturns")
@@ -269,7 +323,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if description:
         items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
     items += verdict_items(results, answer)
-    special = curve_reason(results, answer.model, answer.block)
+    special = " ".join(filter(None, [curve_reason(results, answer.model, answer.block),
+                                     slides_first_words(results, answer)]))
     sufficiency = sufficiency_words(results.efficiency, answer.block, cube.attrs.get("intensity_measure", "")
                                     if cube is not None else "", measure_label(cube).split(" [")[0]
                                     if cube is not None else measure)
@@ -411,12 +466,15 @@ def reading_items(results) -> list[Item]:
                        f"{SLIP_NESTING} 'not reached': no record reached the state at any level up to the credible "
                        "cap, the highest intensity the study runs. '≥ X': the fitted median lies below every level "
                        "run, and the records at the lowest level give a lower bound instead of the fit's tail. "
-                       f"{no_curve_words(answers[0])} Beside it, how many records reached each state at those "
-                       "levels: a probability where none did is the fitted curve's tail alone."),
+                       f"{no_curve_words(answers[0])} '-': no level was run as low as that intensity, so the records "
+                       "say nothing there. Beside it, how many records reached each state at those levels: a "
+                       "probability where none did is the fitted curve's tail alone."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. A smaller "
                        f"lift off a bed is not rocking: the block {TILT_WORDS} (the bed gives under its toe). The "
                        "motion table counts each record once, at its most severe motion; the records that rock, "
-                       "slide and rock, fly or overturn there are the records that reach uplift."),
+                       "slide and rock, fly or overturn there are the records that reach uplift. 'Flies' on a bed "
+                       "is the block bouncing clear of its bed after an impact (the vertical ground motion is not "
+                       "applied), not a loss of support."),
              paragraph(f"The probability in the design life of {life} is the fitted curve integrated over the site's "
                        f"hazard, with how often the state happens on average. {BOUND_WORDS} {BOUND_POLICY}"),
              heading("The verdicts"),

@@ -214,6 +214,52 @@ def spectra_page(showcase, caption):
     return figure
 
 
+def hazard_page(sites, return_periods, caption, unit: str = "g"):
+    """The hazard behind every probability: annual frequency of exceedance against the intensity, log-log.
+
+    ``sites`` is the study's ``rockfrag.site_hazard.SiteHazards`` (each soil's curve, and the reference site's it
+    was carried from, if any); the return periods' frequencies 1/T are dotted. A soil whose curve is the reference
+    one is named in the reference curve's legend entry.
+    """
+    figure = new_page("Site hazard: the hazard curve of each soil's site", caption)
+    axis = panels(figure)[0, 0]
+    reference = getattr(sites, "reference", None)
+    same = [soil for soil, curve in sites.items() if reference is not None and curve is reference]
+    shown = reference if reference is not None else next(iter(sites.values()))
+    if reference is not None:
+        vs30 = getattr(sites, "reference_vs30", None)
+        label = "reference site" + (f" (Vs30 {vs30:,.0f} m/s)" if vs30 else "") + (
+            f": also {', '.join(same)}" if same else "")
+        axis.loglog(reference.intensity, reference.annual_frequency, color="black", ls="--", lw=1.2, label=label)
+    for index, (soil, curve) in enumerate(sites.items()):
+        if soil in same:
+            continue
+        axis.loglog(curve.intensity, curve.annual_frequency, color=soil_colour(soil, index), lw=1.4, label=soil)
+    periods = [float(t) for t in return_periods]
+    for t in periods:
+        axis.axhline(1.0 / t, color=MARK_COLOUR, ls=":", lw=0.9)
+    if periods:
+        axis.plot([], [], color=MARK_COLOUR, ls=":", lw=0.9,
+                  label="dotted: once in " + ", ".join(f"{t:,.0f}" for t in periods) + " years (1/T)")
+    frequencies = np.concatenate([np.asarray(curve.annual_frequency, float) for curve in sites.values()])
+    frequencies = frequencies[frequencies > 0]
+    low = min(frequencies.min(), 0.2 / max(periods)) if periods else frequencies.min()
+    bottom, top = max(low, 1e-7), min(frequencies.max() * 2, 1.0)
+    axis.set_ylim(bottom, top)
+    inside = np.concatenate([np.asarray(curve.intensity, float)[(np.asarray(curve.annual_frequency) >= bottom)
+                                                                 & (np.asarray(curve.annual_frequency) <= 0.1)]
+                             for curve in sites.values()])
+    if inside.size:  # the intensities between 0.1/yr and the rarest frequency shown: the range a verdict reads
+        axis.set_xlim(inside.min(), inside.max())
+    axis.set_xlabel(f"{shown.label} [{unit}]")
+    axis.set_ylabel("annual frequency of exceedance [1/yr]")
+    log_minor_ticks(axis.xaxis)
+    log_minor_ticks(axis.yaxis)
+    axis.grid(alpha=0.3, which="both")
+    outside_legend(figure, [axis])
+    return figure
+
+
 def showcase_ground_page(showcase, caption):
     """A page figure of the showcase record, raw and processed, over its whole length.
 
@@ -350,7 +396,8 @@ def _ida_rows(models, soils, per_soil=(), most_columns=5):
     columns = min(max(len(soils) if founded else 1, len(rigid), 1), most_columns)
     rows = []
     for start in range(0, len(rigid), columns):
-        rows.append(("rigid base: the same on every soil", [(m, None) for m in rigid[start:start + columns]]))
+        rows.append(("rigid base: its rocking is the same on every soil",
+                     [(m, None) for m in rigid[start:start + columns]]))
     for model in founded:
         heading = panel_label(model)
         if model.rigid_base:
@@ -647,6 +694,7 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
         axis.set_visible(False)
     levels = block_levels(fragility, block)
     probability = fragility.outcome_probability
+    shaded = False
     for axis, model in zip(axes.flat, models):
         soils = soils_of(probability.to_dataset(name="p"), model, block, "p")
         for index, soil in enumerate(soils):
@@ -661,11 +709,13 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
             axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
             if soil is None or len(soils) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
+                shaded = True
         axis.set_title(textwrap.fill(short_label(model), chars_across(axis, 9.5)), fontsize=9.5)
     _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): lift-off, rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
-    axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
+    if shaded:  # the band is drawn only where one curve pair is on its panel (a legend entry only if drawn)
+        axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
     for axis in axes.flat:
         if axis.get_visible():
             axis.tick_params(labelbottom=True)
@@ -882,12 +932,16 @@ def sensitivity_page(fragility, caption, names: dict | None = None):
                      label=f"{parameter}", color=f"C{index % 10}")
         form = fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()
         if np.isfinite(form):
-            axis.axhline(form, color="k", lw=0.9, ls="--", label=f"beta_form {form:.2f} (FEMA P-695 rating)")
+            axis.axhline(form, color="k", lw=0.9, ls="--", label=f"model-form β {form:.2f} (FEMA P-695 rating)")
         if not np.isfinite(spread.values).any():
             empty_note(axis, "no median: the state was not reached below the credible cap")
-        axis.set_xticks(x, soils, fontsize=8)
+            axis.set_ylim(0.0, max(form, 0.1) * 1.3 if np.isfinite(form) else 1.0)
+        missing = [not np.isfinite(spread.sel(soil=soil).values).any() for soil in soils]
+        missing = missing if not all(missing) else [False] * len(soils)  # an empty panel says so once, inside
+        axis.set_xticks(x, [f"{soil}\n(no median)" if gone else soil for soil, gone in zip(soils, missing)],
+                        fontsize=8)
         axis.set_ylabel("σ of ln median [-]", fontsize=9)
-        axis.set_title(names.get(block, block), fontsize=10)
+        axis.set_title(textwrap.fill(names.get(block, block), chars_across(axis, 10)), fontsize=10)
         axis.grid(alpha=0.3, axis="y")
     for axis in axes[len(blocks):]:
         axis.set_visible(False)

@@ -64,7 +64,7 @@ from rockfrag.report.adapters import (
     vertical_applied,
 )
 from rockfrag.report.layout import pretty
-from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS
+from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, hazard_caveat
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
@@ -253,6 +253,13 @@ def n_runs(cube) -> int:
     return int(cells * cube.sizes["record"] * cube.sizes["im_level"] * twice)
 
 
+def member_runs(cube) -> int:
+    """Solver runs of the designed sample's members (each member on every soil, block, record and level), or 0."""
+    if "member" not in cube.dims or "member_outcome" not in cube:
+        return 0
+    return int(np.asarray(cube.member_outcome.notnull().values).sum())
+
+
 def capacity_runs(cube) -> int | None:
     """Solver runs added to the grid to refine the overturning capacities (the study's log line), or None."""
     value = cube.attrs.get("capacity_runs")
@@ -268,6 +275,9 @@ def runs_words(results) -> str:
     """
     cube = results.cube
     text = f"{n_runs(cube):,} simulations on the intensity grid"
+    members = member_runs(cube)
+    if members:
+        text += f", {members:,} more for the recommended model's designed sample"
     refining = capacity_runs(cube)
     if refining:
         text += f" and {refining:,} more refining the overturning capacities"
@@ -344,8 +354,7 @@ def title_items(results: Results) -> list[Item]:
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
         *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
-        *([strong(f"Hazard: {EXAMPLE_HAZARD_WORDS}.")] if any(answer.example_hazard for answer in results.answers)
-          else []),
+        *([strong(f"Hazard: {caveat}.")] if (caveat := hazard_caveat(results)) else []),
         paragraph("The next page is the summary: the action for each block on each soil, and why. Then the "
                   "contents, one answer page per block (at the site's return periods, how likely each damage state "
                   "is, how likely in the design life, and what the records did), the fragility of each block on each "
@@ -480,6 +489,10 @@ def _ordered_models(results: Results):
     return [m for m in models if m.name == first] + [m for m in models if m.name != first]
 
 
+GOF_LEVEL = 0.05
+"""Below this goodness-of-fit p-value (fragility.nc ``gof_p_value``) the fitted table marks the curve ‡."""
+
+
 def fitted_items(results: Results) -> list[Item]:
     """Per block, model and soil: median and β of every damage state, the answering model first.
 
@@ -513,7 +526,9 @@ def fitted_items(results: Results) -> list[Item]:
                         cells.append("-")
                         continue
                     flag = status.get((str(picked.soil.values), str(block), model.name, state), "within")
-                    mark = ("*" if flag not in ("within", "no fit") else "") + ("†" if median > largest else "")
+                    gof = float(picked["gof_p_value"].sel(damage_state=state)) if "gof_p_value" in picked else np.nan
+                    mark = ("*" if flag not in ("within", "no fit") else "") + ("†" if median > largest else "") \
+                        + ("‡" if np.isfinite(gof) and gof < GOF_LEVEL else "")
                     row_marks.update(mark)
                     shown = results.facts.say("fitted median", (block, model.name, str(picked.soil.values), state),
                                               _g(median))
@@ -536,6 +551,10 @@ def fitted_items(results: Results) -> list[Item]:
     if "*" in marks:
         items.append(note("* the median lies outside the studied intensity range (an extrapolation of the fit; see "
                           "Limitations)."))
+    if "‡" in marks:
+        items.append(note(f"‡ the fit fails its goodness-of-fit test (p < {GOF_LEVEL:g}): the lognormal does not "
+                          "follow the records' fractions well; read the points on its fragility page beside the "
+                          "curve."))
     if "†" in marks:
         largest = ", ".join(f"{block_name(results.config, b)} {v:.2g} {shown_unit}"
                             for b, v in results.largest_recorded.items())
@@ -586,7 +605,11 @@ def _hazard_words(results: Results) -> str:
         return "none for the study's intensity measure"
     if EXAMPLE_HAZARD in results.hazard.source:
         return EXAMPLE_HAZARD_WORDS
-    return "the site's curve given with the study (its file is named in 'How to reproduce this report')"
+    site = getattr(results.hazard, "site", None)
+    where = (f", at longitude {site.longitude:g}°, latitude {site.latitude:g}°" if site is not None else "")
+    caveat = hazard_caveat(results)
+    return ((f"{caveat}: the curve given with the study" if caveat else "the site's curve given with the study")
+            + f"{where} (its file is named in 'How to reproduce this report'; the page 'Site hazard' draws it)")
 
 
 def _beta(value: float) -> str:

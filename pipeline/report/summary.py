@@ -12,6 +12,9 @@ Nothing here decides a verdict: rockfrag.answer does. This module only says it, 
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import numpy as np
 
 from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT
@@ -38,6 +41,52 @@ EXAMPLE_WARNING = ("The hazard of this report is the example hazard curve that c
 
 EXAMPLE_HAZARD_WORDS = "the example hazard (not a site's: see the summary)"
 """How every other page names the shipped example hazard: a reference to ``EXAMPLE_WARNING``, not a repeat."""
+
+
+ILLUSTRATIVE = re.compile(r"illustrative|not the result of a hazard model|not site-specific|placeholder", re.I)
+"""Words of a hazard file's own header that say it is not a site's hazard study (its first comment lines)."""
+
+
+def _file_header(results) -> str:
+    """The first comment lines of the study's hazard file ("" when it cannot be read)."""
+    source = getattr(getattr(results, "hazard", None), "source", "") or ""
+    config = getattr(results, "config", None)
+    study = Path(str(getattr(config, "source", "") or ""))
+    for path in (Path(source), study.parent / source):
+        try:
+            if path.is_file():
+                with open(path, encoding="utf-8", errors="replace") as handle:
+                    lines = [next(handle, "") for _ in range(5)]
+                return " ".join(line for line in lines if line.lstrip().startswith("#"))
+        except OSError:
+            continue
+    return ""
+
+
+def illustrative_hazard(results) -> bool:
+    """Whether the study's own hazard file says in its header that it is illustrative, not a site's hazard study."""
+    answers = getattr(results, "answers", None) or []
+    if not answers or any(answer.example_hazard for answer in answers):
+        return False
+    return bool(ILLUSTRATIVE.search(_file_header(results)))
+
+
+ILLUSTRATIVE_WARNING = ("The hazard curve of this study is illustrative: its own file says it is not the result of a "
+                        "hazard model. No verdict in this report applies to the site until the site's hazard study "
+                        "replaces it; the probabilities show how the method reads a hazard. The other pages say this "
+                        "once more only as 'the illustrative hazard (not for a verdict: see the summary)'.")
+"""The summary's first line when the study's own hazard file says it is illustrative (the user-site example)."""
+
+ILLUSTRATIVE_WORDS = "the illustrative hazard (not for a verdict: see the summary)"
+"""How every other page names an illustrative hazard file: a reference to ``ILLUSTRATIVE_WARNING``."""
+
+
+def hazard_caveat(results) -> str:
+    """The hazard in the few words every page after the summary uses, when it is not a site's ("" when it is)."""
+    answers = getattr(results, "answers", None) or []
+    if any(answer.example_hazard for answer in answers):
+        return EXAMPLE_HAZARD_WORDS
+    return ILLUSTRATIVE_WORDS if illustrative_hazard(results) else ""
 
 
 def action(verdict: str, soil=None) -> str:
@@ -98,7 +147,7 @@ SLIP_NESTING = ("A slip state counts a record that overturns too (it is beyond e
 
 BOUND_WORDS = ("'< X': no record reached the state at any level up to the credible cap, the highest intensity the "
                "study runs (Methods), so its probability is at most X, that of the site's intensity exceeding the "
-               "cap.")
+               "cap. '< 0.1%' alone is the print floor: a value below 0.1%, computed or bounded.")
 """What a "< X" cell means, on the summary and the answer pages (rockfrag.answer's not-reached limit)."""
 
 BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a probability ('< X', '≥ X') these pages "
@@ -248,7 +297,8 @@ def hazard_words(results, answer) -> str:
     """The hazard the probabilities come from, named: the shipped example or the site's, per soil or not."""
     if not answer.return_periods:
         return "no hazard curve"
-    source = EXAMPLE_HAZARD_WORDS if answer.example_hazard else "the site's hazard"
+    source = EXAMPLE_HAZARD_WORDS if answer.example_hazard else (ILLUSTRATIVE_WORDS if illustrative_hazard(results)
+                                                                  else "the site's hazard")
     sites = getattr(results, "site_hazards", None)
     if sites is None or len(sites) < 2:
         return source
@@ -267,6 +317,8 @@ def summary_items(results) -> list[Item]:
     items = []
     if any(answer.example_hazard for answer in answers):
         items.append(strong(EXAMPLE_WARNING))
+    elif illustrative_hazard(results):
+        items.append(strong(ILLUSTRATIVE_WARNING))
     periods = first.return_periods
     life = numbers.years(first.design_life)
     header = ["asset, soil", "action", "governing damage state", *(f"P at {numbers.years(t)}" for t in periods),
@@ -340,6 +392,8 @@ def terminal_verdicts(results) -> str:
     lines = [f"Verdict per asset and soil (probabilities in {life} with {hazard_words(results, first)}):"]
     if any(answer.example_hazard for answer in answers):
         lines.append(EXAMPLE_WARNING)
+    elif illustrative_hazard(results):
+        lines.append(ILLUSTRATIVE_WARNING)
     header = ["asset", "soil", "action", "governing damage state", f"P in {life} (limit)", "reason"]
     table = []
     for answer in answers:
@@ -359,7 +413,8 @@ def verdict_items(results, answer) -> list[Item]:
     groups: dict[str, list] = {}
     for soil in answer.soils:
         groups.setdefault(soil.verdict, []).append(soil)
-    lead = (f"With {EXAMPLE_HAZARD_WORDS}, the {name}: " if answer.example_hazard else f"Verdict for the {name}: ")
+    caveat = hazard_caveat(results)
+    lead = f"With {caveat}, the {name}: " if caveat else f"Verdict for the {name}: "
     parts = []
     for verdict, soils in groups.items():
         where = _and([soil.soil for soil in soils])
