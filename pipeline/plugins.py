@@ -64,6 +64,9 @@ class Registry(MutableMapping):
         The class every plugin object must be an instance of.
     order : callable, optional
         Sort key of the values: the registry is kept sorted by it (damage states by severity).
+    check : callable, optional
+        ``check(name, value)``: what is wrong with a plugin's object beyond its kind and name, as one phrase, or
+        None (contact laws: the module's hooks).
 
     Notes
     -----
@@ -71,8 +74,8 @@ class Registry(MutableMapping):
     reading (``[]``, ``in``, iteration, ``len``, ``get``, ``values``) does, once.
     """
 
-    def __init__(self, group: str, kind: type, order: Callable | None = None):
-        self.group, self.kind, self._order = group, kind, order
+    def __init__(self, group: str, kind: type, order: Callable | None = None, check: Callable | None = None):
+        self.group, self.kind, self._order, self._check = group, kind, order, check
         self._items: dict = {}
         self._loaded = False
         self._error: PluginError | None = None
@@ -123,6 +126,9 @@ class Registry(MutableMapping):
         if own != entry_point.name:
             raise PluginError(f"{_where(entry_point)}: the {self.kind.__name__} is named {own!r}; the entry point's "
                               "name must be the same")
+        problem = self._check(entry_point.name, value) if self._check is not None else None
+        if problem:
+            raise PluginError(f"{_where(entry_point)}: {problem}")
         return value
 
 

@@ -318,16 +318,26 @@ def test_a_plugin_contact_law_runs_as_a_shipped_one(toy_site, tmp_path):
     assert abs(settled / (g / omega2) - 1) > 1  # not the linear bed's settlement: the law is another
 
 
-def test_a_contact_law_module_without_its_hooks_is_refused():
+def test_a_contact_law_module_without_its_hooks_is_refused(monkeypatch):
+    """The registry's check names the entry point and what the module lacks, in the one line of a PluginError."""
+    import sys
     import types
+    from importlib.metadata import EntryPoint
 
     from rockfrag.models import contact
     from rockfrag.plugins import PluginError
 
     law = types.ModuleType("half_a_law")
     law.NAME, law.force = "half", lambda x, params, sin_t, cos_t: (0.0, 0.0)
-    with pytest.raises(PluginError, match=r"half = half_a_law: .*missing: indicator, indicators, full_contact"):
-        contact._checked("half", law)
+    monkeypatch.setitem(sys.modules, "half_a_law", law)
+    entry_point = EntryPoint(name="half", value="half_a_law", group="rockfrag.contact_laws")
+    with pytest.raises(PluginError, match=r"^entry point rockfrag.contact_laws: half = half_a_law: a contact law "
+                                          r"module needs .*; module half_a_law lacks indicator, indicators, "
+                                          r"full_contact$"):
+        contact.CONTACT_LAWS._load(entry_point)
+    law.indicator = law.indicators = law.full_contact = law.force
     law.NAME = "other"
-    with pytest.raises(PluginError, match="needs NAME = 'half' \\(it has 'other'\\)"):
-        contact._checked("half", law)
+    with pytest.raises(PluginError, match="the module's NAME is 'other'; the entry point's name must be the same"):
+        contact.CONTACT_LAWS._load(entry_point)
+    law.NAME = "half"
+    assert contact.CONTACT_LAWS._load(entry_point) is law

@@ -46,7 +46,7 @@ import numpy as np
 from rockfrag.models import bed_continuous, bed_hunt_crossley, bed_two_spring
 from rockfrag.models.fields import PARAMS_DTYPE
 from rockfrag.models.jit import COMPILED, kernel
-from rockfrag.plugins import GROUPS, PluginError, Registry
+from rockfrag.plugins import GROUPS, Registry
 
 # contact indicators every law reports (see the module docstring)
 N_CONTACT_INDICATORS = 4
@@ -61,20 +61,21 @@ SHIPPED = {CONTINUOUS: bed_continuous, TWO_SPRING: bed_two_spring, HUNT_CROSSLEY
 HOOKS = ("force", "indicator", "indicators", "full_contact")
 """The hooks every law module defines, in the order of a plugin law's table of addresses (``call_hook``)."""
 
-CONTACT_LAWS = Registry(GROUPS["contact_laws"], ModuleType)
+def _law_problem(name: str, law: ModuleType) -> str | None:
+    """What is wrong with a plugin's law module (its NAME, its hooks), as one phrase; None if nothing."""
+    missing = [hook for hook in HOOKS if not callable(getattr(law, hook, None))]
+    if missing:
+        return (f"a contact law module needs the hooks {', '.join(HOOKS)}; module {law.__name__} lacks "
+                f"{', '.join(missing)}")
+    if getattr(law, "NAME", None) != name:
+        return f"the module's NAME is {getattr(law, 'NAME', None)!r}; the entry point's name must be the same"
+    return None
+
+
+CONTACT_LAWS = Registry(GROUPS["contact_laws"], ModuleType, check=_law_problem)
 """The contact laws by option name: the shipped ones, then those of the installed plugins (read at import)."""
 for _law in SHIPPED.values():
     CONTACT_LAWS[_law.NAME] = _law
-
-
-def _checked(name: str, law: ModuleType) -> ModuleType:
-    """A plugin's law module, checked to name itself as its entry point does and to define the four hooks."""
-    missing = [hook for hook in HOOKS if not callable(getattr(law, hook, None))]
-    if getattr(law, "NAME", None) != name or missing:
-        raise PluginError(f"entry point {GROUPS['contact_laws']}: {name} = {law.__name__}: a contact law module "
-                          f"needs NAME = {name!r} (it has {getattr(law, 'NAME', None)!r}) and the hooks "
-                          f"{', '.join(HOOKS)}" + (f" (missing: {', '.join(missing)})" if missing else ""))
-    return law
 
 
 def _codes() -> dict[int, ModuleType]:
@@ -85,7 +86,7 @@ def _codes() -> dict[int, ModuleType]:
         if law in shipped:
             codes[shipped[law]] = law
         else:
-            codes[plugin] = _checked(name, law)
+            codes[plugin] = law
             plugin += 1
     return codes
 
