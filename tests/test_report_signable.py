@@ -480,3 +480,22 @@ def test_the_fitted_table_marks_a_fit_that_fails_its_goodness_of_fit_test(small_
     cells = [cell for item in items if item.kind == "table" for row in item.rows for cell in row[2:] if cell != "-"]
     assert cells and all("‡" in cell for cell in cells if cell)
     assert any(item.text.startswith("‡ the fit fails its goodness-of-fit test") for item in items)
+
+
+def test_the_applicability_legend_says_why_a_block_or_soil_has_no_point(small_pipeline):
+    """Read 2, default B7: the paper block had no clay and sand points without a word, and the squat block's 'no run
+    rocked without overturning in both models' did not parse. A drawn block names its soils without a point; a
+    block without any says 'no point' and why."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report.figures import applicability_page
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    figure = applicability_page(results.cube, "")
+    labels = [text.get_text() for legend in figure.legends for text in legend.get_texts()]
+    labels += [line.get_label() for axis in figure.axes for line in axis.get_lines()]
+    blocks = [label for label in labels if label.startswith("block: ")]
+    assert blocks
+    for label in blocks:
+        assert "no run rocked without overturning in both models" not in label or "no point" in label, label
+    plt.close(figure)

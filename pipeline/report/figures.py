@@ -747,7 +747,7 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
         levels = block_levels(cube, block)
         band = (levels >= 1.2 * uplift) & (levels <= 3.0 * uplift)
         sub = cube.sel(block=block).isel(im_level=np.flatnonzero(band)) if band.any() else None
-        drew = False
+        drew, with_ratio = False, np.zeros(cube.sizes["soil"], bool)
         for model in founded if sub is not None else []:
             rigid_angle = sub.peak_angle.sel(model=reference.name)
             survived = (sub.outcome.sel(model=[reference.name, model.name]) == OUTCOME_ROCKING).all("model")
@@ -755,11 +755,14 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
                      rigid_angle.where(survived).median(["record", "im_level"])).values
             if not np.isfinite(ratio).any():
                 continue
-            drew = True
+            drew, with_ratio = True, with_ratio | np.isfinite(ratio)
             style = styles[model.name]
             axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], ms=5, mfc="white",
                       color=style["color"], ls=style["ls"], lw=1.3)
         name = names.get(str(block), str(block))
+        gaps = [str(soil) for soil, has in zip(cube.soil.values, with_ratio) if not has]
+        if drew and gaps:  # a soil without a point says why in the legend, not as a gap in the line
+            name += f" (no point on {', '.join(gaps)}: no run rocked without overturning in both models there)"
         (drawn_blocks if drew else missing).append((name, markers[b_index % len(markers)]))
     for model in founded:
         style = styles[model.name]
@@ -767,7 +770,8 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     for name, marker in drawn_blocks:
         axis.plot([], [], ls="none", marker=marker, ms=5, mfc="white", color="0.2", label=f"block: {name}")
     for name, _ in missing:
-        axis.plot([], [], ls="none", label=f"block: {name}: no run rocked without overturning in both models")
+        axis.plot([], [], ls="none", label=f"block: {name}: no point (no run rocked without overturning in both "
+                                         "models between 1.2 and 3 times its uplift threshold)")
     axis.axhspan(1 - limit, 1 + limit, color="0.88", label=f"within ±{limit:.0%} of the rigid base", zorder=0)
     axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0,
                  label="300-1000 MPa: above it the paper finds the rigid base good enough")
