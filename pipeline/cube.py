@@ -52,6 +52,14 @@ VERTICAL_APPLIED, VERTICAL_NOT_APPLIED = "applied", "not applied"
 
 DIMS = ("record", "im_level", "soil", "block", "model")
 
+STEP_LEVEL = "step_level"
+"""The dimension of the runs that place a cell's steps between its levels (rockfrag.steps): ``step_intensity``
+(step_level, soil, block, model) [the measure's display unit; NaN: no run] and, of each run, ``step_X`` over
+(record, step_level, soil, block, model) for the per-run variables ``X`` the damage states read
+(``STEP_RUN_VARIABLES``)."""
+STEP_RUN_VARIABLES = ("outcome", "peak_uplift", "peak_angle_ratio", "peak_slip")
+"""The per-run variables kept of a step's runs (besides each damage state's own measure)."""
+
 COMPONENT_ROTD50, COMPONENT_SINGLE = "RotD50", "single component"
 """Values of a cube's per-record ``record_intensity_component`` and of its ``intensity_component`` attribute (which
 is "mixed" when both occur): what the record's intensity, and so its scale factors, is the measure of."""

@@ -18,10 +18,12 @@ pelicun file, the risk and the report carry them. For overturning the refined ca
 ``ida.nc`` (the first overturning transition bisected to ``capacity_resolution``) are also fitted, a
 censored lognormal MLE (``capacity_median``, ``capacity_beta``; ``CAPACITY_FIT``) that checks the
 stripe fit. Every row says what it is (``STATUS``):
-- uplift under each component's own PGA of a model whose uplift is the rigid-body threshold is the exact
-  step g tan(alpha) (``deterministic-threshold``, beta = 0), not a fit; under RotD50 scaling (the cube's
-  ``intensity_component``) a component lifts at g tan(alpha) of its own PGA, which is 0.7-1.4 times its
-  pair's RotD50, so that row is fitted like any other;
+- uplift of a model whose uplift is the rigid-body threshold (a tied base, PGA, no vertical) is known per record:
+  a component lifts when its own scaled PGA exceeds g tan(alpha) (``exact_uplift_thresholds``). Under each
+  component's own PGA that is the exact step g tan(alpha) (``deterministic-threshold``, beta = 0), not a fit;
+  under RotD50 pair scaling (the cube's ``intensity_component``) each record lifts at g tan(alpha) times its
+  pair's RotD50 over its own PGA (0.7-1.4 g tan(alpha)), and the row is the lognormal fit of those exact
+  thresholds (``exact-thresholds``), of which the stripes are a coarse sample (checked level by level);
 - perfectly separated counts have no lognormal MLE: a step between the two bracketing levels,
   beta = 0, status ``separated`` and a warning (never a silent small beta);
 - a median outside the studied range is flagged ``extrapolated``; a state no record reached is
@@ -61,6 +63,7 @@ from rockfrag.cube import (
     OUTCOME_NO_UPLIFT,
     OUTCOME_OVERTURNED,
     OUTCOME_ROCKING,
+    STEP_LEVEL,
     member_cube,
 )
 from rockfrag.damage_states import (
@@ -228,6 +231,55 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     return np.broadcast_to(values, (n_block, n_level)).copy(), units
 
 
+def merged_runs(cube: xr.Dataset, intensity: np.ndarray, unit: str) -> tuple[xr.Dataset, np.ndarray]:
+    """The cube's runs with each cell's step runs (``rockfrag.steps``) merged in between its levels, and its levels.
+
+    Parameters
+    ----------
+    cube : xarray.Dataset
+        The study cube; its step runs, if any, are ``step_X`` over (record, step_level, soil, block, model) at
+        ``step_intensity`` (``rockfrag.cube.STEP_LEVEL``).
+    intensity : numpy.ndarray
+        (n_block, n_level) the levels [``unit``] (``intensity_levels``).
+    unit : str
+        The levels' unit.
+
+    Returns
+    -------
+    runs : xarray.Dataset
+        The per-run variables over (record, im_level, soil, block, model), each cell's runs in increasing
+        intensity (so the first-overturn convention reads them in order), with the cube's other variables; a
+        cube without step runs is returned as it is.
+    levels : numpy.ndarray
+        (soil, block, model, n_level + n_step) each cell's intensities [``unit``], increasing; inf where the cell
+        has no run (its outcome there is failed: unknown, left out of every count).
+    """
+    shape = (cube.sizes["soil"], cube.sizes["block"], cube.sizes["model"])
+    grid = np.broadcast_to(intensity[None, :, None, :], (*shape, intensity.shape[1])).copy()
+    if STEP_LEVEL not in cube.dims or "step_intensity" not in cube:
+        return cube, grid
+    step = cube["step_intensity"]
+    step = np.asarray(convert_units(step.transpose("soil", "block", "model", STEP_LEVEL).values,
+                                    step.attrs.get("units", unit), unit), float)
+    levels = np.concatenate([grid, np.where(np.isfinite(step), step, np.inf)], axis=-1)
+    order = np.argsort(levels, axis=-1, kind="stable")
+    dims = ("record", "soil", "block", "model")
+    runs = cube.drop_dims(["im_level", STEP_LEVEL])
+    for name, variable in cube.data_vars.items():
+        if set(variable.dims) != {"record", "im_level", *dims[1:]}:
+            continue
+        values = variable.transpose(*dims, "im_level").values
+        stepped = f"step_{name}"
+        if stepped in cube:
+            extra = cube[stepped].transpose(*dims, STEP_LEVEL).values.astype(values.dtype)
+        else:
+            extra = np.full((*values.shape[:-1], step.shape[-1]), OUTCOME_FAILED if name == "outcome" else np.nan,
+                            dtype=values.dtype if name == "outcome" else float)
+        merged = np.take_along_axis(np.concatenate([values, extra], axis=-1), order[None], axis=-1)
+        runs[name] = (("record", "im_level", *dims[1:]), np.moveaxis(merged, -1, 1), variable.attrs)
+    return runs, np.take_along_axis(levels, order, axis=-1)
+
+
 def scaled_by_own_component(cube: xr.Dataset) -> bool:
     """Whether every record of the cube is scaled by its own component (a cube from before pairs: yes)."""
     return cube.attrs.get("intensity_component", COMPONENT_SINGLE) == COMPONENT_SINGLE
@@ -265,6 +317,63 @@ def uplift_is_rigid_threshold(model_name: str) -> bool:
     if model is None:  # a cube of a model this installation does not know: fall back on its name
         return model_name in RIGID_UPLIFT_MODELS
     return model.uplift_is_rigid_threshold
+
+
+def exact_uplift_thresholds(cube: xr.Dataset, unit: str) -> np.ndarray | None:
+    """Each record's exact uplift intensity for every block, (n_record, n_block) [``unit``], or None.
+
+    A pivot model at rest (Housner, the paper's ``ssi`` on a tied base) starts to rock the first time a sample of
+    the scaled ground acceleration exceeds g tan(alpha) (the kernel's rest phase, ``rest_until_uplift``): a record
+    scaled by s lifts exactly when s PGA_r > g tan(alpha), i.e. at the intensity g tan(alpha) IM_r / PGA_r, IM_r
+    the record's intensity as the study scales it (``record_im``) and PGA_r its own component's (``record_pga``).
+    Scaled by its own PGA that is g tan(alpha) for every record; by its pair's RotD50 PGA, 0.7-1.4 times it, one
+    threshold per record (checked against runs in tests/test_steps.py). None when the measure is not PGA, when a
+    record ran with its vertical component (it lifts at (g + a_v) tan(alpha)), or when the cube cannot tell.
+    """
+    if cube.attrs.get("intensity_measure", "pga") != "pga":
+        return None
+    if "vertical_applied" in cube and np.any(cube["vertical_applied"].values):
+        return None
+    threshold = uplift_threshold(cube, unit)
+    if threshold is None:
+        return None
+    n_record = cube.sizes["record"]
+    if "record_im" not in cube.variables or "record_pga" not in cube.variables:
+        # a cube from before pairs: every record scaled by its own component, or nothing is known
+        return np.broadcast_to(threshold, (n_record, threshold.size)).copy() if scaled_by_own_component(cube) \
+            else None
+    record_im, pga = cube["record_im"], cube["record_pga"]
+    if "block" not in record_im.dims:
+        record_im = record_im.expand_dims(block=cube.block.values)
+    im = np.asarray(convert_units(record_im.transpose("record", "block").values, record_im.attrs.get("units", unit),
+                                  "m s-2"), float)
+    own = np.asarray(convert_units(pga.values, pga.attrs.get("units", unit), "m s-2"), float)
+    return threshold[None, :] * im / own[:, None]
+
+
+def fit_exact_thresholds(thresholds, cap=np.inf, weights=None):
+    """Lognormal (median, beta) of exact per-record thresholds [their unit], right-censored at the credible ``cap``.
+
+    The closed-form MLE (median exp(mean ln t), beta the standard deviation of ln t with divisor n) or, with
+    thresholds above the cap, the censored MLE (``fit_censored_capacities``). ``weights`` (n_sample, n_record):
+    record multiplicities of bootstrap samples; returns arrays (n_sample,) then, else floats.
+    """
+    thresholds = np.asarray(thresholds, float)
+    above = thresholds > cap * (1 + 1e-9)
+    if weights is None:
+        if above.any():
+            return fit_censored_capacities(np.where(above, np.nan, thresholds), cap)
+        logs = np.log(thresholds)
+        return float(np.exp(logs.mean())), float(logs.std())
+    weights = np.asarray(weights, float)
+    if above.any():
+        fits = [fit_censored_capacities(np.repeat(np.where(above, np.nan, thresholds), w.astype(int)), cap)
+                for w in weights]
+        return np.array([f[0] for f in fits]), np.array([f[1] for f in fits])
+    logs = np.log(thresholds)
+    mean = weights @ logs / weights.sum(1)
+    spread = np.sqrt(np.maximum(weights @ logs**2 / weights.sum(1) - mean**2, 0.0))
+    return np.exp(mean), spread
 
 
 def uplift_threshold(cube: xr.Dataset, unit: str) -> np.ndarray | None:
@@ -355,26 +464,147 @@ def noncrossing_groups(levels, exceed, total, fits, usable, chains=None):
     return [sorted(group) for group in groups], fits
 
 
-def _step_method(levels, exceed, total, unit) -> str:
-    """How a separated row's step was placed: the level where records were mixed, or the bracket's middle."""
+@dataclass(frozen=True)
+class StepContext:
+    """What a cell's step rows need to say how they were placed (``step_refinement``).
+
+    grid : the cell's credible levels [the fit's unit] (the other intensities it ran are step runs);
+    refined : whether the study bisected the cell's separated rows (``rockfrag.steps``); resolution : the relative
+    width it bisects to; reason : why a cell's rows were not refined ("" when they were); n_records : records per run.
+    """
+
+    grid: np.ndarray
+    refined: bool = False
+    resolution: float = 0.0
+    reason: str = ""
+    n_records: int = 0
+
+
+NOT_REFINED = {
+    "off": "the study ran no runs between the levels (capacity_resolution = 0, or a cube from before them)",
+    "member": "the study refines the published rows only (housner, ssi, the recommended central member), not a "
+              "sample member beside the centre",
+}
+"""Why a cell's steps were not refined by runs between the levels (besides a cube's own ``step_not_refined``)."""
+
+
+def step_refinement(cube: xr.Dataset) -> Callable[[tuple, np.ndarray], StepContext]:
+    """``context(index, grid)``: the ``StepContext`` of the cell ``index`` = (soil, block, model) of ``cube``.
+
+    The study says which cells it refined (``step_refined``, with ``step_resolution`` and ``step_not_refined``
+    among the cube's attributes, rockfrag.steps).
+    """
+    resolution = float(cube.attrs.get("step_resolution", 0.0) or 0.0)
+    flags = cube["step_refined"].transpose("soil", "block", "model").values if "step_refined" in cube else None
+    n_records = cube.sizes["record"]
+
+    def context(index, grid):
+        if resolution <= 0:
+            return StepContext(grid, reason=NOT_REFINED["off"], n_records=n_records)
+        if flags is None:
+            return StepContext(grid, reason=NOT_REFINED["member"], n_records=n_records)
+        refined = bool(flags[index])
+        return StepContext(grid, refined, resolution, "" if refined else cube.attrs.get("step_not_refined", ""),
+                           n_records)
+    return context
+
+
+def step_bracket(levels, exceed, total) -> tuple[float, float, float]:
+    """(lower, upper, mixed) of a separated row's step.
+
+    lower: the highest intensity with no record in the state, upper: the lowest with every record, mixed: the one
+    intensity between them where some were (NaN: none, or the bracket is open there).
+    """
     known = total > 0
-    none = np.flatnonzero(known & (exceed == 0))
-    every = np.flatnonzero(known & (exceed == total))
-    mixed = np.flatnonzero(known & (exceed > 0) & (exceed < total))
-    if mixed.size:
-        return f"the one level where some records were in the state ({levels[mixed[0]]:.3g} {unit})"
-    lower = levels[none[none < every[0]][-1]] if every.size and (none < every[0]).any() else np.nan
-    upper = levels[every[0]] if every.size else np.nan
+    levels, exceed, total = levels[known], exceed[known], total[known]
+    some, not_all = np.flatnonzero(exceed > 0), np.flatnonzero(exceed < total)
+    if not some.size or not not_all.size:
+        return np.nan, np.nan, np.nan
+    first, last = some[0], not_all[-1]
+    if last < first:
+        return float(levels[last]), float(levels[first]), np.nan
+    lower = float(levels[first - 1]) if first > 0 else np.nan
+    upper = float(levels[first + 1]) if first + 1 < levels.size else np.nan
+    return lower, upper, float(levels[first])
+
+
+def _step_method(levels, exceed, total, unit, context: StepContext | None = None) -> str:
+    """How a separated row's step was placed: bisected between the levels by runs, or from the levels alone.
+
+    The step is the geometric middle of the bracket between the highest intensity with no record in the state and
+    the lowest with every record, or the one intensity where some records were; ``context`` says which intensities
+    are the levels and which are step runs, and why a row was not refined.
+    """
+    context = context or StepContext(levels, reason=NOT_REFINED["off"])
+    lower, upper, mixed = step_bracket(levels, exceed, total)
+    on_grid = np.isclose(levels[:, None], np.asarray(context.grid)[None, :], rtol=1e-12, atol=0).any(1)
+    grid_lower, grid_upper, grid_mixed = step_bracket(levels[on_grid], exceed[on_grid], total[on_grid])
+    low_end = grid_lower if np.isfinite(grid_lower) else -np.inf
+    high_end = grid_upper if np.isfinite(grid_upper) else np.inf
+    between = ~on_grid & (total > 0) & (levels > low_end) & (levels < high_end)
+    count = int(between.sum())
+    if count:  # runs between the levels placed it
+        runs = f"{count * context.n_records} runs at {count} intensities"
+        short = "" if upper - lower <= context.resolution * upper * (1 + 1e-9) else \
+            " (stopped before the resolution: the study's round limit)"
+        if np.isfinite(mixed):
+            return (f"bisected: the one intensity where some records were in the state ({mixed:.4g} {unit}; none at "
+                    f"{lower:.4g}, all at {upper:.4g} {unit}), found by {runs} between the levels {grid_lower:.3g}-"
+                    f"{grid_upper:.3g} {unit}{short}")
+        return (f"bisected to {context.resolution:.0%}: geometric middle of the bracket {lower:.4g}-{upper:.4g} "
+                f"{unit} (no record in the state at the lower intensity, every record at the upper), narrowed from "
+                f"the levels {grid_lower:.3g}-{grid_upper:.3g} {unit} by {runs}{short}")
+    if context.refined:
+        reason = "the bracket is open at the edge of the levels" if not (np.isfinite(lower) and np.isfinite(upper)) \
+            else f"the levels bracket it to the {context.resolution:.0%} resolution already" \
+            if upper - lower <= context.resolution * upper * (1 + 1e-9) else "no run between the levels"
+    else:
+        reason = context.reason or "no run between the levels"
+    if np.isfinite(mixed):
+        return f"the one level where some records were in the state ({mixed:.3g} {unit}); not refined: {reason}"
     return (f"geometric middle of the bracket {lower:.3g}-{upper:.3g} {unit} (no record in the state at the lower "
-            "level, every record at the upper; not refined by runs between them)")
+            f"level, every record at the upper); not refined by runs between them: {reason}")
 
 
-def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit="", cap=np.inf):
+def exact_uplift_row(levels, exceed, total, thresholds, unit="", cap=np.inf) -> RowFit:
+    """The uplift row of a cell whose records lift at known intensities (``exact_uplift_thresholds``).
+
+    One threshold for every record (each scaled by its own PGA): the exact step g tan(alpha), beta = 0. Thresholds
+    that differ (RotD50 pair scaling): the lognormal fit of the exact thresholds (``fit_exact_thresholds``), which
+    the stripes only sample: their counts at every level are the records whose threshold lies below it. Either way
+    the runs are checked against the thresholds, level by level (a warning where they disagree).
+    exceed, total : (n_level,) the stripes' counts; thresholds : float or (n_record,) [the levels' unit].
+    """
+    thresholds = np.atleast_1d(np.asarray(thresholds, float))
+    row = RowFit()
+    if np.ptp(thresholds) <= 1e-9 * thresholds.max():
+        row.median, row.beta, row.method, row.status = float(thresholds[0]), 0.0, "exact-g-tan-alpha", \
+            "deterministic-threshold"
+        row.step_method = "exact: g tan(alpha), a rigid base's uplift under each component's own PGA"
+    else:
+        row.median, row.beta = fit_exact_thresholds(thresholds, cap)
+        row.method, row.status = "exact-thresholds", "fitted"
+    # the runs: a record at rest lifts where its threshold lies below the level (at it, it stays at rest)
+    expected = (levels[:, None] > thresholds[None, :]).sum(1) if thresholds.size > 1 else \
+        (levels > thresholds[0]) * total
+    clear = (total > 0) & np.all(np.abs(levels[:, None] / thresholds[None, :] - 1) > 1e-6, axis=1)
+    unknown = (thresholds.size - total) if thresholds.size > 1 else 0.0  # failed runs: reached or not, unknown
+    disagree = int(np.sum(clear & ((exceed > expected) | (exceed < expected - unknown))))
+    if disagree:
+        what = "exact g tan(alpha) step" if row.method == "exact-g-tan-alpha" else \
+            "records' exact uplift thresholds g tan(alpha) x their intensity / their own PGA"
+        row.warn(f"at {disagree} levels the runs disagree with the {what}")
+    return row
+
+
+def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit="", cap=np.inf, context=None):
     """Fit every damage state of one cell. exceed, total : (n_state, n_level) counts per level.
 
-    threshold : the exact uplift intensity g tan(alpha) when uplift is a rigid threshold under this
-    scaling, else None. cap : the credible cap [the levels' unit]: the levels are those at or below it, and a
-    median above it is censored (``censored-at-cap``). Returns (rows, groups): a RowFit per state and the
+    threshold : the exact uplift intensity of each record (n_record,), or one for all (g tan(alpha)), when uplift
+    is a rigid threshold under this scaling (``exact_uplift_thresholds``), else None. cap : the credible cap [the
+    levels' unit]: the levels are those at or below it, and a
+    median above it is censored (``censored-at-cap``). context : the cell's ``StepContext`` (which levels are step
+    runs; default: none are). Returns (rows, groups): a RowFit per state and the
     estimator groups (lists of state indices; more than one state = a shared-beta fit), which the bootstrap reuses.
     """
     medians, betas = fit_independent(levels, exceed, total)
@@ -387,14 +617,7 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
             row.status = NOT_APPLICABLE
             row.warn("the base is tied in this cell (no friction): it does not slide")
         elif state.edp == "uplifted" and threshold is not None:
-            row.median, row.beta, row.method, row.status = float(threshold), 0.0, "exact-g-tan-alpha", \
-                "deterministic-threshold"
-            row.step_method = "exact: g tan(alpha), a rigid base's uplift under each component's own PGA"
-            step = (levels > threshold).astype(float)
-            clear = has_data & (np.abs(levels / threshold - 1) > 1e-6)
-            disagree = int(np.sum(clear & (exceed[s] != step * total[s])))
-            if disagree:
-                row.warn(f"at {disagree} levels the runs disagree with the exact g tan(alpha) step")
+            row = exact_uplift_row(levels, exceed[s], total[s], threshold, unit, cap)
         elif not (exceed[s][has_data] > 0).any():
             row.warn(f"not reached by any record within the studied range {span}")
         elif np.isnan(medians[s]) and exceed[s][has_data][0] >= 0.5 * total[s][has_data][0]:
@@ -407,7 +630,7 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
                      f"{int(total[s][has_data][-1])} records; the median lies above {levels[-1]:.3g} {unit}")
         elif betas[s] == 0:
             row.median, row.beta, row.method, row.status = medians[s], 0.0, "step-between-levels", "separated"
-            row.step_method = _step_method(levels, exceed[s], total[s], unit)
+            row.step_method = _step_method(levels, exceed[s], total[s], unit, context)
             row.warn("perfectly separated counts: no lognormal MLE exists; reported as a step at "
                      f"{medians[s]:.3g} {unit} with beta = 0")
         else:
@@ -436,16 +659,21 @@ def fit_cell(levels, exceed, total, states, threshold=None, n_records=None, unit
         if row.method.startswith("mle") and not levels[0] <= row.median <= levels[-1]:
             row.status = "extrapolated"
             row.warn(f"median {row.median:.3g} {unit} outside the studied range {span} (extrapolated)")
+        if row.method == "exact-thresholds" and not levels[0] <= row.median <= levels[-1]:
+            row.status = "extrapolated"
+            row.warn(f"median {row.median:.3g} {unit} outside the studied range {span} (from the exact thresholds)")
         if n_records is not None and n_records < SMALL_SAMPLE and row.method != "exact-g-tan-alpha" \
                 and np.isfinite(row.median):
             row.warn(f"only {n_records} records (fewer than {SMALL_SAMPLE}): beta and the bounds are rough")
     return rows, groups
 
 
-def bootstrap_cell(levels, exceed, total, rows, groups):
+def bootstrap_cell(levels, exceed, total, rows, groups, weights=None, thresholds=None, cap=np.inf):
     """Refit resampled counts with each row's own estimator. exceed, total : (n_boot, n_state, n_level).
 
-    Returns medians, betas of shape (n_boot, n_state) (NaN where a sample cannot identify the curve).
+    An ``exact-thresholds`` row refits the resampled records' exact ``thresholds`` (n_record,) with their
+    multiplicities ``weights`` (n_boot, n_record). Returns medians, betas of shape (n_boot, n_state) (NaN where a
+    sample cannot identify the curve).
     """
     n_boot, n_state = exceed.shape[:2]
     medians, betas = np.full((n_boot, n_state), np.nan), np.full((n_boot, n_state), np.nan)
@@ -459,6 +687,8 @@ def bootstrap_cell(levels, exceed, total, rows, groups):
         first = rows[group[0]]
         if len(group) == 1 and first.method == "exact-g-tan-alpha":
             medians[:, group[0]], betas[:, group[0]] = first.median, 0.0
+        elif len(group) == 1 and first.method == "exact-thresholds" and weights is not None:
+            medians[:, group[0]], betas[:, group[0]] = fit_exact_thresholds(thresholds, cap, weights)
         elif len(group) > 1:
             e, t = exceed[:, group], total[:, group]
             separated, *_ = separation(e, t)
@@ -474,6 +704,84 @@ def bootstrap_cell(levels, exceed, total, rows, groups):
 
 
 # ---------------------------------------------------------------- the whole cube
+
+@dataclass
+class FitInputs:
+    """What every cell's fit reads, computed once for a cube (``fit_inputs``).
+
+    intensity : (n_block, n_level) the levels [unit]; caps : (n_block,) the credible caps [unit]; credible :
+    (n_block, n_level) the levels at or below the cap; levels : (soil, block, model, n) each cell's levels with its
+    step runs between them (``merged_runs``); usable : where those are finite and credible; reached, valid :
+    (record, n, soil, block, model, state) each run's exceedance (0/1) and whether it is known; fractions :
+    (n_level, soil, block, model, state) the empirical fraction on the levels; thresholds : (record, block) the
+    exact uplift intensities or None; exact : (soil, block, model) where they apply (a tied pivot model).
+    """
+
+    intensity: np.ndarray
+    unit: str
+    caps: np.ndarray
+    credible: np.ndarray
+    levels: np.ndarray
+    usable: np.ndarray
+    reached: np.ndarray
+    valid: np.ndarray
+    fractions: np.ndarray
+    thresholds: np.ndarray | None
+    exact: np.ndarray
+    context: Callable[[tuple, np.ndarray], StepContext]
+    n_records: int
+
+    def cell(self, index: tuple):
+        """(levels, data, exceed, total, threshold) of the cell ``index`` = (soil, block, model).
+
+        levels (n,) [unit]; data indexes ``reached``/``valid`` down to (record, n, state); exceed, total (state, n)
+        counts; threshold (n_record,) the exact uplift intensities or None.
+        """
+        block = index[1]
+        levels = self.levels[index][self.usable[index]]
+        data = (slice(None), self.usable[index], *index)
+        exceed = self.reached[data].sum(0).T
+        total = self.valid[data].sum(0).T.astype(float)
+        threshold = self.thresholds[:, block] if self.thresholds is not None and self.exact[index] else None
+        return levels, data, exceed, total, threshold
+
+    def fit(self, index: tuple, states: list[DamageState]):
+        """``fit_cell`` of the cell ``index``: (rows, groups)."""
+        levels, _, exceed, total, threshold = self.cell(index)
+        block = index[1]
+        return fit_cell(levels, exceed, total, states, threshold, self.n_records, unit_label(self.unit),
+                        self.caps[block], self.context(index, self.intensity[block][self.credible[block]]))
+
+
+def fit_inputs(cube: xr.Dataset, states: list[DamageState]) -> FitInputs:
+    """The ``FitInputs`` of a cube for ``states`` (the fragility stage's, and rockfrag.steps' in the study)."""
+    intensity, unit = intensity_levels(cube)
+    group_dims = ("soil", "block", "model")
+    models = [str(m) for m in cube.model.values]
+    sliding = np.isfinite(cube["friction_static"].transpose(*group_dims).values) if "friction_static" in cube \
+        else np.zeros(tuple(cube.sizes[d] for d in group_dims), bool)
+    # the exact uplift is the rigid base's only where the base is tied: one that slides before it can rock (base
+    # friction, Shenton 1996) need not lift at g tan(alpha), so its uplift is fitted from its runs
+    rigid = np.array([uplift_is_rigid_threshold(m) for m in models])
+    exact = rigid[None, None, :] & ~sliding
+
+    def exceedances(runs):  # (record, level, soil, block, model, state)
+        return np.stack([exceedance(runs, s).transpose("record", "im_level", *group_dims).values for s in states],
+                        axis=-1)
+
+    runs, levels = merged_runs(cube, intensity, unit)  # the levels with each cell's step runs between them
+    exceed_all = exceedances(runs)
+    on_levels = exceed_all if runs is cube else exceedances(cube)  # the empirical fractions are the levels' own
+    with np.errstate(invalid="ignore"):
+        fractions = np.nan_to_num(on_levels).sum(0) / np.isfinite(on_levels).sum(0)
+    caps = credible_caps(cube, unit)
+    return FitInputs(
+        intensity=intensity, unit=unit, caps=caps, credible=intensity <= caps[:, None] * (1 + 1e-9),
+        levels=levels, usable=np.isfinite(levels) & (levels <= caps[None, :, None, None] * (1 + 1e-9)),
+        reached=np.nan_to_num(exceed_all), valid=np.isfinite(exceed_all), fractions=fractions,
+        thresholds=exact_uplift_thresholds(cube, unit), exact=exact, context=step_refinement(cube),
+        n_records=cube.sizes["record"])
+
 
 ROW_VARIABLES = {
     "median": ("median intensity of the lognormal fragility", None),
@@ -581,31 +889,20 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         warnings and empirical fractions per soil x block x model x damage state.
     """
     states = states or list(DAMAGE_STATES.values())
-    intensity, unit = intensity_levels(cube)
+    inputs = fit_inputs(cube, states)
+    intensity, unit, caps, reached, valid = inputs.intensity, inputs.unit, inputs.caps, inputs.reached, inputs.valid
     measure = cube.attrs.get("intensity_measure", "")
-    # g tan(alpha) is exact in the study's own intensity only when each record is scaled by its own PGA
-    thresholds = uplift_threshold(cube, unit) if measure == "pga" and scaled_by_own_component(cube) else None
     group_dims = ("soil", "block", "model")
-    models = [str(m) for m in cube.model.values]
-    rigid = {m: uplift_is_rigid_threshold(m) for m in models}
-    sliding = np.isfinite(cube["friction_static"].transpose(*group_dims).values) if "friction_static" in cube \
-        else np.zeros(tuple(cube.sizes[d] for d in group_dims), bool)
     shape = tuple(cube.sizes[d] for d in group_dims) + (len(states),)
     out = {name: np.full(shape, np.nan) for name in ROW_VARIABLES}
     text = {name: np.full(shape, "", dtype=object) for name in ("fit_method", "status", "fit_warning", "step_method")}
     extrapolated = np.zeros(shape, np.int8)
-    exceed_all = np.stack([exceedance(cube, s).transpose("record", "im_level", *group_dims).values
-                           for s in states], axis=-1)  # (record, level, soil, block, model, state)
-    valid = np.isfinite(exceed_all)
-    reached = np.nan_to_num(exceed_all)
-    with np.errstate(invalid="ignore"):
-        fraction = reached.sum(0) / valid.sum(0)
+    fraction = inputs.fractions
     n_records = cube.sizes["record"]
     weights = record_resamples(n_records, n_bootstrap, seed)
     n_resurrected = resurrected(cube.outcome.transpose("record", *group_dims, "im_level").values).sum(0)
     capacities = refined_capacities(ida, unit)
-    caps = credible_caps(cube, unit)
-    credible = intensity <= caps[:, None] * (1 + 1e-9)  # (block, level): the levels the fits may use
+    credible = inputs.credible
     label = unit_label(unit)
     tail = (1 - confidence) / 2
     at_cap = {name: np.full(shape, np.nan) for name in ("probability_at_cap", "probability_at_cap_low",
@@ -613,25 +910,19 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
     cells = list(np.ndindex(*shape[:-1]))
     for index in tqdm(cells, desc="fragility fits + bootstrap", unit="cell", disable=not progress):
         soil, block, model = index
-        levels = intensity[block][credible[block]]
-        data = (slice(None), credible[block], *index)
-        exceed = reached[data].sum(0).T  # (state, level)
-        total = valid[data].sum(0).T.astype(float)
+        levels, data, exceed, total, threshold = inputs.cell(index)
         if levels.size:  # the records that reached each state at the highest credible level, with bounds
             last = total[:, -1]
             with np.errstate(invalid="ignore"):
                 at_cap["probability_at_cap"][index] = np.where(last > 0, exceed[:, -1] / last, np.nan)
             at_cap["probability_at_cap_low"][index], at_cap["probability_at_cap_high"][index] = clopper_pearson(
                 exceed[:, -1], last, confidence)
-        # the exact step is the rigid base's only where the base is tied: one that slides before it can rock
-        # (base friction, Shenton 1996) need not lift at g tan(alpha), so its uplift is fitted from its runs
-        threshold = thresholds[block] if thresholds is not None and rigid[models[model]] \
-            and not sliding[index] else None
-        rows, groups = fit_cell(levels, exceed, total, states, threshold, n_records, label, caps[block])
+        rows, groups = inputs.fit(index, states)
         if n_bootstrap:
             boot_exceed = np.einsum("br,rls->bsl", weights, reached[data])
             boot_total = np.einsum("br,rls->bsl", weights, valid[data].astype(float))
-            boot_median, boot_beta = bootstrap_cell(levels, boot_exceed, boot_total, rows, groups)
+            boot_median, boot_beta = bootstrap_cell(levels, boot_exceed, boot_total, rows, groups, weights,
+                                                    threshold, caps[block])
         for s, (state, row) in enumerate(zip(states, rows)):
             key = (*index, s)
             out["median"][key], out["beta"][key] = row.median, row.beta
@@ -657,8 +948,8 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
             long_name = f"{confidence:.0%} two-sided interval: {long_name}"
         data_vars[name] = (dims, out[name], {"long_name": long_name, "units": unit if units is None else units})
     data_vars["fit_method"] = (dims, text["fit_method"].astype(str), {
-        "long_name": "estimator: mle-binomial | mle-binomial-shared-beta | exact-g-tan-alpha | "
-                     "step-between-levels | none"})
+        "long_name": "estimator: mle-binomial | mle-binomial-shared-beta | exact-g-tan-alpha | exact-thresholds "
+                     "(lognormal MLE of the records' exact uplift intensities) | step-between-levels | none"})
     data_vars["status"] = (dims, text["status"].astype(str), {
         "long_name": "what the row is: " + " | ".join(STATUS),
         "description": json.dumps(STATUS)})

@@ -52,6 +52,7 @@ from rockfrag.blocks import Block
 from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
 from rockfrag.checkpoints import CheckpointStore
 from rockfrag.cube import COMPARISON_CUBE, build_cube
+from rockfrag.damage_states import damage_states_from_config
 from rockfrag.errors import PipelineError, RecordError
 from rockfrag.executors import check_workers, make_executor, pool_executor, run_tasks
 from rockfrag.ida import capacity_from_stripes, uniform_stripe_runs
@@ -74,6 +75,7 @@ from rockfrag.records import Record, group_components, load_records, split_verti
 from rockfrag.records.components import horizontal_partners, pair_window
 from rockfrag.site_hazard import study_site_hazards
 from rockfrag.soils import soil_block_stiffness
+from rockfrag.steps import refine_steps
 
 
 @dataclass(frozen=True)
@@ -947,6 +949,13 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
                                                                                          config.beyond_credible)),
                         stats)
     dataset, capacity_stats = cubes[variants[0]]
+    if resolution > 0:  # the separated rows' steps, bisected by runs between the levels (rockfrag.steps)
+        dataset = refine_steps(dataset, damage_states_from_config(config.raw), config.blocks, resolution,
+                               lambda requests: step_runs(requests, records, all_cells[variants[0]], record_im,
+                                                          config, store, stiffness_of_model, calibration,
+                                                          verticals if variants[0] else None,
+                                                          lambda: make_executor(compute_cells, workers, scheduler,
+                                                                                dask_workers)), log)
     if config.vertical:  # the comparison first: a cube.nc on disk always has its comparison beside it
         comparison = cubes[False][0]
         comparison.attrs["title"] += " without the vertical components (compare with cube.nc)"
@@ -954,12 +963,57 @@ def _run_locked(config, output, workers, scheduler, dask_workers, progress, log,
         dataset.attrs["vertical_comparison"] = COMPARISON_CUBE
     write_dataset(dataset, output / "cube.nc")
     elapsed = time.perf_counter() - started
+    capacity_stats["step_runs"] = int(dataset.attrs.get("step_runs", 0))
     statistics = {"runs_computed": runs_total, "cells_reused": n_cells - n_missing, "cells": n_cells,
                   "seconds": elapsed, "failures": [str(f) for f in failures],
                   "checkpoints_quarantined": [str(p) for p in store.quarantined], **capacity_stats}
     if config.vertical:
         statistics["comparison"] = output / COMPARISON_CUBE
     return dataset, statistics
+
+
+def step_runs(requests, records, all_cells, record_im, config, store, stiffness, calibration, verticals,
+              executor) -> np.ndarray:
+    """Summaries (n_record, n_request) of every record at each ``rockfrag.steps`` request ((soil, block, model), SI).
+
+    Each run is a checkpoint of its own (the cell's key, "-step-" and the scale factor), so a resumed study redoes
+    none; the missing ones run as the study's tasks do (``compute_cells`` on ``executor()``). A run lost with its
+    worker reads as failed (unknown). ``verticals``: each record's vertical component, or None (not applied).
+    """
+    cube_models = [str(m) for m in config.models if split_variant(str(m))[1] in (None, "centre")]
+    runs, pending = {}, {}
+    for j, ((soil, block, model), intensity) in enumerate(requests):
+        name = cube_models[model]
+        for r, cells in enumerate(all_cells):
+            cell = next(c for c in cells if c.block_index == block and c.model == name
+                        and c.soil_index in (None, soil))
+            scale = float(intensity / record_im[r, block])
+            step = Cell(f"{cell.key}-step-{scale:.12g}", block, cell.soil_index, name, cell.friction)
+            runs[(r, j)] = step.key
+            pending.setdefault((r, block, scale), {})[step.key] = step
+    results = store.load_verified(list(dict.fromkeys(runs.values())), (1,), SUMMARY_DTYPE)
+    tasks = []
+    for (r, block, scale), cells in pending.items():
+        listing = [[] for _ in records]
+        listing[r] = list(cells.values())
+        tasks += [(*task, scale) for task in block_tasks(listing, results, config, stiffness, 0.0, calibration)]
+
+    def keep(task, computed):
+        for key, summary in computed.items():
+            store.save(key, summary)
+            results[key] = summary
+
+    if tasks:
+        run_tasks(tasks, lambda task: (records[task[0]].acceleration, records[task[0]].dt, [task[3]], task[2],
+                                       solver_options(config), config.tail, 0.0,
+                                       verticals[task[0]].acceleration if verticals is not None else None),
+                  executor, keep, describe=lambda task: f"record {records[task[0]].id}, a step run")
+    out = new_summaries((len(records), len(requests)))
+    out["status"] = int(Outcome.FAILED)
+    for (r, j), key in runs.items():
+        if key in results:
+            out[r, j] = results[key][0]
+    return out
 
 
 def _gather_summaries(all_cells, results, config, n_records, n_levels) -> np.ndarray:

@@ -35,7 +35,7 @@ LAYERS: list[tuple[str, ...]] = [
     ("rockfrag.cube", "rockfrag.ida", "rockfrag.risk", "rockfrag.calibrate", "rockfrag.records_report",
      "rockfrag.exchange"),
     # 7 stages that combine them: the sweep, the fits (which add the risk), the measure ranking
-    ("rockfrag.study", "rockfrag.fragility", "rockfrag.efficiency"),
+    ("rockfrag.study", "rockfrag.steps", "rockfrag.fragility", "rockfrag.efficiency"),
     # 8 stages built on the sweep
     ("rockfrag.showcase", "rockfrag.applicability"),
     # 9 what the reader gets: the report and the terminal's answer table

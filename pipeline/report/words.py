@@ -25,6 +25,8 @@ FIT_METHODS = {
     "mle-binomial": "maximum likelihood on the counts per level",
     "mle-binomial-shared-beta": "maximum likelihood with one dispersion shared by the states (no crossing)",
     "exact-g-tan-alpha": "the exact uplift threshold g·tanα (a step)",
+    "exact-thresholds": "a lognormal fit of each record's exact uplift intensity (g·tanα × its pair's RotD50 / its own "
+                        "PGA)",
     "step-between-levels": "a step between two levels (every record changed state there)",
     "none": "no fit (the state was not reached, or reached by most records at the lowest level)",
 }
