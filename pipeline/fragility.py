@@ -164,7 +164,7 @@ def tilts(cube: xr.Dataset, outcome: xr.DataArray) -> xr.DataArray | bool:
     return (outcome == OUTCOME_ROCKING) & bed & (cube.peak_uplift < uplift_lift(cube.block_b))
 
 
-def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
+def exceedance(cube: xr.Dataset, state: DamageState, outcome: xr.DataArray | None = None) -> xr.DataArray:
     """1.0 where a run reached the damage state, 0.0 where not, NaN where unknown.
 
     A record is beyond every state from its first overturning level on (``first_overturn_outcomes``).
@@ -176,9 +176,10 @@ def exceedance(cube: xr.Dataset, state: DamageState) -> xr.DataArray:
 
     Slip states (``edp = "peak_slip"``): reached where the peak slip is at least the threshold [m] or the block
     overturned; known only in the cells that run with friction (the cube's ``friction_static`` finite): a
-    tied cell's runs are all unknown, and its row is ``not-applicable``.
+    tied cell's runs are all unknown, and its row is ``not-applicable``. ``outcome``: the cube's
+    ``first_overturn_outcomes`` when the caller has them already.
     """
-    outcome = first_overturn_outcomes(cube)
+    outcome = first_overturn_outcomes(cube) if outcome is None else outcome
     if is_slip_state(state):
         if state.edp not in cube or "friction_static" not in cube:  # a cube from before sliding: every base tied
             return xr.full_like(outcome, np.nan, dtype=float)
@@ -231,7 +232,7 @@ def intensity_levels(cube: xr.Dataset) -> tuple[np.ndarray, str]:
     return np.broadcast_to(values, (n_block, n_level)).copy(), units
 
 
-def merged_runs(cube: xr.Dataset, intensity: np.ndarray, unit: str) -> tuple[xr.Dataset, np.ndarray]:
+def merged_runs(cube: xr.Dataset, intensity: np.ndarray, unit: str, names=None) -> tuple[xr.Dataset, np.ndarray]:
     """The cube's runs with each cell's step runs (``rockfrag.steps``) merged in between its levels, and its levels.
 
     Parameters
@@ -243,6 +244,8 @@ def merged_runs(cube: xr.Dataset, intensity: np.ndarray, unit: str) -> tuple[xr.
         (n_block, n_level) the levels [``unit``] (``intensity_levels``).
     unit : str
         The levels' unit.
+    names : collection of str, optional
+        The per-run variables to merge (default: all; the others are left out of ``runs``).
 
     Returns
     -------
@@ -266,7 +269,7 @@ def merged_runs(cube: xr.Dataset, intensity: np.ndarray, unit: str) -> tuple[xr.
     dims = ("record", "soil", "block", "model")
     runs = cube.drop_dims(["im_level", STEP_LEVEL])
     for name, variable in cube.data_vars.items():
-        if set(variable.dims) != {"record", "im_level", *dims[1:]}:
+        if set(variable.dims) != {"record", "im_level", *dims[1:]} or (names is not None and name not in names):
             continue
         values = variable.transpose(*dims, "im_level").values
         stepped = f"step_{name}"
@@ -753,8 +756,11 @@ class FitInputs:
                         self.caps[block], self.context(index, self.intensity[block][self.credible[block]]))
 
 
-def fit_inputs(cube: xr.Dataset, states: list[DamageState]) -> FitInputs:
-    """The ``FitInputs`` of a cube for ``states`` (the fragility stage's, and rockfrag.steps' in the study)."""
+def fit_inputs(cube: xr.Dataset, states: list[DamageState], fractions: bool = True) -> FitInputs:
+    """The ``FitInputs`` of a cube for ``states`` (the fragility stage's, and rockfrag.steps' in the study).
+
+    ``fractions``: compute the empirical fractions on the levels (else NaN: the study's steps do not need them).
+    """
     intensity, unit = intensity_levels(cube)
     group_dims = ("soil", "block", "model")
     models = [str(m) for m in cube.model.values]
@@ -765,15 +771,24 @@ def fit_inputs(cube: xr.Dataset, states: list[DamageState]) -> FitInputs:
     rigid = np.array([uplift_is_rigid_threshold(m) for m in models])
     exact = rigid[None, None, :] & ~sliding
 
-    def exceedances(runs):  # (record, level, soil, block, model, state)
-        return np.stack([exceedance(runs, s).transpose("record", "im_level", *group_dims).values for s in states],
-                        axis=-1)
+    read = {"outcome", "peak_uplift", *(s.edp for s in states)}  # the per-run variables exceedance reads
 
-    runs, levels = merged_runs(cube, intensity, unit)  # the levels with each cell's step runs between them
+    def exceedances(runs):  # (record, level, soil, block, model, state)
+        # only what exceedance reads: xarray aligns every coordinate of every operand (the cube has dozens)
+        runs = runs[[name for name in (*read, "friction_static") if name in runs]]
+        runs = runs.drop_vars([name for name in runs.coords if name not in runs.dims and name != "block_b"])
+        outcome = first_overturn_outcomes(runs)
+        return np.stack([exceedance(runs, s, outcome).transpose("record", "im_level", *group_dims).values
+                         for s in states], axis=-1)
+
+    runs, levels = merged_runs(cube, intensity, unit, read)  # the levels with each cell's step runs between them
     exceed_all = exceedances(runs)
-    on_levels = exceed_all if runs is cube else exceedances(cube)  # the empirical fractions are the levels' own
-    with np.errstate(invalid="ignore"):
-        fractions = np.nan_to_num(on_levels).sum(0) / np.isfinite(on_levels).sum(0)
+    if fractions:
+        on_levels = exceed_all if runs is cube else exceedances(cube)  # the empirical fractions are the levels' own
+        with np.errstate(invalid="ignore"):
+            fractions = np.nan_to_num(on_levels).sum(0) / np.isfinite(on_levels).sum(0)
+    else:
+        fractions = np.full(exceed_all.shape[1:], np.nan)
     caps = credible_caps(cube, unit)
     return FitInputs(
         intensity=intensity, unit=unit, caps=caps, credible=intensity <= caps[:, None] * (1 + 1e-9),

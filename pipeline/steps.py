@@ -64,7 +64,7 @@ def requested_runs(cube: xr.Dataset, states: list[DamageState], resolution: floa
     ``refine`` (soil, block, model): the cells to refine. Rows are fitted as the fragility stage fits them
     (``rockfrag.fragility.fit_inputs``), step runs so far included.
     """
-    inputs = fit_inputs(cube, states)
+    inputs = fit_inputs(cube, states, fractions=False)
     si = parse_units(inputs.unit)[0]  # SI value of one display unit
     requests, separated = [], 0
     for index in zip(*np.nonzero(refine)):

@@ -13,7 +13,13 @@ from rockfrag import study as study_module
 from rockfrag.blocks import Block
 from rockfrag.config import load_study
 from rockfrag.damage_states import DAMAGE_STATES, uplift_lift
-from rockfrag.fragility import fit_cell, fragility_dataset, fragility_stage, with_recommended
+from rockfrag.fragility import (
+    exact_uplift_thresholds,
+    fit_cell,
+    fragility_dataset,
+    fragility_stage,
+    with_recommended,
+)
 from rockfrag.ida import ida_stage
 from rockfrag.measures import MEASURES, pga
 from rockfrag.models import simulate_batch
@@ -23,6 +29,7 @@ from rockfrag.processing import process_record
 from rockfrag.records import load_records
 from rockfrag.records.components import pair_window
 from rockfrag.soils import SOILS, soil_block_stiffness
+from rockfrag.steps import bisection_intensity
 from rockfrag.study import run_study
 
 UPLIFT, ROCKING = DAMAGE_STATES["uplift"], DAMAGE_STATES["rocking-0.2"]
@@ -293,3 +300,24 @@ def test_the_model_uncertainty_widens_a_recommended_step_like_any_other_row():
     assert step.beta.item() == pytest.approx(model_beta, rel=1e-12) and step.beta_record_to_record.item() == 0
     assert curve.beta.item() == pytest.approx(np.hypot(0.3, model_beta), rel=1e-12)
     assert out.sel(model="housner", damage_state="step").beta.item() == 0  # a reference's step stays a step
+
+
+def test_the_next_intensity_halves_the_bracket_or_its_wider_side_and_stops_at_the_resolution():
+    levels, total = np.array([0.1, 0.2, 0.4, 0.8]), np.full(4, 10.0)
+    assert bisection_intensity(levels, [0, 0, 10, 10], total, 0.02) == pytest.approx(np.sqrt(0.2 * 0.4))
+    # one mixed intensity (0.25): the wider side, 0.25-0.4, is bisected next
+    mixed = np.array([0.1, 0.2, 0.25, 0.4, 0.8])
+    assert bisection_intensity(mixed, [0, 0, 3, 10, 10], np.full(5, 10.0), 0.02) == pytest.approx(np.sqrt(0.1))
+    assert bisection_intensity([0.1, 0.2, 0.203, 0.8], [0, 0, 10, 10], total, 0.02) is None  # within 2%
+    assert bisection_intensity(levels, [4, 10, 10, 10], total, 0.02) is None  # open at the lowest level
+
+
+def test_a_record_run_with_its_vertical_has_no_exact_uplift_threshold(rigid_step):
+    # it lifts where |a_h| > (g + a_v) tan(alpha): not at a known intensity, so its rows are fitted from the runs
+    cube = rigid_step[2]  # scaled by each component's own PGA, as a PGA study
+    cube = cube.assign(record_im=cube.record_pga.expand_dims(block=cube.block.values).transpose("record", "block"))
+    cube = cube.assign_attrs(intensity_measure="pga")
+    assert exact_uplift_thresholds(cube, "9.80665 m s-2") is not None
+    with_vertical = cube.assign(vertical_applied=cube.vertical_applied.copy(data=np.ones(cube.sizes["record"],
+                                                                                          np.int8)))
+    assert exact_uplift_thresholds(with_vertical, "9.80665 m s-2") is None
