@@ -55,12 +55,21 @@ def probability(value) -> str:
 def bound(value, side: str) -> str:
     """A probability that is a bound: "< 0.81%" (at most) or "≥ 61%" (at least); a certainty prints as itself.
 
-    ``side`` is "<" or "≥". A lower bound of 1 is "100%"; an upper bound below ``FLOOR`` stays "< 0.1%".
+    ``side`` is "<" or "≥". The two significant figures are rounded away from the bound's safe side: an upper
+    bound up, a lower bound down (0.197 prints "≥ 19%", never "≥ 20%", which the value does not reach). A lower
+    bound of 1 is "100%"; an upper bound below ``FLOOR`` stays "< 0.1%".
     """
     text = probability(value)
-    if text in ("-", "< 0.1%") or (side == "≥" and text == "100%") or text.startswith(">"):
+    if text in ("-", "< 0.1%", "0%") or (side == "≥" and text == "100%"):
         return text
-    return f"{side} {text}"
+    percent = 100 * float(value)
+    scale = 10 ** (math.floor(math.log10(percent)) - 1)  # the second significant figure's place
+    steps = percent / scale
+    steps = math.floor(steps + 1e-9) if side == "≥" else math.ceil(steps - 1e-9)
+    shown = float(f"{steps * scale:.10g}")
+    if side == "≥" and shown >= 99 and float(value) > 0.99:
+        return "> 99%"  # as ``probability`` prints a share just below all
+    return f"{side} {shown:g}%" if shown < 10 else f"{side} {shown:.0f}%"
 
 
 def intensity(value, unit: str) -> str:
