@@ -2,10 +2,13 @@
 
 Input : the fragility dataset (``rockfrag.fragility.fragility_dataset``: ``median`` and ``beta`` per
         soil x block x model x damage state, the row's ``status``, the block's studied range, the intensity
-        measure and unit in its attributes; optional ``beta_model``) and the study's Sa period [s].
+        measure and unit in its attributes; for rows ``censored-at-cap`` also ``intensity``, ``credible_max``,
+        ``empirical_fraction`` and ``probability_at_cap`` with its bounds; optional ``beta_model``) and the
+        study's Sa period [s].
 Output: ``fragility_pelicun.csv``, pelicun 3.x damage-model parameters (``pelicun_table``), and
-        ``fragility_openquake.xml``, an OpenQuake NRML 0.5 ``fragilityModel`` of continuous lognormal
-        functions (``openquake_model``); ``write_exchange_files`` writes both beside ``fragility.csv``.
+        ``fragility_openquake.xml``, an OpenQuake NRML 0.5 ``fragilityModel`` (``openquake_model``) of
+        continuous lognormal functions and, for a cell with a censored row, a discrete one;
+        ``write_exchange_files`` writes both beside ``fragility.csv``.
 
 One pelicun component and one OpenQuake fragility function per block x soil x model, with the same ID
 (``pelicun_id``), rows of the model "recommended" first; one limit state per damage state, in order of
@@ -21,11 +24,31 @@ a second component, ``ID.SLIP``, and its functions go to ``fragility_openquake_s
   ``deterministic``; OpenQuake has no step in its continuous format, so a lognormal with ``STEP_BETA``;
 - ``below-range`` (most records reached the state already at the lowest level studied, so no median):
   reached from the lowest level studied on (a step there);
+- ``censored-at-cap`` (the fitted median lies above the credible cap, so no median; some records reached
+  the state at the levels studied): the records' fractions (``empirical_fraction``) at the levels at or
+  below the cap, linear between levels (both consumers interpolate so), 0 below the lowest level (a rise over
+  ``STEP_WIDTH`` below it where records reached the state there), and **held at the probability at the cap
+  above it**: an assumption, since no level above the cap is credible; the true probability there is
+  likely higher (``rockfrag.fragility.RISK_BOUND`` bounds it by 1 instead). The value at the cap is
+  ``probability_at_cap``. pelicun: ``multilinear_CDF`` of the capacity, points (level, fraction) and the
+  rest of the probability at the capacity ``inf``; pelicun wants that CDF strictly rising, so where the
+  fraction falls from one level to the next the file keeps the higher earlier value (the running maximum,
+  never below the records), and a level whose fraction repeats the previous one is written ``PELICUN_RISE``
+  higher (at most 14 x 1e-5 over a study's levels); the value at the cap is then ``probability_at_cap``
+  unless the fractions fall there. OpenQuake: the function of the cell becomes ``discrete`` (one format per
+  function; one model may mix them, as OpenQuake's own qa_tests_data/scenario_damage/case_13 does): its
+  IMLs are the study's levels up to the cap, each step's two points, and for each lognormal row points
+  every beta/``DISCRETE_POINTS_PER_BETA`` (at most ``DISCRETE_MAX_SPACING`` in ln) over ``TAIL_SIGMAS``
+  beta either side (OpenQuake interpolates
+  linearly between IMLs: within ``DISCRETE_ERROR`` of the lognormal), the fractions as they are (OpenQuake
+  needs no monotone curve); risklib holds a discrete function at its last IML's value above it
+  (``FragilityFunctionDiscrete``), which is the probability at the cap for the censored row and 1 (to 1e-9)
+  for the others. The comment before the function says so;
 - ``not-reached`` and ``above-range`` (no record, or a few only at the highest level): not reached. pelicun
   leaves the limit state out (empty family and parameters; it skips such a state). It cannot skip the
   first limit state of a component (its capacity anchors the others: an IndexError) nor all of them (a
   KeyError), so a state it needs is written ``deterministic`` with the capacity ``inf``: never reached.
-  OpenQuake needs every limit state of a function: a step at twice ``maxIML``.
+  OpenQuake needs every limit state of a function: a step at twice ``maxIML`` (0 in a discrete function).
 
 A file whose consumer has no such intensity measure (pelicun has no demand type for AvgSa, CAV or a plugin's
 measure without ``pelicun_demand``; OpenQuake no IMT without ``openquake_imt``) cannot carry the rows: they are
@@ -49,6 +72,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy.stats import norm
 
 from rockfrag.damage_states import NOT_APPLICABLE, families_of
 from rockfrag.errors import ConfigError
@@ -79,10 +103,31 @@ starts at 0.005 g would find hundreds of times our annual frequency (docs/guide/
 
 NRML_NAMESPACE = "http://openquake.org/xmlns/nrml/0.5"
 
+STEP_WIDTH = 1e-3
+"""A step in a piecewise-linear curve (pelicun's ``multilinear_CDF``, OpenQuake's discrete format) rises over
+this fraction of its intensity below it: pelicun rewrites the points with 6 significant digits and wants them
+strictly rising, so the two points of a step must differ in the 4th digit."""
+
+PELICUN_RISE = 1e-5
+"""pelicun wants a ``multilinear_CDF`` strictly rising (its points differing by more than 1e-8, after its
+rewrite with 6 significant digits): a level whose records' fraction repeats the previous one's is written this
+much higher (at most 1.4e-4 over 14 levels, against 1/44 between two counts of 44 records)."""
+
+DISCRETE_POINTS_PER_BETA = 12
+DISCRETE_MAX_SPACING = 0.1
+"""In a discrete OpenQuake function, a lognormal row is sampled every beta/12 in ln(intensity), at most every
+0.1, over ``TAIL_SIGMAS`` beta either side of its median; OpenQuake interpolates linearly in the intensity
+between the points (the 0.1: for a wide curve that linear interpolation, not the curve's bend, sets the error)."""
+
+DISCRETE_ERROR = 5e-4
+"""The largest difference between a lognormal and its linear interpolation on those points: measured 4.6e-4
+over beta 0.02-2 (2e5 intensities per curve; ``tests/test_openquake.py`` checks it on every written row)."""
+
 OPENQUAKE_FORMS = {
     "lognormal": "",
     "step": f" (a step: beta {STEP_BETA:g})",
     "from-lowest": " (a step at the lowest level studied)",
+    "censored": "",  # said in full by censored_note
     "not-reached": " (a step at twice maxIML: never reached)",
 }
 """What the XML comment before each function says about a row written as each kind (``KINDS``)."""
@@ -91,6 +136,8 @@ KINDS = {
     "lognormal": "a lognormal fit (median, beta)",
     "step": "a step at the median (beta = 0)",
     "from-lowest": "reached by most records already at the lowest level studied: a step there",
+    "censored": "censored at the credible cap: the records' fractions at the levels up to the cap, held at the "
+                "probability at the cap above it",
     "not-reached": "not reached within the studied range",
 }
 """How a fragility row is written (``written_state``), and what it means."""
@@ -132,7 +179,107 @@ def written_state(median: float, beta: float, status: str, lowest: float) -> Wri
         return WrittenState("lognormal", median, beta) if beta > 0 else WrittenState("step", median, 0.0)
     if status == "below-range":
         return WrittenState("from-lowest", lowest, 0.0)
+    if status == "censored-at-cap":
+        return WrittenState("censored", np.nan, np.nan)
     return WrittenState("not-reached", np.nan, np.nan)
+
+
+@dataclass(frozen=True)
+class CensoredRow:
+    """What the records did for a row ``censored-at-cap``, at the levels at or below the credible cap.
+
+    ``levels`` [the dataset's intensity unit] with a known fraction, ``fractions`` [-] the records' fraction
+    that reached the state at each, ``cap`` the credible cap [intensity unit], ``at_cap`` (``probability_at_cap``,
+    the fraction at the highest of the levels) with its bounds ``low`` and ``high`` and their ``confidence``.
+    """
+
+    levels: np.ndarray
+    fractions: np.ndarray
+    cap: float
+    at_cap: float
+    low: float
+    high: float
+    confidence: str
+
+
+def censored_row(cell: xr.Dataset, state: str) -> CensoredRow:
+    """The records' fractions of one row ``censored-at-cap`` of a cell (``dataset.sel(soil, block, model)``).
+
+    Parameters
+    ----------
+    cell : xarray.Dataset
+        One cell of the fragility dataset, with ``intensity``, ``empirical_fraction``, ``probability_at_cap``
+        (and its bounds) and ``credible_max`` (absent: no cap).
+    state : str
+        The damage state.
+
+    Returns
+    -------
+    CensoredRow
+        The levels at or below the cap with a known fraction, their fractions and the probability at the cap.
+    """
+    cap = float(cell["credible_max"]) if "credible_max" in cell else np.inf
+    levels = np.asarray(cell["intensity"].values, float)
+    fractions = np.asarray(cell["empirical_fraction"].sel(damage_state=state).values, float)
+    keep = (levels <= cap * (1 + 1e-9)) & np.isfinite(fractions)  # the same levels as the fits and the risk
+    bound = cell["probability_at_cap_low"].attrs.get("long_name", "") if "probability_at_cap_low" in cell else ""
+    confidence = re.search(r"\d+(\.\d+)?\s*%", bound)
+    at_cap = {name: float(cell[name].sel(damage_state=state)) if name in cell else np.nan
+              for name in ("probability_at_cap", "probability_at_cap_low", "probability_at_cap_high")}
+    return CensoredRow(levels[keep], fractions[keep], cap, at_cap["probability_at_cap"],
+                       at_cap["probability_at_cap_low"], at_cap["probability_at_cap_high"],
+                       confidence.group(0).replace(" ", "") if confidence else "")
+
+
+def censored_points(row: CensoredRow) -> tuple[np.ndarray, np.ndarray]:
+    """The curve of a censored row as (intensity, probability) points, empty without a known fraction.
+
+    0 below the lowest level (a rise over ``STEP_WIDTH`` below it), the records' fractions at the levels,
+    linear between them; the reader holds the last value (the probability at the cap) above the last point
+    (OpenQuake's discrete format).
+    """
+    if not row.levels.size:
+        return np.array([]), np.array([])
+    return (np.concatenate([[row.levels[0] * (1 - STEP_WIDTH)], row.levels]),
+            np.concatenate([[0.0], row.fractions]))
+
+
+def pelicun_points(row: CensoredRow) -> tuple[np.ndarray, np.ndarray]:
+    """The censored row as the points of pelicun's ``multilinear_CDF`` of the capacity, empty as above.
+
+    From 0 at the last point of ``censored_points`` whose running maximum is 0, strictly rising (the running
+    maximum of the fractions, and ``PELICUN_RISE`` more where it repeats), then 1 at the capacity ``inf``
+    (the probability not reached at the cap is never reached above it); 1 at the last level instead if the
+    fractions reach 1 there.
+    """
+    x, y = censored_points(row)
+    if not x.size:
+        return np.array([]), np.array([])
+    y = np.maximum.accumulate(y)
+    start = int(np.flatnonzero(y == 0)[-1])
+    points_x, points_y = [x[start]], [0.0]
+    for level, fraction in zip(x[start + 1:], y[start + 1:]):
+        value = max(fraction, points_y[-1] + PELICUN_RISE)
+        if value >= 1 - 10 * PELICUN_RISE:  # certain from here on: the CDF ends at this level
+            points_x.append(level)
+            points_y.append(1.0)
+            break
+        points_x.append(level)
+        points_y.append(value)
+    if points_y[-1] < 1:
+        points_x.append(np.inf)
+        points_y.append(1.0)
+    return np.array(points_x), np.array(points_y)
+
+
+def censored_note(row: CensoredRow, unit: str, written: str) -> str:
+    """What a censored row is, for the comments of both files: never "not reached"."""
+    cap_level = f"{row.levels[-1]:.4g} {unit}" if row.levels.size else "the cap"
+    interval = (f" ({row.confidence} interval {100 * row.low:.0f}-{100 * row.high:.0f} %)"
+                if np.isfinite(row.low) and np.isfinite(row.high) else "")
+    return (f"censored at the credible cap {row.cap:.4g} {unit} (median above it): reached by "
+            f"{100 * row.at_cap:.0f} % of the records at {cap_level}{interval}; written as {written}, held at "
+            f"{100 * row.at_cap:.0f} % above {cap_level} (assumed: no level above the cap is credible)")
 
 
 def pelicun_id(block: str, soil: str, model: str) -> str:
@@ -261,6 +408,25 @@ def _cell_notes(cell: xr.Dataset, state: str) -> str:
 
 # ---------------------------------------------------------------- pelicun damage-model parameters
 
+def _pelicun_censored(dataset: xr.Dataset, measure: Measure | None, cell: xr.Dataset, state: str, unit: str,
+                      note: str) -> tuple[str, float | str, str]:
+    """The pelicun family, Theta_0 and comment of a row ``censored-at-cap`` (``pelicun_points``)."""
+    row = censored_row(cell, state)
+    x, y = pelicun_points(row)
+    if not x.size:  # no record's outcome known at a credible level (a fit needs some: not seen)
+        return "deterministic", np.inf, note + (", censored at the credible cap, no record's fraction known "
+                                                "below it: written with the capacity inf")
+    x = _consumer_values(dataset, measure, x)
+    theta_0 = ",".join(f"{v:.8g}" for v in x) + "|" + ",".join(f"{v:.8g}" for v in y)
+    note += ", " + censored_note(row, unit, "a multilinear_CDF through the records' fractions up to the cap, "
+                                            "the rest at the capacity inf")
+    held = y[-2] if np.isinf(x[-1]) else 1.0
+    if abs(held - row.at_cap) > 10 * PELICUN_RISE:
+        note += (f"; the fractions fall before the cap, and pelicun's curve must rise: it keeps the earlier "
+                 f"{100 * held:.0f} % there")
+    return "multilinear_CDF", theta_0, note
+
+
 def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFrame:
     """The pelicun damage-model table: one component per block x soil x model, LS1..LSn the damage states.
 
@@ -321,7 +487,9 @@ def pelicun_table(dataset: xr.Dataset, period: float | None = None) -> pd.DataFr
                                         "from-lowest": ("deterministic", median, np.nan)}.get(
                 form.kind, ("", np.nan, np.nan))
             note = f"LS{level} {state}: {_cell_notes(cell, state)}"
-            if form.kind == "from-lowest":
+            if form.kind == "censored":
+                family, theta_0, note = _pelicun_censored(dataset, measure, cell, state, unit, note)
+            elif form.kind == "from-lowest":
                 note += f", written as reached from the lowest level studied ({low:.4g} {unit})"
             elif form.kind == "not-reached" and level - 1 <= last:  # pelicun needs it: never reached
                 family, theta_0 = "deterministic", np.inf
@@ -460,7 +628,11 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None,
         f"level; a state not reached within the studied range is a step at twice maxIML (never reached). "
         f"OpenQuake holds a function at its value at minIML (maxIML) below (above) them, so they are set "
         f"{TAIL_SIGMAS:g} beta beyond every curve and the studied range; the comment before each function gives "
-        f"the studied range." + (f" Limit states renamed: {renamed}." if renamed else ""))
+        f"the studied range. A state censored at the credible cap (its fitted median above the cap) is the "
+        f"records' fractions at the levels studied up to the cap, held at the probability at the cap above it "
+        f"(an assumption: no level above the cap is credible); a function with such a state is discrete (P at its "
+        f"IMLs, linear between them), its other states sampled on its IMLs." +
+        (f" Limit states renamed: {renamed}." if renamed else ""))
     ElementTree.SubElement(model, "limitStates").text = " ".join(limit_states)
     for soil, block, model_name in cells:
         cell = dataset.sel(soil=soil, block=block, model=model_name)
@@ -469,6 +641,12 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None,
         forms = [written_state(float(cell["median"].sel(damage_state=s)), float(cell["beta"].sel(damage_state=s)),
                                str(cell["status"].sel(damage_state=s).values), float(cell.studied_im_min))
                  for s in states]
+        component = pelicun_id(block, soil, model_name) + family
+        if any(form.kind == "censored" for form in forms):
+            _discrete_function(model, dataset, measure, cell, states, forms, component, imt, unit,
+                               f" {component}: {block} on {soil}, model {model_name}; studied range {low:.4g}-"
+                               f"{high:.4g} {unit}; ")
+            continue
         curves = [(float(_consumer_values(dataset, measure, f.median)) / measure.openquake_factor,
                    f.beta if f.kind == "lognormal" else STEP_BETA) for f in forms]
         spans = [(m * np.exp(-TAIL_SIGMAS * b), m * np.exp(TAIL_SIGMAS * b)) for m, b in curves if np.isfinite(m)]
@@ -477,12 +655,13 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None,
         curves = [(m, b) if np.isfinite(m) else (2 * max_iml, STEP_BETA) for m, b in curves]
         notes = [f"{s}: {_cell_notes(cell, s)}{OPENQUAKE_FORMS[form.kind]}" for s, form in zip(states, forms)]
         model.append(ElementTree.Comment(
-            f" {pelicun_id(block, soil, model_name) + family}: {block} on {soil}, model {model_name}; studied range "
+            f" {component}: {block} on {soil}, model {model_name}; studied range "
             f"{low:.4g}-{high:.4g} {unit}; " + "; ".join(notes) + " "))
         function = ElementTree.SubElement(model, "fragilityFunction", {
-            "id": pelicun_id(block, soil, model_name) + family, "format": "continuous", "shape": "logncdf"})
-        ElementTree.SubElement(function, "imls", {"imt": imt, "minIML": f"{min_iml:.10g}",
-                                                  "maxIML": f"{max_iml:.10g}"})
+            "id": component, "format": "continuous", "shape": "logncdf"})
+        # 1e-9 outward: the 10 digits written must not round the studied range's ends inside it
+        ElementTree.SubElement(function, "imls", {"imt": imt, "minIML": f"{min_iml * (1 - 1e-9):.10g}",
+                                                  "maxIML": f"{max_iml * (1 + 1e-9):.10g}"})
         for limit_state, (median, beta) in zip(limit_states, curves):
             mean, stddev = openquake_mean_stddev(median, beta)
             ElementTree.SubElement(function, "params", {"ls": limit_state, "mean": f"{mean:.10g}",
@@ -490,6 +669,87 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None,
     tree = ElementTree.ElementTree(root)
     ElementTree.indent(tree, space="  ")
     return tree
+
+
+def discrete_curves(forms: list[WrittenState], censored: dict[int, tuple[np.ndarray, np.ndarray]],
+                    studied: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """A function's limit states on one grid of intensities, for OpenQuake's discrete format.
+
+    The rules: the module docstring.
+
+    Parameters
+    ----------
+    forms : list of WrittenState
+        How each row is written, medians in OpenQuake's unit.
+    censored : dict
+        Row index -> (intensities, probabilities) of each ``censored`` row (``censored_points``, in OpenQuake's
+        unit).
+    studied : tuple of float
+        The studied range (lowest, highest level) in OpenQuake's unit: always on the grid.
+
+    Returns
+    -------
+    imls : numpy.ndarray
+        The grid, strictly rising and distinct at 10 significant digits (as the file writes them).
+    poes : numpy.ndarray
+        (row, iml) P(reaching the row's state | iml).
+    """
+    points = [np.asarray(studied, float)]
+    for k, form in enumerate(forms):
+        if form.kind == "lognormal":
+            step = min(form.beta / DISCRETE_POINTS_PER_BETA, DISCRETE_MAX_SPACING)
+            offsets = np.arange(-TAIL_SIGMAS * form.beta, TAIL_SIGMAS * form.beta + step / 2, step)
+            points.append(form.median * np.exp(offsets))
+        elif form.kind in ("step", "from-lowest"):
+            points.append(form.median * np.array([1 - STEP_WIDTH, 1.0]))
+        elif k in censored:
+            points.append(censored[k][0])
+    imls = np.unique(np.array([float(f"{v:.10g}") for v in np.concatenate(points) if np.isfinite(v) and v > 0]))
+    poes = np.zeros((len(forms), imls.size))
+    for k, form in enumerate(forms):
+        if form.kind == "lognormal":
+            poes[k] = norm.cdf(np.log(imls / form.median) / form.beta)
+        elif form.kind in ("step", "from-lowest"):
+            poes[k] = np.interp(imls, form.median * np.array([1 - STEP_WIDTH, 1.0]), [0.0, 1.0])
+        elif k in censored and censored[k][0].size:
+            x, y = censored[k]
+            poes[k] = np.interp(imls, x, y, left=0.0, right=y[-1])  # held at the probability at the cap above
+    return imls, poes
+
+
+def _discrete_function(model: ElementTree.Element, dataset: xr.Dataset, measure: Measure, cell: xr.Dataset,
+                       states: list[str], forms: list[WrittenState], component: str, imt: str, unit: str,
+                       heading: str) -> None:
+    """Append to ``model`` the discrete function of a cell with a censored row (``discrete_curves``)."""
+    def oq(values):  # the dataset's intensities -> OpenQuake's unit
+        return np.asarray(_consumer_values(dataset, measure, values), float) / measure.openquake_factor
+
+    forms = [WrittenState(f.kind, float(oq(f.median)), f.beta) for f in forms]
+    rows = {k: censored_row(cell, s) for k, (s, f) in enumerate(zip(states, forms)) if f.kind == "censored"}
+    censored = {k: (oq(x), y) for k, (x, y) in ((k, censored_points(r)) for k, r in rows.items())}
+    imls, poes = discrete_curves(forms, censored, (float(oq(cell.studied_im_min)), float(oq(cell.studied_im_max))))
+    data_unit = intensity_unit_label(dataset)
+    discrete_forms = {"lognormal": f" (the lognormal at IMLs every beta/{DISCRETE_POINTS_PER_BETA} over "
+                                   f"{TAIL_SIGMAS:g} beta either side: within {DISCRETE_ERROR:g} of it between them)",
+                      "step": " (a step)", "from-lowest": " (a step at the lowest level studied)",
+                      "not-reached": " (0 at every IML: not reached)"}
+    notes = []
+    for k, (state, form) in enumerate(zip(states, forms)):
+        note = f"{state}: {_cell_notes(cell, state)}"
+        if form.kind == "censored":
+            note += ", " + censored_note(rows[k], data_unit, "the records' fractions up to the cap, linear between "
+                                         "levels, 0 below the lowest")
+        else:
+            note += discrete_forms[form.kind]
+        notes.append(note)
+    model.append(ElementTree.Comment(
+        heading + "discrete: P(limit state) at the IMLs, linear between them (OpenQuake's interpolation), held at "
+        "the last IML's value above it (risklib's FragilityFunctionDiscrete); " + "; ".join(notes) + " "))
+    function = ElementTree.SubElement(model, "fragilityFunction", {"id": component, "format": "discrete"})
+    ElementTree.SubElement(function, "imls", {"imt": imt}).text = " ".join(f"{v:.10g}" for v in imls)
+    for state, row in zip(states, poes):
+        ElementTree.SubElement(function, "poes", {"ls": openquake_limit_state(state)}).text = " ".join(
+            f"{v:.8g}" for v in row)
 
 
 def write_openquake(dataset: xr.Dataset, path: str | Path, period: float | None = None, family: str = "") -> bool:

@@ -8,11 +8,13 @@ main environment, and tests/consumers/pelicun_damage.py computes the damage stat
 Python. `make test` requires the environment; elsewhere those tests are skipped when it is not built.
 
 The expected P(DS >= k) is the documented way each row is written (pipeline/exchange.py): a lognormal, a step at
-the median (beta = 0), a step at the lowest level studied (below-range), or never (not reached), evaluated with
-scipy here. pelicun samples the capacities of a component's limit states perfectly correlated and reports the
-most severe state exceeded, so P(DS >= k) is the largest of our curves k..n (the curves may cross in a tail
-outside the data). The demand is held at each level over all realizations, so pelicun's Latin hypercube
-capacities give the probability to within one over the sample size: the 0.01 tolerance is not Monte-Carlo noise.
+the median (beta = 0), a step at the lowest level studied (below-range), the records' fractions up to the credible
+cap held above it (censored-at-cap; pelicun: their running maximum), or never (not reached), evaluated here from
+the dataset with scipy and numpy. pelicun samples the capacities of a component's limit states perfectly
+correlated and reports the most severe state exceeded, so P(DS >= k) is the largest of our curves k..n (the
+curves may cross in a tail outside the data). The demand is held at each level over all realizations, so
+pelicun's Latin hypercube capacities give the probability to within one over the sample size: the 0.01
+tolerance is not Monte-Carlo noise.
 """
 
 from __future__ import annotations
@@ -42,24 +44,34 @@ STATES = ["uplift", "rocking-0.2", "rocking-0.5", "overturning"]
 NAN = (np.nan, np.nan)
 ROWS = {  # (block, model): (median [g], beta, status) per damage state, every way a row can be written
     ("b-1", "ssi"): [(0.2, 0.0, "deterministic-threshold"), (0.4, 0.35, "fitted"), (0.6, 0.4, "fitted"),
-                     (0.9, 0.45, "fitted")],
+                     (*NAN, "censored-at-cap")],
     ("b-1", RECOMMENDED): [(*NAN, "below-range"), (0.3, 0.5, "fitted"), (0.5, 0.45, "fitted"),
                                  (0.8, 0.5, "fitted")],
     ("b-1", "winkler"): [(0.1, 0.3, "fitted"), (0.45, 0.0, "separated"), (*NAN, "above-range"),
                          (*NAN, "not-reached")],
-    ("stocky", "ssi"): [(5.0, 0.0, "deterministic-threshold"), *[(*NAN, "not-reached")] * 3],
+    ("stocky", "ssi"): [(5.0, 0.0, "deterministic-threshold"), (*NAN, "censored-at-cap"), (*NAN, "censored-at-cap"),
+                        (*NAN, "not-reached")],
     ("stocky", RECOMMENDED): [(*NAN, "not-reached")] * 4,
     ("stocky", "winkler"): [(2.5, 0.3, "extrapolated"), (*NAN, "not-reached"), (*NAN, "not-reached"),
                             (3.5, 0.35, "extrapolated")],  # states that do not nest (a study's own states could)
 }
-STUDIED = {"b-1": (0.05, 3.0), "stocky": (0.1, 4.0)}  # studied range of each block [g]
+STUDIED = {"b-1": (0.05, 3.0), "stocky": (0.1, 4.0)}  # studied range of each block [g], the top at the credible cap
+LEVELS = {block: np.append(np.geomspace(low, high, 8), 1.3 * high) for block, (low, high) in STUDIED.items()}
+"""The intensity levels of each block [g]: 8 up to the credible cap, one above it (not credible: never written)."""
+CENSORED = {  # the records' fraction at each level of the rows censored-at-cap (the same on both soils)
+    ("b-1", "ssi", "overturning"): [0, 0, 0, 0, 0.05, 0.1, 0.1, 0.2, 0.95],  # a flat stretch: pelicun must rise
+    ("stocky", "ssi", "rocking-0.2"): [0.1, 0.1, 0.2, 0.35, 0.3, 0.4, 0.45, 0.4, 0.9],  # reached at the lowest
+    # level, falling twice (at the cap too: pelicun's rising curve keeps 0.45 there)
+    ("stocky", "ssi", "rocking-0.5"): [0, 0, 0, 0, 0, 0, 0.05, 0.1, 0.9],
+}
 SOIL_FACTOR = {"sand": 1.0, "rock": 1.2}  # rock: the fitted medians 20% higher
 
 
 def exchange_dataset() -> xr.Dataset:
-    """A fragility dataset with a row of every kind: lognormal, step, below-range, above-range, not reached
-    (as the first state, after others, between others, and in every state of a cell). The model "recommended"
-    is not first in the model coordinate; ``beta_model`` is there (the files carry it in comments only)."""
+    """A fragility dataset with a row of every kind: lognormal, step, below-range, above-range, censored at the
+    credible cap (beside a step and lognormals, and beside a step and a state not reached), not reached (as the
+    first state, after others, between others, and in every state of a cell). The model "recommended" is not
+    first in the model coordinate; ``beta_model`` is there (the files carry it in comments only)."""
     soils, blocks, models = list(SOIL_FACTOR), list(STUDIED), ["ssi", RECOMMENDED, "winkler"]
     shape = (len(soils), len(blocks), len(models), len(STATES))
     median, beta = np.full(shape, np.nan), np.full(shape, np.nan)
@@ -70,18 +82,42 @@ def exchange_dataset() -> xr.Dataset:
             factor = SOIL_FACTOR[soil] if row_beta > 0 else 1.0  # steps (g tan alpha) do not depend on the soil
             median[s, b, m, k], beta[s, b, m, k], status[s, b, m, k] = row_median * factor, row_beta, row_status
     dims = ("soil", "block", "model", "damage_state")
+    fraction = np.full((LEVELS[blocks[0]].size, *shape), np.nan)
+    for (block, model, state), fractions in CENSORED.items():
+        fraction[:, :, blocks.index(block), models.index(model), STATES.index(state)] = np.array(fractions)[:, None]
+    at_cap = fraction[-2]  # the highest level at or below the cap
     g = {"units": "9.80665 m s-2"}
     return xr.Dataset(
         {"median": (dims, median, g), "beta": (dims, beta), "status": (dims, status.astype(str)),
          "beta_model": (dims, np.where(beta > 0, 0.2, np.nan)),
          "studied_im_min": ("block", [STUDIED[b][0] for b in blocks], g),
-         "studied_im_max": ("block", [STUDIED[b][1] for b in blocks], g)},
+         "studied_im_max": ("block", [STUDIED[b][1] for b in blocks], g),
+         "credible_max": ("block", [STUDIED[b][1] for b in blocks], g),
+         "intensity": (("block", "im_level"), [LEVELS[b] for b in blocks], g),
+         "empirical_fraction": (("im_level", *dims), fraction),
+         "probability_at_cap": (dims, at_cap),
+         "probability_at_cap_low": (dims, np.clip(at_cap - 0.1, 0, 1),
+                                    {"long_name": "lower 90% Clopper-Pearson bound of probability_at_cap"}),
+         "probability_at_cap_high": (dims, np.clip(at_cap + 0.1, 0, 1))},
         coords={"soil": soils, "block": blocks, "model": models, "damage_state": STATES},
         attrs={"intensity_measure": "pga", "intensity_unit": "9.80665 m s-2", "intensity_unit_label": "g"})
 
 
-def our_curves(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
-    """P(state k | demand) of one cell as the exchange files write it (pipeline/exchange.py): (k, demand)."""
+def censored_curve(cell: xr.Dataset, state: str, demand: np.ndarray, rising: bool = False) -> np.ndarray:
+    """P(state | demand) of a row censored at the credible cap as the files write it: the records' fractions at
+    the levels up to the cap, linear between them, 0 below the lowest level and the fraction at the cap above it
+    (``rising``: their running maximum, pelicun's curve)."""
+    levels = cell.intensity.values
+    keep = levels <= float(cell.credible_max) * (1 + 1e-9)
+    fractions = cell.empirical_fraction.sel(damage_state=state).values[keep]
+    if rising:
+        fractions = np.maximum.accumulate(fractions)
+    return np.where(demand < levels[0], 0.0, np.interp(demand, levels[keep], fractions))
+
+
+def our_curves(cell: xr.Dataset, demand: np.ndarray, rising: bool = False) -> np.ndarray:
+    """P(state k | demand) of one cell as the exchange files write it (pipeline/exchange.py): (k, demand);
+    ``rising``: a censored row as pelicun's rising curve."""
     curves = []
     for state in cell.damage_state.values:
         median, beta = float(cell["median"].sel(damage_state=state)), float(cell.beta.sel(damage_state=state))
@@ -92,6 +128,8 @@ def our_curves(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
             curves.append((demand >= median).astype(float))
         elif status == "below-range":
             curves.append((demand >= float(cell.studied_im_min)).astype(float))
+        elif status == "censored-at-cap":
+            curves.append(censored_curve(cell, state, demand, rising))
         else:
             curves.append(np.zeros_like(demand))
     return np.array(curves)
@@ -99,7 +137,7 @@ def our_curves(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
 
 def pelicun_expected(cell: xr.Dataset, demand: np.ndarray) -> np.ndarray:
     """P(DS >= k | demand) in pelicun: the most severe state exceeded, capacities perfectly correlated: (demand, k)."""
-    curves = our_curves(cell, demand)
+    curves = our_curves(cell, demand, rising=True)
     return np.maximum.accumulate(curves[::-1], axis=0)[::-1].T
 
 
@@ -185,6 +223,51 @@ def test_every_row_is_written_as_documented():
     assert "LS4 overturning: not-reached, left out" in trailing["Comment"]
     middle = table.loc["ROCK.stocky.sand.winkler"]  # a state left out before a written one would renumber pelicun's
     assert [middle[f"LS{k}-Theta_0"] for k in (2, 3)] == [np.inf, np.inf]  # damage states: never reached instead
+
+
+def multilinear(theta_0: str) -> tuple[np.ndarray, np.ndarray]:
+    """The points of a ``multilinear_CDF`` Theta_0 ("x1,...,xn|y1,...,yn") as pelicun splits them."""
+    xs, ys = theta_0.split("|")
+    return np.array(xs.split(","), float), np.array(ys.split(","), float)
+
+
+def test_a_row_censored_at_the_cap_is_written_as_what_the_records_did():
+    """A censored row is a multilinear_CDF that pelicun accepts (y from 0 to 1, x and y strictly rising by more
+    than its 1e-8, 1 at the capacity inf), through the records' fractions at the credible levels and never the
+    one above the cap; its value at the cap is probability_at_cap (the running maximum where the fractions fall
+    there); its comment says what it is, never "not reached"."""
+    dataset = exchange_dataset()
+    table = pelicun_table(dataset).set_index("ID")
+    checked = 0
+    for soil in dataset.soil.values:
+        for block, model, state in CENSORED:
+            cell = dataset.sel(soil=soil, block=block, model=model)
+            row = table.loc[pelicun_id(block, soil, model)]
+            k = STATES.index(state) + 1
+            assert row[f"LS{k}-Family"] == "multilinear_CDF"
+            x, y = multilinear(row[f"LS{k}-Theta_0"])
+            assert y[0] == 0 and y[-1] == 1 and x[-1] == np.inf and pd.isna(row[f"LS{k}-Theta_1"])
+            assert (np.diff(x) > 1e-8).all() and (np.diff(y) > 1e-8).all()
+            # what pelicun's rewrite with 6 significant digits keeps strictly rising too
+            assert all((np.diff([float(f"{v:g}") for v in values]) > 0).all() for values in (x, y))
+            cap = float(cell.studied_im_max)
+            fractions = np.array(CENSORED[block, model, state][:-1])
+            at_cap = float(cell.probability_at_cap.sel(damage_state=state))
+            assert at_cap == fractions[-1]
+            value = np.interp(cap, x, y)
+            assert value == pytest.approx(np.maximum.accumulate(fractions)[-1], abs=2e-4)
+            if fractions[-1] == fractions.max():
+                assert value == pytest.approx(at_cap, abs=2e-4)  # 0.2 and 0.1 here: the file's value at the cap
+            assert np.interp(100 * cap, x, y) == value  # held above the cap (the rest at the capacity inf)
+            levels = LEVELS[block][:-1]
+            np.testing.assert_allclose(np.interp(levels, x, y), np.maximum.accumulate(fractions), atol=2e-4)
+            note = row["Comment"].split(f"LS{k} {state}:")[1].split("; LS")[0]
+            assert "not reached" not in note and "never reached" not in note
+            assert f"reached by {100 * at_cap:.0f} % of the records at {cap:.4g} g" in note, note
+            checked += 1
+    assert checked == 6
+    falling = table.loc["ROCK.stocky.sand.ssi", "Comment"]
+    assert "pelicun's curve must rise: it keeps the earlier 45 % there" in falling
 
 
 @ROUND_TRIP

@@ -9,7 +9,8 @@ in this process). Reads each
 FOLDER/fragility_openquake.xml and FOLDER/query.json
 ({"levels": [intensity...], "hazard": {"imls": [...], "poes": [...], "investigation_time": years,
 "risk_investigation_time": years}}). Writes FOLDER/openquake.json: the model's id, categories and limit states,
-and per function (in the file's order) its id, IMT, format, minIML, maxIML, the (mean, stddev) per limit state,
+and per function (in the file's order) its id, IMT, format, minIML, maxIML, the (mean, stddev) per limit state
+(a continuous function) or its IMLs and the table of P per limit state and IML as read (a discrete one),
 P(limit state | level) from ``FragilityFunctionList.build`` and, from ``scientific.classical_damage``, the
 probability of reaching each limit state in the risk investigation time. Imports openquake, never pipeline.
 """
@@ -40,10 +41,14 @@ def read(folder: Path) -> dict:
         levels = np.array(query["levels"], float)
         poos = scientific.classical_damage(built, np.array(hazard["imls"], float), np.array(hazard["poes"], float),
                                            hazard["investigation_time"], hazard["risk_investigation_time"])
+        continuous = functions_list.format == "continuous"  # else discrete: poes at its imls
         functions.append({
             "id": function_id, "imt": imt, "format": functions_list.format,
-            "minIML": functions_list.minIML, "maxIML": functions_list.maxIML,
-            "mean": functions_list.array[:, 0].tolist(), "stddev": functions_list.array[:, 1].tolist(),
+            "minIML": getattr(functions_list, "minIML", None), "maxIML": getattr(functions_list, "maxIML", None),
+            "mean": functions_list.array[:, 0].tolist() if continuous else None,
+            "stddev": functions_list.array[:, 1].tolist() if continuous else None,
+            "imls": None if continuous else list(functions_list.imls),
+            "table": None if continuous else functions_list.array.tolist(),
             "poes": [function(levels).tolist() for function in built],
             "in_life": (1 - np.cumsum(poos)[:-1]).tolist(),  # P(reaching limit state k) from P(damage state k)
         })
