@@ -2,12 +2,12 @@
 
 Input : the fragility dataset (``rockfrag.fragility.fragility_dataset``: ``median`` and ``beta`` per
         soil x block x model x damage state, the row's ``status``, the block's studied range, the intensity
-        measure and unit in its attributes; for rows ``censored-at-cap`` also ``intensity``, ``credible_max``,
-        ``empirical_fraction`` and ``probability_at_cap`` with its bounds; optional ``beta_model``) and the
-        study's Sa period [s].
+        measure and unit in its attributes; for rows ``censored-at-cap`` and ``above-range`` also
+        ``intensity``, ``credible_max``, ``empirical_fraction`` and ``probability_at_cap`` with its bounds;
+        optional ``beta_model``) and the study's Sa period [s].
 Output: ``fragility_pelicun.csv``, pelicun 3.x damage-model parameters (``pelicun_table``), and
         ``fragility_openquake.xml``, an OpenQuake NRML 0.5 ``fragilityModel`` (``openquake_model``) of
-        continuous lognormal functions and, for a cell with a censored row, a discrete one;
+        continuous lognormal functions and, for a cell with a row of records' fractions, a discrete one;
         ``write_exchange_files`` writes both beside ``fragility.csv``.
 
 One pelicun component and one OpenQuake fragility function per block x soil x model, with the same ID
@@ -24,27 +24,27 @@ a second component, ``ID.SLIP``, and its functions go to ``fragility_openquake_s
   ``deterministic``; OpenQuake has no step in its continuous format, so a lognormal with ``STEP_BETA``;
 - ``below-range`` (most records reached the state already at the lowest level studied, so no median):
   reached from the lowest level studied on (a step there);
-- ``censored-at-cap`` (the fitted median lies above the credible cap, so no median; some records reached
-  the state at the levels studied): the records' fractions (``empirical_fraction``) at the levels at or
-  below the cap, linear between levels (both consumers interpolate so), 0 below the lowest level (a rise over
-  ``STEP_WIDTH`` below it where records reached the state there), and **held at the probability at the cap
-  above it**: an assumption, since no level above the cap is credible; the true probability there is
-  likely higher (``rockfrag.fragility.RISK_BOUND`` bounds it by 1 instead). The value at the cap is
-  ``probability_at_cap``. pelicun: ``multilinear_CDF`` of the capacity, points (level, fraction) and the
-  rest of the probability at the capacity ``inf``; pelicun wants that CDF strictly rising, so where the
-  fraction falls from one level to the next the file keeps the higher earlier value (the running maximum,
-  never below the records), and a level whose fraction repeats the previous one is written ``PELICUN_RISE``
-  higher (at most 14 x 1e-5 over a study's levels); the value at the cap is then ``probability_at_cap``
-  unless the fractions fall there. OpenQuake: the function of the cell becomes ``discrete`` (one format per
-  function; one model may mix them, as OpenQuake's own qa_tests_data/scenario_damage/case_13 does): its
-  IMLs are the study's levels up to the cap, each step's two points, and for each lognormal row points
-  every beta/``DISCRETE_POINTS_PER_BETA`` (at most ``DISCRETE_MAX_SPACING`` in ln) over ``TAIL_SIGMAS``
-  beta either side (OpenQuake interpolates
-  linearly between IMLs: within ``DISCRETE_ERROR`` of the lognormal), the fractions as they are (OpenQuake
-  needs no monotone curve); risklib holds a discrete function at its last IML's value above it
+- ``censored-at-cap`` (the fitted median lies above the credible cap, so no median; some records reached the
+  state at the levels studied) and ``above-range`` (a few records reached it, only at the highest level
+  studied): the records' fractions (``empirical_fraction``) at the levels at or below the cap, linear between
+  levels (both consumers interpolate so), 0 below the lowest level (a rise over ``STEP_WIDTH`` below it where
+  records reached the state there), and **held at the probability at the cap above it**: an assumption, since
+  no level above the cap is credible; the true probability there is likely higher
+  (``rockfrag.fragility.RISK_BOUND`` bounds it by 1 instead). The value at the cap is ``probability_at_cap``.
+  pelicun: ``multilinear_CDF`` of the capacity, points (level, fraction) and the rest of the probability at
+  the capacity ``inf``; pelicun wants that CDF strictly rising, so where the fraction falls from one level to
+  the next the file keeps the higher earlier value (the running maximum, never below the records), and a level
+  whose fraction repeats the previous one is written ``PELICUN_RISE`` higher (at most 14 x 1e-5 over a study's
+  levels); the value at the cap is then ``probability_at_cap`` unless the fractions fall there. OpenQuake: the
+  function of the cell becomes ``discrete`` (one format per function; one model may mix them, as OpenQuake's
+  own qa_tests_data/scenario_damage/case_13 does): its IMLs are the study's levels up to the cap, each step's
+  two points, and for each lognormal row points every beta/``DISCRETE_POINTS_PER_BETA`` (at most
+  ``DISCRETE_MAX_SPACING`` in ln) over ``TAIL_SIGMAS`` beta either side (OpenQuake interpolates linearly
+  between IMLs: within ``DISCRETE_ERROR`` of the lognormal), the fractions as they are (OpenQuake needs no
+  monotone curve); risklib holds a discrete function at its last IML's value above it
   (``FragilityFunctionDiscrete``), which is the probability at the cap for the censored row and 1 (to 1e-9)
   for the others. The comment before the function says so;
-- ``not-reached`` and ``above-range`` (no record, or a few only at the highest level): not reached. pelicun
+- ``not-reached`` (no record reached the state at any level up to the cap): not reached. pelicun
   leaves the limit state out (empty family and parameters; it skips such a state). It cannot skip the
   first limit state of a component (its capacity anchors the others: an IndexError) nor all of them (a
   KeyError), so a state it needs is written ``deterministic`` with the capacity ``inf``: never reached.
@@ -136,11 +136,19 @@ KINDS = {
     "lognormal": "a lognormal fit (median, beta)",
     "step": "a step at the median (beta = 0)",
     "from-lowest": "reached by most records already at the lowest level studied: a step there",
-    "censored": "censored at the credible cap: the records' fractions at the levels up to the cap, held at the "
-                "probability at the cap above it",
+    "censored": "no median, but reached by some records (censored at the credible cap, or reached only at the "
+                "highest level): the records' fractions at the levels up to the cap, held at the probability at the "
+                "cap above it",
     "not-reached": "not reached within the studied range",
 }
 """How a fragility row is written (``written_state``), and what it means."""
+
+RECORDS_FRACTIONS = {
+    "censored-at-cap": "censored at the credible cap {cap} (median above it)",
+    "above-range": "median above the levels studied (reached only at the highest)",
+}
+"""The statuses of rows without a median that records reached, written as the records' fractions (the kind
+``censored``), and what their comments call them."""
 
 
 @dataclass(frozen=True)
@@ -179,20 +187,22 @@ def written_state(median: float, beta: float, status: str, lowest: float) -> Wri
         return WrittenState("lognormal", median, beta) if beta > 0 else WrittenState("step", median, 0.0)
     if status == "below-range":
         return WrittenState("from-lowest", lowest, 0.0)
-    if status == "censored-at-cap":
+    if status in RECORDS_FRACTIONS:
         return WrittenState("censored", np.nan, np.nan)
     return WrittenState("not-reached", np.nan, np.nan)
 
 
 @dataclass(frozen=True)
 class CensoredRow:
-    """What the records did for a row ``censored-at-cap``, at the levels at or below the credible cap.
+    """What the records did for a row without a median (``RECORDS_FRACTIONS``), at the levels up to the cap.
 
-    ``levels`` [the dataset's intensity unit] with a known fraction, ``fractions`` [-] the records' fraction
-    that reached the state at each, ``cap`` the credible cap [intensity unit], ``at_cap`` (``probability_at_cap``,
-    the fraction at the highest of the levels) with its bounds ``low`` and ``high`` and their ``confidence``.
+    ``status`` the row's, ``levels`` [the dataset's intensity unit] with a known fraction, ``fractions`` [-]
+    the records' fraction that reached the state at each, ``cap`` the credible cap [intensity unit], ``at_cap``
+    (``probability_at_cap``, the fraction at the highest of the levels) with its bounds ``low`` and ``high`` and
+    their ``confidence``.
     """
 
+    status: str
     levels: np.ndarray
     fractions: np.ndarray
     cap: float
@@ -203,7 +213,7 @@ class CensoredRow:
 
 
 def censored_row(cell: xr.Dataset, state: str) -> CensoredRow:
-    """The records' fractions of one row ``censored-at-cap`` of a cell (``dataset.sel(soil, block, model)``).
+    """The records' fractions of one row of a cell (``dataset.sel(soil, block, model)``) without a median.
 
     Parameters
     ----------
@@ -226,9 +236,9 @@ def censored_row(cell: xr.Dataset, state: str) -> CensoredRow:
     confidence = re.search(r"\d+(\.\d+)?\s*%", bound)
     at_cap = {name: float(cell[name].sel(damage_state=state)) if name in cell else np.nan
               for name in ("probability_at_cap", "probability_at_cap_low", "probability_at_cap_high")}
-    return CensoredRow(levels[keep], fractions[keep], cap, at_cap["probability_at_cap"],
-                       at_cap["probability_at_cap_low"], at_cap["probability_at_cap_high"],
-                       confidence.group(0).replace(" ", "") if confidence else "")
+    return CensoredRow(str(cell["status"].sel(damage_state=state).values), levels[keep], fractions[keep], cap,
+                       at_cap["probability_at_cap"], at_cap["probability_at_cap_low"],
+                       at_cap["probability_at_cap_high"], confidence.group(0).replace(" ", "") if confidence else "")
 
 
 def censored_points(row: CensoredRow) -> tuple[np.ndarray, np.ndarray]:
@@ -277,9 +287,10 @@ def censored_note(row: CensoredRow, unit: str, written: str) -> str:
     cap_level = f"{row.levels[-1]:.4g} {unit}" if row.levels.size else "the cap"
     interval = (f" ({row.confidence} interval {100 * row.low:.0f}-{100 * row.high:.0f} %)"
                 if np.isfinite(row.low) and np.isfinite(row.high) else "")
-    return (f"censored at the credible cap {row.cap:.4g} {unit} (median above it): reached by "
-            f"{100 * row.at_cap:.0f} % of the records at {cap_level}{interval}; written as {written}, held at "
-            f"{100 * row.at_cap:.0f} % above {cap_level} (assumed: no level above the cap is credible)")
+    what = RECORDS_FRACTIONS.get(row.status, row.status).format(cap=f"{row.cap:.4g} {unit}")
+    return (f"{what}: reached by {100 * row.at_cap:.0f} % of the records at {cap_level}{interval}; written as "
+            f"{written}, held at {100 * row.at_cap:.0f} % above {cap_level} (assumed: no level above it is "
+            "credible)")
 
 
 def pelicun_id(block: str, soil: str, model: str) -> str:
@@ -410,12 +421,12 @@ def _cell_notes(cell: xr.Dataset, state: str) -> str:
 
 def _pelicun_censored(dataset: xr.Dataset, measure: Measure | None, cell: xr.Dataset, state: str, unit: str,
                       note: str) -> tuple[str, float | str, str]:
-    """The pelicun family, Theta_0 and comment of a row ``censored-at-cap`` (``pelicun_points``)."""
+    """The pelicun family, Theta_0 and comment of a row of the kind ``censored`` (``pelicun_points``)."""
     row = censored_row(cell, state)
     x, y = pelicun_points(row)
     if not x.size:  # no record's outcome known at a credible level (a fit needs some: not seen)
-        return "deterministic", np.inf, note + (", censored at the credible cap, no record's fraction known "
-                                                "below it: written with the capacity inf")
+        return "deterministic", np.inf, note + (", no median and no record's fraction known up to the "
+                                                "cap: written with the capacity inf")
     x = _consumer_values(dataset, measure, x)
     theta_0 = ",".join(f"{v:.8g}" for v in x) + "|" + ",".join(f"{v:.8g}" for v in y)
     note += ", " + censored_note(row, unit, "a multilinear_CDF through the records' fractions up to the cap, "
@@ -628,10 +639,10 @@ def openquake_model(dataset: xr.Dataset, period: float | None = None,
         f"level; a state not reached within the studied range is a step at twice maxIML (never reached). "
         f"OpenQuake holds a function at its value at minIML (maxIML) below (above) them, so they are set "
         f"{TAIL_SIGMAS:g} beta beyond every curve and the studied range; the comment before each function gives "
-        f"the studied range. A state censored at the credible cap (its fitted median above the cap) is the "
-        f"records' fractions at the levels studied up to the cap, held at the probability at the cap above it "
-        f"(an assumption: no level above the cap is credible); a function with such a state is discrete (P at its "
-        f"IMLs, linear between them), its other states sampled on its IMLs." +
+        f"the studied range. A state censored at the credible cap (its fitted median above the cap) or reached "
+        f"only at the highest level studied is the records' fractions at the levels studied up to the cap, held at "
+        f"the probability at the cap above it (an assumption: no level above the cap is credible); a function with "
+        f"such a state is discrete (P at its IMLs, linear between them), its other states sampled on its IMLs." +
         (f" Limit states renamed: {renamed}." if renamed else ""))
     ElementTree.SubElement(model, "limitStates").text = " ".join(limit_states)
     for soil, block, model_name in cells:

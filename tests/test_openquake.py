@@ -39,8 +39,8 @@ from rockfrag.hazard import HazardCurve
 from rockfrag.models.variants import RECOMMENDED
 from rockfrag.risk import annual_frequency, probability_in_life
 from tests.helpers import CONSUMERS, consumer_python
+from tests.test_pelicun import FRACTIONS, censored_curve, exchange_dataset, our_curves, readme_example
 from tests.test_pelicun import LEVELS as LEVELS_OF
-from tests.test_pelicun import censored_curve, exchange_dataset, our_curves, readme_example
 
 LEVELS = np.geomspace(0.001, 100.0, 61)
 """PGA [g] at which OpenQuake evaluates every function: far below and above every studied range."""
@@ -78,16 +78,16 @@ def near_a_step(cell: xr.Dataset, levels: np.ndarray) -> np.ndarray:
     """Levels within 2% of a step of the cell (written as a lognormal with beta 0.001 in OpenQuake's continuous
     format, a rise over 0.1% in its discrete one), or of a censored row's rise at the lowest level."""
     steps = [float(m) for m, b in zip(cell["median"].values, cell.beta.values) if np.isfinite(m) and b == 0]
-    steps += [float(cell.studied_im_min)] if {"below-range", "censored-at-cap"} & set(cell.status.values) else []
+    steps += [float(cell.studied_im_min)] if {"below-range", *FRACTIONS} & set(cell.status.values) else []
     return np.array([any(abs(np.log(level / step)) < 0.02 for step in steps) for level in levels], bool)
 
 
 def check_functions(dataset: xr.Dataset, read: dict) -> None:
     """Every cell has its function, with our limit states, IMT, medians, betas and curves (the rocking states:
-    a sliding cell's slip states are a file of their own); a cell with a row censored at the credible cap is a
-    discrete function: OpenQuake gives the records' fraction at the cap there and above it (held), and the
-    other rows within the discrete format's DISCRETE_ERROR of our curves (the lognormals), or to the 8 digits the file
-    writes."""
+    a sliding cell's slip states are a file of their own); a cell with a row of records' fractions (censored at
+    the credible cap, or above-range: ``FRACTIONS``) is a discrete function: OpenQuake gives the records'
+    fraction at the cap there and above it (held), and the other rows within the discrete format's
+    DISCRETE_ERROR of our curves (the lognormals), or to the 8 digits the file writes."""
     dataset = dataset.sel(damage_state=state_families(dataset)[""])
     assert read["limitStates"] == [openquake_limit_state(s) for s in dataset.damage_state.values]
     cells = {pelicun_id(b, s, m): (s, b, m) for s in dataset.soil.values for b in dataset.block.values
@@ -100,7 +100,7 @@ def check_functions(dataset: xr.Dataset, read: dict) -> None:
     for function in read["functions"]:
         soil, block, model = cells[function["id"]]
         cell = dataset.sel(soil=soil, block=block, model=model)
-        censored = cell.status.values == "censored-at-cap"
+        censored = np.isin(cell.status.values, FRACTIONS)
         assert function["imt"] == "PGA"
         if censored.any():
             assert function["format"] == "discrete"
@@ -132,7 +132,7 @@ def check_discrete(cell: xr.Dataset, function: dict) -> None:
     assert error[~lognormal].max(initial=0) <= 1e-7, function["id"]  # the file: 8 significant digits
     cap = float(cell.studied_im_max)
     imls = np.array(function["imls"])
-    for k in np.flatnonzero(cell.status.values == "censored-at-cap"):
+    for k in np.flatnonzero(np.isin(cell.status.values, FRACTIONS)):
         at_cap = float(cell.probability_at_cap.values[k])
         assert np.isfinite(at_cap)
         table = np.array(function["table"])[k]
@@ -190,7 +190,7 @@ def test_risklib_classical_damage_gives_our_probability_in_the_design_life(round
         for k, state in enumerate(cell.damage_state.values):
             median, beta = float(cell["median"].sel(damage_state=state)), float(cell.beta.sel(damage_state=state))
             step = HAZARD_RATES[0] / HAZARD_RATES[1] - 1
-            if str(cell.status.sel(damage_state=state).values) == "censored-at-cap":
+            if str(cell.status.sel(damage_state=state).values) in FRACTIONS:
                 ours = censored_in_life(cell, state)
                 rises_at_lowest = cell.empirical_fraction.sel(damage_state=state).values[0] > 0
                 tolerance = step if rises_at_lowest else 0.001
@@ -202,7 +202,7 @@ def test_risklib_classical_damage_gives_our_probability_in_the_design_life(round
                 tolerance = 0.001 if beta > 0 else step
             assert function["in_life"][k] == pytest.approx(ours, rel=tolerance), (function["id"], state)
             compared += 1
-    assert compared >= 20 and censored == 6
+    assert compared >= 20 and censored == 8
 
 
 @pytest.mark.slow
@@ -293,7 +293,7 @@ def test_a_row_censored_at_the_cap_is_the_records_fractions_held_above_the_cap(t
     discrete = 0
     for function in root.iterfind(".//nrml:fragilityFunction", NRML):
         cell = cells[function.get("id")]
-        if "censored-at-cap" not in cell.status.values:
+        if not np.isin(cell.status.values, FRACTIONS).any():
             assert function.get("format") == "continuous"
             continue
         discrete += 1
@@ -306,7 +306,7 @@ def test_a_row_censored_at_the_cap_is_the_records_fractions_held_above_the_cap(t
         for state, poes in zip(cell.damage_state.values, function.iterfind("nrml:poes", NRML)):
             poes = np.array(poes.text.split(), float)
             row = cell.sel(damage_state=state)
-            if str(row.status.values) == "censored-at-cap":
+            if str(row.status.values) in FRACTIONS:
                 at_cap = float(row.probability_at_cap)
                 assert poes[imls == cap][0] == pytest.approx(at_cap, abs=1e-8) and poes[-1] == pytest.approx(at_cap)
                 levels = LEVELS_OF[str(cell.block.values)]
@@ -323,7 +323,7 @@ def test_a_row_censored_at_the_cap_is_the_records_fractions_held_above_the_cap(t
             elif np.isfinite(float(row["median"])) and float(row.beta) > 0:
                 exact = norm.cdf(np.log(dense / float(row["median"])) / float(row.beta))
                 assert np.abs(np.interp(dense, imls, poes) - exact).max() <= DISCRETE_ERROR
-    assert discrete == 4
+    assert discrete == 6
 
 
 @pytest.mark.parametrize("beta", [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.8, 1.0, 1.5, 2.0])

@@ -9,7 +9,8 @@ Python. `make test` requires the environment; elsewhere those tests are skipped 
 
 The expected P(DS >= k) is the documented way each row is written (pipeline/exchange.py): a lognormal, a step at
 the median (beta = 0), a step at the lowest level studied (below-range), the records' fractions up to the credible
-cap held above it (censored-at-cap; pelicun: their running maximum), or never (not reached), evaluated here from
+cap held above it (censored-at-cap, above-range; pelicun: their running maximum), or never (not reached),
+evaluated here from
 the dataset with scipy and numpy. pelicun samples the capacities of a component's limit states perfectly
 correlated and reports the most severe state exceeded, so P(DS >= k) is the largest of our curves k..n (the
 curves may cross in a tail outside the data). The demand is held at each level over all realizations, so
@@ -58,11 +59,14 @@ ROWS = {  # (block, model): (median [g], beta, status) per damage state, every w
 STUDIED = {"b-1": (0.05, 3.0), "stocky": (0.1, 4.0)}  # studied range of each block [g], the top at the credible cap
 LEVELS = {block: np.append(np.geomspace(low, high, 8), 1.3 * high) for block, (low, high) in STUDIED.items()}
 """The intensity levels of each block [g]: 8 up to the credible cap, one above it (not credible: never written)."""
-CENSORED = {  # the records' fraction at each level of the rows censored-at-cap (the same on both soils)
+FRACTIONS = ("censored-at-cap", "above-range")
+"""The statuses of rows without a median that records reached: written as the records' fractions."""
+CENSORED = {  # the records' fraction at each level of those rows (the same on both soils)
     ("b-1", "ssi", "overturning"): [0, 0, 0, 0, 0.05, 0.1, 0.1, 0.2, 0.95],  # a flat stretch: pelicun must rise
     ("stocky", "ssi", "rocking-0.2"): [0.1, 0.1, 0.2, 0.35, 0.3, 0.4, 0.45, 0.4, 0.9],  # reached at the lowest
     # level, falling twice (at the cap too: pelicun's rising curve keeps 0.45 there)
     ("stocky", "ssi", "rocking-0.5"): [0, 0, 0, 0, 0, 0, 0.05, 0.1, 0.9],
+    ("b-1", "winkler", "rocking-0.5"): [0, 0, 0, 0, 0, 0, 0, 0.05, 0.6],  # above-range: only at the highest level
 }
 SOIL_FACTOR = {"sand": 1.0, "rock": 1.2}  # rock: the fitted medians 20% higher
 
@@ -128,7 +132,7 @@ def our_curves(cell: xr.Dataset, demand: np.ndarray, rising: bool = False) -> np
             curves.append((demand >= median).astype(float))
         elif status == "below-range":
             curves.append((demand >= float(cell.studied_im_min)).astype(float))
-        elif status == "censored-at-cap":
+        elif status in FRACTIONS:
             curves.append(censored_curve(cell, state, demand, rising))
         else:
             curves.append(np.zeros_like(demand))
@@ -219,8 +223,10 @@ def test_every_row_is_written_as_documented():
     assert all(pd.isna(nothing[f"LS{k}-Theta_0"]) and not nothing[f"LS{k}-Family"] for k in (2, 3, 4))
     trailing = table.loc["ROCK.b_1.rock.winkler"]
     assert trailing["LS2-Family"] == "deterministic" and trailing["LS2-Theta_0"] == 0.45  # separated: the step
-    assert pd.isna(trailing["LS3-Theta_0"]) and pd.isna(trailing["LS4-Theta_0"])  # left out
-    assert "LS4 overturning: not-reached, left out" in trailing["Comment"]
+    assert trailing["LS3-Family"] == "multilinear_CDF"  # above-range: the records' fractions
+    assert "LS3 rocking-0.5: above-range, median above the levels studied (reached only at the highest): reached " \
+           "by 5 % of the records at 3 g" in trailing["Comment"]
+    assert pd.isna(trailing["LS4-Theta_0"]) and "LS4 overturning: not-reached, left out" in trailing["Comment"]
     middle = table.loc["ROCK.stocky.sand.winkler"]  # a state left out before a written one would renumber pelicun's
     assert [middle[f"LS{k}-Theta_0"] for k in (2, 3)] == [np.inf, np.inf]  # damage states: never reached instead
 
@@ -265,7 +271,7 @@ def test_a_row_censored_at_the_cap_is_written_as_what_the_records_did():
             assert "not reached" not in note and "never reached" not in note
             assert f"reached by {100 * at_cap:.0f} % of the records at {cap:.4g} g" in note, note
             checked += 1
-    assert checked == 6
+    assert checked == 8
     falling = table.loc["ROCK.stocky.sand.ssi", "Comment"]
     assert "pelicun's curve must rise: it keeps the earlier 45 % there" in falling
 
