@@ -27,6 +27,7 @@ blocks of one soil and model, where a measure that collapses the blocks onto one
 from __future__ import annotations
 
 import csv
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -206,6 +207,104 @@ def efficiency_dataset(cube: xr.Dataset, records, config, sites=None) -> xr.Data
     dataset.attrs.update({"study_measure": config.measure, "config_hash": cube.attrs.get("config_hash", ""),
                           "capacity_resolution": cube.attrs.get("capacity_resolution", np.nan)})
     return dataset
+
+
+CONFIDENCE = 0.90
+"""Two-sided confidence of the band drawn around a dispersion (a test on few records has a wide one)."""
+
+CELL_RESULTS = ("dispersion", "n_records", "p_magnitude", "p_distance", "p_pulse_period")
+"""The variables whose equality on two soils says the cells are the same runs (one independent test)."""
+
+
+@dataclass(frozen=True)
+class IndependentTest:
+    """One independent efficiency test: the overturning capacities of one block and model on ``soils``.
+
+    A tied rigid base does not feel the soil: its runs, and so its capacities, are the same on every soil where it is
+    tied, and ``efficiency.nc`` repeats one test in each of those cells. ``soils`` lists them (in the file's order);
+    ``records`` is how many records overturned (the capacities the dispersion is taken over) in the study's measure.
+    """
+
+    block: str
+    model: str
+    soils: tuple[str, ...]
+    records: int
+
+
+def independent_tests(dataset: xr.Dataset, measure: str | None = None) -> list[IndependentTest]:
+    """The independent tests of ``efficiency.nc``: each block and model's cells grouped where they are the same runs.
+
+    Cells of one block and model whose results (``CELL_RESULTS`` over every measure, NaN equal to NaN) are identical
+    on several soils are one test, not several: counting a tied rigid base's test on five soils five times would make
+    a median over copies. Only tests with a dispersion (enough overturning records) are returned, the most records
+    first (then block, model, soil order).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        ``efficiency.nc`` (dims soil, block, model, measure).
+    measure : str, optional
+        The measure whose ``n_records`` and dispersion decide (default: the study's, else the first).
+    """
+    measure = measure or str(dataset.attrs.get("study_measure", "")) or str(dataset.measure.values[0])
+    if measure not in dataset.measure.values:
+        measure = str(dataset.measure.values[0])
+    variables = [name for name in CELL_RESULTS if name in dataset]
+    soils = [str(s) for s in dataset.soil.values]
+    tests = []
+    for block in map(str, dataset.block.values):
+        for model in map(str, dataset.model.values):
+            groups: list[tuple[list[str], list[np.ndarray]]] = []
+            for soil in soils:
+                where = dict(soil=soil, block=block, model=model)
+                results = [np.asarray(dataset[name].sel(where).values, float) for name in variables]
+                same = next((group for group in groups if all(np.array_equal(a, b, equal_nan=True)
+                                                              for a, b in zip(group[1], results))), None)
+                if same is None:
+                    groups.append(([soil], results))
+                else:
+                    same[0].append(soil)
+            for members, _ in groups:
+                where = dict(soil=members[0], block=block, model=model, measure=measure)
+                if not np.isfinite(float(dataset.dispersion.sel(where))):
+                    continue
+                records = int(dataset.n_records.sel(where)) if "n_records" in dataset else 0
+                tests.append(IndependentTest(block, model, tuple(members), records))
+    order = {name: index for index, name in enumerate(map(str, dataset.block.values))}
+    models = {name: index for index, name in enumerate(map(str, dataset.model.values))}
+    return sorted(tests, key=lambda t: (-t.records, order[t.block], models[t.model], soils.index(t.soils[0])))
+
+
+def dispersion_interval(dispersion, records, confidence: float = CONFIDENCE) -> tuple[np.ndarray, np.ndarray]:
+    """Two-sided confidence interval of a dispersion (standard deviation of ln capacity) from ``records`` values.
+
+    The sample variance of n normal values (ln capacity of a lognormal) times (n - 1) over the true variance is
+    chi-square with n - 1 degrees of freedom, so sigma lies in s * sqrt((n - 1) / chi2_{1-a/2}) to
+    s * sqrt((n - 1) / chi2_{a/2}) (e.g. Montgomery & Runger, Applied Statistics and Probability for Engineers,
+    section 8.3). NaN where n < 2.
+
+    Parameters
+    ----------
+    dispersion : array_like
+        Sample standard deviations s [-].
+    records : array_like
+        The number of values n behind each.
+    confidence : float, optional
+        Two-sided confidence level (default ``CONFIDENCE``).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Lower and upper bound [-].
+    """
+    dispersion = np.asarray(dispersion, float)
+    freedom = np.asarray(records, float) - 1.0
+    valid = freedom >= 1
+    freedom = np.where(valid, freedom, 1.0)
+    tail = (1.0 - confidence) / 2.0
+    low = dispersion * np.sqrt(freedom / stats.chi2.ppf(1.0 - tail, freedom))
+    high = dispersion * np.sqrt(freedom / stats.chi2.ppf(tail, freedom))
+    return np.where(valid, low, np.nan), np.where(valid, high, np.nan)
 
 
 def sufficiency_verdict(p_values) -> str:

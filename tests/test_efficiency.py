@@ -112,3 +112,37 @@ def test_outputs_and_a4_figure(tmp_path):
     figure = plot_efficiency(dataset)
     assert isinstance(figure, Figure) and plt.get_fignums() == []  # no pyplot state left behind
     np.testing.assert_allclose(figure.get_size_inches(), [8.27, 11.69])
+
+
+def test_the_dispersion_band_is_the_chi_square_interval_and_covers_as_stated():
+    """The whiskers of the efficiency page: for n = 5 the 90% band is s·sqrt(4/9.488) to s·sqrt(4/0.711) (chi-square
+    table, 4 degrees of freedom, 5% and 95%), and over many samples of 5 normal values it holds the true sigma in
+    90% of them (coverage, not the formula again)."""
+    from rockfrag.efficiency import dispersion_interval
+
+    low, high = dispersion_interval([0.27], [5])
+    assert low[0] == pytest.approx(0.27 * np.sqrt(4 / 9.488), rel=1e-3)
+    assert high[0] == pytest.approx(0.27 * np.sqrt(4 / 0.711), rel=1e-3)
+    samples = np.random.default_rng(3).normal(0.0, 0.4, size=(20000, 5))
+    low, high = dispersion_interval(samples.std(axis=1, ddof=1), np.full(20000, 5))
+    assert np.mean((low <= 0.4) & (0.4 <= high)) == pytest.approx(0.90, abs=0.01)
+    assert np.isnan(dispersion_interval([0.3], [1])[0][0])  # one record: no spread, no band
+
+
+def test_cells_that_are_the_same_runs_are_one_independent_test():
+    """Cold read 3 (default B2): the tied rigid base is the same runs on every soil, and efficiency.nc repeats its
+    test in each soil's cell (the slender cabinet on five soils, the paper block on three). Counted once each: two
+    tests, with the records behind each, not 'the 8 of 45 cells'."""
+    from pathlib import Path
+
+    from rockfrag.efficiency import independent_tests
+
+    dataset = xr.load_dataset(Path(__file__).parent / "data" / "efficiency_default_study.nc")
+    assert int(np.isfinite(dataset.dispersion.sel(measure="pga")).sum()) == 8  # the copies the file holds
+    tests = independent_tests(dataset)
+    assert [(t.block, t.model, t.soils, t.records) for t in tests] == [
+        ("slender-cabinet", "housner", ("clay", "sand", "gravel", "rock", "steel"), 44),
+        ("paper", "housner", ("gravel", "rock", "steel"), 5)]
+    changed = dataset.copy(deep=True)
+    changed["dispersion"].loc[dict(soil="rock", block="paper", model="housner", measure="pgv")] = 0.31
+    assert [t.soils for t in independent_tests(changed) if t.block == "paper"] == [("gravel", "steel"), ("rock",)]

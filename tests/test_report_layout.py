@@ -97,7 +97,9 @@ def layout_defects(figure) -> list[str]:
         box = legend.get_window_extent()
         if box.x0 < page.x0 - 0.5 or box.y0 < page.y0 - 0.5 or box.x1 > page.x1 + 0.5 or box.y1 > page.y1 + 0.5:
             defects.append(f"legend clipped: {box.x0:.0f}-{box.x1:.0f} px across a page of {page.x1:.0f} px")
+    defects += footer_defects(figure, shown)
     axes = [axis for axis in figure.axes if axis.get_visible() and axis.axison and not _is_secondary(axis)]
+    defects += cut_markers(axes)
     data = {axis: data_points(axis) for axis in axes}
     for text, box in shown:
         inner = _shrunk(box)
@@ -115,6 +117,53 @@ def layout_defects(figure) -> list[str]:
         notes = [text for text, box in shown if inner.contains(*box.get_points().mean(axis=0))]
         if not notes:
             defects.append(f"empty axes without a note: {axis.get_title()!r}")
+    return defects
+
+
+def footer_defects(figure, shown) -> list[str]:
+    """Texts, legends and axes of the page that reach below the footer's rule (over the footer) or off the page.
+
+    The footer (its rule, the report title, the page number: ``FOOTER_ID``) owns the strip under the rule; a
+    caption too long for its lines, or a figure too tall, runs into it and both become unreadable.
+    """
+    from rockfrag.report.layout import FOOTER_ID, FOOTER_RULE
+
+    page = figure.bbox
+    rule = page.y0 + FOOTER_RULE * page.height
+    defects = [f"over the footer: {text.get_text()[:50]!r}" for text, box in shown
+               if text.get_gid() != FOOTER_ID and box.y0 < rule - 0.5]
+    for legend in [*figure.legends, *(axis.get_legend() for axis in figure.axes if axis.get_legend())]:
+        if legend.get_window_extent().y0 < rule - 0.5:
+            defects.append("legend over the footer")
+    for axis in figure.axes:
+        if not axis.get_visible():
+            continue
+        box = axis.get_window_extent()
+        if box.y0 < rule - 0.5:
+            defects.append(f"axes over the footer: {axis.get_title()!r}")
+        if box.x0 < page.x0 - 0.5 or box.x1 > page.x1 + 0.5 or box.y1 > page.y1 + 0.5:
+            defects.append(f"axes off the page: {axis.get_title()!r}")
+    return defects
+
+
+def cut_markers(axes) -> list[str]:
+    """Markers (the records' fractions, a model's points) that the frame of their axes cuts: a point at the last
+    level drawn on the right frame is half a disc, and it is the evidence a censored curve rests on."""
+    defects = []
+    for axis in axes:
+        box = axis.get_window_extent()
+        for line in axis.get_lines():
+            if not line.get_visible() or line.get_marker() in (None, "None", "none", "", " "):
+                continue
+            xy = line.get_transform().transform(np.asarray(line.get_xydata(), float))
+            xy = xy[np.isfinite(xy).all(axis=1)]
+            radius = line.get_markersize() / 2.0 * axis.figure.dpi / 72.0
+            # a point on the frame (centre at the axis limit) is cut; one wholly beyond the view is a choice of range
+            seen = _inside(xy, Bbox.from_extents(box.x0 - 1, box.y0 - 1, box.x1 + 1, box.y1 + 1))
+            cut = seen & ((xy[:, 0] - radius < box.x0 - 0.5) | (xy[:, 0] + radius > box.x1 + 0.5)
+                          | (xy[:, 1] - radius < box.y0 - 0.5) | (xy[:, 1] + radius > box.y1 + 0.5))
+            if cut.any():
+                defects.append(f"marker cut by the frame: {axis.get_title()[:40]!r}")
     return defects
 
 
@@ -226,3 +275,85 @@ def test_every_figure_of_the_small_study_is_free_of_layout_defects(small_pipelin
         finally:
             plt.close(figure)
     assert found == {}
+
+
+def test_the_layout_check_fails_on_a_caption_over_the_footer_and_on_a_figure_run_into_it():
+    """Cold read 3 (user B4, default B3): the efficiency page's caption, six lines long, was printed over the page
+    footer. A caption of that length, and an axes reaching below the footer's rule, are defects."""
+    from rockfrag.report.layout import add_footer, new_page, outside_legend, panels
+
+    figure = new_page("A page", "A sentence of a caption that goes on. " * 40)
+    axis = panels(figure)[0, 0]
+    axis.plot([0, 1], [0, 1], label="a curve")
+    outside_legend(figure, [axis])
+    add_footer(figure, "a report title", 1, 2)
+    try:
+        assert any(defect.startswith("over the footer: 'A sentence") for defect in layout_defects(figure))
+    finally:
+        plt.close(figure)
+    figure, left, _ = _clean_figure()
+    add_footer(figure, "a report title", 1, 2)
+    try:
+        assert layout_defects(figure) == []  # the footer itself is no defect
+        left.set_position([0.07, 0.01, 0.3, 0.5])
+        assert "axes over the footer: ''" in layout_defects(figure)
+    finally:
+        plt.close(figure)
+
+
+def test_the_layout_check_fails_on_a_marker_cut_by_the_frame():
+    """Cold read 3 (user B6, default B7): the records' fraction at the highest level (the credible cap) sat on the
+    right frame of every fragility panel, half a disc. A marker on the frame is a defect; inside, none."""
+    figure, left, _ = _clean_figure()
+    try:
+        left.plot([0.2, 0.5, 1.0], [0.1, 0.3, 0.6], "o", ms=3)
+        left.set_xlim(0.0, 1.0)
+        left.set_title("overturning")
+        assert "marker cut by the frame: 'overturning'" in layout_defects(figure)
+        left.set_xlim(0.0, 1.08)
+        assert layout_defects(figure) == []
+    finally:
+        plt.close(figure)
+
+
+def _default_efficiency():
+    from pathlib import Path
+
+    import xarray as xr
+
+    return xr.load_dataset(Path(__file__).parent / "data" / "efficiency_default_study.nc")
+
+
+def test_the_efficiency_page_of_the_default_study_counts_each_test_once_and_keeps_off_the_footer():
+    """Cold read 3 (default B2, B3; user B4, B5). The page drew bars as medians over 8 cells that were 2 tests
+    copied across soils (one on 5 records, without a band), titled its p-values 'median over soils, models and
+    blocks', and its caption ran over the footer. Drawn from the default study's efficiency.nc with the caption the
+    report writes: one bar per independent test and measure, each with its confidence band, the records behind each
+    test in the legend, and no layout defect with the footer drawn."""
+    from rockfrag.config import load_study
+    from rockfrag.report import CAPTIONS, _twins_words, figures, measure_choice_words
+    from rockfrag.report.adapters import block_name
+    from rockfrag.report.layout import add_footer
+
+    dataset = _default_efficiency()
+    config = load_study(None)
+    names = {str(b): block_name(config, b) for b in dataset.block.values}
+    caption = CAPTIONS["efficiency"] + _twins_words(dataset) + measure_choice_words(dataset, names, True)
+    figure = figures.efficiency_page(dataset, caption, names=names)
+    add_footer(figure, "Seismic fragility of unanchored rocking blocks · study 'default'", 44, 49)
+    try:
+        assert layout_defects(figure) == []
+        top, bottom = figure.axes[:2]
+        measures = len(top.get_xticks())
+        bars = [container for container in top.containers if isinstance(container, BarContainer)]
+        assert len(bars) == 2 and all(len(container.patches) == measures for container in bars)
+        whiskers = [container for container in top.containers if type(container).__name__ == "ErrorbarContainer"]
+        assert sum(1 for c in whiskers if c.has_yerr and len(c.lines[2][0].get_segments()) == measures) == 2
+        legend = " ".join(text.get_text().replace("\n", " ") for text in figure.legends[0].get_texts())
+        assert "44 records overturned" in legend and "5 records overturned" in legend
+        assert "on every soil (the same runs)" in legend and "on gravel, rock, steel" in legend
+        assert "median p-value over" not in bottom.get_title()
+        assert "Housner (rigid base)" in caption and "count once" in caption
+        assert "8 of 45 cells" not in caption
+    finally:
+        plt.close(figure)

@@ -46,7 +46,14 @@ from rockfrag.damage_states import damage_states_from_config  # noqa: E402
 from rockfrag.outputs import atomic_path  # noqa: E402
 from rockfrag.report import figures as pages  # noqa: E402
 from rockfrag.report import numbers  # noqa: E402
-from rockfrag.report.adapters import block_name, models_of, record_pga_g, short_label, soils_of  # noqa: E402
+from rockfrag.report.adapters import (  # noqa: E402
+    block_name,
+    model_info,
+    models_of,
+    record_pga_g,
+    short_label,
+    soils_of,
+)
 from rockfrag.report.answer_page import SUFFICIENCY_LEVEL, answer_items, reading_items  # noqa: E402
 from rockfrag.report.layout import Page, add_footer, new_page  # noqa: E402
 from rockfrag.report.sections import (  # noqa: E402
@@ -244,8 +251,7 @@ CAPTIONS = {
                    "marked 'no median' has no curve of this state below the credible cap.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
-                  "below the dashed line it does, and the measure alone is not enough; the test of Luco & Cornell "
-                  "2007).",
+                  "below the dashed line it does; the test of Luco & Cornell 2007).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
 
@@ -270,8 +276,7 @@ def _twins_words(efficiency) -> str:
     if not twins:
         return ""
     pairs = "; ".join(f"{pages.measure_words(m)} repeats {pages.measure_words(o)}" for m, o in twins.items())
-    return (f" Not drawn ({pairs}): dividing an intensity by a constant of the block (its uplift acceleration "
-            "g·tanα) changes nothing within one block, so their bars and p-values are identical by construction.")
+    return f" Not drawn ({pairs}): identical by construction (a constant of the block divides them)."
 
 
 def hazard_caption(results) -> str:
@@ -306,68 +311,77 @@ def sweep_words(applicability) -> str:
     return text
 
 
-def tested_cells_words(efficiency, measure: str) -> str:
-    """Which cells the bars and p-values rest on: those with enough overturning records (efficiency.nc's finite ones).
+def tested_cells_words(efficiency, names: dict | None = None) -> str:
+    """What the efficiency page's bars and p-values rest on: independent tests, named in its legend.
 
-    "The bars and p-values rest on 12 of 45 cells (block, soil and model), all Housner (rigid base); the fewest
-    overturning records behind one: 5." ("" when every cell is tested).
+    "Each bar is one independent test, named in the legend with the records that overturned in it; a tied rigid
+    base's same runs on several soils count once; ..." ("" without a test). ``names`` is unused (the legend names).
     """
-    if "dispersion" not in efficiency or measure not in efficiency.measure.values:
+    if "dispersion" not in efficiency:
         return ""
-    values = efficiency.dispersion.sel(measure=measure)
-    tested = np.isfinite(values)
-    total, count = int(tested.size), int(tested.sum())
-    if count == 0 or count == total:
+    tests, total = pages.tests_drawn(efficiency)
+    if not tests:
         return ""
-    models = [short_label(model) for model in models_of(efficiency)
-              if bool(tested.sel(model=model.name).any())] if "model" in efficiency.dims else []
-    fewest = ""
-    if "n_records" in efficiency:
-        records = efficiency.n_records.sel(measure=measure).where(tested)
-        fewest = f"; the fewest overturning records behind one: {int(records.min())}"
-    return (f" The bars and p-values rest on the {count} of {total} cells (block, soil and model) with enough "
-            f"overturning records ({'; '.join(models)}){fewest}: the others are not tested.")
+    drawn = f" (the {len(tests)} with the most records drawn)" if total > len(tests) else ""
+    copies = any(len(test.soils) > 1 for test in tests)
+    return (f" Each bar is one independent test{drawn}, named in the legend with the records that overturned in it"
+            + ("; a tied rigid base's same runs on several soils count once" if copies else "")
+            + "; no other block, model or soil had enough overturning records.")
 
 
 def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:
-    """The efficiency caption's sentences on why the study's measure is used though another scatters less ("" else).
+    """The efficiency caption's sentences: why the study's measure, what a better one would change, what it misses.
 
-    Per block, the measure with the smallest dispersion of the overturning capacity (the top bars: median over
-    soils and models) against the study's measure; the study's measure is the hazard's, which the fragility must
-    share to be integrated with it. Where the study's measure fails the sufficiency test (p < 0.05 against the
-    pulse period, magnitude or distance, median over cells as the bottom panel draws it), the curves hold for
-    records like the study's: the bias this leaves for other records is said, not sized.
+    Per independent test (``rockfrag.efficiency.independent_tests``), the measure with the smallest dispersion of
+    the overturning capacity against the study's measure, said better only where their confidence bands do not
+    overlap; the study's measure is the hazard's, which the fragility must share to be integrated with it. Where the
+    study's measure fails the sufficiency test (p < 0.05 against the pulse period, magnitude or distance) in a test,
+    the caption names the test (block, model, soils): the curves hold for records like the study's.
     """
+    from rockfrag.efficiency import dispersion_interval
+
     study = str(efficiency.attrs.get("study_measure", ""))
     if not study or study not in efficiency.measure.values or "dispersion" not in efficiency:
         return ""
     twins = pages.efficiency_twins(efficiency)
     measures = [str(m) for m in efficiency.measure.values if str(m) not in twins]
-    better = []
-    for block in map(str, efficiency.block.values):
-        middle = efficiency.dispersion.sel(block=block, measure=measures).median(["soil", "model"])
-        values = dict(zip(measures, np.asarray(middle.values, float)))
-        if not np.isfinite(values.get(study, np.nan)):
-            continue
-        best = min((m for m in measures if np.isfinite(values[m])), key=values.get)
-        if best != study:
-            better.append(f"{pages.measure_words(best)} for the {names.get(block, block)} "
-                          f"({numbers.dispersion(values[best])} against {numbers.dispersion(values[study])})")
+    tests, _ = pages.tests_drawn(efficiency)
     words = pages.measure_words(study)
-    text = (f" The fragility curves are in {words} because the site's hazard is: a curve must be in the hazard's "
-            "measure to be integrated with it." if hazard else f" The fragility curves are in {words}, the study's "
-            "measure.")
+    better, unresolved, failing = [], [], []
+    for test in tests:
+        where = dict(soil=test.soils[0], block=test.block, model=test.model)
+        cell = efficiency.sel(where)
+        values = dict(zip(measures, np.asarray(cell.dispersion.sel(measure=measures).values, float)))
+        name = names.get(test.block, test.block)
+        if np.isfinite(values.get(study, np.nan)):
+            best = min((m for m in measures if np.isfinite(values[m])), key=values.get)
+            if best != study:
+                said = (f"{pages.measure_words(best)} for the {name} ({numbers.dispersion(values[best])} against "
+                        f"{numbers.dispersion(values[study])})")
+                if "n_records" in cell:
+                    counts = [float(cell.n_records.sel(measure=m)) for m in (best, study)]
+                    low, high = dispersion_interval([values[best], values[study]], counts)
+                    if high[0] >= low[1]:  # the bands overlap: the records cannot tell the two apart
+                        unresolved.append(f"{said[:-1]}, {test.records} records)")
+                        continue
+                better.append(said)
+        failed = [what.removeprefix("against ") for variable, _, _, what in pages.P_MARKERS if variable in cell
+                  and float(cell[variable].sel(measure=study)) < SUFFICIENCY_LEVEL]
+        if failed:
+            model = short_label(model_info(test.model))
+            failing.append(f"the {name}, {model}, {pages.soils_words(test.soils, list(efficiency.soil.values))}"
+                           f" (against {' and '.join(failed)})")
+    text = (f" The curves are in {words} because the site's hazard is (a curve must share the hazard's measure)."
+            if hazard else f" The curves are in {words}, the study's measure.")
     if better:
-        text += (f" A measure scatters less than {words} for some blocks: {'; '.join(better)}. In {words} their "
-                 "curves are wider (a larger record-to-record β), not shifted.")
-    text += tested_cells_words(efficiency, study)
-    insufficient = [name for name, _, _, what in pages.P_MARKERS if name in efficiency
-                    and float(efficiency[name].sel(measure=study).median()) < SUFFICIENCY_LEVEL]
-    if insufficient:
-        text += (f" {words} fails the sufficiency test (bottom, below the dashed line): at a given {words} the "
-                 "capacity still depends on the records' character, so the curves hold for records like the "
-                 "study's set and are biased, by an amount this study does not size, for a site whose motions "
-                 "differ (near a fault: long velocity pulses; run records like the site's there).")
+        text += f" Less scatter than {words}: {'; '.join(better)}; in {words} those curves are wider, not shifted."
+    if unresolved:
+        text += f" Within {words}'s confidence band, so not shown better: {'; '.join(unresolved)}."
+    text += tested_cells_words(efficiency, names)
+    if failing:
+        text += (f" {words} fails the sufficiency test (bottom) for {'; '.join(failing)}: those curves hold for "
+                 "records like the study's, biased by an amount not sized here where the site's motions differ (near "
+                 "a fault).")
     return text
 
 

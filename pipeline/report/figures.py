@@ -37,6 +37,7 @@ from rockfrag.report.layout import (
     FRACTILE_STYLES,
     GRID,
     LEGEND_ANCHOR,
+    caption_room,
     chars_across,
     log_axis,
     log_minor_ticks,
@@ -174,14 +175,29 @@ def soil_marks(axis, marks: CredibleMarks, along: str = "x") -> None:
         top.spines["top"].set_visible(False)
 
 
-def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
-    """The intensity range of a block's axes: its levels, widened to show the return-period intensities."""
+LEVEL_MARGIN = 1.1
+"""Factor the intensity axes reach beyond the lowest and highest level: a level's point (the records' fraction at
+the credible cap, the only evidence of a censored curve) is drawn whole, not cut in half by the frame."""
+
+
+def curve_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
+    """The intensities a fitted curve is drawn over: the block's levels, widened to the return-period intensities."""
     low, high = float(levels[0]), float(levels[-1])
     shown = [] if marks is None else [*marks.intensities, *(im for _, values in marks.by_soil for im in values)]
     if shown:
         low = min(low, 0.9 * min(shown))
         high = max(high, 1.1 * max(shown))
     return low, high
+
+
+def axis_range(levels, marks: CredibleMarks | None) -> tuple[float, float]:
+    """The intensity range of a block's axes: ``curve_range`` with a margin beyond the lowest and highest level.
+
+    The margin keeps the points at the first and last level (the credible cap) inside the frame; no curve is drawn
+    into it beyond the cap (``curve_range``).
+    """
+    low, high = curve_range(levels, marks)
+    return min(low, float(levels[0]) / LEVEL_MARGIN), max(high, float(levels[-1]) * LEVEL_MARGIN)
 
 
 def _grid(n):
@@ -615,7 +631,7 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
     states, axes = _state_axes(figure, fragility)
     labels, short = state_labels(fragility), short_states(fragility)
     levels = block_levels(fragility, block)
-    span = axis_range(levels, marks)
+    span = curve_range(levels, marks)  # the curves; the axes get a margin
     for axis, state in zip(axes.flat, states):
         reasons = []
         for index, soil in enumerate(map(str, fragility.soil.values)):
@@ -649,7 +665,7 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
     states, axes = _state_axes(figure, fragility, n_rows=len(soils))
     labels, short = state_labels(fragility), short_states(fragility)
     levels = block_levels(fragility, block)
-    span = axis_range(levels, marks)
+    span = curve_range(levels, marks)  # the curves; the axes get a margin
     for row, soil in enumerate(soils):
         for column, state in enumerate(states):
             # one soil: _state_axes lays the states out on a grid, not in one row
@@ -852,43 +868,100 @@ def efficiency_twins(dataset) -> dict[str, str]:
     return twins
 
 
-def efficiency_page(dataset, caption, names: dict | None = None):
-    """Which intensity measure predicts overturning best, from ``efficiency.nc``.
+MAX_TESTS = 6
+"""Independent tests drawn on the efficiency page at most (those with the most overturning records; the caption
+says how many were left out)."""
 
-    Top: the dispersion of the overturning capacity per measure and block (median over soils and
-    models, whiskers their range; smaller is better). Bottom: the sufficiency p-values against magnitude,
-    distance and pulse period (median over cells), on a log axis floored at ``P_FLOOR``. A measure that
+EFFICIENCY_CAPTION_LINES = 6  # the efficiency caption says which tests the bars rest on: three lines more
+
+
+def tests_drawn(dataset):
+    """The independent tests the efficiency page draws, and how many there are in all.
+
+    At most ``MAX_TESTS`` of ``rockfrag.efficiency.independent_tests``, those with the most records first.
+    """
+    from rockfrag.efficiency import independent_tests
+
+    tests = independent_tests(dataset)
+    return tests[:MAX_TESTS], len(tests)
+
+
+def soils_words(soils, every) -> str:
+    """The soils one test rests on: "every soil (the same runs)", "gravel, rock, steel (the same runs)", "sand"."""
+    if len(soils) > 1 and len(soils) == len(every):
+        return "every soil (the same runs)"
+    return ", ".join(soils) + (" (the same runs)" if len(soils) > 1 else "")
+
+
+def test_words(test, dataset, names: dict | None = None) -> str:
+    """One independent test as the efficiency page names it: block, model, soils and the records behind it."""
+    from rockfrag.report.adapters import model_info
+
+    names = names or {}
+    model = short_label(model_info(test.model))
+    records = f": {test.records} records overturned" if test.records else ""
+    return (f"{names.get(test.block, test.block)}, {model}, on "
+            f"{soils_words(test.soils, list(dataset.soil.values))}{records}")
+
+
+def efficiency_page(dataset, caption, names: dict | None = None):
+    """Which intensity measure predicts overturning best, from ``efficiency.nc``: one bar per independent test.
+
+    A test is one block and model's overturning capacities on the soils where they are the same runs
+    (``rockfrag.efficiency.independent_tests``: a tied rigid base is one test, not one per soil). Top: the
+    dispersion of the capacity per measure, whiskers its 90% confidence band (chi-square on the records that
+    overturned: a test on few records has a wide band); smaller is better. Bottom: each test's sufficiency p-values
+    against magnitude, distance and pulse period, under its bar, on a log axis floored at ``P_FLOOR``. A measure that
     repeats another within every block (``efficiency_twins``) is left out; the caption says why.
     """
+    from rockfrag.efficiency import CONFIDENCE, dispersion_interval
+
     names = names or {}
-    figure = new_page("Efficiency of intensity measures: which one predicts overturning best", caption)
-    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45, left=0.085))[:, 0]
+    figure = new_page("Efficiency of intensity measures: which one predicts overturning best", caption,
+                      caption_lines=EFFICIENCY_CAPTION_LINES)
+    room = caption_room(EFFICIENCY_CAPTION_LINES)
+    top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45, left=0.085, bottom=GRID["bottom"] + room))[:, 0]
     twins = efficiency_twins(dataset)
     measures = [str(m) for m in dataset.measure.values if str(m) not in twins]
     labels = [measure_words(m) for m in measures]
-    blocks = [b for b in map(str, dataset.block.values)
-              if np.isfinite(dataset.dispersion.sel(block=b, measure=measures).values).any()]
+    tests, _ = tests_drawn(dataset)
     x = np.arange(len(measures))
-    width = 0.8 / max(len(blocks), 1)
-    for index, block in enumerate(blocks):
-        dispersion = dataset.dispersion.sel(block=block, measure=measures)
-        middle = dispersion.median(["soil", "model"]).values
-        low, high = dispersion.min(["soil", "model"]).values, dispersion.max(["soil", "model"]).values
-        top.bar(x + (index - (len(blocks) - 1) / 2) * width, middle, width, label=names.get(block, block),
-                yerr=[middle - low, high - middle], capsize=2, color=f"C{index % 10}")
-    if not blocks:
+    width = 0.8 / max(len(tests), 1)
+    offsets = [(index - (len(tests) - 1) / 2) * width for index in range(len(tests))]
+    for index, (test, offset) in enumerate(zip(tests, offsets)):
+        where = dict(soil=test.soils[0], block=test.block, model=test.model, measure=measures)
+        dispersion = np.asarray(dataset.dispersion.sel(where).values, float)
+        records = np.asarray(dataset.n_records.sel(where).values, float) if "n_records" in dataset else None
+        band = None
+        if records is not None:
+            low, high = dispersion_interval(dispersion, records)
+            band = [dispersion - low, high - dispersion]
+        top.bar(x + offset, dispersion, width, yerr=band, capsize=2, color=f"C{index % 10}",
+                error_kw=dict(lw=0.9), label=test_words(test, dataset, names))
+    if tests and "n_records" in dataset:  # an errorbar proxy: listed after the bars
+        top.errorbar([], [], yerr=[], color="black", capsize=2, lw=0.9, ls="none", label=f"whiskers: {CONFIDENCE:.0%} "
+                     "confidence band of the dispersion (from the records overturned)")
+    if not tests:
         empty_note(top, "no dispersion: no block's overturning capacity was found in enough records to measure one")
     top.set_xticks(x, labels, fontsize=8)
     top.set_ylabel("dispersion of ln capacity [-]", fontsize=9)
-    top.set_title("Efficiency: dispersion of the overturning capacity per block (smaller is better)", fontsize=10)
+    top.set_title("Efficiency: dispersion of the overturning capacity, one bar per independent test (smaller is "
+                  "better)", fontsize=10)
     top.grid(alpha=0.3, axis="y")
+    top.set_ylim(bottom=0.0)
     tested = False
-    for name, marker, colour, what in P_MARKERS:
+    for order, (name, marker, colour, what) in enumerate(P_MARKERS):
         if name not in dataset:
             continue
-        p = dataset[name].sel(measure=measures).median(["soil", "model", "block"]).values
-        tested |= bool(np.isfinite(p).any())
-        bottom.scatter(x, np.clip(p, P_FLOOR, 1.0), marker=marker, color=colour, label=f"p-value {what}")
+        spread = (order - (len(P_MARKERS) - 1) / 2) * width / 4  # side by side in the test's column: none hidden
+        for index, (test, offset) in enumerate(zip(tests, offsets)):
+            p = np.asarray(dataset[name].sel(soil=test.soils[0], block=test.block, model=test.model,
+                                             measure=measures).values, float)
+            tested |= bool(np.isfinite(p).any())
+            bottom.scatter(x + offset + spread, np.clip(p, P_FLOOR, 1.0), marker=marker, color=colour, s=22,
+                           label=f"p-value {what}" if index == 0 else None, zorder=3)
+    for index, offset in enumerate(offsets if len(tests) > 1 else []):  # which test a column of p-values is
+        bottom.bar(x + offset, 1.0, width * 0.9, bottom=P_FLOOR * 0.7, color=f"C{index % 10}", alpha=0.12, zorder=0)
     if not tested:
         empty_note(bottom, "no p-value: too few records overturned for the test (it needs their capacities)")
     bottom.axhline(0.05, color="k", lw=0.8, ls="--", label="0.05: below it the measure is not sufficient")
@@ -898,8 +971,10 @@ def efficiency_page(dataset, caption, names: dict | None = None):
     bottom.minorticks_off()
     bottom.set_xticks(x, labels, fontsize=8)
     bottom.set_ylabel("p-value [-]", fontsize=9)
-    bottom.set_title("Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake? "
-                     "(median p-value over soils, models and blocks)", fontsize=10)
+    whose = ("the one test's p-values" if len(tests) == 1 else
+             "each test's p-values, under its bar and in its colour")
+    bottom.set_title(f"Sufficiency (Luco & Cornell 2007): does the capacity still depend on the earthquake? ({whose})",
+                     fontsize=10)
     bottom.grid(alpha=0.3, axis="y")
     outside_legend(figure, [top, bottom])
     return figure

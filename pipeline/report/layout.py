@@ -33,6 +33,8 @@ CAPTION_SIZE = 7.5
 CAPTION_WRAP = 205  # characters of 7.5 pt italic across the page width (tests check the drawn extent)
 CAPTION_LINES = 3  # lines between the axes' labels and the footer
 FOOTER_Y = 0.008
+FOOTER_RULE = FOOTER_Y + 0.018  # the rule above the footer: nothing of the page's own is drawn below it
+FOOTER_ID = "footer"  # the footer's artists carry it (gid): a layout check tells them from the page's own
 TITLE_SIZE = 13
 TITLE_CHARS = 95  # characters of a bold 13 pt title across the page; a longer title is set smaller
 
@@ -89,22 +91,32 @@ class Page:
     heading: str = ""
 
 
-def new_page(title: str, caption: str = "") -> Figure:
+CAPTION_LINE = CAPTION_SIZE * 1.25 / (PAGE_SIZE[1] * 72.0)  # one caption line, as a fraction of the page height
+
+
+def caption_room(lines: int) -> float:
+    """How much higher than the usual the caption (and the axes above it) start on a page with ``lines`` lines."""
+    return max(0, lines - CAPTION_LINES) * CAPTION_LINE
+
+
+def new_page(title: str, caption: str = "", caption_lines: int = CAPTION_LINES) -> Figure:
     """A figure of the page size with its title and caption.
 
     No layout engine: every page has the same fixed margins, which is faster than constrained layout
-    and keeps pages alike.
+    and keeps pages alike. A page whose caption needs more than ``CAPTION_LINES`` lines asks for them
+    (``caption_lines``) and keeps its axes ``caption_room(caption_lines)`` higher; a caption longer than its
+    lines even in 6 pt type runs into the footer (the layout test fails on it).
     """
     figure = plt.figure(figsize=PAGE_SIZE)
     size = TITLE_SIZE if len(title) <= TITLE_CHARS else max(9.0, TITLE_SIZE * TITLE_CHARS / len(title))
     figure.text(0.015, 0.975, title, fontsize=size, weight="bold", va="top", ha="left")
     if caption:
-        for size in (CAPTION_SIZE, 7.0, 6.5, 6.0):  # a long caption in smaller type: three lines above the footer
+        for size in (CAPTION_SIZE, 7.0, 6.5, 6.0):  # a long caption in smaller type: its lines above the footer
             lines = textwrap.wrap(caption, int(CAPTION_WRAP * CAPTION_SIZE / size))
-            if len(lines) <= CAPTION_LINES:
+            if len(lines) <= caption_lines:
                 break
-        figure.text(0.015, CAPTION_Y, "\n".join(lines), fontsize=size, style="italic", va="top", ha="left",
-                    linespacing=1.25)
+        figure.text(0.015, CAPTION_Y + caption_room(caption_lines), "\n".join(lines), fontsize=size,
+                    style="italic", va="top", ha="left", linespacing=1.25)
     return figure
 
 
@@ -117,10 +129,11 @@ def panels(figure, rows=1, columns=1, **options):
 
 def add_footer(figure, left: str, number: int, total: int) -> None:
     """Report title on the left, page number on the right, a rule above both."""
-    figure.add_artist(matplotlib.lines.Line2D([0.015, 0.985], [FOOTER_Y + 0.018] * 2, color="0.6", lw=0.6,
-                                              transform=figure.transFigure))
-    figure.text(0.015, FOOTER_Y, left, fontsize=7.5, color="0.3", va="bottom", ha="left")
-    figure.text(0.985, FOOTER_Y, f"page {number} of {total}", fontsize=7.5, color="0.3", va="bottom", ha="right")
+    figure.add_artist(matplotlib.lines.Line2D([0.015, 0.985], [FOOTER_RULE] * 2, color="0.6", lw=0.6,
+                                              transform=figure.transFigure, gid=FOOTER_ID))
+    figure.text(0.015, FOOTER_Y, left, fontsize=7.5, color="0.3", va="bottom", ha="left", gid=FOOTER_ID)
+    figure.text(0.985, FOOTER_Y, f"page {number} of {total}", fontsize=7.5, color="0.3", va="bottom", ha="right",
+                gid=FOOTER_ID)
 
 
 def log_ticks(low: float, high: float, most: int = 8) -> list[float]:
