@@ -8,9 +8,10 @@ import html as html_module
 import re
 
 import numpy as np
+import xarray as xr
 
 from rockfrag.report.adapters import block_name
-from tests.helpers import pipeline_results
+from tests.helpers import ROOT, pipeline_results
 
 
 def _visible_text(html: str) -> str:
@@ -232,3 +233,185 @@ def test_the_example_hazard_is_said_once_and_referred_to(small_pipeline):
     assert text.count("no verdict in this report applies to a real site") == 1
     assert "shipped example" not in text and "which is no site's" not in text
     assert text.count(EXAMPLE_HAZARD_WORDS) >= 3  # the title page, the answer pages, the methods
+
+
+# Cold read 3 (/work/tmp/read3/READ.md): the findings on the words of both reports.
+
+ACTIONS = ("anchor or restrain", "no action", "specialist check")
+
+
+def _action_cells(results) -> list[str]:
+    """Every action the summary, the answer pages' tables and their verdict sentences print."""
+    from rockfrag.report.answer_page import answer_items
+    from rockfrag.report.summary import summary_items, verdict_items
+
+    cells = []
+    for item in summary_items(results):
+        if item.kind == "table":
+            column = item.header.index("action")
+            cells += [row[column] for row in item.rows if any(row[1:])]
+    for answer in results.answers:
+        for item in answer_items(results, answer):
+            if item.kind == "table" and item.rows and item.rows[-1][0] == "action":
+                cells += [cell for cell in item.rows[-1][2:]]
+        lead = verdict_items(results, answer)[0].text
+        cells += [part.split(" on ")[0].split(": ")[-1] for part in lead.rstrip(".").split("; ")
+                  if part.split(": ")[-1].startswith(ACTIONS)]
+    return cells
+
+
+def test_every_printed_action_names_a_hazard_that_is_not_a_sites(small_pipeline, tmp_path):
+    """Cold read 3, user and default A1: the summary, the answer pages' verdicts and their tables printed a bare
+    "no action" / "anchor or restrain" under the shipped example hazard and under an illustrative hazard file: a
+    cell copied out of the report loses what it rests on. Every action cell then says "(example hazard)" or
+    "(illustrative hazard)"; with a site's hazard file (not marked illustrative), none does."""
+    import shutil
+    from dataclasses import replace
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    assert all(answer.example_hazard for answer in results.answers)
+    cells = _action_cells(results)
+    assert len(cells) >= 2 * len(results.answers) and all(cell.startswith(ACTIONS) for cell in cells), cells
+    assert all(cell.endswith("example hazard)") for cell in cells), cells
+
+    study, hazard = tmp_path / "study.toml", tmp_path / "hazard.csv"
+    shutil.copy(ROOT / "studies" / "user-site-hazard.csv", hazard)
+    study.write_text(small_pipeline.study.read_text().replace(
+        "[intensity]", '[hazard]\nfile = "hazard.csv"\nreference_vs30 = 760.0\nsite = [23.62, 37.94]\n\n[intensity]'))
+    results = pipeline_results(small_pipeline.output, study)
+    cells = _action_cells(results)
+    assert cells and all(cell.endswith("illustrative hazard)") for cell in cells), cells
+
+    hazard.write_text(hazard.read_text().replace("hand-written ILLUSTRATIVE curve", "the site's hazard study")
+                      .replace("not the result of a hazard model", "from the site's own model"))
+    results = pipeline_results(small_pipeline.output, study)
+    results.__dict__["answers"] = [replace(answer, example_hazard=False) for answer in results.answers]
+    cells = _action_cells(results)
+    assert cells and not any("hazard" in cell for cell in cells), cells
+
+
+def test_a_bound_governs_only_where_no_judged_state_is_computed():
+    """Cold read 3, default B5: the squat block on sand was 'governed' by overturning that no record reached (a
+    bound, '< X': P50 0.029% against 1%) over its computed slip (0.29% against 10%): the choice turned on the second
+    figure and the summary printed 'not reached' in every cell. A computed state governs when none is exceeded; the
+    bound governs only where every judged state is a bound; an exceeded state governs whatever it is."""
+    from types import SimpleNamespace
+
+    from rockfrag.answer import StateAnswer
+    from rockfrag.report.summary import GOVERNING_WORDS, governing
+
+    def row(state, p, limit, reached=True):
+        return StateAnswer(state=state, at_return_periods=((p, np.nan, np.nan),) * 3, annual_frequency=p / 50,
+                           probability_in_life=p, limit=limit, not_reached_below=None if reached else 3.0)
+
+    slip, bound = row("slip-0.30", 0.0029, 0.10), row("overturning", 0.00030, 0.01, reached=False)
+    assert bound.probability_in_life / bound.limit > slip.probability_in_life / slip.limit  # the bound is nearer
+    assert governing(SimpleNamespace(states=[slip, bound])) is slip
+    assert governing(SimpleNamespace(states=[bound])) is bound
+    exceeded = row("overturning", 0.02, 0.01, reached=False)
+    assert exceeded.exceeds and governing(SimpleNamespace(states=[slip, exceeded])) is exceeded
+    assert "the computed state nearest its limit" in GOVERNING_WORDS
+
+
+def test_a_structural_base_is_said_to_be_at_ground_level_and_a_floor_needs_its_own_motion(small_pipeline):
+    """Cold read 3, default A2: 'steel' was judged as if it were equipment on a steel deck, with the ground motion of
+    the reference site. The summary says once what a structural base stands for (a plate at ground level under the
+    reference site's motion) and that a block on a structure needs the floor's motion, not modelled; a study
+    without such a base says nothing of it."""
+    from rockfrag.report.adapters import STIFF_BASE
+    from rockfrag.report.sections import grounds
+    from rockfrag.report.summary import summary_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    note = " ".join(item.text for item in summary_items(results) if item.kind == "note")
+    assert "floor spectrum" not in note
+    modulus = results.cube.soil_shear_modulus.copy()
+    modulus.loc[dict(soil="rock")] = 4 * STIFF_BASE  # rock as stiff as a steel plate: a structural base
+    results.cube.coords["soil_shear_modulus"] = modulus
+    note = " ".join(item.text for item in summary_items(results) if item.kind == "note")
+    assert "'rock': a steel plate at ground level, under the reference site's ground motion" in note
+    assert "a floor spectrum" in note and "not one on a structure" in note
+    assert "structural base at ground level (rock; not a soil)" in grounds(results.cube)
+
+
+def test_the_steel_friction_says_why_class_b_and_where_class_a_would_make_a_block_slide(small_pipeline):
+    """Cold read 3, default A2: steel's μ_s 0.50 was 'the slip coefficient of class B steel surfaces (AISC 360-16,
+    J3.8), a value for bolted faying surfaces' with no word on why class B; class A (0.30, clean mill scale) is the
+    closer value for an unprepared base, and for the paper's block (b/h 0.47) the class decides whether it rocks or
+    slides. The words say it is the study's choice, give class A, and name each block whose b/h lies between the
+    two, with what the sample's low-friction member does where it too lies below b/h."""
+    from rockfrag.report.sections import SLIP_CLASS_A, SLIP_CLASS_B, steel_friction_words
+    from rockfrag.soils import SOILS
+
+    # AISC 360-16 J3.8 mean slip coefficients, as printed: class A 0.30, class B 0.50
+    assert (SLIP_CLASS_A, SLIP_CLASS_B) == (0.30, 0.50) and SOILS["steel"].friction_static == SLIP_CLASS_B
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    cube = results.cube.assign_coords(soil=["steel", "rock"])  # sand renamed: the small study has no steel
+    slender = {str(b): float(cube.block_b.sel(block=b) / cube.block_h.sel(block=b)) for b in cube.block.values}
+    between = [block for block, ratio in slender.items() if SLIP_CLASS_A <= ratio < SLIP_CLASS_B]
+    assert between == ["paper"]  # b/h 0.47: the test can tell the blocks apart
+    members = ["friction_low", "friction_high"]
+    cube["member_friction_static"] = xr.DataArray(np.broadcast_to([0.42, 0.6], (2, 3, 2)).copy(),
+                                                  coords={"soil": cube.soil.values, "block": cube.block.values,
+                                                          "member": members}, dims=("soil", "block", "member"))
+    fragility = results.fragility.assign_coords(soil=["steel", "rock"])
+    medians = xr.full_like(fragility["median"].isel(model=0, drop=True), np.nan).expand_dims(member=members).copy()
+    fragility["member_median"] = medians
+    results.__dict__.update(cube=cube, fragility=fragility)
+    words = steel_friction_words(results)
+    assert "class B" in words and "class A (0.30)" in words and "the study's choice" in words
+    name = block_name(results.config, "paper")
+    assert f"the {name[:-1]}; b/h = {slender['paper']:.2f}) rocks with class B" in words or \
+        f"the {name} (b/h = {slender['paper']:.2f}) rocks with class B" in words
+    assert "low-friction run (μ_s 0.42), whose lift-off has no median" in words
+    for block in ("slender-cabinet", "squat-machinery"):
+        assert block_name(results.config, block) not in words
+
+
+def test_a_value_that_rests_on_the_assumed_friction_is_marked_with_the_high_friction_members_median(small_pipeline):
+    """Cold read 3, user B1: the clay overturning of the user study, 'once in 7,400,000 years', exists because the
+    soil's μ_s (0.35) is below the block's b/h (0.40): the block slides instead of rocking, and nothing beside the
+    number said so. On every soil where the block slides before it can rock, the design-life values of the rocking
+    states and overturning carry a mark, and a note under the table gives the medians of the designed sample's
+    high-friction member (fragility.nc member_median friction_high); no other cell is marked."""
+    from rockfrag.report.answer_page import FRICTION_MARK, answer_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    model = results.answers[0].model
+    friction = results.cube.friction_static.copy()
+    friction.loc[dict(model=model)] = 0.45  # as if the answering runs had base friction (sand 0.45, rock 0.7)
+    results.cube["friction_static"] = friction
+    members = ["friction_low", "friction_high"]
+    median = xr.full_like(results.fragility["median"].sel(model=model, drop=True), np.nan)
+    median.loc[dict(soil="rock", damage_state="rocking-0.5")] = 1.234  # the high-friction run rocks on rock
+    results.fragility["member_median"] = xr.concat([median * 0.8, median], dim="member").assign_coords(
+        member=members)
+    results.cube["member_friction_static"] = xr.DataArray(
+        np.full((results.cube.sizes["soil"], results.cube.sizes["block"], 2), 0.9),
+        coords={"soil": results.cube.soil.values, "block": results.cube.block.values, "member": members},
+        dims=("soil", "block", "member"))
+    edps = dict(zip(map(str, results.fragility.damage_state.values),
+                    map(str, results.fragility.damage_state_edp.values)))
+    rocking = {state for state, edp in edps.items() if edp in ("peak_angle_ratio", "overturned")}
+    answer = next(answer for answer in results.answers if answer.block == "squat-machinery")
+    items = answer_items(results, answer)
+    life = next(i for i, item in enumerate(items) if item.kind == "heading" and item.text.startswith("In the design"))
+    table, note = items[life + 1], items[life + 2]
+    short = {row[0]: state for row, state in zip(table.rows, results.fragility.damage_state.values)}
+    soils = [head.removeprefix("on ") for head in table.header[2:]]
+    slender = 1.5 / 2.0
+    marked = 0
+    for row in table.rows[:len(short)]:
+        state = short[row[0]]
+        for soil, cell in zip(soils, row[2:]):
+            mu = next(s.friction_static for s in results.config.soils if s.name == soil)
+            expected = state in rocking and mu < slender and cell.strip("- ") != "" and "not computed" not in cell
+            assert cell.endswith(f" {FRICTION_MARK}") == expected, (state, soil, cell)
+            marked += expected
+    assert marked >= 2
+    assert note.kind == "note" and note.text.startswith(f"{FRICTION_MARK} friction-driven: on sand, rock")
+    assert note.text.endswith("the medians are, on sand (μ_s 0.90): none below the credible cap; on rock (μ_s "
+                              "0.90): θmax/α ≥ 0.5 at 1.2 g."), note.text  # the small study's levels are in g
+    other = next(answer for answer in results.answers if answer.block == "slender-cabinet")  # b/h 0.2: grips
+    assert not any(FRICTION_MARK in cell for item in answer_items(results, other) if item.kind == "table"
+                   for row in item.rows for cell in row)

@@ -262,7 +262,7 @@ def test_a_steel_base_is_not_counted_as_a_soil():
 
     cube = xr.Dataset(coords={"soil": ["clay", "rock", "steel"],
                               "soil_shear_modulus": ("soil", [3.7e7, 1e9, 8e10])})
-    assert grounds(cube) == "2 soils (clay, rock) and a structural base (steel; not a soil)"
+    assert grounds(cube) == "2 soils (clay, rock) and a structural base at ground level (steel; not a soil)"
 
 
 # ---------------------------------------------------------------- credible intensities

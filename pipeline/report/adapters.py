@@ -59,6 +59,17 @@ class ModelInfo:
     uses_bed: bool = False  # a bed of springs (solver.bed), not the pivot-switch rule
 
 
+
+STIFF_BASE = 1e10
+"""Shear modulus [Pa] above which a "soil" of the study is a structural base (steel), not a soil."""
+
+
+def is_soil(cube, soil) -> bool:
+    """True for a soil, False for a structural base such as steel (shear modulus above ``STIFF_BASE``)."""
+    if "soil_shear_modulus" not in cube.variables:
+        return True
+    return float(cube.soil_shear_modulus.sel(soil=soil)) < STIFF_BASE
+
 def model_info(name: str) -> ModelInfo:
     """Label and role of a model from the registry (a model no longer registered keeps its name).
 

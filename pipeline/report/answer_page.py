@@ -47,7 +47,7 @@ from rockfrag.report.summary import (
     soil_intensities,
     verdict_items,
 )
-from rockfrag.report.text import Item, heading, paragraph, table
+from rockfrag.report.text import Item, heading, note, paragraph, table
 
 
 def _years(frequency: float) -> str:
@@ -164,18 +164,23 @@ def curve_reason(results, model: str, block=None) -> str:
             "so read them with the limitations, which say where this model is outside its assumptions.")
 
 
-def slides_first_words(results, answer) -> str:
-    """A sentence on the soils where this block slides before it can rock (μ_s below b/h), "" where none.
+FRICTION_MARK = "§"
+"""Beside a design-life value of a rocking state or overturning on a soil where the block slides before it can rock
+(``sliding_first_soils``): the value rests on the assumed base friction (cold read 3, user B1)."""
 
-    Only soils whose answering runs have base friction (cube.nc ``friction_static`` finite): there the block slides
-    at rest instead of rocking (Shenton 1996), so its rocking and overturning rest on the assumed friction. With the
-    designed sample, the overturning median of the high-friction member says what a base that grips more gives.
+ROCKING_EDPS = ("peak_angle_ratio", "overturned")
+"""The response quantities of the rocking states and overturning: what a base that slides instead of rocking moves."""
+
+
+def sliding_first_soils(results, answer) -> list:
+    """The soils (``SoilClass``) on which this block slides before it can rock: μ_s below b/h (Shenton 1996).
+
+    Only soils whose answering runs have base friction (cube.nc ``friction_static`` finite): a tied base cannot slide.
     """
     cube, config = getattr(results, "cube", None), results.config
     if cube is None or "block_b" not in cube.coords and "block_b" not in cube:
-        return ""
-    b, h = float(cube.block_b.sel(block=answer.block)), float(cube.block_h.sel(block=answer.block))
-    slender = b / h
+        return []
+    slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
     soils = []
     for soil in config.soils:
         if soil.friction_static >= slender:
@@ -185,26 +190,75 @@ def slides_first_words(results, answer) -> str:
             if not np.isfinite(float(value)):
                 continue  # a tied base: it cannot slide in these runs
         soils.append(soil)
+    return soils
+
+
+def _friction_driven_states(results) -> list[str]:
+    """The damage states of the rocking family (rocking angles, overturning) in the study's fragility."""
+    fragility = results.fragility
+    edps = dict(zip(map(str, fragility.damage_state.values), map(str, fragility["damage_state_edp"].values))) \
+        if "damage_state_edp" in fragility.coords else {}
+    return [state for state in map(str, fragility.damage_state.values)
+            if edps.get(state, getattr(DAMAGE_STATES.get(state), "edp", "")) in ROCKING_EDPS]
+
+
+def slides_first_words(results, answer) -> str:
+    """A sentence on the soils where this block slides before it can rock (μ_s below b/h), "" where none.
+
+    There its rocking and overturning rest on the assumed friction: the design-life table marks those values
+    (``FRICTION_MARK``) and ``friction_high_words`` gives what the designed sample's high-friction member does.
+    """
+    soils = sliding_first_soils(results, answer)
     if not soils:
         return ""
+    cube = results.cube
+    slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
     listed = ", ".join(f"{soil.name} {soil.friction_static:g}" for soil in soils)
-    text = (f"On {', '.join(soil.name for soil in soils)} the soil's base friction (μ_s {listed}) is below this "
+    return (f"On {', '.join(soil.name for soil in soils)} the soil's base friction (μ_s {listed}) is below this "
             f"block's b/h = {slender:.2f}: at rest it slides before it can rock (Shenton 1996), so its rocking and "
-            "overturning there rest on the assumed friction; a base that grips more (a grout bed, a keyed plinth) "
-            "would rock instead, and overturn more readily.")
-    fragility = results.fragility
-    if "member_median" in fragility and "friction_high" in fragility.member.values \
-            and "overturning" in fragility.damage_state.values:
-        scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
-        medians = []
-        for soil in soils:
-            value = float(fragility.member_median.sel(member="friction_high", soil=soil.name, block=answer.block,
-                                                      damage_state="overturning")) * scale
-            medians.append(f"{soil.name} {numbers.intensity(value, answer.unit)}" if np.isfinite(value)
-                           else f"{soil.name} none below the credible cap")
-        text += (" With the friction at the high end of its range (the designed sample), the overturning median is "
-                 f"{'; '.join(medians)}.")
-    return text
+            f"overturning there rest on the assumed friction (the values marked {FRICTION_MARK} in the design-life "
+            "table are friction-driven); a base that grips more (a grout bed, a keyed plinth) would rock instead, "
+            "and overturn more readily.")
+
+
+def friction_high_words(results, answer) -> str:
+    """The note under the design-life table: what the marked values become with the friction at its range's high end.
+
+    The medians of the designed sample's high-friction member (fragility.nc ``member_median``, member
+    ``friction_high``) of each rocking state and overturning on each soil where the block slides first; said once
+    where no such state has a median below the credible cap on any of them. "" where no soil is marked.
+    """
+    soils = sliding_first_soils(results, answer)
+    if not soils:
+        return ""
+    names = ", ".join(soil.name for soil in soils)
+    text = (f"{FRICTION_MARK} friction-driven: on {names} the block slides before it can rock, so these values rest "
+            "on the assumed base friction.")
+    fragility, cube = results.fragility, results.cube
+    states = _friction_driven_states(results)
+    if "member_median" not in fragility or "friction_high" not in fragility.member.values or not states:
+        return text
+    short = short_names(results)
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    parts = []
+    for soil in soils:
+        medians = [(state, float(fragility.member_median.sel(member="friction_high", soil=soil.name,
+                                                             block=answer.block, damage_state=state)) * scale)
+                   for state in states]
+        shown = [f"{short[state]} at {numbers.intensity(value, answer.unit)}" for state, value in medians
+                 if np.isfinite(value)]
+        friction = ""
+        if "member_friction_static" in cube:
+            high = cube.member_friction_static.sel(soil=soil.name, block=answer.block, member="friction_high")
+            friction = f" (μ_s {float(high):.2f})"
+        parts.append((soil.name, friction, shown))
+    if not any(shown for _, _, shown in parts):
+        where = "on any of them" if len(soils) > 1 else f"on {names}"
+        return (text + " With the friction at the high end of its range (the designed sample), no rocking state "
+                f"and no overturning has a median below the credible cap {where}.")
+    said = "; ".join(f"on {soil}{friction}: " + (", ".join(shown) if shown else "none below the credible cap")
+                     for soil, friction, shown in parts)
+    return text + f" With the friction at the high end of its range (the designed sample) the medians are, {said}."
 
 
 MOTIONS = ("at rest", TILT_WORDS, "slides", "rocks", "slides and rocks", "flies", "overturns")
@@ -379,6 +433,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     items.append(heading(f"In the design life of {life}"))
     header = ["damage state", "limit", *(f"on {soil.soil}" for soil in answer.soils)]
     rows = []
+    driven = {soil.name for soil in sliding_first_soils(results, answer)}
+    driven_states = _friction_driven_states(results)
     for index, state in enumerate(short):
         cells = [short[state], numbers.probability(limits[state]) if state in limits else "none"]
         for soil in answer.soils:
@@ -386,13 +442,18 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
             text = _not_computed(results, answer, soil.soil, state) or say_p_in_life(results, answer, soil, row)
             if row.not_reached_below is None and row.below_lowest is None and np.isfinite(row.probability_in_life):
                 text += f", {_years(row.annual_frequency)}" if _years(row.annual_frequency) else ""
+            if soil.soil in driven and state in driven_states and np.isfinite(row.probability_in_life):
+                text += f" {FRICTION_MARK}"
             cells.append(text)
         rows.append(cells)
     rows.append(["β of the answering curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
-    from rockfrag.report.summary import action
+    from rockfrag.report.summary import action, hazard_tag
 
-    rows.append(["action", "", *(action(soil.verdict, soil) for soil in answer.soils)])
+    tag = hazard_tag(results)
+    rows.append(["action", "", *(action(soil.verdict, soil, tag) for soil in answer.soils)])
     items.append(table(header, rows))
+    if driven:
+        items.append(note(friction_high_words(results, answer)))
     return items
 
 

@@ -47,6 +47,7 @@ from rockfrag.report.adapters import (
     cell,
     extrapolation,
     friction_flag,
+    is_soil,
     largest_recorded,
     measure_label,
     model_info,
@@ -311,17 +312,6 @@ def results_date(output) -> str | None:
     return f"{day:%Y-%m-%d}"  # not "26 November 2026": a capitalised word and a year read as a citation
 
 
-STIFF_BASE = 1e10
-"""Shear modulus [Pa] above which a "soil" of the study is a structural base (steel), not a soil."""
-
-
-def is_soil(cube, soil) -> bool:
-    """True for a soil, False for a structural base such as steel (shear modulus above ``STIFF_BASE``)."""
-    if "soil_shear_modulus" not in cube.variables:
-        return True
-    return float(cube.soil_shear_modulus.sel(soil=soil)) < STIFF_BASE
-
-
 def grounds(cube) -> str:
     """The study's foundations in words: "4 soils (clay, sand, gravel, rock) and a steel base (steel)"."""
     soils = [str(s) for s in cube.soil.values if is_soil(cube, s)]
@@ -331,7 +321,7 @@ def grounds(cube) -> str:
         parts.append(f"{len(soils)} soil{'s' if len(soils) != 1 else ''} ({', '.join(soils)})")
     if bases:
         parts.append(f"{'a' if len(bases) == 1 else len(bases)} structural base{'s' if len(bases) != 1 else ''} "
-                     f"({', '.join(bases)}; not a soil)")
+                     f"at ground level ({', '.join(bases)}; not a soil)")
     return " and ".join(parts)
 
 
@@ -591,9 +581,9 @@ def site_hazard_items(results: Results) -> list[Item]:
             "site class in the USGS hazard tools (ASCE 7-16 Table 20.3-1's classes), not a measurement: a site's "
             "measured Vs30 replaces it (the appendix names the setting).")
     if steel:
-        text += (f" A structural base ({', '.join(steel)}) keeps the reference curve: the block then feels the "
-                 "ground motion of the reference site, not that of a floor or deck above it, which this study "
-                 "does not model.")
+        text += (f" A structural base ({', '.join(steel)}) keeps the reference curve: a plate at ground level "
+                 "under the reference site's ground motion, not a floor or deck of a structure, whose motion (a "
+                 "floor spectrum) this study does not model (the summary says so once).")
     return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class", "site hazard"], rows)]
 
 
@@ -862,6 +852,55 @@ def _kinetic_words(soils) -> str:
     return "Kinetic friction " + "; ".join(words + own)
 
 
+SLIP_CLASS_A, SLIP_CLASS_B = 0.30, 0.50
+"""Mean slip coefficients of AISC 360-16 J3.8 (Specification for Structural Steel Buildings): class A, unpainted
+clean mill scale steel surfaces (or class A coatings on blast-cleaned steel); class B, unpainted blast-cleaned steel
+surfaces (or class B coatings). Both are measured on clamped faying surfaces of bolted slip-critical joints. The
+shipped steel's μ_s is class B's (rockfrag.soils.FRICTION_SOURCES); class A is the lower value of the same clause."""
+
+
+def steel_friction_words(results: Results) -> str:
+    """Why the steel base's μ_s is AISC's class B, and where class A's lower value would change what a block does.
+
+    A block whose b/h lies between the two classes rocks with class B and slides before it can rock with class A
+    (Shenton 1996: μ_s < b/h); the sample's low-friction member (cube.nc ``member_friction_static``), where it too
+    lies below b/h, shows what the lift-off then does (fragility.nc ``member_median``).
+    """
+    from rockfrag.soils import SOILS
+
+    steel = SOILS["steel"].friction_static
+    text = (f"a steel base on steel: {steel:.2f}, AISC 360-16 J3.8's mean slip coefficient of class B surfaces "
+            f"(unpainted blast-cleaned steel), taken as the study's choice for a block's steel base on a steel "
+            f"plate; it is measured on the clamped faying surfaces of bolted joints, and an unprepared mill-scale "
+            f"surface is class A ({SLIP_CLASS_A:.2f})")
+    cube, fragility = results.cube, results.fragility
+    if "block_b" not in cube.coords and "block_b" not in cube or "steel" not in cube.soil.values:
+        return text
+    decided = []
+    for block in map(str, cube.block.values):
+        slender = float(cube.block_b.sel(block=block)) / float(cube.block_h.sel(block=block))
+        if not SLIP_CLASS_A <= slender < steel:
+            continue
+        name = block_name(results.config, block)
+        name = f"{name[:-1]}; b/h = {slender:.2f})" if name.endswith(")") else f"{name} (b/h = {slender:.2f})"
+        words = f"the {name} rocks with class B; with class A it would slide before it can rock"
+        if "member_friction_static" in cube and "member_median" in fragility \
+                and "friction_low" in fragility.member.values and "uplift" in fragility.damage_state.values:
+            low = float(cube.member_friction_static.sel(soil="steel", block=block, member="friction_low"))
+            median = float(fragility.member_median.sel(member="friction_low", soil="steel", block=block,
+                                                       damage_state="uplift"))
+            if low < slender:
+                scale, unit = display_scale(_level_units(fragility))
+                words += (f", as it does in the sample's low-friction run (μ_s {low:.2f}), whose lift-off has "
+                          + (f"a median of {numbers.intensity(median * scale, unit)}" if np.isfinite(median)
+                             else "no median"))
+        decided.append(words)
+    if decided:
+        text += (". Where a block's b/h lies between the two classes, the class decides whether it rocks or slides: "
+                 + "; ".join(decided))
+    return text
+
+
 def sources_items(results: Results) -> list[Item]:
     """Where each limit and value the report states comes from: a reference, or the study's choice in words."""
     from rockfrag.models.variants import DEFAULT_DESIGN
@@ -891,10 +930,9 @@ def sources_items(results: Results) -> list[Item]:
         ranges = "; ".join(NAVFAC_RANGES[soil.name] for soil in shipped_soils if soil.name in NAVFAC_RANGES)
         items.append(bullet(f"Base friction μ_s of {names} ({results.friction_text}): the ultimate friction factor "
                             f"of mass concrete on the material, NAVFAC DM-7.02 (1986) Table 1 ({ranges})"
-                            + ("; a steel base on steel: the slip coefficient of class B steel surfaces (AISC "
-                                       "360-16, J3.8), a value for bolted faying surfaces taken here for a block "
-                                       "bearing on steel" if any(soil.name == "steel" for soil in shipped_soils)
-                                       else "") + f". {_kinetic_words(shipped_soils)}: " + CHOICE_WORDS + "."))
+                            + (f"; {steel_friction_words(results)}" if any(soil.name == "steel"
+                                                                           for soil in shipped_soils) else "")
+                            + f". {_kinetic_words(shipped_soils)}: " + CHOICE_WORDS + "."))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
     design = config.design

@@ -19,7 +19,7 @@ import numpy as np
 
 from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT
 from rockfrag.report import numbers
-from rockfrag.report.adapters import block_name, state_labels
+from rockfrag.report.adapters import block_name, is_soil, state_labels
 from rockfrag.report.text import Item, bullet, note, paragraph, strong, table
 
 ACTION_WORDS = {ANCHOR: "anchor or restrain", CHECK_SLIDING: "specialist check",
@@ -89,13 +89,30 @@ def hazard_caveat(results) -> str:
     return ILLUSTRATIVE_WORDS if illustrative_hazard(results) else ""
 
 
-def action(verdict: str, soil=None) -> str:
+EXAMPLE_TAG, ILLUSTRATIVE_TAG = "example hazard", "illustrative hazard"
+"""Said beside every action the report prints when its hazard is not a site's: "no action (illustrative hazard)".
+A cell copied out of the report keeps what the verdict rests on (cold read 3, user and default A1)."""
+
+
+def hazard_tag(results) -> str:
+    """The words beside each printed action: ``EXAMPLE_TAG``, ``ILLUSTRATIVE_TAG``, or "" for a site's hazard."""
+    answers = getattr(results, "answers", None) or []
+    if any(answer.example_hazard for answer in answers):
+        return EXAMPLE_TAG
+    return ILLUSTRATIVE_TAG if illustrative_hazard(results) else ""
+
+
+def action(verdict: str, soil=None, hazard: str = "") -> str:
     """A verdict in the client's words ("anchor or restrain").
 
     With ``soil``: "(rocking only)" beside it where the study did not compute that base's sliding (``SoilAnswer.tied``).
+    With ``hazard`` (``hazard_tag``): the hazard it rests on when that is not a site's ("no action (example hazard)").
     """
     words = ACTION_WORDS.get(verdict, str(verdict).replace("_", " "))
-    return words + (f" ({ROCKING_ONLY})" if _tied(soil) else "")
+    notes = [ROCKING_ONLY] if _tied(soil) else []
+    if hazard and verdict != NO_VERDICT:
+        notes.append(hazard)
+    return words + (f" ({'; '.join(notes)})" if notes else "")
 
 
 ROCKING_ONLY = "rocking only"
@@ -158,17 +175,45 @@ BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a pr
 """How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
+STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level, under the reference site's ground motion. A block "
+                         "on a structure (floor, deck) feels the floor's amplified motion, a floor spectrum this study "
+                         "does not model: the {names} rows judge a block at ground level, not one on a structure.")
+"""What a structural base of the study (steel) stands for, said once, in the summary's note (cold read 3, A2)."""
+
+
+def structural_bases(results) -> list[str]:
+    """The study's structural bases (steel: rockfrag.report.adapters.is_soil), in the study's order."""
+    cube = getattr(results, "cube", None)
+    if cube is None or "soil" not in cube.coords:
+        return []
+    return [str(soil) for soil in cube.soil.values if not is_soil(cube, soil)]
+
+
+def structural_base_words(results) -> str:
+    """``STRUCTURAL_BASE_WORDS`` for the study's structural bases ("" where it has none)."""
+    bases = structural_bases(results)
+    return STRUCTURAL_BASE_WORDS.format(names=_and(bases)) if bases else ""
+
+
 def governing(soil) -> object | None:
     """The damage state that governs a block's verdict on one soil (a ``StateAnswer``), or None.
 
-    An exceeded state with the largest probability over its limit; else the judged state nearest its limit;
-    None where no state is judged or none has a probability.
+    An exceeded state with the largest probability over its limit; else the judged state nearest its limit among
+    those with a computed probability (``GOVERNING_WORDS``): a state no record reached has only a bound ("< X"),
+    which says how small it is, not how near its limit, so it governs only where every judged state is such a
+    bound. None where no state is judged or none has a probability.
     """
     judged = [row for row in soil.states if row.limit and np.isfinite(row.probability_in_life)]
     if not judged:
         return None
     exceeded = [row for row in judged if row.exceeds]
-    return max(exceeded or judged, key=lambda row: row.probability_in_life / row.limit)
+    computed = [row for row in judged if row.not_reached_below is None]
+    return max(exceeded or computed or judged, key=lambda row: row.probability_in_life / row.limit)
+
+
+GOVERNING_WORDS = ("Governing: the state furthest above its limit; where none is above, the computed state nearest "
+                   "its limit (a state no record reached has only a bound, '< X', and governs only where all do).")
+"""How the summary picks the state it prints (``governing``), said in its note."""
 
 
 def p_in_life(row) -> str:
@@ -267,8 +312,7 @@ def reason(results, answer, soil) -> str:
         return f"{numbers.count(reached, total)} records already at {numbers.intensity(level, unit)}: a bound"
     censored = _censored_at_cap(results, answer, soil, row)
     if censored is not None:
-        return (f"median above the {numbers.intensity(censored, unit)} cap: P is a bound (it adds the hazard's "
-                "exceedance of the cap)")
+        return f"a bound: median above {numbers.intensity(censored, unit)}"  # the cap: said in the note
     if row.tail_only:
         first = numbers.intensity(row.first_reached, unit) if row.first_reached is not None else "any level"
         return f"fitted tail only: no record below {first}"
@@ -276,7 +320,7 @@ def reason(results, answer, soil) -> str:
         reached, total, level = row.records[-1]
         results.facts.say("records reaching", (answer.block, soil.soil, row.state, answer.return_periods[-1]),
                           str(reached))
-        return f"{numbers.count(reached, total)} records reach it at {numbers.intensity(level, unit)}"
+        return f"{numbers.count(reached, total)} reach it at {numbers.intensity(level, unit)}"
     return "from the fitted curve"
 
 
@@ -340,15 +384,19 @@ def summary_items(results) -> list[Item]:
               ("specialist check", "'Specialist check': the base would slide, and its sliding was not computed."),
               ("no action", "'No action': every judged damage state is within its limit."),
               (ROCKING_ONLY, "'Rocking only': the study did not compute this base's sliding, so the verdict covers "
-                             "rocking and overturning only.")]
+                             "rocking and overturning only."),
+              (EXAMPLE_TAG, "'(Example hazard)': what the example hazard gives, not a site's verdict."),
+              (ILLUSTRATIVE_TAG, "'(Illustrative hazard)': what the illustrative hazard gives, not the site's "
+                                 "verdict.")]
     said = " ".join(words for key, words in legend if any(key in cell for cell in used))
     cells = " ".join(cell for row in rows for cell in row[3:3 + len(periods) + 1])
     bounds = " ".join(words for words, shown in ((BOUND_WORDS, "< "), (no_curve_words(first), " of "))
                       if shown in cells)
     items.append(note(" ".join(filter(None, [
-        said, bounds, "Reason: the records at the level run at or below the largest return period's intensity. β: "
-        "records, the variability from record to record; model, the model's own uncertainty. The answer pages give "
-        "every damage state and the records behind each number."]))))
+        said, GOVERNING_WORDS, bounds, structural_base_words(results),
+        "Reason: the records at the level run at or below the largest return period's intensity. β: records, the "
+        "variability from record to record; model, the model's own uncertainty. The answer pages give every damage "
+        "state and the records behind each number."]))))
     return items
 
 
@@ -360,6 +408,7 @@ def verdict_rows(results, answer) -> list[dict]:
     """
     short = short_names(results)
     periods = answer.return_periods
+    tag = hazard_tag(results)
     lines = []
     for soil in answer.soils:
         row = governing(soil)
@@ -372,7 +421,7 @@ def verdict_rows(results, answer) -> list[dict]:
             at = [say_p_at(results, answer, soil, row, i) for i in range(len(periods))]
             life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.probability(row.limit)})"
             beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
-        lines.append({"soil": soil.soil, "action": action(soil.verdict, soil), "state": state, "at": at,
+        lines.append({"soil": soil.soil, "action": action(soil.verdict, soil, tag), "state": state, "at": at,
                       "life": life_text, "beta": beta, "reason": reason(results, answer, soil)})
     return lines
 
@@ -418,7 +467,7 @@ def verdict_items(results, answer) -> list[Item]:
     parts = []
     for verdict, soils in groups.items():
         where = _and([soil.soil for soil in soils])
-        parts.append(f"{action(verdict)} on {where}")
+        parts.append(f"{action(verdict, hazard=hazard_tag(results))} on {where}")
     tied = [soil.soil for soil in answer.soils if _tied(soil)]
     if tied:
         parts.append(f"sliding was not computed on {_and(tied)} (the study ties the base there), so those verdicts "
@@ -436,5 +485,6 @@ def _and(words) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
-__all__ = ["ACTION_WORDS", "action", "beta_words", "governing", "p_at_return_period", "p_in_life", "reason",
+__all__ = ["ACTION_WORDS", "EXAMPLE_TAG", "GOVERNING_WORDS", "ILLUSTRATIVE_TAG", "STRUCTURAL_BASE_WORDS", "action",
+           "beta_words", "governing", "hazard_tag", "p_at_return_period", "p_in_life", "reason", "structural_bases",
            "summary_items", "terminal_verdicts", "verdict_items", "verdict_rows"]

@@ -190,9 +190,14 @@ MIN_TABLE_SIZE = 7.5  # pt: below it a client cannot read a printed table; a wid
 
 
 def _column_widths(item) -> list[int]:
-    """Characters each column needs: its widest cell, or its header wrapped no narrower than ``MIN_HEADER``."""
+    """Characters each column needs: its widest cell, or its header's longest line wrapped at ``MIN_HEADER``.
+
+    The header as ``table_layout`` sets it at its narrowest ("P at 475 years" needs 8: "P at 475" / "years"), so a
+    table is not wrapped or split for width its columns never take.
+    """
     return [max(max((len(row[c]) for row in item.rows if not is_span(row)), default=0),
-                min(len(item.header[c]), MIN_HEADER)) for c in range(len(item.header))]
+                max((len(line) for line in textwrap.wrap(item.header[c], MIN_HEADER, break_long_words=False)),
+                    default=0)) for c in range(len(item.header))]
 
 
 def fit_table(item) -> list[Item]:
