@@ -68,6 +68,9 @@ is regular at the interval's scale; the data say which (``_decide``; block comme
    region is read off the likelihood itself on the shortest accepted window, without local curvature: every
    point of its 121 x 21 scan within a deviance limit of the scan's best, one scan step beyond, the limit a
    parametric bootstrap of that reading scored on the scan's grid (``_direct_region``).
+7. Intervals that are still the whole search range in k or xi (a decisive window that ends soon after the rocking
+   starts, at large or coloured noise, with other basins that explain it equally): the longest accepted window's
+   region is read off the likelihood the same way (its rocking bounds what the short window did not).
 
 Why not the alternatives alone: profile likelihood over the whole record is the old method; a parametric
 bootstrap of the whole calibration (resimulate, search again) costs hundreds of searches of ~2,000
@@ -309,9 +312,9 @@ class CalibrationResult:
         if self.decisive_window is None:
             return [f"  no window decided: none of the {len(self.windows)} fitted has a regular likelihood{why}"]
         if DIRECT_METHOD in self.interval_method:
-            return [f"  decided by the window 0-{self.decisive_window:.2f} s of 0-{end:.2f} s: none of the "
-                    f"{len(self.windows)} fitted has a regular likelihood, and this one's region is read off a scan "
-                    f"of the search range{why}"]
+            return [f"  decided by the window 0-{self.decisive_window:.2f} s of 0-{end:.2f} s: its likelihood region "
+                    f"is read off a scan of the search range (no regular window bounds k and xi inside it; see the "
+                    f"notes){why}"]
         return [f"  decided by the window 0-{self.decisive_window:.2f} s of 0-{end:.2f} s: the longest whose fit "
                 f"explains the reference at the noise level and whose likelihood is regular{why}"]
 
@@ -687,6 +690,10 @@ WIDENING_NOTED = 0.05  # a widening to the region's simulated points beyond this
 def autocorrelation_time(residual: ArrayLike) -> float:
     """Integrated autocorrelation time [samples] of a series: 1 + 2 sum of rho_k while rho_k >= 2/sqrt(n).
 
+    At least the AR(1) value (1 + rho_1) / (1 - rho_1): the sum cut where rho_k drops into its sampling noise
+    leaves out the tail of an AR(1) series (for phi = 0.8 and 600 samples it gives a median of 8.0 for 9, and
+    fewer independent samples counted means intervals that are too narrow); the AR(1) value has no such cut.
+
     Parameters
     ----------
     residual : array_like
@@ -709,7 +716,11 @@ def autocorrelation_time(residual: ArrayLike) -> float:
     # (a cut at the first negative rho would add its random positive lags, ~10 % at n = 1000)
     small = np.flatnonzero(rho < 2.0 / math.sqrt(n))
     lags = int(small[0]) if small.size else rho.size
-    return max(1.0, 1.0 + 2.0 * float(np.sum(rho[:lags])))
+    lag_one = min(max(float(rho[0]), 0.0), AR1_MAX)
+    return max(1.0, 1.0 + 2.0 * float(np.sum(rho[:lags])), (1.0 + lag_one) / (1.0 - lag_one))
+
+
+AR1_MAX = 0.99  # the largest lag-1 correlation the AR(1) autocorrelation time takes (tau 199)
 
 
 class _Likelihood:
@@ -1227,10 +1238,19 @@ class _Scan:
     grid_residuals: np.ndarray = field(repr=False, default=None)  # (grid points, samples): model - reference
 
     def region(self, best: float, variance: float, level: float) -> np.ndarray:
-        """Basins and grid points whose deviance against RSS ``best`` is within ``level``."""
+        """Basins and grid points whose deviance against RSS ``best`` is within ``level``, and their box's corners.
+
+        The corners are moved out by one scan step, as in ``_direct_region``: the region's edge lies between the
+        last grid point inside and the first outside, and a needle of the likelihood between them is not seen.
+        """
         points = np.concatenate([self.points.reshape(-1, 2), self.grid])
         rss = np.concatenate([self.rss, self.grid_rss])
-        return points[(rss - best) / variance <= level]
+        inside = points[(rss - best) / variance <= level]
+        if not inside.size:
+            return inside
+        steps = np.array([1.0 / (SCAN_K - 1), 1.0 / (SCAN_XI - 1)])
+        corners = np.clip([inside.min(axis=0) - steps, inside.max(axis=0) + steps], 0.0, 1.0)
+        return np.concatenate([inside, corners])
 
 
 MIN_BASE_SAMPLES = 20  # a quiet start shorter than this is no base: the search's first window is
@@ -1326,7 +1346,9 @@ def _decide(search, times, reference, history, full_point, fixed_xi, confidence,
         # no window's likelihood is regular at its interval's scale: no local curvature describes it, so the
         # region is read off the likelihood itself over the whole search range, on the shortest accepted window
         # (the least chaotic), or a longer one where that does not bound k and xi inside the range
-        for window in accepted[:DIRECT_TRIES]:
+        # then the longest accepted ones: the most informative, where the short ones leave k or xi unbounded
+        tries = accepted[:DIRECT_TRIES] + [w for w in accepted[DIRECT_TRIES:][::-1]][:DIRECT_TRIES]
+        for window in tries:
             out = _direct_region(search, times, reference, window, scan_of(window), axes, confidence, floor_rms)
             if not out["whole_range"]:
                 break
@@ -1438,8 +1460,39 @@ def _decide(search, times, reference, history, full_point, fixed_xi, confidence,
                          f"0-{window.end:.2f} s as well as its best")
             range_points += list(region_of(window))
             break
-    return dict(profile, end=chosen.end, identifiable=identifiable, windows=table(), notes=notes, point=point,
-                range_points=np.array(range_points))
+    decision = dict(profile, end=chosen.end, identifiable=identifiable, windows=table(), notes=notes, point=point,
+                    range_points=np.array(range_points))
+    unbounded = _spans_search_range(search, decision, axes)
+    if not unbounded:
+        return decision
+    # the decisive window (short: the likelihood turns irregular soon after the rocking starts, at large or coloured
+    # noise) bounds k or xi only by the search range once the fits that explain it equally are counted. A longer
+    # accepted window carries the information its rocking adds, though no local curvature describes its likelihood:
+    # its region is read off a scan of the search range (``_direct_region``), the longest first.
+    for window in [w for w in accepted if w.n > chosen.n][::-1][:DIRECT_TRIES]:
+        out = _direct_region(search, times, reference, window, scan_of(window), axes, confidence, floor_rms)
+        if out["whole_range"]:
+            continue
+        out["notes"] = [f"the decisive window 0-{chosen.end:.2f} s bounds {' and '.join(unbounded)} only by the "
+                        "search range (its fits that explain it equally span it): the intervals are the likelihood "
+                        f"region of the longer accepted window 0-{out['end']:.2f} s by direct evaluation over the "
+                        "search range"] + out["notes"]
+        out.update({key: value for key, value in profile.items() if key.startswith("profile_")}, windows=table())
+        return out
+    return decision
+
+
+def _spans_search_range(search, decision, axes):
+    """The names of the parameters ("k", "xi") whose interval in ``decision`` is the whole search range."""
+    names = []
+    for axis in axes:
+        name = ("k", "xi")[axis]
+        values = [float(p[axis]) for p in decision["range_points"]]
+        if decision.get(f"{name}_low") is not None:
+            values += [_unit(search, axis, decision[f"{name}_low"]), _unit(search, axis, decision[f"{name}_high"])]
+        if min(values) <= 1e-9 and max(values) >= 1.0 - 1e-9:
+            names.append(name)
+    return names
 
 
 DIRECT_TRIES = 3  # accepted windows tried, shortest first, for a direct region that bounds k and xi

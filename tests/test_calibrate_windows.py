@@ -23,7 +23,10 @@ from rockfrag.calibrate import (
     _explained,
     _interval_fields,
     _irregularity,
+    _Scan,
+    _spans_search_range,
     _Window,
+    autocorrelation_time,
     calibrate,
 )
 from rockfrag.models import simulate
@@ -94,6 +97,53 @@ def test_not_identifiable_is_printed_with_the_range():
     lines = result.interval_lines()
     assert lines[0].startswith(f"{NOT_IDENTIFIABLE} (90%): the fits that explain it equally span k 2e+08 to 8e+08")
     assert lines[1].startswith("  no window decided")
+
+
+def test_a_range_that_spans_the_search_box_is_found_in_either_parameter():
+    class Search:  # k 1e8-9e8 N/m log-spaced, xi 0.01-0.07 in the unit box
+        log_k = (math.log(1e8), math.log(9e8))
+        xi_range = (0.01, 0.07)
+
+    def decision(points, **bounds):
+        return {"range_points": np.array(points, float), **bounds}
+
+    inside = decision([[0.4, 0.5]], k_low=2e8, k_high=4e8, xi_low=0.02, xi_high=0.05)
+    assert _spans_search_range(Search, inside, (0, 1)) == []
+    # the profile bounds xi inside, but basins at both edges of the xi range explain the window as well
+    basins = decision([[0.4, 0.5], [0.45, 0.0], [0.42, 1.0]], k_low=2e8, k_high=4e8, xi_low=0.02, xi_high=0.05)
+    assert _spans_search_range(Search, basins, (0, 1)) == ["xi"]
+    whole_k = decision([[0.4, 0.5]], k_low=1e8, k_high=9e8, xi_low=0.02, xi_high=0.05)
+    assert _spans_search_range(Search, whole_k, (0, 1)) == ["k"]
+    assert _spans_search_range(Search, basins, (0,)) == []  # a fixed xi is no interval
+
+
+def test_a_scan_region_reaches_one_scan_step_beyond_its_outermost_points():
+    grid = np.array([(u, v) for u in np.linspace(0, 1, 121) for v in np.linspace(0, 1, 21)])
+    rss = np.full(len(grid), 10.0)
+    chosen = [int(np.argmin(np.abs(grid - point).sum(axis=1))) for point in ((0.5, 0.5), (0.525, 0.55))]
+    rss[chosen] = 1.0
+    scan = _Scan(np.zeros((0, 2)), np.zeros(0), grid, rss)
+    region = scan.region(best=1.0, variance=1.0, level=2.0)
+    # the two grid points inside, and the corners of their box moved out by one step (1/120 in u, 1/20 in v)
+    assert region.min(axis=0) == pytest.approx([0.5 - 1 / 120, 0.5 - 1 / 20])
+    assert region.max(axis=0) == pytest.approx([0.525 + 1 / 120, 0.55 + 1 / 20])
+    assert scan.region(best=1.0, variance=1.0, level=-1.0).size == 0
+
+
+def test_the_autocorrelation_time_of_ar1_noise_is_not_cut_short_on_a_short_window():
+    # 600 samples of AR(1) noise, phi 0.8 (tau 9): the sum of rho_k cut at its sampling noise (2/sqrt(n)) leaves out
+    # the tail, 8.0 in the median; the AR(1) value keeps it. White noise stays at 1.
+    phi, rng = 0.8, np.random.default_rng(3)
+    taus = []
+    for _ in range(100):
+        shocks = rng.normal(0.0, math.sqrt(1 - phi**2), 600)
+        series = np.empty(600)
+        series[0] = rng.normal()
+        for i in range(1, 600):
+            series[i] = phi * series[i - 1] + shocks[i]
+        taus.append(autocorrelation_time(series))
+    assert np.median(taus) == pytest.approx((1 + phi) / (1 - phi), rel=0.05)
+    assert np.median([autocorrelation_time(rng.normal(size=600)) for _ in range(100)]) < 1.15
 
 
 # ---------------------------------------------------------------- whole calibrations of chaotic references
