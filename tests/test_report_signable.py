@@ -190,10 +190,10 @@ def test_the_applicability_pages_say_what_their_ratio_measures(small_pipeline):
     speed at an impact than Housner's r on the stiffest ground, for every default block."""
     from rockfrag.config import load_study
     from rockfrag.models.restitution import free_rocking_restitution
-    from rockfrag.report import CAPTIONS, sweep_words
+    from rockfrag.report import CAPTIONS, SWEEP_NEXT, sweep_words
     from rockfrag.soils import interface_stiffness
 
-    assert "slides instead of rocking" in CAPTIONS["applicability"] and "differ by design" in CAPTIONS["applicability"]
+    assert "slides instead of rocking" in CAPTIONS["applicability"] and "differ by design" in SWEEP_NEXT
     applicability = xr.open_dataset(small_pipeline.output / "applicability.nc")
     words = sweep_words(applicability)
     xi = float(applicability.attrs["damping_ratio"])

@@ -191,7 +191,8 @@ STATION_NAMES = ("Stations are named as the records' source catalogue spells the
 
 CAPTIONS = {
     "hazard": "Read how often each intensity is exceeded at the site, per year: each soil's curve (its colour) and "
-              "the reference site's it is carried from (black dashed); dotted, the frequencies of the return periods "
+              "the reference site's it is carried from (black dashed; a soil's curve stops where the given one "
+              "ends, at its rarest frequency); dotted, the frequencies of the return periods "
               "(where a curve crosses one, the site's intensity of that return period, as the answer pages print "
               "it).",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled; the 16% "
@@ -215,30 +216,28 @@ CAPTIONS = {
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
                        "the fitted lognormal, one colour per soil; light shading around a line, the confidence "
-                       "bounds of its median; {rigid}. Grey shading: extrapolation by scaling. The notes under the "
-                       "legend say which curves could not be fitted, and why.",
+                       "bounds of its median; {rigid}. Grey shading: extrapolation by scaling.",
     "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil, bottom the "
                         "stiffest. Points: records; lines: fits, one style per model (legend); light shading around "
                         "a line: the confidence bounds of its median. Dotted: the site's return-period intensities; "
-                        "grey shading: extrapolation by scaling. The notes under the legend: curves that could not "
-                        "be fitted, and why.",
+                        "grey shading: extrapolation by scaling.",
     "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
                 "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
-                "bed); dashed, that it overturns; between them it rocks and stays up. Grey shading: extrapolation "
-                "by scaling.",
+                "bed); dashed, that it overturns; between them it rocks and stays up (shaded orange where a panel "
+                "has one pair of curves). Grey shading: extrapolation by scaling.",
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
-    "applicability": "Read where the rigid-base model is good enough: each line is one foundation model (its colour "
-                     "and dashes) for one block (its marker): the median peak angle of the runs between 1.2 and 3 "
-                     "times the block's uplift threshold over the rigid base's. Grey shading: within 10% of the "
+    "applicability": "Read where the rigid-base model is good enough: each line (a point where one soil alone has a "
+                     "ratio) is one foundation model (its colour and dashes) for one block (its marker): the median "
+                     "peak angle of the runs between 1.2 and 3 times the block's uplift threshold over the rigid "
+                     "base's. Grey shading: within 10% of the "
                      "rigid base. Green shading: 300-1000 MPa, the soil stiffness above which the paper finds the "
                      "rigid base good enough. Top axis: the study's soils. Lines that coincide hide each other. "
                      "These are the study's own runs: the recommended model's base has friction and its bed's "
                      "restitution is set within the experiments' range, so where its block slides instead of "
                      "rocking (its kinetic friction below tan α: the limitations' 'Sliding') the ratio falls far "
-                     "below 1, which is sliding, not the bed's stiffness. The next page ties every base and leaves "
-                     "the bed's damping uncalibrated, to isolate stiffness: the two pages differ by design.",
+                     "below 1, which is sliding, not the bed's stiffness.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
@@ -254,6 +253,13 @@ CAPTIONS = {
                   "below the dashed line it does; the test of Luco & Cornell 2007).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
+
+NOTES_WORDS = " The notes under the legend say which series have points but no curve, and why."
+"""A fragility caption's last sentence, on a page whose notes list such series (``figures.has_page_notes``)."""
+
+SWEEP_NEXT = (" The next page ties every base and leaves the bed's damping uncalibrated, to isolate stiffness: the two "
+              "pages differ by design.")
+"""The applicability caption's last sentence, where the sweep's page follows it (a study run with the sweep)."""
 
 
 def _rigid_words(fragility, block) -> str:
@@ -446,11 +452,16 @@ def plan(results: Results) -> list[Page]:
             planned.append(_figure(f"fragility-soils-{block}-{model.name}", "Fragility",
                                    f"Fragility by soil: {names[block]}, {short_label(model)}",
                                    pages.fragility_by_soil_page, fragility, block, model,
-                                   caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block)),
+                                   caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block))
+                                   + (NOTES_WORDS if pages.has_page_notes(
+                                       fragility, block, [model, *(m for m in models_of(fragility) if m.rigid_base)])
+                                      else ""),
                                    marks=results.marks(block), name=names[block]))
         planned.append(_figure(f"fragility-models-{block}", "Fragility", f"Fragility by model: {names[block]}",
                                pages.fragility_by_model_page, fragility, block, extremes,
-                               caption=CAPTIONS["fragility-models"], marks=results.marks(block), name=names[block]))
+                               caption=CAPTIONS["fragility-models"]
+                               + (NOTES_WORDS if pages.has_page_notes(fragility, block, soils=extremes) else ""),
+                               marks=results.marks(block), name=names[block]))
     if "median_sensitivity" in fragility:
         planned.append(_figure("sensitivity", "Fragility", "Model uncertainty: sensitivity of the median",
                                pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names))
@@ -467,7 +478,10 @@ def plan(results: Results) -> list[Page]:
                                    marks=results.marks(block), name=names[block]))
     if any(m.rigid_base for m in models) and any(not m.rigid_base for m in models):
         planned.append(_figure("applicability", "Applicability", "Applicability of the rigid-base model",
-                               pages.applicability_page, cube, caption=CAPTIONS["applicability"], names=names))
+                               pages.applicability_page, cube, caption=CAPTIONS["applicability"]
+                               + (SWEEP_NEXT if results.applicability is not None
+                                  and "peak_angle_ratio_to_housner" in results.applicability else ""),
+                               names=names))
     if results.applicability is not None and "peak_angle_ratio_to_housner" in results.applicability:
         planned.append(_figure("applicability-sweep", "Applicability", "Rigid-base error against soil stiffness",
                                pages.sweep_page, results.applicability,

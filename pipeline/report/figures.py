@@ -110,7 +110,11 @@ def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x", soil=N
     """
     if marks is None:
         return
+    colour, label = MARK_COLOUR, HAZARD_LABEL
     if soil is not None:
+        soils = [name for name, _ in marks.by_soil]
+        if str(soil) in soils:  # the page marks each soil's own intensities: in that soil's colour everywhere
+            colour, label = soil_colour(str(soil), soils.index(str(soil))), SOIL_HAZARD_LABEL
         marks = marks.for_soil(soil)
     elif marks.by_soil:
         soil_marks(axis, marks, along)
@@ -127,8 +131,10 @@ def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x", soil=N
     named = ", ".join(f"{t:,.0f}" for t in periods) + " years"
     for intensities, _ in groups:
         for intensity in intensities:
-            line(intensity, color=MARK_COLOUR, lw=0.9, ls=":",
-                 label=f"{HAZARD_LABEL}: {named}" + (" (from the lowest line up)" if along == "y" else ""))
+            line(intensity, color=colour, lw=0.9, ls=":", label=None if label != HAZARD_LABEL else
+                 f"{HAZARD_LABEL}: {named}" + (" (from the lowest line up)" if along == "y" else ""))
+    if label != HAZARD_LABEL and groups:  # one legend entry with the panels of every soil (``soil_marks``)
+        line(np.nan, color="0.3", lw=0.9, ls=":", label=f"{SOIL_HAZARD_LABEL}: {named}")
     if along == "x" and groups:
         centres = [float(np.exp(np.mean(np.log(intensities)))) for intensities, _ in groups]
         width = axis.get_position().width * axis.figure.get_figwidth() * 72.0  # pt
@@ -230,6 +236,22 @@ def spectra_page(showcase, caption):
     return figure
 
 
+def given_part(curve, reference=None) -> tuple[np.ndarray, np.ndarray]:
+    """The part of a soil's site curve (intensity, annual frequency) that rests on the hazard given.
+
+    A soil's curve carried from a reference curve (site amplification) is computed on a wider grid; below the
+    reference curve's rarest frequency it rests on an extrapolation of the reference beyond its last point, which
+    nobody gave: it is not drawn. A curve given for the soil itself (or without a reference) is drawn whole.
+    """
+    intensity, frequency = np.asarray(curve.intensity, float), np.asarray(curve.annual_frequency, float)
+    if reference is None or curve is reference:
+        return intensity, frequency
+    given = np.asarray(reference.annual_frequency, float)
+    given = given[given > 0]
+    keep = (frequency >= given.min() * (1 - 1e-9)) & (frequency <= given.max() * (1 + 1e-9))
+    return intensity[keep], frequency[keep]
+
+
 def hazard_page(sites, return_periods, caption, unit: str = "g"):
     """The hazard behind every probability: annual frequency of exceedance against the intensity, log-log.
 
@@ -250,21 +272,21 @@ def hazard_page(sites, return_periods, caption, unit: str = "g"):
     for index, (soil, curve) in enumerate(sites.items()):
         if soil in same:
             continue
-        axis.loglog(curve.intensity, curve.annual_frequency, color=soil_colour(soil, index), lw=1.4, label=soil)
+        intensity, frequency = given_part(curve, reference)
+        axis.loglog(intensity, frequency, color=soil_colour(soil, index), lw=1.4, label=soil)
     periods = [float(t) for t in return_periods]
     for t in periods:
         axis.axhline(1.0 / t, color=MARK_COLOUR, ls=":", lw=0.9)
     if periods:
         axis.plot([], [], color=MARK_COLOUR, ls=":", lw=0.9,
                   label="dotted: once in " + ", ".join(f"{t:,.0f}" for t in periods) + " years (1/T)")
-    frequencies = np.concatenate([np.asarray(curve.annual_frequency, float) for curve in sites.values()])
+    drawn = [given_part(curve, reference) for curve in sites.values()]
+    frequencies = np.concatenate([frequency for _, frequency in drawn])
     frequencies = frequencies[frequencies > 0]
     low = min(frequencies.min(), 0.2 / max(periods)) if periods else frequencies.min()
     bottom, top = max(low, 1e-7), min(frequencies.max() * 2, 1.0)
     axis.set_ylim(bottom, top)
-    inside = np.concatenate([np.asarray(curve.intensity, float)[(np.asarray(curve.annual_frequency) >= bottom)
-                                                                 & (np.asarray(curve.annual_frequency) <= 0.1)]
-                             for curve in sites.values()])
+    inside = np.concatenate([intensity[(frequency >= bottom) & (frequency <= 0.1)] for intensity, frequency in drawn])
     if inside.size:  # the intensities between 0.1/yr and the rarest frequency shown: the range a verdict reads
         axis.set_xlim(inside.min(), inside.max())
     axis.set_xlabel(f"{shown.label} [{unit}]")
@@ -333,21 +355,18 @@ def showcase_response_page(showcase, caption, name: str | None = None):
     styles = model_styles(models)
     start, end = _time_window(showcase)
     margins = dict(left=0.075, right=GRID["right"], wspace=0.22)
-    # the ground motion above each column, on the same time axis as the panels below it
-    grounds = figure.add_gridspec(1, 2, top=GRID["top"], bottom=0.785, **margins).subplots(sharex=True, sharey=True)
-    for column, ground in enumerate(grounds):
-        ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35",
-                    lw=0.7)
-        ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
-                       color="0.9", zorder=0, label="strong-motion window (5-95% Arias intensity)" if column == 0
-                       else None)
-        ground.set_xlim(start, end)
-        ground.grid(alpha=0.3)
-        ground.tick_params(labelsize=8)
-        ground.set_xlabel("time [s]", fontsize=8, labelpad=1)
-        ground.set_title("ground acceleration (processed record, unscaled)", fontsize=9)
-    grounds[0].set_ylabel("ground [g]", fontsize=9)
-    ground = grounds[0]
+    # the ground motion once, above the θ column, on the same time axis as the panels below it (the Δy column below
+    # it shares that axis: a second copy of the same record said nothing more)
+    ground = figure.add_subplot(figure.add_gridspec(1, 2, top=GRID["top"], bottom=0.785, **margins)[0, 0])
+    ground.plot(showcase.time_ground.values, showcase.ground_acceleration_processed.values / G, color="0.35", lw=0.7)
+    ground.axvspan(float(showcase.attrs["strong_motion_start_s"]), float(showcase.attrs["strong_motion_end_s"]),
+                   color="0.9", zorder=0, label="strong-motion window (5-95% Arias intensity)")
+    ground.set_xlim(start, end)
+    ground.grid(alpha=0.3)
+    ground.tick_params(labelsize=8)
+    ground.set_xlabel("time [s]", fontsize=8, labelpad=1)
+    ground.set_title("ground acceleration (processed record, unscaled)", fontsize=9)
+    ground.set_ylabel("ground [g]", fontsize=9)
     grid = figure.add_gridspec(len(soils), 2, top=0.69, bottom=GRID["bottom"], hspace=0.12, **margins)
     peak = np.nanmax(np.abs(showcase.theta.values)) if np.isfinite(showcase.theta.values).any() else 0.0
     scale, unit = (1000.0, "mrad") if peak < 0.1 else (1.0, "rad")
@@ -397,7 +416,34 @@ def _finite_capped(values):
 
 
 ROW_GAP = 0.5  # in between two rows of IDA panels: the row's heading and the panels' titles
-VISIBLE_ROCKING = 0.01  # θmax/α: below it every IDA curve of a panel lies on its frame, and the panel says so
+VISIBLE_ROCKING = 0.05  # θmax/α: below it an IDA curve lies on its panel's frame (3 px of a 1.7-wide axis)
+
+
+def frame_note(edp, fractiles, q: float = 0.84) -> str:
+    """The note of an IDA panel whose curves lie on its frame, else "" ("not run" without a run).
+
+    On the frame: θmax/α below ``VISIBLE_ROCKING`` at every level in every record, or in the records below the
+    highest fractile (most records).
+
+    Parameters
+    ----------
+    edp : numpy.ndarray
+        θmax/α of every record and level (NaN: not run; inf: overturned).
+    fractiles : numpy.ndarray
+        The panel's highest fractile curve over the levels.
+    q : float, optional
+        That fractile (0.84).
+    """
+    run = edp[~np.isnan(edp)]
+    if not run.size:
+        return "not run"
+    if not (run >= VISIBLE_ROCKING).any():
+        return f"θmax/α below {VISIBLE_ROCKING:g} in every record at every level: the curves lie on the frame"
+    highest = np.asarray(fractiles, float)
+    if np.isfinite(highest).all() and (highest < VISIBLE_ROCKING).all():
+        return (f"θmax/α below {VISIBLE_ROCKING:g} at every level in most records ({q:.0%} fractile): their curves lie "
+                f"on the frame; {int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs reach more")
+    return ""
 
 
 def _ida_rows(models, soils, per_soil=(), most_columns=5):
@@ -453,9 +499,10 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
             drawn.append(axis)
             picked = cell(ida, model, block, soil)
             edp = np.asarray(picked.edp.values, float)
-            if not (~np.isnan(edp) & (edp >= VISIBLE_ROCKING)).any():  # every curve on the frame, or none run
-                empty_note(axis, f"θmax/α below {VISIBLE_ROCKING:g} in every record at every level: the "
-                           "curves lie on the frame" if (~np.isnan(edp)).any() else "not run")
+            highest = float(ida.fractile.values.max())
+            note = frame_note(edp, picked.edp_fractile.sel(fractile=highest).values, highest)
+            if note:  # every panel whose curves lie on the frame says so, the same way
+                empty_note(axis, note, x=0.6, width=0.75)
                 axis.rockfrag_empty = True
             for curve in picked.edp.transpose("record", "im_level").values:
                 axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
@@ -510,12 +557,35 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
                               color=colour, alpha=0.12, lw=0)
         return ""
     axis.plot([], [], label=label, **style)  # listed once in the legend; the page's notes say why there is no curve
+    reason = no_curve_reason(values)
+    return (label, reason) if reason else ""
+
+
+def no_curve_reason(values) -> str:
+    """Why one series (a model, block and soil's fragility of one state) has points but no curve; "" otherwise.
+
+    "" where the curve is fitted, and where nothing is drawn (a slip state of a model run with a tied base, or no
+    point at all: the empty panel says why). The page's notes list the others (``page_notes``).
+    """
+    if np.isfinite(float(values["median"])) and np.isfinite(float(values["beta"])):
+        return ""
     status = str(values["status"].values) if "status" in values else ""
     if status == NOT_APPLICABLE or not np.isfinite(values.empirical_fraction.values).any():
-        return ""  # e.g. a slip state of a model run with a tied base: nothing drawn (the empty panel says why)
-    reason = {"below-range": "reached by most records at the lowest level",
-              "not-reached": "not reached at any level"}.get(status, plain(status) if status else "no fit")
-    return label, reason
+        return ""
+    return {"below-range": "reached by most records at the lowest level",
+            "not-reached": "not reached at any level"}.get(status, plain(status) if status else "no fit")
+
+
+def has_page_notes(fragility, block, models=None, soils=None) -> bool:
+    """True when a fragility page of ``block`` will list a series without a curve under its legend (``page_notes``).
+
+    ``models`` and ``soils`` are the page's (default: every one). Its caption then says where the notes are.
+    """
+    names = [m.name for m in models] if models is not None else list(map(str, fragility.model.values))
+    soils = list(map(str, fragility.soil.values)) if soils is None else list(soils)
+    picked = fragility.sel(block=block)
+    return any(no_curve_reason(picked.sel(model=model, soil=soil, damage_state=state))
+               for model in names for soil in soils for state in fragility.damage_state.values)
 
 
 NOTE_SIZE = 6.5  # pt, the notes of a page: under its legend, or inside an empty panel
@@ -533,9 +603,12 @@ def _no_curve_note(axis, reasons, state: str, soil: str = "") -> None:
     axis.figure.rockfrag_notes = notes
 
 
-def empty_note(axis, text: str) -> None:
-    """Say inside a panel with nothing drawn why it is empty ("not computed: the base is tied")."""
-    axis.text(0.5, 0.5, textwrap.fill(text, chars_across(axis, NOTE_SIZE) - 4), transform=axis.transAxes,
+def empty_note(axis, text: str, x: float = 0.5, width: float = 1.0) -> None:
+    """Say inside a panel with nothing drawn why it is empty ("not computed: the base is tied").
+
+    ``x`` is the note's centre and ``width`` its share of the panel's width (a note beside curves on the frame).
+    """
+    axis.text(x, 0.5, textwrap.fill(text, int(width * chars_across(axis, NOTE_SIZE)) - 4), transform=axis.transAxes,
               fontsize=NOTE_SIZE + 1, ha="center", va="center", color="0.3")
 
 
@@ -725,12 +798,12 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
             axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
             if soil is None or len(soils) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
-                shaded = True
+                shaded |= bool(np.nanmax(np.asarray(uplift, float) - np.asarray(overturn, float), initial=0.0) > 0.01)
         axis.set_title(textwrap.fill(short_label(model), chars_across(axis, 9.5)), fontsize=9.5)
     _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): lift-off, rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
-    if shaded:  # the band is drawn only where one curve pair is on its panel (a legend entry only if drawn)
+    if shaded:  # the band is drawn only where one curve pair is on its panel (a legend entry only if it shows)
         axes[0, 0].fill_between([], [], [], color="#fdae6b", alpha=0.35, lw=0, label="rocking without overturning")
     for axis in axes.flat:
         if axis.get_visible():
@@ -739,12 +812,34 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
     return figure
 
 
+def no_ratio_reason(cube, block, soil, models, band) -> str:
+    """Why a soil has no point of ``block`` on the applicability page: which model never rocked there, and why.
+
+    ``models`` are the rigid-base reference and the foundation models compared with it, ``band`` the levels (a boolean
+    mask) the ratio reads. A model whose runs never rock in the band (no run ends rocking without overturning) leaves
+    no ratio; a rigid base with base friction below tan α slides instead (the limitations' 'Sliding').
+    """
+    sub = cube.sel(block=block, soil=soil).isel(im_level=np.flatnonzero(band))
+    for model in models:
+        if (sub.outcome.sel(model=model.name) == OUTCOME_ROCKING).any():
+            continue
+        who = "the rigid base" if model.rigid_base else panel_label(model)
+        friction = float(cube.friction_static.sel(soil=soil, block=block, model=model.name)) \
+            if "friction_static" in cube else np.nan
+        alpha = float(cube.block_alpha.sel(block=block)) if "block_alpha" in cube.coords else np.nan
+        if np.isfinite(friction) and np.isfinite(alpha) and friction < np.tan(alpha):
+            return f"{who} slides there and never rocks"
+        return f"{who} never rocks there without overturning"
+    return "no run rocked without overturning in both models there"
+
+
 def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     """Median peak angle of each foundation model over the rigid-base reference against G_s, per block.
 
     A model keeps its colour and dashes, a block its marker; the legend lists the models and the blocks
-    apart (blocks without a run in the band are left out and named in the legend). The soils are named on
-    the top axis.
+    apart (blocks without a run in the band are left out and named in the legend), each model drawn as it is on the
+    axes (a line only where it joins two points). The soils are named on the top axis; a soil without a point says
+    so there, and the legend says why (``no_ratio_reason``).
     """
     models = models_of(cube)
     reference = next(m for m in models if m.rigid_base)
@@ -758,6 +853,7 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     order = np.argsort(shear)
     markers = "os^Dv"
     drawn_blocks, missing = [], []
+    joined, pointless = {model.name: False for model in founded}, set(map(str, cube.soil.values))
     for b_index, block in enumerate(cube.block.values):
         uplift = uplift_intensity(cube, block)
         levels = block_levels(cube, block)
@@ -772,17 +868,26 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
             if not np.isfinite(ratio).any():
                 continue
             drew, with_ratio = True, with_ratio | np.isfinite(ratio)
+            joined[model.name] |= bool(np.isfinite(ratio).sum() >= 2)
             style = styles[model.name]
             axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], ms=5, mfc="white",
                       color=style["color"], ls=style["ls"], lw=1.3)
         name = names.get(str(block), str(block))
         gaps = [str(soil) for soil, has in zip(cube.soil.values, with_ratio) if not has]
+        pointless -= {str(soil) for soil, has in zip(cube.soil.values, with_ratio) if has}
         if drew and gaps:  # a soil without a point says why in the legend, not as a gap in the line
-            name += f" (no point on {', '.join(gaps)}: no run rocked without overturning in both models there)"
+            reasons = {}
+            for soil in gaps:
+                reasons.setdefault(no_ratio_reason(cube, block, soil, [reference, *founded], band), []).append(soil)
+            name += " (no point on " + "; ".join(f"{', '.join(soils)}: {reason}" for reason, soils in
+                                                reasons.items()) + ", so no ratio)"
         (drawn_blocks if drew else missing).append((name, markers[b_index % len(markers)]))
+    single = drawn_blocks[0][1] if len(drawn_blocks) == 1 else "o"
     for model in founded:
         style = styles[model.name]
-        axis.plot([], [], color=style["color"], ls=style["ls"], lw=1.3, label=short_label(model))
+        # drawn as it is on the axes: its dashes where it joins two points, else its marker alone
+        axis.plot([], [], color=style["color"], ls=style["ls"] if joined[model.name] else "none", lw=1.3,
+                  marker=None if joined[model.name] else single, ms=5, mfc="white", label=short_label(model))
     for name, marker in drawn_blocks:
         axis.plot([], [], ls="none", marker=marker, ms=5, mfc="white", color="0.2", label=f"block: {name}")
     for name, _ in missing:
@@ -797,7 +902,8 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     axis.set_ylabel(f"median θmax (model) / median θmax ({panel_label(reference)}) [-]")
     axis.grid(alpha=0.3, which="both")
     top = axis.secondary_xaxis("top")
-    top.set_xticks(shear, [str(s) for s in cube.soil.values], fontsize=8)
+    top.set_xticks(shear, [f"{soil}\n(no point)" if str(soil) in pointless else str(soil)
+                           for soil in cube.soil.values], fontsize=8)
     top.minorticks_off()
     outside_legend(figure, [axis])
     return figure
@@ -821,7 +927,7 @@ def sweep_page(dataset, caption, names: dict | None = None):
                 for l_index, level in enumerate(dataset.level.values):
                     axis.plot(shear, ratios[e_index, l_index], color=f"C{l_index}", ls=dash[e_index % 4],
                               marker=".", label=f"E_b = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
-            axis.axhspan(1 - tolerance, 1 + tolerance, color="0.88", zorder=0)
+            axis.axhspan(1 - tolerance, 1 + tolerance, color="0.8", zorder=0)
             axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
             axis.axhline(1.0, color="k", lw=0.7)
             axis.set_title(textwrap.fill(f"{(names or {}).get(str(block), block)}: {label}", chars_across(axis, 9)),
@@ -830,6 +936,12 @@ def sweep_page(dataset, caption, names: dict | None = None):
             axis.set_xlabel("soil shear modulus G_s [MPa]")
             axis.grid(alpha=0.3, which="both")
         axes[row, 0].set_ylabel("median θmax model / Housner [-]")
+    ratios = np.asarray(dataset.peak_angle_ratio_to_housner.values, float)
+    ratios = ratios[np.isfinite(ratios) & (ratios > 0)]
+    low = min(0.8, 0.9 * ratios.min()) if ratios.size else 0.8
+    high = max(1.25, 1.1 * ratios.max()) if ratios.size else 1.25
+    for axis in axes.flat:  # log: the ±10% band keeps its height however large the ratios run
+        log_y_axis(axis, (low, high))
     outside_legend(figure, [axes.flat[0]])
     return figure
 

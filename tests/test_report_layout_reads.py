@@ -1,0 +1,210 @@
+"""Figures and captions after cold read 3 (issue 36): each test fails on the figure or caption the read found.
+
+- the applicability caption names a next page only where the sweep follows (user B2); a soil without a point says
+  so on the top axis and why in the legend, and a model drawn as points is a point in the legend (user B3);
+- a soil's site hazard curve stops where the hazard given ends (user B7, default B8);
+- every IDA panel whose curves lie on the frame says so, the same way (default C1, the recommended steel panel);
+- the outcomes legend lists the rocking shading only where it shows; the captions name it (default C2);
+- the sweep's ±10% band is visible however large the ratios; one "dotted" entry per legend; the notes under the
+  legend are announced only where there are some; one ground-acceleration panel on the showcase page (user C6).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+import xarray as xr
+
+from rockfrag.report import figures
+
+
+def _legend_labels(figure) -> list[str]:
+    return [text.get_text().replace("\n", " ") for legend in figure.legends for text in legend.get_texts()]
+
+
+@pytest.fixture(scope="module")
+def small_results(small_pipeline):
+    from rockfrag.config import load_study
+    from rockfrag.report import report_results
+
+    output = small_pipeline.output
+    opened = {name: xr.load_dataset(output / f"{name}.nc") for name in ("cube", "ida", "fragility")}
+    return report_results(load_study(small_pipeline.study), opened["cube"], opened["ida"], opened["fragility"], None,
+                          output)
+
+
+def _fresh(results, **changes):
+    from rockfrag.report import numbers
+
+    return dataclasses.replace(results, facts=numbers.Facts(), **changes)
+
+
+@pytest.mark.slow
+def test_the_applicability_caption_points_to_a_next_page_only_where_the_sweep_follows(small_results):
+    from rockfrag.report import SWEEP_NEXT, build_plan
+
+    assert "next page" not in figures_caption(build_plan(_fresh(small_results, applicability=None)), "applicability")
+    planned = build_plan(_fresh(small_results))
+    names = [page.name for page in planned]
+    assert names[names.index("applicability") + 1] == "applicability-sweep"
+    assert figures_caption(planned, "applicability").endswith(SWEEP_NEXT)
+
+
+def figures_caption(planned, name: str) -> str:
+    return next(page.caption for page in planned if page.name == name)
+
+
+@pytest.mark.slow
+def test_a_soil_without_a_ratio_says_so_and_why_and_points_are_points_in_the_legend(small_pipeline):
+    """The rigid base slides on sand (friction below tan α) and never rocks there: sand has no point. The top axis
+    marks it '(no point)', the block's legend entry says why, and each model, drawn as one point (rock alone), is a
+    marker in the legend, not a line."""
+    cube = xr.load_dataset(small_pipeline.output / "cube.nc")
+    changed = cube.copy(deep=True)
+    housner = dict(model="housner", soil="sand")
+    changed["outcome"].loc[housner] = 0  # never lifts off: it slides
+    friction = np.full((changed.sizes["soil"], changed.sizes["block"], changed.sizes["model"]), np.nan)
+    changed["friction_static"] = (("soil", "block", "model"), friction)
+    changed["friction_static"].loc[housner] = 0.1  # below tan α of every block
+    figure = figures.applicability_page(changed, "Read it.")
+    try:
+        top = [axis for axis in figure.axes[0].child_axes if type(axis).__name__ == "SecondaryAxis"][0]
+        ticks = [text.get_text() for text in top.get_xticklabels()]
+        assert "sand\n(no point)" in ticks and "rock" in ticks
+        labels = _legend_labels(figure)
+        assert any("no point on sand: the rigid base slides there and never rocks" in label for label in labels)
+        handles = {text.get_text().replace("\n", " "): handle for legend in figure.legends
+                   for text, handle in zip(legend.get_texts(), legend.legend_handles)}
+        model_entries = [handle for label, handle in handles.items() if not label.startswith(("block", "within",
+                                                                                              "300-"))]
+        assert model_entries and all(handle.get_linestyle() in ("None", "none") and handle.get_marker() not in
+                                     (None, "None", "none", "") for handle in model_entries)
+    finally:
+        plt.close(figure)
+
+
+def _hazard(intensity, frequency, source):
+    from rockfrag.hazard import HazardCurve
+
+    return HazardCurve(np.asarray(intensity, float), np.asarray(frequency, float), "pga", None, source)
+
+
+def test_a_soils_hazard_curve_stops_where_the_given_hazard_ends():
+    """The reference curve ends at 3 g (1e-6 /yr); a soil's curve carried from it was drawn on to 12 g. Its part
+    below the reference's rarest frequency rests on nothing given and is not drawn."""
+    from rockfrag.site_hazard import SiteHazards
+
+    given = np.geomspace(0.05, 3.0, 40)
+    reference = _hazard(given, 1e-4 * given ** -2.5 * 0.0185, "reference")
+    soil_grid = np.geomspace(0.0125, 12.0, 120)
+    soil = _hazard(soil_grid, 2e-6 * soil_grid ** -2.5, "sand")
+    sites = SiteHazards({"sand": soil, "rock": reference}, reference, 760.0)
+    figure = figures.hazard_page(sites, [475, 2475], "Read it.")
+    try:
+        axis = figure.axes[0]
+        sand = next(line for line in axis.get_lines() if line.get_label() == "sand")
+        rarest = reference.annual_frequency.min()
+        assert np.min(sand.get_ydata()) >= rarest * (1 - 1e-9)
+        assert np.max(sand.get_ydata()) <= reference.annual_frequency.max() * (1 + 1e-9)
+        assert len(sand.get_ydata()) > 20  # the given part is drawn
+    finally:
+        plt.close(figure)
+
+
+def test_every_ida_panel_whose_curves_lie_on_the_frame_says_so():
+    """The recommended model's panels of the paper's block (default study): on clay θmax/α stays below 0.05 in
+    every record (0.004-0.044), on steel in all but 2 of 616 runs (84% fractile at most 0.002). Both say so,
+    as the panels below 0.01 did; a panel whose records rock does not."""
+    rng = np.random.default_rng(1)
+    clay = rng.uniform(0.004, 0.044, (44, 14))
+    steel = np.where(rng.uniform(size=(44, 14)) < 0.003, 0.16, rng.uniform(0.0, 0.002, (44, 14)))
+    steel[0, -1] = 0.16
+    rocking = rng.uniform(0.0, 1.2, (44, 14))
+    for edp in (clay, steel):
+        note = figures.frame_note(edp, np.quantile(edp, 0.84, axis=0))
+        assert "the curves lie on the frame" in note or "their curves lie on the frame" in note
+    assert figures.frame_note(rocking, np.quantile(rocking, 0.84, axis=0)) == ""
+    assert figures.frame_note(np.full((2, 3), np.nan), np.full(3, np.nan)) == "not run"
+
+
+@pytest.mark.slow
+def test_the_outcomes_legend_lists_the_rocking_shading_only_where_it_shows(small_pipeline):
+    """A panel with one pair of curves shades rocking without overturning between them; where uplift and
+    overturning coincide nothing shows, and the legend then does not list the shading."""
+    from rockfrag.report import CAPTIONS
+
+    assert "shaded orange" in CAPTIONS["outcomes"]
+    fragility = xr.load_dataset(small_pipeline.output / "fragility.nc")
+    block = str(fragility.block.values[0])
+    changed = fragility.copy(deep=True)
+    probability = changed["outcome_probability"]
+    overturned = probability.sel(outcome_class="overturned")
+    probability.loc[dict(outcome_class="no_uplift")] = 1 - overturned
+    probability.loc[dict(outcome_class="rocking")] = 0.0
+    uplift_states = [str(s) for s, edp in zip(changed.damage_state.values, changed.damage_state_edp.values)
+                     if str(edp) == "uplifted"]
+    for state in uplift_states:
+        changed["empirical_fraction"].loc[dict(damage_state=state)] = np.nan
+    figure = figures.outcomes_page(changed, block, "Read it.")
+    try:
+        assert "rocking without overturning" not in _legend_labels(figure)
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.slow
+def test_the_sweeps_band_is_visible_however_large_the_ratios(small_pipeline):
+    """Ratios up to 17 on a linear axis drew the ±10% band as a hairline; on a log axis it keeps its height."""
+    applicability = xr.load_dataset(small_pipeline.output / "applicability.nc")
+    applicability["peak_angle_ratio_to_housner"] = applicability.peak_angle_ratio_to_housner * 1.0
+    applicability["peak_angle_ratio_to_housner"][..., 0] = 17.0  # the softest soil: a large ratio
+    figure = figures.sweep_page(applicability, "Read it.")
+    try:
+        figure.draw_without_rendering()
+        axis = figure.axes[0]
+        band = [patch for patch in axis.patches if abs(patch.get_facecolor()[0] - 0.8) < 0.01]
+        assert band, "no ±10% band"
+        height = band[0].get_window_extent().height
+        assert height >= 0.04 * axis.get_window_extent().height
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.slow
+def test_one_dotted_entry_per_legend_and_notes_announced_only_where_drawn(small_results):
+    """Default C2 and read 3: an IDA page listed 'dotted: the site's intensity ...' and 'dotted, in each soil's
+    colour ...' (its per-soil panels drew the marks in one colour, its every-soil panels in the soils'); fragility
+    captions announced 'notes under the legend' on pages with none."""
+    from rockfrag.report import CAPTIONS, NOTES_WORDS, build_plan
+
+    assert "notes under the legend" not in CAPTIONS["fragility-soils"] + CAPTIONS["fragility-models"]
+    for page in build_plan(_fresh(small_results)):
+        if page.html is not None or not page.name.startswith(("ida-", "fragility-", "outcomes-")):
+            continue
+        figure = page.draw()
+        try:
+            dotted = [label for label in _legend_labels(figure) if label.lower().startswith("dotted")]
+            assert len(dotted) <= 1, (page.name, dotted)
+            if page.name.startswith("fragility-"):
+                noted = any(text.get_text().startswith("No curve") for text in figure.texts)
+                assert noted == page.caption.endswith(NOTES_WORDS), page.name
+        finally:
+            plt.close(figure)
+    fitted = small_results.fragility.copy(deep=True)
+    fitted["median"] = fitted["median"].fillna(1.0)
+    fitted["beta"] = fitted["beta"].fillna(0.5)
+    assert not figures.has_page_notes(fitted, str(fitted.block.values[0]))
+
+
+@pytest.mark.slow
+def test_the_showcase_page_draws_the_ground_acceleration_once(small_pipeline):
+    showcase = xr.load_dataset(small_pipeline.output / "showcase.nc")
+    figure = figures.showcase_response_page(showcase, "Read it.")
+    try:
+        grounds = [axis for axis in figure.axes if axis.get_title().startswith("ground acceleration")]
+        assert len(grounds) == 1
+    finally:
+        plt.close(figure)
