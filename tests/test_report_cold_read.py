@@ -5,6 +5,7 @@ inputs. Expected values come from the result files or the study, never from the 
 from __future__ import annotations
 
 import html as html_module
+import math
 import re
 
 import numpy as np
@@ -410,9 +411,137 @@ def test_a_value_that_rests_on_the_assumed_friction_is_marked_with_the_high_fric
             assert cell.endswith(f" {FRICTION_MARK}") == expected, (state, soil, cell)
             marked += expected
     assert marked >= 2
-    assert note.kind == "note" and note.text.startswith(f"{FRICTION_MARK} friction-driven: on sand, rock")
+    assert note.kind == "note" and note.text.startswith(f"{FRICTION_MARK} friction-driven: on every soil the block")
     assert note.text.endswith("the medians are, on sand (μ_s 0.90): none below the credible cap; on rock (μ_s "
                               "0.90): θmax/α ≥ 0.5 at 1.2 g."), note.text  # the small study's levels are in g
     other = next(answer for answer in results.answers if answer.block == "slender-cabinet")  # b/h 0.2: grips
     assert not any(FRICTION_MARK in cell for item in answer_items(results, other) if item.kind == "table"
                    for row in item.rows for cell in row)
+
+
+def test_the_bed_frequencies_are_the_closed_forms_of_the_contact_law():
+    """Cold read 3, default B4 (the frequencies the lift-off sentence prints): vertical sqrt(k/m); rocking with the
+    whole base down sqrt((K_r/m - g h) / j), j = (b² + 4h²)/3 about the base centre, K_r = k b² for the two corner
+    springs (k/2 at each corner, ±b) and k b²/3 for the continuous bed (k/2b per metre over the base)."""
+    from types import SimpleNamespace
+
+    from rockfrag.config import load_study
+    from rockfrag.report.answer_page import bed_frequencies
+    from rockfrag.soils import SOILS, soil_block_stiffness
+
+    block = next(block for block in load_study(ROOT / "pipeline" / "defaults.toml").blocks if block.name == "paper")
+    soil = SOILS["gravel"]
+    k, m, g = soil_block_stiffness(soil, block), block.mass, 9.80665
+    j = (block.b ** 2 + 4 * block.h ** 2) / 3
+    for bed, share in (("two-spring", 1.0), ("continuous", 1.0 / 3.0)):
+        vertical, rocking, settlement = bed_frequencies(SimpleNamespace(bed=bed, calibrates_bed=True), block, soil)
+        assert math.isclose(vertical, math.sqrt(k / m) / (2 * math.pi), rel_tol=1e-12)
+        assert math.isclose(rocking, math.sqrt((share * k * block.b ** 2 / m - g * block.h) / j) / (2 * math.pi),
+                            rel_tol=1e-9)
+        assert math.isclose(settlement, m * g / k, rel_tol=1e-12)
+    assert math.isclose(settlement * 1000, 2.67, abs_tol=0.01)  # the reader's m g / k = 2.7 mm on gravel
+
+
+def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed_and_the_records(tmp_path):
+    """Cold read 3, default B4: the paper's block lifted off on gravel at a median (0.20 g) below sand's and rock's,
+    with no word why, and no word from where a lift is measured (the static settlement, 2.7 mm, exceeds the 1 mm
+    lift-off size). The answer page gives, for such a soil, the bed's vertical and rocking frequencies against the
+    records' strongest spectral band, the calibrated damping where it is the study's lowest, and that a lift counts
+    from the bed's unloaded surface (loss of contact), after the static settlement. Medians that rise with the
+    stiffness get no sentence."""
+    from types import SimpleNamespace
+
+    import xarray as xr
+
+    from rockfrag.config import load_study
+    from rockfrag.report.answer_page import bed_frequencies, bed_resonance_words, records_band
+    from tests.helpers import ROOT
+
+    config = load_study(ROOT / "pipeline" / "defaults.toml")
+    soils = [soil.name for soil in config.soils]
+    assert soils == ["clay", "sand", "gravel", "rock", "steel"]
+    medians = xr.DataArray([[[[0.67, 0.31, 0.20, 0.33, 1.5]]]], dims=("model", "block", "damage_state", "soil"),
+                           coords={"model": ["recommended"], "block": ["paper"], "damage_state": ["uplift"],
+                                   "soil": soils}, attrs={"units": "9.80665 m s-2"})
+    fragility = xr.Dataset({"median": medians})
+    damping = xr.DataArray([[[0.39, 0.25, 0.06, 0.16, 0.10]]], dims=("model", "block", "soil"),
+                           coords={"model": ["recommended"], "block": ["paper"], "soil": soils})
+    cube = xr.Dataset({"damping_ratio_calibrated": damping})
+    periods = np.geomspace(0.02, 10.0, 60)
+    shape = np.exp(-np.log(periods / 0.25) ** 2)  # records whose spectra peak at 0.25 s
+    showcase = xr.Dataset({"record_spectrum": (("record", "period"), np.vstack([shape * 2.0, shape * 3.0]) + 0.1),
+                           "record_pga": ("record", [1.0, 1.5])}, coords={"period": periods})
+    results = SimpleNamespace(fragility=fragility, cube=cube, config=config, showcase=showcase)
+    answer = SimpleNamespace(model="recommended", block="paper", unit="g")
+    band = records_band(showcase)
+    assert band[0] < 0.25 < band[1]
+    words = bed_resonance_words(results, answer)
+    block = next(block for block in config.blocks if block.name == "paper")
+    gravel = next(soil for soil in config.soils if soil.name == "gravel")
+    vertical, rocking, settlement = bed_frequencies(config, block, gravel)
+    assert words.startswith("On gravel this block lifts off at a lower median than on sand and rock "
+                            "(0.2 g against 0.31 g and 0.33 g)")
+    assert f"a vertical frequency of {vertical:.2g} Hz" in words and f"{rocking:.2g} Hz, a period of" in words
+    assert f"strongest from {band[0]:.2g} to {band[1]:.2g} s" in words
+    assert "damping calibrated to the restitution is the study's lowest on gravel" in words
+    assert f"static settlement, {settlement * 1000:.2g} mm, before it lifts off" in words
+    assert "loss of contact" in words and "not from rest" in words
+    fragility["median"][:] = [[[[0.1, 0.2, 0.3, 0.4, 0.5]]]]  # rising with the stiffness: nothing to explain
+    assert bed_resonance_words(results, answer) == ""
+
+
+def test_a_block_whose_bed_reaches_no_restitution_says_which_r_its_answering_run_has():
+    """Cold read 3, default B6: the squat block's page said '(r 0.460 to 0.483 asked; it reaches none of them)' and
+    not which r its answering run uses. Its free rocking dies out below what the restitution measure resolves at
+    every damping the bed admits, so it runs at the least such damping with r bounded by the measure's resolution
+    (rockfrag.models.restitution.resolution_bound: sqrt(drop(0.1 α) / drop(0.6 α)), drop(θ) = cos(α - θ) - cos α)."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.answer_page import curve_reason
+    from tests.test_report_answer import _restitution_cube
+
+    requested = np.array([[0.94, 0.97, 0.99], [0.46, 0.4715, 0.483]])  # cabinet, skid
+    reached = np.array([[0.94, 0.95, 0.95], [np.nan] * 3])
+    cube = _restitution_cube(requested, reached, np.array([[0.4, 0.16, 0.16], [0.15, 0.15, 0.15]]),
+                             ["cabinet", "skid"])
+    alpha = math.atan(0.75)  # the skid's b/h
+    cube = cube.assign_coords(block_alpha=("block", [math.atan(0.2), alpha]))
+    results = SimpleNamespace(fragility=xr.Dataset(coords={"model": ["recommended"]}), cube=cube)
+    skid = curve_reason(results, "recommended", "skid")
+    bound = math.sqrt((math.cos(0.9 * alpha) - math.cos(alpha)) / (math.cos(0.4 * alpha) - math.cos(alpha)))
+    assert math.isclose(bound, 0.470, abs_tol=5e-4)
+    assert (f"its r is not measured but bounded, at most {bound:.3f}, below the middle of the range (0.471)"
+            in skid), skid
+    assert "not measured" not in curve_reason(results, "recommended", "cabinet")
+
+
+def test_the_answering_runs_restitution_is_said_per_soil_in_one_plain_sentence():
+    """Cold read 3, user C3 and default C4: "On clay, sand the bed cannot ..." and "The answering run itself is below
+    the middle of the range (0.813) there: it runs at r sand 0.802" ('there' without an antecedent). Now: "On sand
+    the answering run uses r = 0.802, below the middle of the range, 0.813", soils joined with 'and'."""
+    from rockfrag.report.answer_page import _band_reach
+    from tests.test_report_answer import _restitution_cube
+
+    requested = np.array([[0.793, 0.813, 0.833]])
+    cube = _restitution_cube(requested, np.array([[0.793, 0.802, 0.802]]), np.array([[0.3, 0.2, 0.2]]), ["box"])
+    cube["restitution_target"].loc[{"soil": "clay"}] = 0.813  # clay reaches the middle, not the upper end
+    text = _band_reach(cube)
+    assert "On clay and rock the bed cannot dissipate" in text, text
+    assert "it reaches at most 0.802 on clay and 0.802 on rock" in text, text
+    assert "On rock the answering run uses r = 0.802, below the middle of the range, 0.813." in text, text
+    assert " there:" not in text and "itself" not in text
+
+
+def test_the_reading_page_takes_its_example_cell_from_the_report(small_pipeline):
+    """Cold read 3, user C2 and default C3: "(for example 5.6% / 17% / 43%)" on the page 'Reading the answer pages'
+    was no cell of the report. The example is a cell of this report's own answer tables."""
+    from rockfrag.report.answer_page import answer_items, reading_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    text = " ".join(item.text for item in reading_items(results))
+    example = re.search(r"\(for example ([^)]*)\)", text)
+    assert example is not None and example.group(1) != "5.6% / 17% / 43%"
+    cells = {cell for answer in results.answers for item in answer_items(results, answer) if item.kind == "table"
+             for row in item.rows for cell in row[1:]}
+    assert example.group(1) in cells, example.group(1)
+    assert example.group(1).count(" / ") == len(results.answers[0].return_periods) - 1

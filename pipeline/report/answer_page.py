@@ -48,6 +48,7 @@ from rockfrag.report.summary import (
     verdict_items,
 )
 from rockfrag.report.text import Item, heading, note, paragraph, table
+from rockfrag.units import STANDARD_GRAVITY
 
 
 def _years(frequency: float) -> str:
@@ -92,10 +93,10 @@ def _band_reach(cube, block=None) -> str:
         return ""
     soils = [str(s) for s in cube.soil.values if bool(short.sel(soil=s).any())]
     asked = float(requested.where(short).max())
-    reached = ", ".join(f"{soil} {float(target.sel(soil=soil).where(short.sel(soil=soil)).max()):.3f}"
-                        for soil in soils)
-    text = (f" On {', '.join(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
-            f"(r up to {asked:.3f}; at most it reaches {reached}): those runs use the nearest r it reaches, so "
+    reached = _and([f"{float(target.sel(soil=soil).where(short.sel(soil=soil)).max()):.3f} on {soil}"
+                    for soil in soils])
+    text = (f" On {_and(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
+            f"(r up to {asked:.3f}; it reaches at most {reached}): those runs use the nearest r it reaches, so "
             "the restitution part of the model dispersion there leaves out the less dissipative side of the range, "
             "the side on which a block rocks more.")
     if "run" in requested.dims and "centre" in requested.run.values:
@@ -103,10 +104,16 @@ def _band_reach(cube, block=None) -> str:
         low = [str(s) for s in cube.soil.values
                if bool(((centre_asked.sel(soil=s) - centre_run.sel(soil=s)) > 5e-4).any())]
         if low:
-            runs = ", ".join(f"{soil} {float(centre_run.sel(soil=soil).min()):.3f}" for soil in low)
-            text += (f" The answering run itself is below the middle of the range ({float(centre_asked.max()):.3f}) "
-                     f"there: it runs at r {runs}.")
+            runs = _and([f"{float(centre_run.sel(soil=soil).min()):.3f}" for soil in low])
+            text += (f" On {_and(low)} the answering run uses r = {runs}, below the middle of the range, "
+                     f"{float(centre_asked.max()):.3f}.")
     return text
+
+
+def _and(words) -> str:
+    """"a", "a and b", "a, b and c"."""
+    words = list(words)
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 def _band_collapse(cube, block) -> str:
@@ -129,10 +136,23 @@ def _band_collapse(cube, block) -> str:
     asked += (f" asked; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any())
               else " asked; it reaches none of them")
     where = "every soil" if len(collapsed) == cube.soil.size else ", ".join(collapsed)
-    return (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
+    text = (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
             f"restitutions apart ({asked}), so restitution adds nothing to the model dispersion there because there "
             "is one run, not because it is known; the model part of β there rests on FEMA P-695's model-quality "
             "rating.")
+    if not bool(reached.notnull().any()) and "block_alpha" in cube.coords:
+        from types import SimpleNamespace
+
+        from rockfrag.models.restitution import resolution_bound
+
+        bound = resolution_bound(SimpleNamespace(alpha=float(cube.block_alpha.sel(block=block))))
+        middle = float(requested.sel(run="centre", soil=collapsed).max()) if "run" in requested.dims \
+            else float(requested.sel(soil=collapsed).max())
+        side = "below" if round(bound, 3) < round(middle, 3) else "at or above"
+        text += (f" The answering run uses the least bed damping at which this block's free rocking dies out below "
+                 f"what the restitution measure resolves: its r is not measured but bounded, at most {bound:.3f}, "
+                 f"{side} the middle of the range ({middle:.3f}).")
+    return text
 
 
 def curve_reason(results, model: str, block=None) -> str:
@@ -214,11 +234,17 @@ def slides_first_words(results, answer) -> str:
     cube = results.cube
     slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
     listed = ", ".join(f"{soil.name} {soil.friction_static:g}" for soil in soils)
-    return (f"On {', '.join(soil.name for soil in soils)} the soil's base friction (μ_s {listed}) is below this "
+    return (f"On {_where(results, soils)} the soil's base friction (μ_s {listed}) is below this "
             f"block's b/h = {slender:.2f}: at rest it slides before it can rock (Shenton 1996), so its rocking and "
             f"overturning there rest on the assumed friction (the values marked {FRICTION_MARK} in the design-life "
             "table are friction-driven); a base that grips more (a grout bed, a keyed plinth) would rock instead, "
             "and overturn more readily.")
+
+
+def _where(results, soils) -> str:
+    """The soils by name, or "every soil" when they are all the study's (said once, not soil by soil)."""
+    every = len(soils) == len(results.config.soils) and len(soils) > 1
+    return "every soil" if every else ", ".join(soil.name for soil in soils)
 
 
 def friction_high_words(results, answer) -> str:
@@ -231,7 +257,7 @@ def friction_high_words(results, answer) -> str:
     soils = sliding_first_soils(results, answer)
     if not soils:
         return ""
-    names = ", ".join(soil.name for soil in soils)
+    names = _where(results, soils)
     text = (f"{FRICTION_MARK} friction-driven: on {names} the block slides before it can rock, so these values rest "
             "on the assumed base friction.")
     fragility, cube = results.fragility, results.cube
@@ -253,12 +279,114 @@ def friction_high_words(results, answer) -> str:
             friction = f" (μ_s {float(high):.2f})"
         parts.append((soil.name, friction, shown))
     if not any(shown for _, _, shown in parts):
-        where = "on any of them" if len(soils) > 1 else f"on {names}"
+        where = "on any soil" if names == "every soil" else "on any of them" if len(soils) > 1 else f"on {names}"
         return (text + " With the friction at the high end of its range (the designed sample), no rocking state "
                 f"and no overturning has a median below the credible cap {where}.")
     said = "; ".join(f"on {soil}{friction}: " + (", ".join(shown) if shown else "none below the credible cap")
                      for soil, friction, shown in parts)
     return text + f" With the friction at the high end of its range (the designed sample) the medians are, {said}."
+
+
+SPECTRUM_BAND = 0.8
+"""The records' strongest band: the periods where their mean spectrum (each record's scaled to its PGA, geometric
+mean) is within this fraction of its peak."""
+
+
+def records_band(showcase) -> tuple[float, float] | None:
+    """(shortest, longest) period [s] of the records' strongest band (``SPECTRUM_BAND``), None without spectra."""
+    if showcase is None or "record_spectrum" not in showcase or "record_pga" not in showcase:
+        return None
+    spectra = np.asarray(showcase.record_spectrum.transpose("record", "period").values, float)
+    pga = np.asarray(showcase.record_pga.values, float)[:, None]
+    keep = np.isfinite(spectra).all(axis=1) & (pga[:, 0] > 0)
+    if not keep.any():
+        return None
+    mean = np.exp(np.log(spectra[keep] / pga[keep]).mean(axis=0))
+    periods = np.asarray(showcase.period.values, float)[mean >= SPECTRUM_BAND * mean.max()]
+    return float(periods.min()), float(periods.max())
+
+
+def bed_frequencies(config, block, soil) -> tuple[float, float, float]:
+    """(vertical, rocking) frequency [Hz] of ``block`` on its bed over ``soil``, and its static settlement [m].
+
+    Vertical: sqrt(k/m) (rockfrag.soils.foundation). Rocking: small tilts about the base centre with the whole base
+    down, sqrt((K_r/m - g h) / j), K_r the study's contact law's rocking stiffness (its ``full_contact``: K b² for
+    the two corner springs, K b²/3 for the continuous bed) and j = (b² + 4h²)/3 the block's inertia about its base
+    centre per unit mass (rockfrag.models.winkler). NaN where the bed cannot hold the block upright.
+    """
+    from rockfrag.models.contact import CONTACT_LAWS
+    from rockfrag.models.restitution import calibrated_law
+    from rockfrag.soils import foundation
+
+    found = foundation(soil, block)
+    law = CONTACT_LAWS[calibrated_law(config.bed) if config.calibrates_bed else config.bed]
+    full_contact = getattr(law.full_contact, "py_func", law.full_contact)  # the plain function: one call
+    rocking, _ = full_contact(np.zeros(4), {"omega": found.vertical_frequency, "b": block.b}, 0.0)
+    tilt = rocking - STANDARD_GRAVITY * block.h
+    j = (block.b ** 2 + 4.0 * block.h ** 2) / 3.0
+    omega_r = np.sqrt(tilt / j) if tilt > 0 else np.nan
+    return found.vertical_frequency / (2 * np.pi), omega_r / (2 * np.pi), found.settlement
+
+
+def bed_resonance_words(results, answer) -> str:
+    """A sentence for each soil where the block lifts off at a lower median than on both its neighbours in stiffness.
+
+    Lift-off on a bed is not monotonic in its stiffness there, so the page gives the bed's vertical and rocking
+    frequencies under the block against the records' strongest band (``records_band``), says where the bed's
+    damping calibrated to the restitution is the study's lowest (its value is not printed: the precision policy),
+    and from where a lift is measured: the bed's unloaded surface (loss of contact), so a corner first rises by
+    the static settlement. "" where the medians rise with the stiffness, or without the recommended curve.
+    """
+    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
+    if answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None:
+        return ""
+    soils = sorted((soil for soil in config.soils if soil.name in fragility.soil.values),
+                   key=lambda soil: soil.shear_modulus)
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    medians = {soil.name: float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name,
+                                                        damage_state="uplift")) * scale for soil in soils}
+    band = records_band(getattr(results, "showcase", None))
+    block = next(block for block in config.blocks if block.name == answer.block)
+    texts = []
+    for index in range(1, len(soils) - 1):
+        low, soil, high = soils[index - 1], soils[index], soils[index + 1]
+        values = [medians[low.name], medians[soil.name], medians[high.name]]
+        if not np.isfinite(values).all() or not values[1] < min(values[0], values[2]):
+            continue
+        vertical, rocking, settlement = bed_frequencies(config, block, soil)
+
+        def inside(frequency):
+            return band is not None and band[0] <= 1.0 / frequency <= band[1]
+
+        def at(ground, frequency):
+            where = "" if band is None else (", inside" if inside(frequency) else ", outside")
+            return f"{ground} {frequency:.2g} Hz ({1.0 / frequency:.2g} s{where})"
+
+        text = (f"On {soil.name} this block lifts off at a lower median than on {low.name} and {high.name} "
+                f"({numbers.intensity(values[1], answer.unit)} against {numbers.intensity(values[0], answer.unit)} "
+                f"and {numbers.intensity(values[2], answer.unit)})")
+        if band is not None:
+            text += (f". The records' spectra are strongest from {band[0]:.2g} to {band[1]:.2g} s (their mean "
+                     f"spectrum, each scaled to its PGA, within {SPECTRUM_BAND:.0%} of its peak)")
+        others = [at(ground.name, bed_frequencies(config, block, ground)[1]) for ground in (low, high)]
+        period = f"a period of {1.0 / rocking:.2g} s" + ("" if band is None else
+                                                          " inside that band" if inside(rocking) else
+                                                          " outside that band")
+        text += (f"; under this block the bed on {soil.name} has a vertical frequency of {vertical:.2g} Hz and a "
+                 f"rocking frequency with the whole base down of {rocking:.2g} Hz, {period} (on "
+                 f"{' and on '.join(others)})")
+        if "damping_ratio_calibrated" in cube and answer.model in cube.model.values:
+            xi = cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block)
+            if "soil" in xi.dims and str(xi.idxmin("soil").values) == soil.name:
+                text += (f", and its damping calibrated to the restitution is the study's lowest on {soil.name}: a "
+                         "bed that dissipates least" + (" at a rocking frequency within the records' band"
+                                                        if inside(rocking) else "")
+                         + " is consistent with the earlier lift-off")
+        text += (f". A lift counts from the bed's unloaded surface, where the tensionless bed lets go (loss of "
+                 f"contact), not from rest: on {soil.name} a corner first rises by the static settlement, "
+                 f"{settlement * 1000:.2g} mm, before it lifts off.")
+        texts.append(text)
+    return " ".join(texts)
 
 
 MOTIONS = ("at rest", TILT_WORDS, "slides", "rocks", "slides and rocks", "flies", "overturns")
@@ -378,7 +506,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
     items += verdict_items(results, answer)
     special = " ".join(filter(None, [curve_reason(results, answer.model, answer.block),
-                                     slides_first_words(results, answer)]))
+                                     slides_first_words(results, answer), bed_resonance_words(results, answer)]))
     sufficiency = sufficiency_words(results.efficiency, answer.block, cube.attrs.get("intensity_measure", "")
                                     if cube is not None else "", measure_label(cube).split(" [")[0]
                                     if cube is not None else measure)
@@ -500,6 +628,23 @@ def _records_cell(row, index: int) -> str:
     return str(reached) if reached >= 0 else "-"
 
 
+def _example_cell(answers) -> str:
+    """The reading page's example of a cell, taken from this report: " (for example 22% / 30% / 42%)".
+
+    The first cell of the answer tables with a probability at every return period, all different and none a
+    bound; "" where there is none.
+    """
+    for answer in answers:
+        for soil in answer.soils:
+            for row in soil.states:
+                cells = [p_at_return_period(row, i, soil_intensities(answer, soil))
+                         for i in range(len(answer.return_periods))]
+                if len(cells) > 1 and len(set(cells)) == len(cells) and all(
+                        cell.endswith("%") and cell[0].isdigit() for cell in cells):
+                    return f" (for example {_joined(cells)})"
+    return ""
+
+
 def reading_items(results) -> list[Item]:
     """What every answer page shares, said once: the curve, the base friction, the tables, the verdicts."""
     answers = results.answers
@@ -521,7 +666,7 @@ def reading_items(results) -> list[Item]:
                        "Above the largest intensity of the unscaled records every result comes from records scaled "
                        "up (extrapolation by scaling)."),
              paragraph("P(damage state) at the site's intensity of each return period, the three return periods in "
-                       "one cell (for example 5.6% / 17% / 43%), each read as 'this state or worse' within its "
+                       f"one cell{_example_cell(answers)}, each read as 'this state or worse' within its "
                        "family: uplift, the rocking angles and overturning; the slip states and overturning. Within "
                        "a family a milder state is never less likely than a more severe one. "
                        f"{SLIP_NESTING} 'not reached': no record reached the state at any level up to the credible "
@@ -530,8 +675,11 @@ def reading_items(results) -> list[Item]:
                        f"{no_curve_words(answers[0])} '-': no level was run as low as that intensity, so the records "
                        "say nothing there. Beside it, how many records reached each state at those levels: a "
                        "probability where none did is the fitted curve's tail alone."),
-             paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. A smaller "
-                       f"lift off a bed is not rocking: the block {TILT_WORDS} (the bed gives under its toe). The "
+             paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. On a bed "
+                       "the lift is the corner's height above the bed's unloaded surface, where the tensionless bed "
+                       "lets go (loss of contact), not a rise from rest: a corner first rises by the block's static "
+                       f"settlement. A smaller lift off a bed is not rocking: the block {TILT_WORDS} (the bed gives "
+                       "under its toe). The "
                        "motion table counts each record once, at its most severe motion; the records that rock, "
                        "slide and rock, fly or overturn there are the records that reach uplift. 'Flies' on a bed "
                        "is the block bouncing clear of its bed after an impact (the vertical ground motion is not "
