@@ -481,10 +481,11 @@ def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed
     vertical, rocking, settlement = bed_frequencies(config, block, gravel)
     assert words.startswith("On gravel this block lifts off at a lower median than on sand and rock "
                             "(0.2 g against 0.31 g and 0.33 g)")
-    assert f"a vertical frequency of {vertical:.2g} Hz" in words and f"{rocking:.2g} Hz, a period of" in words
-    assert f"strongest from {band[0]:.2g} to {band[1]:.2g} s" in words
+    assert f"a vertical frequency of {vertical:.2g} Hz" in words
+    assert f"a rocking frequency (whole base down) of {rocking:.2g} Hz, {1 / rocking:.2g} s" in words
+    assert f"the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s" in words
     assert "damping calibrated to the restitution is the study's lowest on gravel" in words
-    assert f"static settlement, {settlement * 1000:.2g} mm, before it lifts off" in words
+    assert f"static settlement, {settlement * 1000:.2g} mm on gravel" in words
     assert "loss of contact" in words and "not from rest" in words
     fragility["median"][:] = [[[[0.1, 0.2, 0.3, 0.4, 0.5]]]]  # rising with the stiffness: nothing to explain
     assert bed_resonance_words(results, answer) == ""
@@ -545,3 +546,116 @@ def test_the_reading_page_takes_its_example_cell_from_the_report(small_pipeline)
              for row in item.rows for cell in row[1:]}
     assert example.group(1) in cells, example.group(1)
     assert example.group(1).count(" / ") == len(results.answers[0].return_periods) - 1
+
+
+def test_the_footer_headers_and_formulas_speak_the_clients_spelling(small_pipeline):
+    """Cold read 3, user C4 and default C6: every footer ended "study 'user-site'" (the study file's name), the
+    planar-model table's header read "density [kg/m^3]" and the methods wrote "r = 1 - 1.5 sin^2(α)" where the
+    other pages write sin²α. The footer is the project and title; one spelling of each unit and formula."""
+    from rockfrag.report import report_footer
+    from rockfrag.report.sections import limitations_items, methods_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    footer = report_footer(results)
+    assert "study '" not in footer and results.config.name not in footer.split(" · ")
+    assert footer.endswith(results.title)
+    texts = [item.text for item in methods_items(results) + limitations_items(results)]
+    headers = [head for item in limitations_items(results) if item.kind == "table" for head in item.header]
+    assert "density [kg/m³]" in headers and not any("^" in head for head in headers)
+    housner = next(text for text in texts if "Housner (rigid base)" in text and "dissipate" in text)
+    assert "sin²α" in housner and not any("sin^2" in text for text in texts)
+
+
+def test_a_site_intensity_just_below_a_level_that_prints_the_same_is_told_apart():
+    """Cold read 3, user C1: clay's 975-year PGA 0.3721 g printed '0.37 g' beside the levels read '0.3 g / 0.3 g /
+    0.37 g' (the level 0.3722 g is just above it, so the level below is read): a reader sees a contradiction. A note
+    gives both to the figures that tell them apart; an intensity clear of its next level gets none."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.answer_page import knife_edge_words
+
+    levels = [0.24, 0.302, 0.3722, 0.46]
+    soil = SimpleNamespace(soil="clay", intensities=(0.323, 0.3721, 0.441))
+    answer = SimpleNamespace(soils=[soil], return_periods=(475.0, 975.0, 2475.0), unit="g", intensities=())
+    assert knife_edge_words(answer, levels) == ("On clay the 975-year intensity, 0.3721 g, lies just below the level "
+                                                "0.3722 g (both print 0.37 g), so the tables read the level below "
+                                                "it, 0.3 g.")
+    soil.intensities = (0.323, 0.36, 0.441)
+    assert knife_edge_words(answer, levels) == ""
+
+
+def test_a_probability_read_from_a_curve_that_fails_its_fit_test_is_marked_on_the_answer_page(small_pipeline):
+    """Cold read 3, default C5: the paper block's uplift on steel (β 1.12, the fitted table's ‡: it fails its
+    goodness-of-fit test) gave the answer page 7.2% / 11% / 19% and 8.4% in 50 years without a word. Its cells
+    there carry ‡ and a note says what it means; a curve that passes the test carries none."""
+    from rockfrag.report.answer_page import POOR_FIT_MARK, answer_items
+    from rockfrag.report.sections import GOF_LEVEL
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    answer = results.answers[0]
+    soil = answer.soils[0]
+    fitted = [row for row in soil.states if row.not_reached_below is None and row.below_lowest is None
+              and np.isfinite(row.probability_in_life)]
+    assert fitted
+    gof = results.fragility.gof_p_value.copy()
+    gof[:] = 0.5
+    gof.loc[dict(model=answer.model, block=answer.block, soil=soil.soil, damage_state=fitted[0].state)] = 0.01
+    results.fragility["gof_p_value"] = gof
+    items = answer_items(results, answer)
+    marked = [(row[0], cell) for item in items if item.kind == "table" for row in item.rows
+              for cell in row[1:] if cell.endswith(POOR_FIT_MARK)]
+    assert len(marked) == 2, marked  # its probabilities at the return periods and in the design life
+    assert any(item.kind == "note" and item.text.startswith(f"{POOR_FIT_MARK} read from a fitted curve")
+               and f"p < {GOF_LEVEL:g}" in item.text for item in items)
+    gof[:] = 0.5
+    results.fragility["gof_p_value"] = gof
+    assert not any(cell.endswith(POOR_FIT_MARK) for item in answer_items(results, answer) if item.kind == "table"
+                   for row in item.rows for cell in row)
+
+
+def test_a_tables_lead_in_never_ends_a_page_without_its_table():
+    """Cold read 3 nit (orphan table headings): a line that introduces a table ("Records that reached each state at
+    those levels (of 44):") stood at the foot of a page and its table began on the next. A heading or a lead-in
+    paragraph ending with a colon goes to the page its table starts on; other paragraphs stay."""
+    from rockfrag.report.text import _lines, paginate, paragraph, table
+
+    capacity = 40
+    filler = [paragraph(f"Line {i}.") for i in range(18)]  # 2 lines each: 36 of the page's 40
+    lead = paragraph("Records that reached each state at those levels (of 44):")
+    rows = [[f"state {i}", "1 / 2 / 3"] for i in range(30)]
+    pages = paginate(filler + [lead, table(["damage state", "on clay"], rows)], capacity)
+    assert sum(_lines(item) for item in filler) + _lines(lead) <= capacity  # the lead-in alone would fit
+    for page in pages:
+        assert not (page[-1].kind == "paragraph" and page[-1].text.endswith(":")), [i.text for i in page[-2:]]
+    start = next(i for i, page in enumerate(pages) if any(item.kind == "table" for item in page))
+    assert lead in pages[start]
+    plain = paragraph("A sentence that introduces nothing.")
+    pages = paginate(filler + [plain, table(["damage state", "on clay"], rows)], capacity)
+    assert plain in pages[0]
+
+
+def test_the_sufficiency_sentence_names_the_runs_its_test_rests_on():
+    """Cold read 3, user B5 and default B2: "At a given PGA this block's overturning still depends on the records'
+    pulse period" read as a property of the answering curve, while the test rests on Housner's rigid base on sand
+    alone (the one cell with enough overturning records). Where the answering model was not tested, the sentence
+    names the runs it rests on (soils named unless the test holds on every soil)."""
+    import xarray as xr
+
+    from rockfrag.report.answer_page import sufficiency_words
+
+    dims = ("soil", "block", "model", "measure")
+    p = np.full((2, 1, 2, 1), np.nan)
+    p[1, 0, 0, 0] = 1e-3  # sand, housner: depends on the pulse period; the recommended runs untested
+    efficiency = xr.Dataset({"p_pulse_period": (dims, p)},
+                            coords={"soil": ["clay", "sand"], "block": ["box"], "model": ["housner", "recommended"],
+                                    "measure": ["pga"]})
+    words = sufficiency_words(efficiency, "box", "pga", "PGA", "recommended")
+    assert words.startswith("At a given PGA this block's overturning still depends on the records' pulse period in "
+                            "the runs of Housner (rigid base) on sand, the only ones with enough overturning records "
+                            "to test it, not in the answering model's (the measure-efficiency page"), words
+    p[0, 0, 0, 0] = 1e-3  # the same on every soil (a tied rigid base): no soil named
+    words = sufficiency_words(efficiency.assign(p_pulse_period=(dims, p)), "box", "pga", "PGA", "recommended")
+    assert "in the runs of Housner (rigid base), the only ones" in words
+    p[1, 0, 1, 0] = 1e-3  # the answering model tested too: the sentence is about its curve, no qualification
+    words = sufficiency_words(efficiency.assign(p_pulse_period=(dims, p)), "box", "pga", "PGA", "recommended")
+    assert "in the runs of" not in words and "pulse period" in words

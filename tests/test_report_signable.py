@@ -285,7 +285,7 @@ def test_the_limitations_give_each_blocks_depth_and_density_and_speak_of_cranes_
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     items = limitations_items(results)
-    table = next(item for item in items if item.kind == "table" and "density [kg/m^3]" in item.header)
+    table = next(item for item in items if item.kind == "table" and "density [kg/m³]" in item.header)
     for block, row in zip(results.config.blocks, table.rows):
         area = block.footprint_area
         assert row[3] == f"{area / (2 * block.b):.3g}"

@@ -820,8 +820,12 @@ def report_results(config: StudyConfig, cube: xr.Dataset, ida: xr.Dataset, fragi
 
 
 def report_footer(results: Results) -> str:
-    """The left footer of every page: project, report title and study name, joined by middle dots."""
-    parts = (results.settings.get("project"), results.title, f"study '{results.config.name}'")
+    """The left footer of every page: project and report title, joined by a middle dot.
+
+    Not the study's file name ("study 'user-site'"): a tool's word on every client page (cold read 3, C4/C6);
+    the appendix 'How to reproduce this report' names the study file.
+    """
+    parts = (results.settings.get("project"), results.title)
     return " · ".join(str(part) for part in parts if part)
 
 

@@ -358,33 +358,25 @@ def bed_resonance_words(results, answer) -> str:
         def inside(frequency):
             return band is not None and band[0] <= 1.0 / frequency <= band[1]
 
-        def at(ground, frequency):
-            where = "" if band is None else (", inside" if inside(frequency) else ", outside")
-            return f"{ground} {frequency:.2g} Hz ({1.0 / frequency:.2g} s{where})"
-
+        grounds = [(soil.name, rocking)] + [(g.name, bed_frequencies(config, block, g)[1]) for g in (low, high)]
         text = (f"On {soil.name} this block lifts off at a lower median than on {low.name} and {high.name} "
                 f"({numbers.intensity(values[1], answer.unit)} against {numbers.intensity(values[0], answer.unit)} "
-                f"and {numbers.intensity(values[2], answer.unit)})")
+                f"and {numbers.intensity(values[2], answer.unit)}). Under it the bed on {soil.name} has a vertical "
+                f"frequency of {vertical:.2g} Hz and a rocking frequency (whole base down) of {rocking:.2g} Hz, "
+                f"{1.0 / rocking:.2g} s ({'; '.join(f'{n} {f:.2g} Hz, {1.0 / f:.2g} s' for n, f in grounds[1:])})")
         if band is not None:
-            text += (f". The records' spectra are strongest from {band[0]:.2g} to {band[1]:.2g} s (their mean "
-                     f"spectrum, each scaled to its PGA, within {SPECTRUM_BAND:.0%} of its peak)")
-        others = [at(ground.name, bed_frequencies(config, block, ground)[1]) for ground in (low, high)]
-        period = f"a period of {1.0 / rocking:.2g} s" + ("" if band is None else
-                                                          " inside that band" if inside(rocking) else
-                                                          " outside that band")
-        text += (f"; under this block the bed on {soil.name} has a vertical frequency of {vertical:.2g} Hz and a "
-                 f"rocking frequency with the whole base down of {rocking:.2g} Hz, {period} (on "
-                 f"{' and on '.join(others)})")
+            inner = [name for name, frequency in grounds if inside(frequency)]
+            said = ("all within" if len(inner) == len(grounds) else f"{_and(inner)} within" if inner
+                    else "none within")
+            text += (f", {said} the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s (their mean spectrum "
+                     f"within {SPECTRUM_BAND:.0%} of its peak)")
         if "damping_ratio_calibrated" in cube and answer.model in cube.model.values:
             xi = cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block)
             if "soil" in xi.dims and str(xi.idxmin("soil").values) == soil.name:
-                text += (f", and its damping calibrated to the restitution is the study's lowest on {soil.name}: a "
-                         "bed that dissipates least" + (" at a rocking frequency within the records' band"
-                                                        if inside(rocking) else "")
-                         + " is consistent with the earlier lift-off")
-        text += (f". A lift counts from the bed's unloaded surface, where the tensionless bed lets go (loss of "
-                 f"contact), not from rest: on {soil.name} a corner first rises by the static settlement, "
-                 f"{settlement * 1000:.2g} mm, before it lifts off.")
+                text += (f"; its damping calibrated to the restitution is the study's lowest on {soil.name}, "
+                         "consistent with the earlier lift-off")
+        text += (f". A lift counts from the bed's unloaded surface (loss of contact), not from rest: a corner first "
+                 f"rises by the static settlement, {settlement * 1000:.2g} mm on {soil.name}.")
         texts.append(text)
     return " ".join(texts)
 
@@ -509,7 +501,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                      slides_first_words(results, answer), bed_resonance_words(results, answer)]))
     sufficiency = sufficiency_words(results.efficiency, answer.block, cube.attrs.get("intensity_measure", "")
                                     if cube is not None else "", measure_label(cube).split(" [")[0]
-                                    if cube is not None else measure)
+                                    if cube is not None else measure, answer.model)
     for text in (special, sufficiency):
         if text:
             items.append(paragraph(text))
@@ -530,12 +522,22 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if len({tuple(row[1:]) for row in sites}) == 1:  # one site hazard for every soil: one row
         sites = [["every soil", *sites[0][1:]]]
     items.append(table(["soil", f"site {measure}", "records counted at the level"], sites))
+    if cube is not None and "intensity" in cube:
+        edge = knife_edge_words(answer, np.asarray(cube.intensity.sel(block=answer.block).values, float)
+                                * display_scale(cube.intensity.attrs.get("units", ""))[0])
+        if edge:
+            items.append(note(edge))
     header = ["damage state", *(f"on {soil.soil}" for soil in answer.soils)]
     rows = [[short[state], *(_not_computed(results, answer, soil.soil, state)
                              or _joined(say_p_at(results, answer, soil, soil.states[index], i)
-                                        for i in range(len(periods))) for soil in answer.soils)]
+                                        for i in range(len(periods)))
+                             + _poor_fit_mark(results, answer, soil, soil.states[index]) for soil in answer.soils)]
             for index, state in enumerate(short)]
     items.append(table(header, rows))
+    if any(cell.endswith(POOR_FIT_MARK) for row in rows for cell in row[1:]):
+        from rockfrag.report.sections import GOF_LEVEL
+
+        items.append(note(POOR_FIT_WORDS.format(level=GOF_LEVEL)))
     counts = [[short[state], *(_joined(results.facts.say("records reaching", (answer.block, soil.soil, state, t),
                                                          _records_cell(soil.states[index], i))
                                        for i, t in enumerate(periods)) for soil in answer.soils)]
@@ -572,6 +574,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                 text += f", {_years(row.annual_frequency)}" if _years(row.annual_frequency) else ""
             if soil.soil in driven and state in driven_states and np.isfinite(row.probability_in_life):
                 text += f" {FRICTION_MARK}"
+            if not _not_computed(results, answer, soil.soil, state):
+                text += _poor_fit_mark(results, answer, soil, row)
             cells.append(text)
         rows.append(cells)
     rows.append(["β of the answering curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
@@ -583,6 +587,30 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if driven:
         items.append(note(friction_high_words(results, answer)))
     return items
+
+
+POOR_FIT_MARK = "‡"
+"""Beside a probability read from a fitted curve that fails its goodness-of-fit test (as the fitted table marks it)."""
+
+POOR_FIT_WORDS = ("‡ read from a fitted curve that fails its goodness-of-fit test (p < {level:g}, as the fitted "
+                  "table marks it): the lognormal follows the records' fractions poorly there; the records that "
+                  "reached the state at each level (the table below) are the firmer evidence.")
+"""The note under an answer page's probability table where a cell carries ``POOR_FIT_MARK`` (cold read 3, C5)."""
+
+
+def _poor_fit_mark(results, answer, soil, row) -> str:
+    """" ‡" where the cell's probabilities come from a curve that fails its goodness-of-fit test, else ""."""
+    from rockfrag.report.sections import GOF_LEVEL
+
+    fragility = results.fragility
+    if "gof_p_value" not in fragility or row.not_reached_below is not None or row.below_lowest is not None:
+        return ""
+    try:
+        p = float(fragility.gof_p_value.sel(model=answer.model, block=answer.block, soil=soil.soil,
+                                            damage_state=row.state))
+    except KeyError:
+        return ""
+    return f" {POOR_FIT_MARK}" if np.isfinite(p) and p < GOF_LEVEL else ""
 
 
 def _not_computed(results, answer, soil: str, state: str) -> str:
@@ -618,6 +646,31 @@ def _levels_read(answer, soil) -> str:
             values = [record[2] for record in state.records]
             return " / ".join(numbers.intensity(v, answer.unit) if np.isfinite(v) else NO_LEVEL for v in values)
     return "-"
+
+
+def knife_edge_words(answer, levels) -> str:
+    """A note where a site intensity prints as the level just above it (two figures) while below it, "" elsewhere.
+
+    The tables then read the level below, which a reader of "0.37 g" beside "0.37 g" takes for a contradiction
+    (cold read 3, user C1): the note gives both to the figures that tell them apart. ``levels``: the block's
+    levels in the answer's unit.
+    """
+    levels = np.sort(np.asarray(levels, float)[np.isfinite(levels)])
+    said = []
+    for soil in answer.soils:
+        for period, site in zip(answer.return_periods, soil_intensities(answer, soil)):
+            above = levels[levels > site]
+            if not above.size or numbers.intensity(site, answer.unit) != numbers.intensity(above[0], answer.unit):
+                continue
+            digits = next(d for d in range(3, 10) if f"{site:.{d}g}" != f"{above[0]:.{d}g}")
+            below = levels[levels <= site]
+            read = f"the level below it, {numbers.intensity(below[-1], answer.unit)}" if below.size \
+                else "no level (none was run that low)"
+            said.append(f"on {soil.soil} the {numbers.as_stated(period)}-year intensity, {site:.{digits}g} "
+                        f"{answer.unit}, lies just below the level {above[0]:.{digits}g} {answer.unit} (both print "
+                        f"{numbers.intensity(site, answer.unit)}), so the tables read {read}")
+    text = "; ".join(said)
+    return (text[0].upper() + text[1:] + ".") if said else ""
 
 
 def _records_cell(row, index: int) -> str:
@@ -742,7 +795,7 @@ SUFFICIENCY_LEVEL = 0.05
 """Below this p-value the overturning capacity in the study's measure still depends on the parameter."""
 
 
-def sufficiency_words(efficiency, block: str, study_measure: str, measure: str) -> str:
+def sufficiency_words(efficiency, block: str, study_measure: str, measure: str, model: str | None = None) -> str:
     """One sentence when the study's measure is not sufficient for this block's overturning ("" when it is).
 
     Reads the smallest p-value over the block's soils and models of each parameter of ``SUFFICIENCY_PARAMETERS``
@@ -753,16 +806,30 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str) 
     if efficiency is None or study_measure not in efficiency.coords.get("measure", []) \
             or block not in efficiency.block.values:
         return ""
-    failing = []
+    failing, cells = [], set()
     for variable, words in SUFFICIENCY_PARAMETERS.items():
         if variable not in efficiency:
             continue
-        values = efficiency[variable].sel(block=block, measure=study_measure).values
-        if np.isfinite(values).any() and float(np.nanmin(values)) < SUFFICIENCY_LEVEL:
+        values = efficiency[variable].sel(block=block, measure=study_measure)
+        if np.isfinite(values.values).any() and float(np.nanmin(values.values)) < SUFFICIENCY_LEVEL:
             failing.append(words)
+            below = values.where(values < SUFFICIENCY_LEVEL).stack(cell=("model", "soil")).dropna("cell")
+            cells.update((str(m), str(s)) for m, s in below.cell.values)
     if not failing:
         return ""
-    return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)} (the "
+    tested = {str(m) for m in efficiency.model.values
+              if np.isfinite(efficiency[next(v for v in SUFFICIENCY_PARAMETERS if v in efficiency)]
+                             .sel(block=block, measure=study_measure, model=m).values).any()}
+    where = ""
+    if model is not None and model not in tested:
+        runs = []
+        for name in sorted({m for m, _ in cells}):
+            soils = sorted({s for m, s in cells if m == name}, key=list(map(str, efficiency.soil.values)).index)
+            on = "" if len(soils) == efficiency.sizes["soil"] else f" on {_and(soils)}"
+            runs.append(f"{model_info(name).label}{on}")
+        where = (f" in the runs of {_and(runs)}, the only ones with enough overturning records to test it, not "
+                 "in the answering model's")
+    return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)}{where} (the "
             "measure-efficiency page; Luco & Cornell 2007): these curves hold for ground motions like the study's "
             "records. For a site whose motions differ in that (near a fault: velocity pulses), the study must run "
             "records like the site's (for example the near-field set).")

@@ -68,7 +68,7 @@ from rockfrag.report.layout import pretty
 from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, hazard_caveat
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
-from rockfrag.report.words import PAPER_CITATION, plain, state_short_label
+from rockfrag.report.words import PAPER_CITATION, formulas, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS
 from rockfrag.version import __version__
@@ -696,7 +696,7 @@ def methods_items(results: Results) -> list[Item]:
         described.setdefault(f"{model.description}; {role}.", []).append(short_label(model))
     every_model = [short_label(m) for m in models_of(cube)]
     for text, labels in described.items():
-        items.append(bullet(pretty(f"{_models_words(labels, every_model)}: {text}")))
+        items.append(bullet(pretty(formulas(f"{_models_words(labels, every_model)}: {text}"))))
     items.append(paragraph(
         f"All models: planar rocking of a rigid block; the base does not slide unless the study's friction runs "
         "let it (a block whose base friction coefficient is below its width over height slides before it can "
@@ -1133,7 +1133,7 @@ def limitations_items(results: Results) -> list[Item]:
     items.append(heading("Planar model"))
     items.append(paragraph(PLANAR_WORDS))
     items.append(table(["block", "rocks across: half-width b [m]", "half-height h [m]", "depth [m]",
-                        "density [kg/m^3]"],
+                        "density [kg/m³]"],
                        [[block_name(config, block), f"{float(cube.block_b.sel(block=block)):.3g}",
                          f"{float(cube.block_h.sel(block=block)):.3g}", *_depth_and_density(config, cube, block)]
                         for block in cube.block.values]))

@@ -144,7 +144,7 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
             room = capacity - used - 1 - _header_lines(item)
             if room < 3 and current:
                 carried = []
-                while current and current[-1].kind == "heading":  # a heading goes with its table
+                while current and _leads_to_table(current[-1]):  # a heading or lead-in goes with its table
                     carried.insert(0, current.pop())
                 if current:
                     pages.append(current)
@@ -163,9 +163,12 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
                 queue.insert(0, tail)
             continue
         if used + need > capacity and current:
-            if current[-1].kind == "heading":  # keep the headings (a section's, then its first) with what follows
+            follows = item.kind == "table"
+            if current[-1].kind == "heading" or (follows and _leads_to_table(current[-1])):
+                # keep the headings (a section's, then its first) and a table's lead-in with what follows
                 kept = 1
-                while kept < len(current) and current[-1 - kept].kind == "heading":
+                while kept < len(current) and (current[-1 - kept].kind == "heading"
+                                               or (follows and _leads_to_table(current[-1 - kept]))):
                     kept += 1
                 if kept < len(current):  # a page of headings only stays as it is
                     pages.append(current[:-kept])
@@ -179,6 +182,11 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
     if current or not pages:
         pages.append(current)
     return pages
+
+
+def _leads_to_table(item) -> bool:
+    """A heading, or a paragraph or note that ends with a colon: it introduces what follows and goes with it."""
+    return item.kind == "heading" or (item.kind in ("paragraph", "note") and item.text.rstrip().endswith(":"))
 
 
 TABLE_CHARS = int((0.985 - LEFT - 0.01) / CHAR)  # characters of 8.5 pt type across the page

@@ -240,6 +240,17 @@ def state_short_label(name: str, description: str) -> str:
     return name.replace("-", " ").replace("_", " ")
 
 
+FORMULAS = ((re.compile(r"sin\^2\s*\(?\s*(?:alpha|α)\s*\)?"), "sin²α"),)
+"""A formula as a registry or model description writes it in ASCII, and as the report prints it (one spelling)."""
+
+
+def formulas(text: str) -> str:
+    """The ASCII formulas of ``text`` in the report's spelling: "1 - 1.5 sin^2(alpha)" -> "1 - 1.5 sin²α"."""
+    for pattern, spelled in FORMULAS:
+        text = pattern.sub(spelled, text)
+    return text
+
+
 def plain(text: str) -> str:
     """A status, fit method or rule as words (the input when it has none)."""
     for table in (STATUS_WORDS, FIT_METHODS, SWITCH_WORDS, BED_WORDS):
