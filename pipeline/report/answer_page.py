@@ -497,14 +497,14 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if description:
         items.append(paragraph(f"{name[0].upper() + name[1:]}: {description}."))
     items += verdict_items(results, answer)
-    special = " ".join(filter(None, [curve_reason(results, answer.model, answer.block),
-                                     slides_first_words(results, answer), bed_resonance_words(results, answer)]))
     sufficiency = sufficiency_words(results.efficiency, answer.block, cube.attrs.get("intensity_measure", "")
                                     if cube is not None else "", measure_label(cube).split(" [")[0]
                                     if cube is not None else measure, answer.model)
-    for text in (special, sufficiency):
+    # one paragraph per subject (restitution, friction, the bed's lift-off, the measure): not one wall of text
+    for text in (curve_reason(results, answer.model, answer.block), slides_first_words(results, answer),
+                 bed_resonance_words(results, answer), sufficiency):
         if text:
-            items.append(paragraph(text))
+            items.append(paragraph(text.strip()))
     if not answer.return_periods:
         items.append(paragraph(f"The study has no hazard curve for {measure}: no return-period intensities and no "
                                "probability in the design life. The fragility curves are on the pages that follow."))
@@ -526,7 +526,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         edge = knife_edge_words(answer, np.asarray(cube.intensity.sel(block=answer.block).values, float)
                                 * display_scale(cube.intensity.attrs.get("units", ""))[0])
         if edge:
-            items.append(note(edge))
+            items.append(paragraph(edge))
     header = ["damage state", *(f"on {soil.soil}" for soil in answer.soils)]
     rows = [[short[state], *(_not_computed(results, answer, soil.soil, state)
                              or _joined(say_p_at(results, answer, soil, soil.states[index], i)
