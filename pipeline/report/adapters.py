@@ -25,6 +25,7 @@ from rockfrag.models import get_model, model_label
 from rockfrag.models.base import Outcome
 from rockfrag.models.variants import RECOMMENDED
 from rockfrag.report.layout import MODEL_STYLES, RECOMMENDED_STYLE, RIGID_STYLE, pretty
+from rockfrag.report.words import formulas
 from rockfrag.soils import DEFAULT_FRICTION
 
 OUTCOME_ROCKING, OUTCOME_FAILED, OUTCOME_FREE_FLIGHT = int(Outcome.ROCKING), int(Outcome.FAILED), \
@@ -409,7 +410,7 @@ def block_description(config, block) -> str:
     """The study's description of the block (its ``why``), or ""."""
     for item in getattr(config, "blocks", ()) or ():
         if item.name == str(block):
-            return pretty(item.description)
+            return pretty(formulas(item.description))
     return ""
 
 

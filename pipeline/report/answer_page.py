@@ -93,8 +93,7 @@ def _band_reach(cube, block=None) -> str:
         return ""
     soils = [str(s) for s in cube.soil.values if bool(short.sel(soil=s).any())]
     asked = float(requested.where(short).max())
-    reached = _and([f"{float(target.sel(soil=soil).where(short.sel(soil=soil)).max()):.3f} on {soil}"
-                    for soil in soils])
+    reached = _grouped({soil: float(target.sel(soil=soil).where(short.sel(soil=soil)).max()) for soil in soils})
     text = (f" On {_and(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
             f"(r up to {asked:.3f}; it reaches at most {reached}): those runs use the nearest r it reaches, so "
             "the restitution part of the model dispersion there leaves out the less dissipative side of the range, "
@@ -104,10 +103,19 @@ def _band_reach(cube, block=None) -> str:
         low = [str(s) for s in cube.soil.values
                if bool(((centre_asked.sel(soil=s) - centre_run.sel(soil=s)) > 5e-4).any())]
         if low:
-            runs = _and([f"{float(centre_run.sel(soil=soil).min()):.3f}" for soil in low])
+            values = [f"{float(centre_run.sel(soil=soil).min()):.3f}" for soil in low]
+            runs = values[0] if len(set(values)) == 1 else _and(values)
             text += (f" On {_and(low)} the answering run uses r = {runs}, below the middle of the range, "
                      f"{float(centre_asked.max()):.3f}.")
     return text
+
+
+def _grouped(values: dict) -> str:
+    """Soil -> r as "0.750 on sand, 0.742 on gravel and 0.728 on rock and steel" (equal values said once)."""
+    groups: dict[str, list[str]] = {}
+    for soil, value in values.items():
+        groups.setdefault(f"{value:.3f}", []).append(soil)
+    return _and([f"{value} on {_and(soils)}" for value, soils in groups.items()])
 
 
 def _and(words) -> str:
@@ -135,7 +143,7 @@ def _band_collapse(cube, block) -> str:
     reached = target.sel(soil=collapsed)
     asked += (f" asked; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any())
               else " asked; it reaches none of them")
-    where = "every soil" if len(collapsed) == cube.soil.size else ", ".join(collapsed)
+    where = "every soil" if len(collapsed) == cube.soil.size else _and(collapsed)
     text = (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
             f"restitutions apart ({asked}), so restitution adds nothing to the model dispersion there because there "
             "is one run, not because it is known; the model part of β there rests on FEMA P-695's model-quality "
@@ -244,7 +252,7 @@ def slides_first_words(results, answer) -> str:
 def _where(results, soils) -> str:
     """The soils by name, or "every soil" when they are all the study's (said once, not soil by soil)."""
     every = len(soils) == len(results.config.soils) and len(soils) > 1
-    return "every soil" if every else ", ".join(soil.name for soil in soils)
+    return "every soil" if every else _and([soil.name for soil in soils])
 
 
 def friction_high_words(results, answer) -> str:

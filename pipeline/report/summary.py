@@ -312,7 +312,7 @@ def reason(results, answer, soil) -> str:
         return f"{numbers.count(reached, total)} records already at {numbers.intensity(level, unit)}: a bound"
     censored = _censored_at_cap(results, answer, soil, row)
     if censored is not None:
-        return f"a bound: median above {numbers.intensity(censored, unit)}"  # the cap: said in the note
+        return f"a bound (median above {numbers.intensity(censored, unit)})"  # the cap: said in the note
     if row.tail_only:
         first = numbers.intensity(row.first_reached, unit) if row.first_reached is not None else "any level"
         return f"fitted tail only: no record below {first}"

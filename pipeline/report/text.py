@@ -152,6 +152,8 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
                 queue.insert(0, item)
                 continue
             room = max(room, 3)
+            if len(item.rows) - room == 1 and room > 3:
+                room -= 1  # no single row alone under a repeated header on the next page: it takes two
             while 1 < room < len(item.rows) and (not item.rows[room][0] or is_span(item.rows[room - 1])):
                 room -= 1  # a wrapped cell's lines stay on one page, and a group heading with its first row
             head = replace(item, rows=item.rows[:room])

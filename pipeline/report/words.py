@@ -240,12 +240,13 @@ def state_short_label(name: str, description: str) -> str:
     return name.replace("-", " ").replace("_", " ")
 
 
-FORMULAS = ((re.compile(r"sin\^2\s*\(?\s*(?:alpha|α)\s*\)?"), "sin²α"),)
+FORMULAS = ((re.compile(r"sin\^2\s*\(?\s*(?:alpha|α)\s*\)?"), "sin²α"),
+            (re.compile(r"(?<=[A-Za-z])\^2(?![0-9])"), "²"), (re.compile(r"(?<=[A-Za-z])\^3(?![0-9])"), "³"))
 """A formula as a registry or model description writes it in ASCII, and as the report prints it (one spelling)."""
 
 
 def formulas(text: str) -> str:
-    """The ASCII formulas of ``text`` in the report's spelling: "1 - 1.5 sin^2(alpha)" -> "1 - 1.5 sin²α"."""
+    """ASCII formulas and units of ``text`` as the report spells them: "sin^2(alpha)" -> "sin²α", "m^3" -> "m³"."""
     for pattern, spelled in FORMULAS:
         text = pattern.sub(spelled, text)
     return text
