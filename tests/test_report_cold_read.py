@@ -559,6 +559,7 @@ def test_the_footer_headers_and_formulas_speak_the_clients_spelling(small_pipeli
     footer = report_footer(results)
     assert "study '" not in footer and results.config.name not in footer.split(" · ")
     assert footer.endswith(results.title)
+    assert "study file" not in results.friction_words  # read 4, user B2: the appendix names the setting
     texts = [item.text for item in methods_items(results) + limitations_items(results)]
     headers = [head for item in limitations_items(results) if item.kind == "table" for head in item.header]
     assert "density [kg/m³]" in headers and not any("^" in head for head in headers)

@@ -126,8 +126,8 @@ class Results:
         sources = ([f"the soil class's default coefficient ({'; '.join(bases)})"] if shipped else []) \
             + ([f"the study file's own value ({', '.join(own)})"] if own else [])
         return (f"Base friction: static/kinetic μ_s/μ_k {pairs}, {' and '.join(sources)}, not a value of each "
-                "block's own base: a plinth, a grout bed or a steel shim under the block changes it. The study file "
-                "can give each soil its own coefficients (see 'How to reproduce this report').")
+                "block's own base: a plinth, a grout bed or a steel shim under the block changes it. Each soil can "
+                "be given its own coefficients ('How to reproduce this report' names the setting).")
 
     @cached_property
     def hazard(self) -> HazardCurve | None:
