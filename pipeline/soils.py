@@ -91,6 +91,8 @@ FRICTION_SOURCES = (
     f"Kinetic = {KINETIC_OVER_STATIC} x "
     "static (rounded to 0.01). Steel base on a steel deck: 0.50 static, the slip coefficient of blast-cleaned "
     "steel faying surfaces (AISC 360-16 Specification for Structural Steel Buildings, J3.8, class B surfaces), "
+    "the study's choice of the clause's two classes: class A (unpainted clean mill scale) is 0.30, under which "
+    "a block with b/h between 0.30 and 0.50 (the paper's block, 0.47) slides before it can rock; both lie "
     "below the 0.74 of clean dry mild steel in the laboratory (Marks' Standard Handbook for Mechanical "
     "Engineers, Table 3.2.1); 0.40 kinetic (0.8 x static).")
 """Where the shipped soils' friction coefficients come from (docs/theory/sliding.md)."""
