@@ -412,8 +412,8 @@ def test_a_value_that_rests_on_the_assumed_friction_is_marked_with_the_high_fric
             marked += expected
     assert marked >= 2
     assert note.kind == "note" and note.text.startswith(f"{FRICTION_MARK} friction-driven: on every soil the block")
-    assert note.text.endswith("the medians are, on sand (μ_s 0.90): none below the credible cap; on rock (μ_s "
-                              "0.90): θmax/α ≥ 0.5 at 1.2 g."), note.text  # the small study's levels are in g
+    assert note.text.endswith("the medians are, on sand (μ_s 0.90): none below the highest intensity studied; "
+                              "on rock (μ_s 0.90): θmax/α ≥ 0.5 at 1.2 g."), note.text  # the small study's levels: g
     other = next(answer for answer in results.answers if answer.block == "slender-cabinet")  # b/h 0.2: grips
     assert not any(FRICTION_MARK in cell for item in answer_items(results, other) if item.kind == "table"
                    for row in item.rows for cell in row)
@@ -529,7 +529,7 @@ def test_the_answering_runs_restitution_is_said_per_soil_in_one_plain_sentence()
     text = _band_reach(cube)
     assert "On clay and rock the bed cannot dissipate" in text, text
     assert "it reaches at most 0.802 on clay and rock" in text, text  # an equal value said once
-    assert "On rock the answering run uses r = 0.802, below the middle of the range, 0.813." in text, text
+    assert "On rock the best-estimate run uses r = 0.802, below the middle of the range, 0.813." in text, text
     assert " there:" not in text and "itself" not in text
 
 
@@ -581,13 +581,26 @@ def test_a_site_intensity_just_below_a_level_that_prints_the_same_is_told_apart(
     from rockfrag.report.answer_page import knife_edge_words
 
     levels = [0.24, 0.302, 0.3722, 0.46]
-    soil = SimpleNamespace(soil="clay", intensities=(0.323, 0.3721, 0.441))
+    soil = SimpleNamespace(soil="clay", intensities=(0.323, 0.3698, 0.441))  # 0.65 % below the level 0.3722 g
     answer = SimpleNamespace(soils=[soil], return_periods=(475.0, 975.0, 2475.0), unit="g", intensities=())
-    assert knife_edge_words(answer, levels) == ("On clay the 975-year intensity, 0.3721 g, lies just below the level "
+    assert knife_edge_words(answer, levels) == ("On clay the 975-year intensity, 0.3698 g, lies just below the level "
                                                 "0.3722 g (both print 0.37 g), so the tables read the level below "
                                                 "it, 0.3 g.")
     soil.intensities = (0.323, 0.36, 0.441)
     assert knife_edge_words(answer, levels) == ""
+    soil.intensities = (0.323, 0.3721, 0.441)  # 0.03 % below: read as at the level (no note, no lower level)
+    assert knife_edge_words(answer, levels) == ""
+
+
+def test_a_level_a_hair_above_the_site_intensity_counts_as_at_it():
+    """Cold read 4, user B4: clay's 975-year PGA 0.3721 g read the level below the level 0.3722 g, so its record
+    counts were the 475-year ones. A level within 0.5 % above the intensity is read as at it; one 5 % above is not."""
+    from rockfrag.answer import level_at_or_below
+
+    levels = [0.24, 0.302, 0.3722, 0.46]
+    assert level_at_or_below(levels, 0.3721) == 2  # 0.03 % below the level
+    assert level_at_or_below(levels, 0.3722 / 1.05) == 1
+    assert level_at_or_below(levels, 0.2) is None
 
 
 def test_a_probability_read_from_a_curve_that_fails_its_fit_test_is_marked_on_the_answer_page(small_pipeline):
@@ -658,7 +671,7 @@ def test_the_sufficiency_sentence_names_the_runs_its_test_rests_on():
     words = sufficiency_words(efficiency, "box", "pga", "PGA", "recommended")
     assert words.startswith("At a given PGA this block's overturning still depends on the records' pulse period in "
                             "the runs of Housner (rigid base) on sand, the only ones with enough overturning records "
-                            "to test it, not in the answering model's (the measure-efficiency page"), words
+                            "to test it, not in the recommended model's (the measure-efficiency page"), words
     p[0, 0, 0, 0] = 1e-3  # the same on every soil (a tied rigid base): no soil named
     words = sufficiency_words(efficiency.assign(p_pulse_period=(dims, p)), "box", "pga", "PGA", "recommended")
     assert "in the runs of Housner (rigid base), the only ones" in words
@@ -683,3 +696,15 @@ def test_a_table_split_by_a_page_break_leaves_no_single_row_on_the_next_page():
             split += 1
             assert all(len(part.rows) >= 2 for part in parts), [len(part.rows) for part in parts]
     assert split
+
+
+def test_a_computed_value_below_the_print_floor_with_its_return_period_gets_a_note():
+    """Cold read 4, user C: '< 0.1%, once in 2,900,000 years §' mixed the print floor with a computed return period;
+    a note under the design-life table says the value is computed and below the floor. A bound '< 0.81%' or a
+    value above the floor gets none."""
+    from rockfrag.report.answer_page import FLOOR_WITH_PERIOD_WORDS, below_floor_with_period
+
+    assert below_floor_with_period([["θmax/α ≥ 0.2", "none", "< 0.1%, once in 2,900,000 years §", "1.4%"]])
+    assert not below_floor_with_period([["overturning", "1%", "< 0.81%", "0.28%, once in 18,000 years"]])
+    assert not below_floor_with_period([["overturning", "< 0.1%, once in 9 years", "0.28%"]])  # the limit column
+    assert "computed" in FLOOR_WITH_PERIOD_WORDS and "print floor" in FLOOR_WITH_PERIOD_WORDS

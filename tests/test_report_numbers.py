@@ -16,7 +16,8 @@ from tests.helpers import pipeline_results
 
 
 @pytest.mark.parametrize("value, shown", [
-    (0.123, "12%"), (0.0234, "2.3%"), (0.00812, "0.81%"), (0.0010, "0.1%"), (0.00099, "< 0.1%"),
+    (0.123, "12%"), (0.0234, "2.3%"), (0.00812, "0.81%"), (0.0010, "0.10%"), (0.004028, "0.40%"), (0.02, "2.0%"),
+    (0.00099, "< 0.1%"),
     (0.00052, "< 0.1%"), (0.0, "0%"), (1.0, "100%"), (0.996, "> 99%"), (0.994, "99%"), (0.5, "50%"),
     (0.0999, "10%"), (np.nan, "-"), (None, "-")])
 def test_probabilities_print_to_two_significant_figures_and_below_a_tenth_of_a_percent_as_a_bound(value, shown):

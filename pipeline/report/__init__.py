@@ -247,7 +247,7 @@ CAPTIONS = {
                    "stiffness), the others central; the dashed line is the model-form β (FEMA P-695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
-                   "marked 'no median' has no curve of this state below the credible cap.",
+                   "marked 'no median' has no curve of this state below the highest intensity studied.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does; the test of Luco & Cornell 2007).",
@@ -302,7 +302,7 @@ def sweep_words(applicability) -> str:
     ratio does not tend to 1 as the ground stiffens; the paper's model, whose dashpot takes out what the corner
     impact would, does.
     """
-    xi = numbers.probability(float(applicability.attrs.get("damping_ratio", 0.05)))
+    xi = numbers.stated_probability(float(applicability.attrs.get("damping_ratio", 0.05)))
     models = {str(m) for m in applicability.model.values} if "model" in applicability.coords else set()
     text = (f" Every run here ties the base (no sliding) and gives the foundation's dashpot {xi} of critical "
             "damping, not calibrated to Housner's restitution: it isolates stiffness, and the page before compares "

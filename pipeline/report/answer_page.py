@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from rockfrag.answer import ANCHOR, RECOMMENDED, BlockAnswer, display_scale, level_at_or_below
+from rockfrag.answer import ANCHOR, LEVEL_TOLERANCE, RECOMMENDED, BlockAnswer, display_scale, level_at_or_below
 from rockfrag.damage_states import DAMAGE_STATES, NOT_APPLICABLE, TILT_WORDS
 from rockfrag.fragility import exceedance, first_overturn_outcomes  # the fits' counting rules, in one place
 from rockfrag.models.base import Outcome
@@ -105,7 +105,7 @@ def _band_reach(cube, block=None) -> str:
         if low:
             values = [f"{float(centre_run.sel(soil=soil).min()):.3f}" for soil in low]
             runs = values[0] if len(set(values)) == 1 else _and(values)
-            text += (f" On {_and(low)} the answering run uses r = {runs}, below the middle of the range, "
+            text += (f" On {_and(low)} the best-estimate run uses r = {runs}, below the middle of the range, "
                      f"{float(centre_asked.max()):.3f}.")
     return text
 
@@ -157,7 +157,7 @@ def _band_collapse(cube, block) -> str:
         middle = float(requested.sel(run="centre", soil=collapsed).max()) if "run" in requested.dims \
             else float(requested.sel(soil=collapsed).max())
         side = "below" if round(bound, 3) < round(middle, 3) else "at or above"
-        text += (f" The answering run uses the least bed damping at which this block's free rocking dies out below "
+        text += (f" The best-estimate run uses the least bed damping at which this block's free rocking dies out below "
                  f"what the restitution measure resolves: its r is not measured but bounded, at most {bound:.3f}, "
                  f"{side} the middle of the range ({middle:.3f}).")
     return text
@@ -168,8 +168,8 @@ def curve_reason(results, model: str, block=None) -> str:
     if model == RECOMMENDED:
         text = ("The answers use the recommended curve: the tensionless Winkler bed with friction at the base, at "
                 "the middle of the experimental range of impact restitution and the soil's stated friction and "
-                "stiffness (the central member). Its β adds the model dispersion to the record-to-record one: the "
-                "larger of the spread of its median over a designed sample (restitution, friction and bed stiffness "
+                "stiffness (the best estimate). Its β adds the model dispersion to the record-to-record one: the "
+                "larger of the spread of its median over sensitivity runs (restitution, friction and bed stiffness "
                 "each at both ends of its range) and FEMA P-695's rating of the model's form (a planar rigid block: "
                 "no three-dimensional rocking, no flexible superstructure).")
         if block is not None:
@@ -288,11 +288,12 @@ def friction_high_words(results, answer) -> str:
         parts.append((soil.name, friction, shown))
     if not any(shown for _, _, shown in parts):
         where = "on any soil" if names == "every soil" else "on any of them" if len(soils) > 1 else f"on {names}"
-        return (text + " With the friction at the high end of its range (the designed sample), no rocking state "
-                f"and no overturning has a median below the credible cap {where}.")
-    said = "; ".join(f"on {soil}{friction}: " + (", ".join(shown) if shown else "none below the credible cap")
+        return (text + " With the friction at the high end of its range (a sensitivity run), no rocking state "
+                f"and no overturning has a median below the highest intensity studied {where}.")
+    nothing = "none below the highest intensity studied"
+    said = "; ".join(f"on {soil}{friction}: " + (", ".join(shown) if shown else nothing)
                      for soil, friction, shown in parts)
-    return text + f" With the friction at the high end of its range (the designed sample) the medians are, {said}."
+    return text + f" With the friction at the high end of its range (a sensitivity run) the medians are, {said}."
 
 
 SPECTRUM_BAND = 0.8
@@ -574,7 +575,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     driven = {soil.name for soil in sliding_first_soils(results, answer)}
     driven_states = _friction_driven_states(results)
     for index, state in enumerate(short):
-        cells = [short[state], numbers.probability(limits[state]) if state in limits else "none"]
+        cells = [short[state], numbers.stated_probability(limits[state]) if state in limits else "none"]
         for soil in answer.soils:
             row = soil.states[index]
             text = _not_computed(results, answer, soil.soil, state) or say_p_in_life(results, answer, soil, row)
@@ -586,7 +587,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                 text += _poor_fit_mark(results, answer, soil, row)
             cells.append(text)
         rows.append(cells)
-    rows.append(["β of the answering curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
+    rows.append(["β of the recommended curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
     from rockfrag.report.summary import action, hazard_tag
 
     tag = hazard_tag(results)
@@ -594,7 +595,25 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     items.append(table(header, rows))
     if driven:
         items.append(note(friction_high_words(results, answer)))
+    if below_floor_with_period(rows):
+        items.append(note(FLOOR_WITH_PERIOD_WORDS))
     return items
+
+
+def below_floor_with_period(rows) -> bool:
+    """True where a design-life cell prints a computed value under the print floor with its return period."""
+    return any(cell.startswith(f"{numbers.probability(numbers.FLOOR / 2)}, once in") for row in rows
+               for cell in row[2:])
+
+
+FLOOR_WITH_PERIOD_WORDS = ("'< 0.1%, once in ... years': the fitted curve's value, computed but below the print "
+                           "floor of 0.1%; its return period says how far below.")
+"""The note under the design-life table where a computed probability below the print floor has its return period."""
+
+
+CERTAINTY_WORDS = ("'100%': every record reached the state (a count), or a certainty; '> 99%': a fitted value above "
+                   "99%, which two figures would round to 100%.")
+"""The two forms of a probability near one (rockfrag.report.numbers), said once on 'Reading the answer pages'."""
 
 
 POOR_FIT_MARK = "‡"
@@ -667,11 +686,11 @@ def knife_edge_words(answer, levels) -> str:
     said = []
     for soil in answer.soils:
         for period, site in zip(answer.return_periods, soil_intensities(answer, soil)):
-            above = levels[levels > site]
+            above = levels[levels > site * (1 + LEVEL_TOLERANCE)]  # a level within the tolerance is read as at it
             if not above.size or numbers.intensity(site, answer.unit) != numbers.intensity(above[0], answer.unit):
                 continue
-            digits = next(d for d in range(3, 10) if f"{site:.{d}g}" != f"{above[0]:.{d}g}")
-            below = levels[levels <= site]
+            digits = next(d for d in range(4, 10) if f"{site:.{d}g}" != f"{above[0]:.{d}g}")
+            below = levels[levels <= site * (1 + LEVEL_TOLERANCE)]
             read = f"the level below it, {numbers.intensity(below[-1], answer.unit)}" if below.size \
                 else "no level (none was run that low)"
             said.append(f"on {soil.soil} the {numbers.as_stated(period)}-year intensity, {site:.{digits}g} "
@@ -715,7 +734,8 @@ def reading_items(results) -> list[Item]:
     labels = labels_of(results)
     limits = {state: limit for state, limit in results.decision["max_probability_in_life"].items() if state in labels}
     short = short_names(results)
-    judged = ", ".join(f"{short[state]} {numbers.probability(limit)}" for state, limit in limits.items()) or "none"
+    judged = ", ".join(f"{short[state]} {numbers.stated_probability(limit)}"
+                       for state, limit in limits.items()) or "none"
     life = numbers.years(answers[0].design_life)
     items = [paragraph(curve_reason(results, model)),
              paragraph(results.friction_words),
@@ -723,18 +743,21 @@ def reading_items(results) -> list[Item]:
                        "limitations name the half-width b each block rocks across, and what that leaves out."),
              heading("The tables of each answer page"),
              paragraph(f"The site's intensity at each return period ({hazard_words(results, answers[0])}), on each "
-                       "soil, and the level run nearest at or below it: the tables count the records of that level. "
+                       "soil, and the level run nearest at or below it (a level at most "
+                       f"{LEVEL_TOLERANCE:.1%} above it counts as at it): the tables count the records of that level. "
                        "Above the largest intensity of the unscaled records every result comes from records scaled "
                        "up (extrapolation by scaling)."),
              paragraph("P(damage state) at the site's intensity of each return period, the three return periods in "
                        f"one cell{_example_cell(answers)}, each read as 'this state or worse' within its "
                        "family: uplift, the rocking angles and overturning; the slip states and overturning. Within "
-                       "a family a milder state is never less likely than a more severe one. "
-                       f"{SLIP_NESTING} 'not reached': no record reached the state at any level up to the credible "
-                       "cap, the highest intensity the study runs. '≥ X': the fitted median lies below every level "
+                       "a family a milder state is never less likely than a more severe one."),
+             paragraph(SLIP_NESTING),
+             paragraph("Marks: 'not reached': no record reached the state at any level up to "
+                       "the highest intensity studied (Methods). '≥ X': the fitted median lies below every level "
                        "run, and the records at the lowest level give a lower bound instead of the fit's tail. "
                        f"{no_curve_words(answers[0])} '-': no level was run as low as that intensity, so the records "
-                       "say nothing there. Beside it, how many records reached each state at those levels: a "
+                       "say nothing there."),
+             paragraph("Beside the probabilities, how many records reached each state at those levels: a "
                        "probability where none did is the fitted curve's tail alone."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. On a bed "
                        "the lift is the corner's height above the bed's unloaded surface, where the tensionless bed "
@@ -746,7 +769,8 @@ def reading_items(results) -> list[Item]:
                        "is the block bouncing clear of its bed after an impact (the vertical ground motion is not "
                        "applied), not a loss of support."),
              paragraph(f"The probability in the design life of {life} is the fitted curve integrated over the site's "
-                       f"hazard, with how often the state happens on average. {BOUND_WORDS} {BOUND_POLICY}"),
+                       f"hazard, with how often the state happens on average. {BOUND_WORDS} {CERTAINTY_WORDS} "
+                       f"{BOUND_POLICY}"),
              heading("The verdicts"),
              paragraph(f"'Anchor or restrain' where a probability in {life} exceeds the study's limit ({judged}; "
                        "an anchorage holds the block against sliding too). 'Specialist check of sliding' where "
@@ -836,7 +860,7 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str, 
             on = "" if len(soils) == efficiency.sizes["soil"] else f" on {_and(soils)}"
             runs.append(f"{model_info(name).label}{on}")
         where = (f" in the runs of {_and(runs)}, the only ones with enough overturning records to test it, not "
-                 "in the answering model's")
+                 "in the recommended model's")
     return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)}{where} (the "
             "measure-efficiency page; Luco & Cornell 2007): these curves hold for ground motions like the study's "
             "records. For a site whose motions differ in that (near a fault: velocity pulses), the study must run "

@@ -6,10 +6,11 @@ Output: their text under one precision policy, and ``Facts``, the ledger of ever
 
 The precision policy, applied here and nowhere else:
 
-- a probability (or a share of records or runs) to two significant figures, "< 0.1%" below 0.1%, "0%" for
-  none, "100%" for all, "> 99%" just below all (two figures would round it to a certainty);
+- a probability (or a share of records or runs) to two significant figures, both printed ("0.40%", "2.0%"),
+  "< 0.1%" below 0.1%, "0%" for none, "100%" for all, "> 99%" just below all (two figures would round it to a
+  certainty);
 - a computed intensity to two significant figures ("0.54 g"); a dispersion β to two decimals ("0.50");
-- an input as the study states it (``as_stated``: "0.35", "50 years");
+- an input as the study states it (``as_stated``: "0.35", "50 years"; ``stated_probability``: a limit "1%");
 - a calibrated model parameter (the bed's damping ratio fitted to a restitution) is not printed for the client.
 """
 
@@ -35,7 +36,7 @@ def probability(value) -> str:
     Returns
     -------
     str
-        "12%", "2.3%", "0.21%", "< 0.1%", "0%", "> 99%", "100%" or "-".
+        "12%", "2.3%", "2.0%", "0.21%", "0.40%", "< 0.1%", "0%", "> 99%", "100%" or "-".
     """
     if value is None or not math.isfinite(float(value)):
         return "-"
@@ -49,7 +50,13 @@ def probability(value) -> str:
     shown = float(f"{100 * value:.2g}")
     if shown >= 100:
         return "> 99%"
-    return f"{shown:g}%" if shown < 10 else f"{shown:.0f}%"
+    return _percent(shown)
+
+
+def _percent(shown: float) -> str:
+    """A percentage already rounded to two significant figures, printed with both ("0.40%", "2.0%", "12%")."""
+    decimals = max(0, 1 - math.floor(math.log10(shown)))
+    return f"{shown:.{decimals}f}%"
 
 
 def bound(value, side: str) -> str:
@@ -69,7 +76,12 @@ def bound(value, side: str) -> str:
     shown = float(f"{steps * scale:.10g}")
     if side == "≥" and shown >= 99 and float(value) > 0.99:
         return "> 99%"  # as ``probability`` prints a share just below all
-    return f"{side} {shown:g}%" if shown < 10 else f"{side} {shown:.0f}%"
+    return f"{side} {_percent(shown)}"
+
+
+def stated_probability(value) -> str:
+    """A probability the study states (a verdict's limit) in percent as stated: 0.01 -> "1%", 0.025 -> "2.5%"."""
+    return f"{100 * float(value):.10g}%"
 
 
 def intensity(value, unit: str) -> str:

@@ -278,7 +278,7 @@ def runs_words(results) -> str:
     text = f"{n_runs(cube):,} simulations on the intensity grid"
     members = member_runs(cube)
     if members:
-        text += f", {members:,} more for the recommended model's designed sample"
+        text += f", {members:,} more for the recommended model's sensitivity runs"
     refining = capacity_runs(cube)
     if refining:
         text += f" and {refining:,} more refining the overturning capacities"
@@ -428,7 +428,7 @@ def verdict_settings(results: Results) -> list[list[str]]:
 OPTIONAL_SETTINGS = (
     ("hazard", "reference_vs30", "the Vs30 of the hazard file's site: each soil's site hazard is amplified from it"),
     ("hazard", "vs30", "a soil's site Vs30: the site hazard its probabilities use"),
-    ("intensity", "credible_max", "the credible cap on the intensity: no level, fit or median above it, and the "
+    ("intensity", "credible_max", "the highest intensity studied: no level, fit or median above it, and the "
                                   "hazard's exceedance of it a stated bound"),
     ("intensity", "component", "which horizontal component the intensity is of: it must be the hazard's"),
 )
@@ -531,7 +531,7 @@ def fitted_items(results: Results) -> list[Item]:
     dashes = (f" {dropped} curves' rows with no fitted state at all are left out (the limitations say why no "
               "median)." if dropped else "")
     items = [paragraph(f"Fitted lognormal fragility functions: each cell is the median in {unit} / the dispersion "
-                       "β, for every damage state the answer pages and verdicts use, the answering model first. A "
+                       "β, for every damage state the answer pages and verdicts use, the recommended model first. A "
                        "rigid-base model has one row per block (soil '(any)') unless base friction lets the block "
                        "slide on some soils: then one row per soil. '-': no curve for that state (the limitations "
                        f"say why).{dashes} These are each curve's own fit; the answer pages print a slip state no "
@@ -810,8 +810,8 @@ NAVFAC_RANGES = {"rock": "clean sound rock 0.70",
 def soil_source_words(names: str, soils) -> str:
     """Where the shipped soils' moduli and damping come from: the paper's stated values, and what they are not."""
     damping = sorted({soil.damping_ratio for soil in soils})
-    xi = (f"Damping ratio {_percent(damping[0])} of each: within the range the paper studies (1% to 7% of critical, "
-          "its Fig. 8), not a measured value." if len(damping) == 1 else "")
+    xi = (f"Damping ratio {numbers.stated_probability(damping[0])} of each: within the range the paper studies "
+          "(1% to 7% of critical, its Fig. 8), not a measured value." if len(damping) == 1 else "")
     return (f"Soil moduli of {names}: the values the paper states (its Table 1: shear modulus, Poisson's ratio, "
             "density; clay's E_d = 130 MPa from its Figs. 9-11, Poisson's ratio 0.3 assumed). The paper cites no "
             "source for them: they are representative values of each class of ground, not measurements, and the "
@@ -915,8 +915,8 @@ def sources_items(results: Results) -> list[Item]:
         shipped = registered is not None and registered.limit == limit and bool(registered.limit_source)
         source = client_words(registered.limit_source) if shipped else "the study's own limit (see 'How to " \
             "reproduce this report')"
-        items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', {limit:.0%} in the "
-                            f"design life: {source}."))
+        items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', "
+                            f"{numbers.stated_probability(limit)} in the design life: {source}."))
     life = float(fragility.attrs.get("design_life_years", config.design_life))
     items.append(bullet(f"Design life {life:g} years: {CHOICE_WORDS}; 50 years is the span over which ASCE 7-22 "
                         "and the return periods below are stated."))
@@ -994,7 +994,7 @@ def _counts(fragility, model, block, soil, state, n_records) -> str:
 
 
 NO_MEDIAN = {"below-range": "reached below the lowest level", "above-range": "reached only at the highest levels",
-             "not-reached": "no record reached it", "censored-at-cap": "median above the credible cap"}
+             "not-reached": "no record reached it", "censored-at-cap": "median above the highest intensity studied"}
 """Why a curve has no median: the reason column of the limitations' table (short: one table row each)."""
 OUTSIDE = {"below": "below the lowest level", "above": "above the highest level"}
 """Where an extrapolated median lies: the reason column of the limitations' table."""

@@ -162,16 +162,16 @@ SLIP_NESTING = ("A slip state counts a record that overturns too (it is beyond e
                 "without lifting off, so a slip state may be more likely than uplift.")
 """How the slip states and overturning are ordered, said once on the page 'Reading the answer pages'."""
 
-BOUND_WORDS = ("'< X': no record reached the state at any level up to the credible cap, the highest intensity the "
-               "study runs (Methods), so its probability is at most X, that of the site's intensity exceeding the "
-               "cap. '< 0.1%' alone is the print floor: a value below 0.1%, computed or bounded.")
+BOUND_WORDS = ("'< X': no record reached the state at any level up to the highest intensity studied (Methods), "
+               "so its probability is at most X, that of the site's intensity exceeding it. '< 0.1%' alone is the "
+               "print floor: a value below 0.1%, computed or bounded.")
 """What a "< X" cell means, on the summary and the answer pages (rockfrag.answer's not-reached limit)."""
 
 BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a probability ('< X', '≥ X') these pages "
                 "print the bound, and a state is never printed less likely than a more severe one of its family; "
                 "the result tables keep each curve's own fitted value and say where it is extrapolated or censored "
-                "at the cap, so a bound here and a fitted value there are one result read two ways. The verdicts "
-                "use the values printed here.")
+                "at the highest intensity studied, so a bound here and a fitted value there are one result read "
+                "two ways. The verdicts use the values printed here.")
 """How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
@@ -254,9 +254,9 @@ def no_curve_words(answer) -> str:
     """What a count in a probability cell means ("0 of 44": ``p_at_return_period`` of a state without a curve)."""
     total = next((record[1] for soil in answer.soils for row in soil.states for record in row.records), None)
     example = f"'0 of {total}'" if total else "'0 of n'"
-    return (f"{example} in a probability cell: the state has no fitted curve (its median lies above the credible "
-            "cap) and no record reached it at that level, so the records give no probability there, only that it "
-            "is small; the probability in the design life bounds it.")
+    return (f"{example} in a probability cell: the state has no fitted curve (its median lies above the highest "
+            "intensity studied) and no record reached it at that level, so the records give no probability there, "
+            "only that it is small; the probability in the design life bounds it.")
 
 
 def say_p_at(results, answer, soil, row, index: int) -> str:
@@ -320,6 +320,8 @@ def reason(results, answer, soil) -> str:
         reached, total, level = row.records[-1]
         results.facts.say("records reaching", (answer.block, soil.soil, row.state, answer.return_periods[-1]),
                           str(reached))
+        if reached == 0:  # a non-zero P beside "0 of 44" says where it comes from
+            return f"{numbers.count(reached, total)} at {numbers.intensity(level, unit)}: fitted tail"
         return f"{numbers.count(reached, total)} reach it at {numbers.intensity(level, unit)}"
     return "from the fitted curve"
 
@@ -394,9 +396,10 @@ def summary_items(results) -> list[Item]:
                       if shown in cells)
     items.append(note(" ".join(filter(None, [
         said, GOVERNING_WORDS, bounds, structural_base_words(results),
-        "Reason: the records at the level run at or below the largest return period's intensity. β: records, the "
-        "variability from record to record; model, the model's own uncertainty. The answer pages give every damage "
-        "state and the records behind each number."]))))
+        "Reason: the records at the level run at or below the largest return period's intensity; where none "
+        "reach the state there, its probabilities are the fitted curve's tail (fitted to the higher levels). "
+        "β: records, the variability from record to record; model, the model's own uncertainty. The answer pages "
+        "give every damage state and the records behind each number."]))))
     return items
 
 
@@ -419,7 +422,7 @@ def verdict_rows(results, answer) -> list[dict]:
         else:
             state = short[row.state]
             at = [say_p_at(results, answer, soil, row, i) for i in range(len(periods))]
-            life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.probability(row.limit)})"
+            life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.stated_probability(row.limit)})"
             beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
         lines.append({"soil": soil.soil, "action": action(soil.verdict, soil, tag), "state": state, "at": at,
                       "life": life_text, "beta": beta, "reason": reason(results, answer, soil)})

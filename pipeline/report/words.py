@@ -39,7 +39,7 @@ STATUS_WORDS = {
     "above-range": "reached only at the highest levels: median above the studied range",
     "below-range": "reached by most records at the lowest level: median below the studied range",
     "not-reached": "not reached at any level",
-    "censored-at-cap": "median above the credible cap: the records' fraction at the cap instead",
+    "censored-at-cap": "median above the highest intensity studied: the records' fraction there instead",
     "deterministic-threshold": "an exact step at the uplift threshold",
     "separated": "a step between two levels",
     "no fit": "no fit",
@@ -164,7 +164,7 @@ GLOSSARY = (
                        "adds it."),
     ("confidence bounds", "the bounds of a fitted curve's median from fitting it again with the records "
                           "resampled (bootstrap); drawn as shading around the curve."),
-    ("designed sample", "the runs of the recommended model with one uncertain parameter (restitution, friction, "
+    ("sensitivity runs", "the runs of the recommended model with one uncertain parameter (restitution, friction, "
                         "bed stiffness) at the low or high end of its range, the others central; the spread of "
                         "their medians is the parameters' part of the model dispersion."),
     ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
@@ -209,10 +209,10 @@ GLOSSARY = (
     ("recommended curve", "the tensionless bed with the soil's stated friction and stiffness and the centre of the "
                           "experimental restitution range; its β adds the model's uncertainty (FEMA P-695's "
                           "model-quality rating, the counterpart of FEMA P-58's modelling dispersion β_q, or the "
-                          "designed sample's spread where larger) to the record-to-record part."),
-    ("credible cap", "the highest intensity the study runs (3 g PGA by default, above the largest horizontal PGA "
-                     "ever recorded); no level, fit or median lies above it, and a probability adds the site's "
-                     "chance of exceeding it as an upper bound."),
+                          "sensitivity runs' spread where larger) to the record-to-record part."),
+    ("highest intensity studied", "the highest intensity the study runs (3 g PGA by default, above the "
+                                  "largest horizontal PGA ever recorded); no level, fit or median lies above it, "
+                                  "and a probability adds the site's chance of exceeding it as an upper bound."),
     ("RotD50", "the median over all horizontal orientations of a station's two components (Boore 2010), the "
                "intensity hazard models give; each pair of components is scaled together by it."),
 )
