@@ -208,3 +208,38 @@ def test_the_showcase_page_draws_the_ground_acceleration_once(small_pipeline):
         assert len(grounds) == 1
     finally:
         plt.close(figure)
+
+
+def _tick_texts(axis) -> list[str]:
+    """The labels of the major ticks inside the view, as drawn (after a draw: formatters run then)."""
+    axis.figure.canvas.draw()
+    low, high = sorted(axis.get_view_interval())
+    return [tick.label1.get_text() for tick in axis.get_major_ticks() if low <= tick.get_loc() <= high]
+
+
+def test_intensity_and_period_axes_are_labelled_in_plain_numbers():
+    """Cold read 4: the hazard page's PGA axis and the spectra page's period and Sa axes read 10^-1, 10^0 (mathtext);
+    an engineer reads 0.1, 0.5, 1 g and 0.1, 1 s. The hazard page's annual frequency keeps 10^n."""
+    import xarray as xr
+
+    from rockfrag.site_hazard import SiteHazards
+
+    given = np.geomspace(0.03, 3.0, 40)
+    reference = _hazard(given, 1e-4 * given ** -2.5 * 0.0185, "reference")
+    figure = figures.hazard_page(SiteHazards({"rock": reference}, reference, 760.0), [475, 2475], "Read it.")
+    try:
+        x = _tick_texts(figure.axes[0].xaxis)
+        assert len(x) >= 3 and all(text and "^" not in text and "$" not in text for text in x), x
+        assert float(x[0]) < float(x[-1])
+    finally:
+        plt.close(figure)
+    periods = np.geomspace(0.02, 10.0, 60)
+    spectra = np.exp(np.random.default_rng(2).normal(0.0, 0.4, (10, 60))) * 9.81 / (1 + periods)
+    showcase = xr.Dataset({"record_spectrum": (("record", "period"), spectra)}, coords={"period": periods})
+    figure = figures.spectra_page(showcase, "Read it.")
+    try:
+        for axis in (figure.axes[0].xaxis, figure.axes[0].yaxis):
+            texts = _tick_texts(axis)
+            assert len(texts) >= 3 and all(t and "^" not in t and "$" not in t for t in texts), texts
+    finally:
+        plt.close(figure)

@@ -229,11 +229,24 @@ def spectra_page(showcase, caption):
         axis.loglog(periods, np.quantile(spectra, q, axis=0), label=f"{q:.0%} fractile", **style)
     axis.set_xlabel("period T [s]")
     axis.set_ylabel("spectral acceleration Sa(T, 5%) [g]")
-    log_minor_ticks(axis.xaxis)
-    log_minor_ticks(axis.yaxis)
+    finish_log_log(figure, axis, plain_y=True)
+    return figure
+
+
+def finish_log_log(figure, axis, plain_y: bool) -> None:
+    """A log-log page axis finished: plain-number ticks, minor ticks, grid, legend outside.
+
+    Periods and intensities on x read "0.1", "1", "3", never 10^n; so does y where ``plain_y`` (accelerations;
+    an annual frequency keeps 10^n, the hazard curve's convention). Call it after the data and the limits are
+    set: the tick values are chosen over the limits.
+    """
+    log_axis(axis)
+    if plain_y:
+        log_y_axis(axis)
+    else:
+        log_minor_ticks(axis.yaxis)
     axis.grid(alpha=0.3, which="both")
     outside_legend(figure, [axis])
-    return figure
 
 
 def given_part(curve, reference=None) -> tuple[np.ndarray, np.ndarray]:
@@ -291,10 +304,7 @@ def hazard_page(sites, return_periods, caption, unit: str = "g"):
         axis.set_xlim(inside.min(), inside.max())
     axis.set_xlabel(f"{shown.label} [{unit}]")
     axis.set_ylabel("annual frequency of exceedance [1/yr]")
-    log_minor_ticks(axis.xaxis)
-    log_minor_ticks(axis.yaxis)
-    axis.grid(alpha=0.3, which="both")
-    outside_legend(figure, [axis])
+    finish_log_log(figure, axis, plain_y=False)
     return figure
 
 
