@@ -71,7 +71,10 @@ def test_no_client_page_speaks_tool_syntax_and_the_appendix_holds_it(small_pipel
     assert {name: entries for name, entries in headings.items() if entries} == {}
     appendix = _texts(reproduce_items(results))
     for key in ("[hazard] file", "[decision] max_probability_in_life", "[decision] max_sliding_share",
-                "[solver] friction", "rockfrag fragility", str(small_pipeline.study)):
+                "[solver] friction", "rockfrag fragility", str(small_pipeline.study),
+                # cold read 5, B7: the methods promise the appendix names these
+                "[soils_custom.NAME] friction_static, friction_kinetic", "[soils_custom.NAME] shear_modulus",
+                "[uncertainty] restitution_range"):
         assert key in appendix, key
     assert planned[-1].section == "How to reproduce this report" or "How to reproduce this report" in \
         planned[-1].also

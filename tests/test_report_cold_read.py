@@ -332,7 +332,7 @@ def test_a_structural_base_is_said_to_be_at_ground_level_and_a_floor_needs_its_o
     results.cube.coords["soil_shear_modulus"] = modulus
     note = " ".join(item.text for item in summary_items(results) if item.kind == "note")
     assert "'rock': a steel plate at ground level, under the reference site's ground motion" in note
-    assert "a floor spectrum" in note and "not one on a structure" in note
+    assert "a floor spectrum" in note and "not one on a structure" in note  # said in one sentence
     assert "structural base at ground level (rock; not a soil)" in grounds(results.cube)
 
 
@@ -484,7 +484,8 @@ def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed
     assert f"a vertical frequency of {vertical:.2g} Hz" in words
     assert f"a rocking frequency (whole base down) of {rocking:.2g} Hz, {1 / rocking:.2g} s" in words
     assert f"the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s" in words
-    assert "damping calibrated to the restitution is the study's lowest on gravel" in words
+    assert "damping, calibrated to the impact restitution, is the study's lowest on gravel" in words
+    assert words.index("damping") < words.index("vertical frequency")  # the likely reason comes first
     assert f"static settlement, {settlement * 1000:.2g} mm on gravel" in words
     assert "loss of contact" in words and "not from rest" in words
     fragility["median"][:] = [[[[0.1, 0.2, 0.3, 0.4, 0.5]]]]  # rising with the stiffness: nothing to explain
@@ -708,3 +709,40 @@ def test_a_computed_value_below_the_print_floor_with_its_return_period_gets_a_no
     assert not below_floor_with_period([["overturning", "1%", "< 0.81%", "0.28%, once in 18,000 years"]])
     assert not below_floor_with_period([["overturning", "< 0.1%, once in 9 years", "0.28%"]])  # the limit column
     assert "computed" in FLOOR_WITH_PERIOD_WORDS and "print floor" in FLOOR_WITH_PERIOD_WORDS
+
+
+def test_a_work_cited_with_an_ampersand_is_in_the_references():
+    """Cold read 5, default B8: Seyhan & Stewart 2014 and Bazzurro & Cornell 2004 were cited by the methods but left
+    out of the references: the pages' text is HTML ('&amp;'), in which the short name was not found."""
+    from rockfrag.report.words import references_items
+
+    text = " ".join(item.text for item in references_items("the model of Seyhan &amp; Stewart 2014 (Bazzurro &amp; "
+                                                           "Cornell 2004)"))
+    assert "Seyhan, E., Stewart, J. P. (2014)" in text and "Bazzurro, P., Cornell, C. A. (2004)" in text
+    assert "Shenton, H. W." not in text  # not cited
+
+
+def test_a_block_less_deep_than_wide_is_said_on_the_summary_to_be_judged_across_its_width_only():
+    """Cold read 5, default A: the squat skid (3 m wide, 2 m deep) was judged across its width, b/h 0.75; across its
+    depth (b/h 0.5) it is less stable, which only the limitations said. The summary names such a block; a block at
+    least as deep as wide is not named."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.summary import weaker_direction_words
+
+    skid = SimpleNamespace(name="skid", b=1.5, h=2.0, footprint_area=6.0)
+    square = SimpleNamespace(name="square", b=1.5, h=2.0, footprint_area=9.0)
+    config = SimpleNamespace(blocks=(skid, square), raw={})
+    words = weaker_direction_words(SimpleNamespace(config=config))
+    assert "skid (b/h 0.5 across its 2 m depth)" in words, words
+    assert "square" not in words and words.startswith("Judged across the width only")
+    assert weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(square,), raw={}))) == ""
+
+
+def test_the_run_time_says_when_the_simulations_were_reused():
+    """Cold read 5, default C15: 'run time 9 s' beside 80,000 simulations read as all of them in 9 s."""
+    from rockfrag.report.sections import run_time_line
+
+    reused = run_time_line(9.0, {"cells": 10, "cells_reused": 10, "runs_computed": 0})
+    assert "reused from the earlier run are not in it" in reused
+    assert "reused" not in run_time_line(9.0, {"cells": 10, "cells_reused": 0, "runs_computed": 100})

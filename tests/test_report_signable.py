@@ -104,7 +104,7 @@ def test_the_model_form_dispersion_names_its_rating_and_value(small_pipeline):
         fragility.model == "ssi", 0.0)
     text = model_form_words(results.config, fragility)
     assert results.config.model_quality == "fair"
-    assert text.startswith("Model-form dispersion β 0.35: FEMA P-695's rating 'fair'") and ": ," not in text
+    assert text.startswith("Model-form dispersion β 0.35: FEMA P695's rating 'fair'") and ": ," not in text
     for rating, value in FORM_RATINGS.items():
         assert f"{rating} {value:.2f}" in text
 

@@ -244,7 +244,7 @@ CAPTIONS = {
                            "enough; colours: the intensity level; solid concrete block, dashed steel block.",
     "sensitivity": "Read which uncertain parameter of the recommended model moves its median most on each soil: "
                    "each bar is the σ of ln median over that parameter's range (restitution, friction, bed "
-                   "stiffness), the others central; the dashed line is the model-form β (FEMA P-695's rating). The "
+                   "stiffness), the others central; the dashed line is the model-form β (FEMA P695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
                    "marked 'no median' has no curve of this state below the highest intensity studied.",

@@ -82,7 +82,7 @@ def model_info(name: str) -> ModelInfo:
         return ModelInfo(name, "Recommended (tensionless bed with friction, best estimate)", False,
                          "the tensionless Winkler bed with friction at the base, at the middle of the experimental "
                          "range of impact restitution and the soil's stated friction and stiffness; its model "
-                         "dispersion (the sensitivity runs' spread or FEMA P-695's rating) added to beta", False,
+                         "dispersion (the sensitivity runs' spread or FEMA P695's rating) added to beta", False,
                          True)
     try:
         model = get_model(name)

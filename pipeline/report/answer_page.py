@@ -146,7 +146,7 @@ def _band_collapse(cube, block) -> str:
     where = "every soil" if len(collapsed) == cube.soil.size else _and(collapsed)
     text = (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
             f"restitutions apart ({asked}), so restitution adds nothing to the model dispersion there because there "
-            "is one run, not because it is known; the model part of β there rests on FEMA P-695's model-quality "
+            "is one run, not because it is known; the model part of β there rests on FEMA P695's model-quality "
             "rating.")
     if not bool(reached.notnull().any()) and "block_alpha" in cube.coords:
         from types import SimpleNamespace
@@ -170,7 +170,7 @@ def curve_reason(results, model: str, block=None) -> str:
                 "the middle of the experimental range of impact restitution and the soil's stated friction and "
                 "stiffness (the best estimate). Its β adds the model dispersion to the record-to-record one: the "
                 "larger of the spread of its median over sensitivity runs (restitution, friction and bed stiffness "
-                "each at both ends of its range) and FEMA P-695's rating of the model's form (a planar rigid block: "
+                "each at both ends of its range) and FEMA P695's rating of the model's form (a planar rigid block: "
                 "no three-dimensional rocking, no flexible superstructure).")
         if block is not None:
             return (_band_reach(getattr(results, "cube", None), block)
@@ -249,6 +249,72 @@ def slides_first_words(results, answer) -> str:
             "and overturn more readily.")
 
 
+KINETIC_SENSITIVE = 0.25
+"""Where μ_k < b/h ≤ μ_s, the block's rocking rests on its friction when the high-friction sensitivity run's uplift
+median differs from the best estimate's by more than this fraction (steel under the paper's block: 0.57 g against
+1.5 g); where it does not (gravel: 0.2 g both), the block rocks before it ever slides and the friction is moot."""
+
+
+def slides_then_soils(results, answer) -> list:
+    """The soils (``SoilClass``) on which this block rocks at rest but cannot while it slides, and does slide.
+
+    μ_k < b/h ≤ μ_s: at rest the block tips before it slides (Shenton 1996), but once its base slips the friction
+    force, μ_k m g at most, cannot tip it (that needs b/h m g); it counts where the high-friction sensitivity run
+    shows the friction decides (``KINETIC_SENSITIVE``). Only soils whose runs have base friction.
+    """
+    cube, fragility = getattr(results, "cube", None), results.fragility
+    if cube is None or "block_b" not in cube.coords and "block_b" not in cube or "member_median" not in fragility \
+            or "friction_high" not in fragility.member.values:
+        return []
+    slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
+    soils = []
+    for soil in results.config.soils:
+        if not soil.friction_kinetic < slender <= soil.friction_static:
+            continue
+        if "friction_static" in cube and answer.model in cube.model.values and not np.isfinite(float(
+                cube.friction_static.sel(model=answer.model, block=answer.block, soil=soil.name))):
+            continue  # a tied base
+        try:
+            best = float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name,
+                                                 damage_state="uplift"))
+            high = float(fragility.member_median.sel(member="friction_high", block=answer.block, soil=soil.name,
+                                                     damage_state="uplift"))
+        except KeyError:
+            continue
+        if np.isfinite(best) and np.isfinite(high) and abs(best - high) > KINETIC_SENSITIVE * min(best, high):
+            soils.append(soil)
+    return soils
+
+
+def friction_driven_soils(results, answer) -> list:
+    """The soils where this block's rocking and overturning rest on its base friction (marked § on its page)."""
+    return [*sliding_first_soils(results, answer), *slides_then_soils(results, answer)]
+
+
+def slides_then_words(results, answer) -> str:
+    """A sentence on the soils of ``slides_then_soils``, with the uplift medians that show it; "" where none."""
+    soils = slides_then_soils(results, answer)
+    if not soils:
+        return ""
+    cube, fragility = results.cube, results.fragility
+    slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    said = []
+    for soil in soils:
+        best, high = (float(fragility[name].sel(block=answer.block, soil=soil.name, damage_state="uplift",
+                                                **selection)) * scale
+                      for name, selection in (("median", {"model": answer.model}),
+                                              ("member_median", {"member": "friction_high"})))
+        said.append(f"on {soil.name} (μ_s {soil.friction_static:g}, μ_k {soil.friction_kinetic:g}) it lifts off at "
+                    f"a median of {numbers.intensity(best, answer.unit)}, and at "
+                    f"{numbers.intensity(high, answer.unit)} with the friction at the high end of its range")
+    return (f"On {_and([soil.name for soil in soils])} the base friction at rest is at least this block's "
+            f"b/h = {slender:.2f}, so at rest it rocks before it slides, but its kinetic friction is below b/h: once "
+            "the base slips, the friction force can no longer tip the block, which slides instead of rocking. "
+            f"The friction decides what it does there: {'; '.join(said)}. Its rocking and "
+            f"overturning there rest on the assumed friction (marked {FRICTION_MARK} in the design-life table).")
+
+
 def _where(results, soils) -> str:
     """The soils by name, or "every soil" when they are all the study's (said once, not soil by soil)."""
     every = len(soils) == len(results.config.soils) and len(soils) > 1
@@ -262,12 +328,16 @@ def friction_high_words(results, answer) -> str:
     ``friction_high``) of each rocking state and overturning on each soil where the block slides first; said once
     where no such state has a median below the credible cap on any of them. "" where no soil is marked.
     """
-    soils = sliding_first_soils(results, answer)
+    first, then = sliding_first_soils(results, answer), slides_then_soils(results, answer)
+    soils = [*first, *then]
     if not soils:
         return ""
     names = _where(results, soils)
-    text = (f"{FRICTION_MARK} friction-driven: on {names} the block slides before it can rock, so these values rest "
-            "on the assumed base friction.")
+    how = "slides before it can rock" if not then else "cannot rock while it slides" if not first else \
+        f"slides before it can rock ({_and([soil.name for soil in first])}) or cannot rock while it slides " \
+        f"({_and([soil.name for soil in then])})"
+    text = f"{FRICTION_MARK} friction-driven: on {names} the block {how}, so these values rest on the assumed base " \
+           "friction."
     fragility, cube = results.fragility, results.cube
     states = _friction_driven_states(results)
     if "member_median" not in fragility or "friction_high" not in fragility.member.values or not states:
@@ -370,20 +440,23 @@ def bed_resonance_words(results, answer) -> str:
         grounds = [(soil.name, rocking)] + [(g.name, bed_frequencies(config, block, g)[1]) for g in (low, high)]
         text = (f"On {soil.name} this block lifts off at a lower median than on {low.name} and {high.name} "
                 f"({numbers.intensity(values[1], answer.unit)} against {numbers.intensity(values[0], answer.unit)} "
-                f"and {numbers.intensity(values[2], answer.unit)}). Under it the bed on {soil.name} has a vertical "
-                f"frequency of {vertical:.2g} Hz and a rocking frequency (whole base down) of {rocking:.2g} Hz, "
-                f"{1.0 / rocking:.2g} s ({'; '.join(f'{n} {f:.2g} Hz, {1.0 / f:.2g} s' for n, f in grounds[1:])})")
+                f"and {numbers.intensity(values[2], answer.unit)}).")
+        if "damping_ratio_calibrated" in cube and answer.model in cube.model.values:
+            xi = cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block)
+            if "soil" in xi.dims and str(xi.idxmin("soil").values) == soil.name:
+                text += (f" A likely reason: the bed's damping, calibrated to the impact restitution, is the "
+                         f"study's lowest on {soil.name}, and a less damped bed lets the block rebound off it sooner.")
+        text += (f" The bed on {soil.name} has a vertical frequency of {vertical:.2g} Hz and a rocking frequency "
+                 f"(whole base down) of {rocking:.2g} Hz, {1.0 / rocking:.2g} s "
+                 f"({'; '.join(f'{n} {f:.2g} Hz, {1.0 / f:.2g} s' for n, f in grounds[1:])})")
         if band is not None:
             inner = [name for name, frequency in grounds if inside(frequency)]
             said = ("all within" if len(inner) == len(grounds) else f"{_and(inner)} within" if inner
                     else "none within")
             text += (f", {said} the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s (their mean spectrum "
                      f"within {SPECTRUM_BAND:.0%} of its peak)")
-        if "damping_ratio_calibrated" in cube and answer.model in cube.model.values:
-            xi = cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block)
-            if "soil" in xi.dims and str(xi.idxmin("soil").values) == soil.name:
-                text += (f"; its damping calibrated to the restitution is the study's lowest on {soil.name}, "
-                         "consistent with the earlier lift-off")
+            if len(inner) == len(grounds):
+                text += f": the band does not single {soil.name} out"
         text += (f". A lift counts from the bed's unloaded surface (loss of contact), not from rest: a corner first "
                  f"rises by the static settlement, {settlement * 1000:.2g} mm on {soil.name}.")
         texts.append(text)
@@ -511,7 +584,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                     if cube is not None else measure, answer.model)
     # one paragraph per subject (restitution, friction, the bed's lift-off, the measure): not one wall of text
     for text in (curve_reason(results, answer.model, answer.block), slides_first_words(results, answer),
-                 bed_resonance_words(results, answer), sufficiency):
+                 slides_then_words(results, answer), bed_resonance_words(results, answer), sufficiency):
         if text:
             items.append(paragraph(text.strip()))
     if not answer.return_periods:
@@ -572,7 +645,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     items.append(heading(f"In the design life of {life}"))
     header = ["damage state", "limit", *(f"on {soil.soil}" for soil in answer.soils)]
     rows = []
-    driven = {soil.name for soil in sliding_first_soils(results, answer)}
+    driven = {soil.name for soil in friction_driven_soils(results, answer)}
     driven_states = _friction_driven_states(results)
     for index, state in enumerate(short):
         cells = [short[state], numbers.stated_probability(limits[state]) if state in limits else "none"]
@@ -581,6 +654,9 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
             text = _not_computed(results, answer, soil.soil, state) or say_p_in_life(results, answer, soil, row)
             if row.not_reached_below is None and row.below_lowest is None and np.isfinite(row.probability_in_life):
                 text += f", {_years(row.annual_frequency)}" if _years(row.annual_frequency) else ""
+            if row.below_lowest is not None and _fitted_beside_bound(results, answer, soil.soil, state) != \
+                    f" (fitted curve: {text.lstrip('≥ ')})":
+                text += _fitted_beside_bound(results, answer, soil.soil, state)
             if soil.soil in driven and state in driven_states and np.isfinite(row.probability_in_life):
                 text += f" {FRICTION_MARK}"
             if not _not_computed(results, answer, soil.soil, state):
@@ -598,6 +674,24 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if below_floor_with_period(rows):
         items.append(note(FLOOR_WITH_PERIOD_WORDS))
     return items
+
+
+def _fitted_beside_bound(results, answer, soil: str, state: str) -> str:
+    """" (fitted curve: 57%)" beside a design-life lower bound '≥ X' (fragility.nc ``probability_in_life``), else "".
+
+    The bound (the records' fraction at the lowest level times the chance of exceeding that level) leaves out every
+    intensity below the lowest level; the fitted curve's value, which does not, can be far above it (cold read 5:
+    the paper block's uplift on gravel, '≥ 19%' beside clay's fitted 19%, where its curve gives 57%).
+    """
+    fragility = results.fragility
+    if "probability_in_life" not in fragility:
+        return ""
+    try:
+        fitted = float(fragility.probability_in_life.sel(model=answer.model, block=answer.block, soil=soil,
+                                                         damage_state=state))
+    except KeyError:
+        return ""
+    return f" (fitted curve: {numbers.probability(fitted)})" if np.isfinite(fitted) else ""
 
 
 def below_floor_with_period(rows) -> bool:
@@ -754,7 +848,9 @@ def reading_items(results) -> list[Item]:
              paragraph(SLIP_NESTING),
              paragraph("Marks: 'not reached': no record reached the state at any level up to "
                        "the highest intensity studied (Methods). '≥ X': the fitted median lies below every level "
-                       "run, and the records at the lowest level give a lower bound instead of the fit's tail. "
+                       "run, and the records at the lowest level give a lower bound instead of the fit's tail (in the "
+                       "design life: their fraction times the chance of exceeding that level, with the fitted curve's "
+                       "own value beside it). "
                        f"{no_curve_words(answers[0])} '-': no level was run as low as that intensity, so the records "
                        "say nothing there."),
              paragraph("Beside the probabilities, how many records reached each state at those levels: a "

@@ -1133,7 +1133,7 @@ def sensitivity_page(fragility, caption, names: dict | None = None):
                      label=f"{parameter}", color=f"C{index % 10}")
         form = fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()
         if np.isfinite(form):
-            axis.axhline(form, color="k", lw=0.9, ls="--", label=f"model-form β {form:.2f} (FEMA P-695 rating)")
+            axis.axhline(form, color="k", lw=0.9, ls="--", label=f"model-form β {form:.2f} (FEMA P695 rating)")
         if not np.isfinite(spread.values).any():
             empty_note(axis, "no median: the state was not reached below the highest intensity studied")
             axis.set_ylim(0.0, max(form, 0.1) * 1.3 if np.isfinite(form) else 1.0)

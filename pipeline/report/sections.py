@@ -365,12 +365,21 @@ def run_time_words(runtime_s: float) -> str:
     return f"{runtime_s / 60:.0f} min" if runtime_s >= 120 else f"{runtime_s:.0f} s"
 
 
-def run_time_line(runtime_s: float) -> str:
-    """The run time as the title page and the provenance state it: what it covers, as the log says it."""
+def run_time_line(runtime_s: float, run: dict | None = None) -> str:
+    """The run time as the title page and the provenance state it: what it covers, as the log says it.
+
+    ``run`` (``Results.run``): where an earlier run's simulations were reused, the time says so, so that it is not
+    read as the time of every simulation the report counts (cold read 5: '9 s' beside 80,000 simulations).
+    """
     words = run_time_words(runtime_s)
     if words.startswith("not recorded"):
         return words
-    return f"{words} up to this report (simulations, fits and result files; drawing the report not included)"
+    reused = bool(run) and int(run.get("cells_reused", 0)) > 0
+    covers = "simulations not reused, fits and result files" if reused else "simulations, fits and result files"
+    text = f"{words} up to this report ({covers}; drawing the report not included)"
+    if reused:
+        text += "; the simulations reused from the earlier run are not in it"
+    return text
 
 
 def _toml(value) -> str:
@@ -412,8 +421,21 @@ def verdict_settings(results: Results) -> list[list[str]]:
              "above this share of records a tied base that needs more friction gets a sliding check"],
             ["[solver] friction", _toml(config.friction),
              "where sliding is computed (\"all\": everywhere; its slip damage states then judge the base)"],
-            ["[soils_custom.NAME] friction_static, friction_kinetic", results.friction_text,
-             "the base friction of a soil (list NAME in soils = [...]): sliding, and where it is computed"],
+            ["[soils_custom.NAME] friction_static, friction_kinetic",
+             ", ".join(f"{soil.name} {soil.friction_static:g}/{soil.friction_kinetic:g}" for soil in config.soils),
+             "the base friction of a soil, static/kinetic (list NAME in soils = [...]): sliding, and where it is "
+             "computed"],
+            ["[soils_custom.NAME] shear_modulus, poisson_ratio, density, damping_ratio",
+             "; ".join(f"{soil.name} {_mpa(soil.shear_modulus)} MPa, {soil.poisson_ratio:g}, "
+                       f"{soil.density:,.0f} kg/m³, {soil.damping_ratio:g}" for soil in config.soils),
+             "the bed under the block: its stiffness (the paper's eq. 19) and damping; a site investigation's "
+             "moduli replace the paper's"],
+            ["[hazard] vs30", ", ".join(f"{soil.name} {soil.vs30:,.0f} m/s" for soil in config.soils
+                                        if soil.vs30 is not None) or "none (the reference site)",
+             "each soil's site Vs30: the site hazard its probabilities use; a measured Vs30 replaces the class's"],
+            ["[uncertainty] restitution_range, friction_factor, stiffness_factor, model_quality",
+             _uncertainty_values(config), "the sensitivity runs and the model part of every β of the recommended "
+             "curve"],
             ["[blocks.NAME] b, h, mass, E_b", "the blocks of the methods pages",
              "the block itself: its slenderness and size set when it rocks and overturns"],
             ["[damage_states.NAME] edp, threshold", "the shipped damage states",
@@ -425,9 +447,21 @@ def verdict_settings(results: Results) -> list[list[str]]:
     return rows
 
 
+def _mpa(modulus: float) -> str:
+    """A modulus [Pa] in MPa as the methods print it: "37.1", "1,000", "80,000"."""
+    value = modulus / 1e6
+    return f"{value:,.0f}" if value >= 100 else f"{value:.3g}"
+
+
+def _uncertainty_values(config) -> str:
+    """The study's ``[uncertainty]`` settings (``config.design``, ``model_quality``) as the appendix prints them."""
+    design = config.design
+    return ", ".join([_toml([float(v) for v in design.restitution_range]), _toml(float(design.friction_factor)),
+                      _toml(float(design.stiffness_factor)), f'"{config.model_quality}"'])
+
+
 OPTIONAL_SETTINGS = (
     ("hazard", "reference_vs30", "the Vs30 of the hazard file's site: each soil's site hazard is amplified from it"),
-    ("hazard", "vs30", "a soil's site Vs30: the site hazard its probabilities use"),
     ("intensity", "credible_max", "the highest intensity studied: no level, fit or median above it, and the "
                                   "hazard's exceedance of it a stated bound"),
     ("intensity", "component", "which horizontal component the intensity is of: it must be the hazard's"),
@@ -451,7 +485,7 @@ def reproduce_items(results: Results) -> list[Item]:
             ["random seed of the bootstrap", str(fragility.attrs.get("bootstrap_seed", "not recorded"))],
             ["hazard curve", results.hazard.source if results.hazard is not None else "none"],
             ["simulations", runs_words(results)],
-            ["run time", run_time_line(results.runtime_s)],
+            ["run time", run_time_line(results.runtime_s, results.run)],
             ["result files read", ", ".join(_result_files(results))],
             ["tables of every fitted curve", "fragility.csv (confidence bounds, goodness of fit, fit warnings)"]]
     return [paragraph("The commands, the study file and the settings behind this report. The other pages speak of "
@@ -463,9 +497,9 @@ def reproduce_items(results: Results) -> list[Item]:
             bullet(("rockfrag study --keys" if shipped else f"rockfrag study {study} --keys")
                    + ": every key of the study with its value, allowed range and unit (nothing is run)."),
             heading("Settings that would change a verdict"),
-            paragraph("Each is a key of the study file (TOML); a study file gives only the keys it changes, the "
-                      "others keep the shipped defaults."),
-            table(["key", "in this study", "what it changes"], verdict_settings(results)),
+            paragraph("Each is a key of the study file (TOML), with its value in this study and what it changes; a "
+                      "study file gives only the keys it changes, the others keep the shipped defaults."),
+            *[bullet(f"{key} = {value}: {what}.") for key, value, what in verdict_settings(results)],
             heading("What this report was computed from"),
             paragraph("The configuration fingerprint changes with any setting of the study; the same fingerprint, "
                       "software version and records give the same numbers."),
@@ -563,13 +597,17 @@ def site_hazard_items(results: Results) -> list[Item]:
         return []
     config = results.config
     rows, reference = [], []
+    gaps = []
     for soil in config.soils:
+        under = f"{math.sqrt(soil.shear_modulus / soil.density):,.0f}"  # the bed's own shear-wave speed
         if soil.vs30 is None or soil.vs30 == sites.reference_vs30:
             reference.append(soil.name)
             rows.append([soil.name, f"{sites.reference_vs30:,.0f} (the reference site)", "-",
-                         "the reference curve itself"])
+                         "the reference curve itself", under if is_soil(results.cube, soil.name) else "-"])
         else:
-            rows.append([soil.name, f"{soil.vs30:,.0f}", soil.site_class, "amplified"])
+            rows.append([soil.name, f"{soil.vs30:,.0f}", soil.site_class, "amplified", under])
+            if soil.vs30 > VS_GAP * math.sqrt(soil.shear_modulus / soil.density):
+                gaps.append(soil.name)
     if len(reference) == len(config.soils):
         return []
     steel = [name for name in reference if not is_soil(results.cube, name)]
@@ -584,7 +622,21 @@ def site_hazard_items(results: Results) -> list[Item]:
         text += (f" A structural base ({', '.join(steel)}) keeps the reference curve: a plate at ground level "
                  "under the reference site's ground motion, not a floor or deck of a structure, whose motion (a "
                  "floor spectrum) this study does not model (the summary says so once).")
-    return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class", "site hazard"], rows)]
+    text += (" The bed under the block and the site's hazard are separate inputs: the bed's stiffness is the soil's "
+             "shear modulus G (with its density ρ, a shear-wave speed √(G/ρ), the last column), the hazard's site "
+             "is its Vs30, the average over the upper 30 m, which is stiffer with depth than the ground right under "
+             "the base.")
+    if gaps:
+        text += (f" On {', '.join(gaps)} the Vs30 is more than {VS_GAP:g} times the bed's own speed: the hazard's "
+                 "site is stiffer ground than the bed (for rock, another site class); a site investigation gives "
+                 "both, and its values replace these (the appendix names the settings).")
+    return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class", "site hazard",
+                                    "√(G/ρ) of the bed [m/s]"], rows)]
+
+
+VS_GAP = 1.25
+"""A soil whose site Vs30 exceeds the bed's own shear-wave speed √(G/ρ) by more than this factor is named in the
+methods (cold read 5: rock's bed, 632 m/s, is class C ground while its hazard's Vs30, 1,080 m/s, is class B)."""
 
 
 def _hazard_words(results: Results) -> str:
@@ -683,7 +735,8 @@ def methods_items(results: Results) -> list[Item]:
     """The methods pages: models, soils and blocks, records and processing, scaling, fits, hazard and risk."""
     config, cube, fragility = results.config, results.cube, results.fragility
     items = [heading("Models and their assumptions"),
-             paragraph(f"'The paper' on these pages is the seed paper of this project: {PAPER_CITATION}")]
+             paragraph(f"'The paper' on these pages is the source of the SSI-rocking model and of the soils' moduli, a "
+                       f"preprint (not peer-reviewed): {PAPER_CITATION}")]
     bed = (config.raw.get("solver", {}) or {}).get("bed", "continuous")
     described: dict[str, list[str]] = {}  # models described alike (the restitution band's runs): one bullet
     for model in models_of(cube):
@@ -731,7 +784,8 @@ def methods_items(results: Results) -> list[Item]:
     pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
     items += [heading("Record set and processing"),
-              paragraph(f"Record sets {', '.join(config.record_sets)}: {cube.sizes['record']} horizontal components "
+              paragraph(f"The record set{'s' if len(config.record_sets) > 1 else ''} "
+                        f"({', '.join(config.record_sets)}): {cube.sizes['record']} horizontal components "
                         f"from {events} earthquake{'s' if events != 1 else ''}; peak ground acceleration of each "
                         f"processed component {pga.min():.2g} to {pga.max():.2g} g. {_vertical_records(cube)}"
                         f"Every record is processed before use: {_processing_text(cube)}. Checksums of the record "
@@ -957,7 +1011,7 @@ def sources_items(results: Results) -> list[Item]:
 
 
 def model_form_words(config, fragility) -> str:
-    """The model-form dispersion's source: the rating the study gives the model and its β (FEMA P-695 Section 5.7)."""
+    """The model-form dispersion's source: the rating the study gives the model and its β (FEMA P695 Section 5.7)."""
     from rockfrag.fragility import FORM_RATINGS
 
     quality = str(getattr(config, "model_quality", "fair"))
@@ -966,7 +1020,7 @@ def model_form_words(config, fragility) -> str:
     beta = float(rated.max()) if rated.size else FORM_RATINGS.get(quality, float("nan"))
     choice = "the study's choice" if quality == "fair" else "the study's own rating"
     ratings = ", ".join(f"{name} {numbers.dispersion(value)}" for name, value in FORM_RATINGS.items())
-    return (f"Model-form dispersion β {numbers.dispersion(beta)}: FEMA P-695's rating '{quality}' of a nonlinear "
+    return (f"Model-form dispersion β {numbers.dispersion(beta)}: FEMA P695's rating '{quality}' of a nonlinear "
             f"model (Section 5.7: {ratings}), given to the recommended model's "
             f"form (a planar rigid block on a bed of springs), {choice}; it stands in for FEMA P-58's modelling "
             "dispersion β_q.")

@@ -175,9 +175,8 @@ BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a pr
 """How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
-STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level, under the reference site's ground motion. A block "
-                         "on a structure (floor, deck) feels the floor's amplified motion, a floor spectrum this study "
-                         "does not model: the {names} rows judge a block at ground level, not one on a structure.")
+STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level, under the reference site's ground motion, not one "
+                         "on a structure (a floor's amplified motion, a floor spectrum, is not modelled).")
 """What a structural base of the study (steel) stands for, said once, in the summary's note (cold read 3, A2)."""
 
 
@@ -287,6 +286,32 @@ def beta_words(results, answer, soil: str, state: str) -> str:
     return results.facts.say("total beta", (answer.block, soil, state), text)
 
 
+def weaker_direction_words(results) -> str:
+    """A sentence naming each block whose depth out of plane is less than its width, "" where none.
+
+    The planar model rocks it across its width only, and across its depth it is less stable (cold read 5: a 2 m
+    deep skid judged across its 3 m width).
+
+    "" where every block is at least as deep as it is wide (or its footprint is not stated).
+    """
+    said = []
+    for block in getattr(results.config, "blocks", ()) or ():
+        area = getattr(block, "footprint_area", None)
+        if not area or not hasattr(block, "b") or not hasattr(block, "h"):
+            continue
+        depth = area / (2 * block.b)
+        if depth < 2 * block.b * (1 - 1e-9):
+            said.append(f"{block_name(results.config, block.name)} (b/h {depth / (2 * block.h):.2g} across its "
+                        f"{depth:.3g} m depth)")
+    if not said:
+        return ""
+    return "Judged across the width only, not across a less stable depth: " + "; ".join(said) + "."
+
+
+FRACTIONS_REASON = "no fit"
+"""The summary's reason where the governing state has no fitted curve (its median lies above the highest level)."""
+
+
 def reason(results, answer, soil) -> str:
     """One short sentence: what in the records (or the fit) the verdict on this soil rests on.
 
@@ -312,7 +337,7 @@ def reason(results, answer, soil) -> str:
         return f"{numbers.count(reached, total)} records already at {numbers.intensity(level, unit)}: a bound"
     censored = _censored_at_cap(results, answer, soil, row)
     if censored is not None:
-        return f"a bound (median above {numbers.intensity(censored, unit)})"  # the cap: said in the note
+        return f"{FRACTIONS_REASON} (median above {numbers.intensity(censored, unit)})"  # no fit: the note says
     if row.tail_only:
         first = numbers.intensity(row.first_reached, unit) if row.first_reached is not None else "any level"
         return f"fitted tail only: no record below {first}"
@@ -394,8 +419,12 @@ def summary_items(results) -> list[Item]:
     cells = " ".join(cell for row in rows for cell in row[3:3 + len(periods) + 1])
     bounds = " ".join(words for words, shown in ((BOUND_WORDS, "< "), (no_curve_words(first), " of "))
                       if shown in cells)
+    if any(row[-1].startswith(FRACTIONS_REASON) for row in rows):
+        bounds += (" 'No fit' (reason): the same, with the design-life value from the records' share at each level."
+                   if " of " in cells else " 'No fit' (reason): the state's median lies above the highest intensity "
+                   "studied, so no curve is fitted; its probabilities come from the records' share at each level.")
     items.append(note(" ".join(filter(None, [
-        said, GOVERNING_WORDS, bounds, structural_base_words(results),
+        said, GOVERNING_WORDS, bounds, structural_base_words(results), weaker_direction_words(results),
         "Reason: the records at the level run at or below the largest return period's intensity; where none "
         "reach the state there, its probabilities are the fitted curve's tail (fitted to the higher levels). "
         "β: records, the variability from record to record; model, the model's own uncertainty. The answer pages "

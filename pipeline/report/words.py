@@ -10,6 +10,7 @@ Output: plain words for each (``FIT_METHODS``, ``STATUS_WORDS``, ``SWITCH_WORDS`
 
 from __future__ import annotations
 
+import html
 import re
 
 from rockfrag.damage_states import TILT_WORDS, UPLIFT_WORDS
@@ -17,7 +18,8 @@ from rockfrag.models.ssi import PAPER_CITATION as _CITATION
 from rockfrag.models.ssi import PAPER_TITLE  # noqa: F401 (the report's name for it)
 from rockfrag.report.text import Item, bullet, heading, paragraph
 
-PAPER_CITATION = re.sub(r" \([^()]*/[^()]*\)", "", _CITATION)
+PAPER_CITATION = re.sub(r" \([^()]*/[^()]*\)", "", _CITATION).replace("The copy the project holds",
+                                                                     "The copy used")
 """The seed paper's citation as the client reads it: without the path of the project's copy (a file path is no
 client's word; the appendix and cube.nc keep it)."""
 
@@ -56,7 +58,7 @@ SWITCH_WORDS = {
 
 BED_WORDS = {
     "continuous": "springs and dashpots over the whole footprint",
-    "two-spring": "the bed's stiffness as one spring and dashpot under each corner (the default)",
+    "two-spring": "the bed's stiffness as one spring and dashpot under each corner",
     "hunt-crossley": "springs over the footprint with impact damping that vanishes with the penetration",
 }
 """The tensionless bed's contact law in words."""
@@ -68,7 +70,7 @@ CODE_IDENTIFIERS = ("exact-g-tan-alpha", "mle-binomial", "pga_ratio", "pgv_ratio
 
 
 REFERENCES = {
-    "paper": PAPER_CITATION + " The SSI-rocking model this project implements (a rigid block on one vertical "
+    "paper": PAPER_CITATION + " The SSI-rocking model this study uses (a rigid block on one vertical "
              "spring-dashpot, derived from the Lagrangian; interface stiffness k of its eq. 19), its soils (Table "
              "1, representative values it states without a source) and its record (Duzce, Bolu). A preprint: "
              "Preprints.org posts papers before, and without, peer review.",
@@ -102,6 +104,12 @@ REFERENCES = {
                  "and model uncertainty).",
     "ASCE 7-22": "ASCE (2022). Minimum Design Loads and Associated Criteria for Buildings and Other Structures, "
                  "ASCE/SEI 7-22 (risk-targeted ground motions: 1% probability of collapse in 50 years).",
+    "ASCE 7-16": "ASCE (2017). Minimum Design Loads and Associated Criteria for Buildings and Other Structures, "
+                 "ASCE/SEI 7-16 (Table 20.3-1: site classes by Vs30).",
+    "ASCE 4-16": "ASCE (2017). Seismic Analysis of Safety-Related Nuclear Structures, ASCE/SEI 4-16 (the range of "
+                 "soil stiffness to analyse, G(1 + C_v) to G/(1 + C_v)).",
+    "USGS hazard tools": "U.S. Geological Survey, National Seismic Hazard Model project: the nshmp-haz code and the "
+                         "Unified Hazard Tool (the Vs30 that stands for each site class).",
     "IEEE 693": "IEEE (2018). IEEE Recommended Practice for Seismic Design of Substations, IEEE Std 693-2018.",
     "Psycharis & Jennings 1983": "Psycharis, I. N., Jennings, P. C. (1983). Rocking of slender rigid bodies allowed "
                                  "to uplift. Earthquake Engineering & Structural Dynamics 11(1), 57-76.",
@@ -134,7 +142,8 @@ def references_items(cited: str | None = None) -> list[Item]:
     With ``cited`` (the text of the report's other pages), only the works it cites: a study without a steel base
     does not cite the steel slip coefficient's source, nor one with a curve per soil the site term's.
     """
-    items = [paragraph("The pages cite these works by the short name in bold.")]
+    cited = html.unescape(cited) if cited is not None else None  # the pages' HTML: "Seyhan &amp; Stewart 2014"
+    items = [paragraph("The pages cite these works by the short name before each entry.")]
     items += [bullet(f"{'The paper' if key == 'paper' else key}: {text}") for key, text in REFERENCES.items()
               if cited is None or key == "paper" or key in cited]
     return items
@@ -155,8 +164,8 @@ GLOSSARY = (
     ("anchor (verdict)", "the block must not stand free; the report does not size the anchorage, which is designed "
                          "as a nonstructural component fixed to its support (ASCE 7-22 Chapter 13) or to the "
                          "equipment's own qualification standard (IEEE 693 for substation equipment)."),
-    ("damage state", "an outcome the fragility gives the probability of: uplift, θmax/α above a limit, "
-                     "overturning."),
+    ("damage state", "an outcome the fragility gives the probability of: uplift, a base slip of at least a stated "
+                     "distance (0.05 m, 0.30 m), θmax/α above a limit, overturning."),
     ("fragility curve", "P(damage state | intensity), a lognormal distribution: median (the intensity at which "
                         "half the records reach the state) and dispersion β."),
     ("β (dispersion)", "the standard deviation of the logarithm of the intensity at which the state is reached; "
@@ -192,8 +201,10 @@ GLOSSARY = (
                     "velocity pulse) are those of FEMA P695."),
     ("flies, free flight", "the whole base leaves the ground, a corner at least the uplift size: after an "
                            "impact on a bed (the block bounces), or in free flight, where the ground drops faster "
-                           "than gravity (g + a_v < 0 under the vertical component); the pivot models stop at free "
-                           "flight, the Winkler bed follows the block through the air until it lands."),
+                           "than gravity (g + a_v < 0 under the vertical component, only where a study applies "
+                           "it); the pivot "
+                           "models stop at free flight, the Winkler bed follows the block through the air until it "
+                           "lands."),
     ("pulse period, pulse acceleration", "of a record's dominant velocity pulse, taken as one full sine cycle: "
                                          "its period T_p and its acceleration amplitude a_p = 2π·PGV/T_p; the "
                                          "efficiency page tests whether the capacity still "
@@ -207,12 +218,13 @@ GLOSSARY = (
     ("tensionless Winkler bed", "a rigid block on a bed of springs and dashpots that push but never pull: the block "
                                 "lifts off instead (Psycharis & Jennings 1983; Chopra & Yim 1985)."),
     ("recommended curve", "the tensionless bed with the soil's stated friction and stiffness and the centre of the "
-                          "experimental restitution range; its β adds the model's uncertainty (FEMA P-695's "
+                          "experimental restitution range; its β adds the model's uncertainty (FEMA P695's "
                           "model-quality rating, the counterpart of FEMA P-58's modelling dispersion β_q, or the "
                           "sensitivity runs' spread where larger) to the record-to-record part."),
-    ("highest intensity studied", "the highest intensity the study runs (3 g PGA by default, above the "
-                                  "largest horizontal PGA ever recorded); no level, fit or median lies above it, "
-                                  "and a probability adds the site's chance of exceeding it as an upper bound."),
+    ("highest intensity studied", "the highest intensity the study runs (its value and reason are in the "
+                                  "methods: 3 g PGA lies above the largest horizontal PGA ever recorded); no "
+                                  "level, fit or median lies above it, and a probability adds the site's chance "
+                                  "of exceeding it as an upper bound."),
     ("RotD50", "the median over all horizontal orientations of a station's two components (Boore 2010), the "
                "intensity hazard models give; each pair of components is scaled together by it."),
 )
