@@ -131,8 +131,8 @@ register_damage_state(DamageState("uplift", "uplifted", 1.0, f"lift-off: {UPLIFT
 register_damage_state(DamageState("rocking-0.2", "peak_angle_ratio", 0.2, "theta_max/alpha >= 0.2"))
 register_damage_state(DamageState(
     "rocking-0.5", "peak_angle_ratio", 0.5, "theta_max/alpha >= 0.5", limit=0.10,
-    limit_source="the 10% in 50 years of the design-basis earthquake (475-year return period), applied here to "
-                 "damage short of collapse: " + STUDY_CHOICE))
+    limit_source="the 10% in 50 years of the conventional 475-year design level (older codes, Eurocode 8), applied "
+                 "here to damage short of collapse: " + STUDY_CHOICE))
 register_damage_state(DamageState(
     "overturning", "overturned", 1.0, "the block overturns", limit=0.01,
     limit_source="the 1% probability of collapse in 50 years that ASCE 7-22's risk-targeted ground motions aim at "
@@ -142,7 +142,7 @@ register_damage_state(DamageState("slip-0.05", "peak_slip", 0.05,
 register_damage_state(DamageState(
     "slip-0.30", "peak_slip", 0.30, "the base slid 0.30 m or more: enough to leave a plinth whose edge is 0.30 m "
     "beyond the base (an assumed, typical edge distance)", limit=0.10,
-    limit_source="the 10% in 50 years of the design-basis earthquake, as for θmax/α ≥ 0.5: " + STUDY_CHOICE))
+    limit_source="the 10% in 50 years of the conventional 475-year design level, as for θmax/α ≥ 0.5: " + STUDY_CHOICE))
 
 
 def is_slip_state(state: DamageState) -> bool:

@@ -551,3 +551,10 @@ def test_no_table_of_the_report_is_set_below_the_smallest_type(small_pipeline):
             assert not small, (page.name, sorted(small)[:3])
         finally:
             plt.close(figure)
+
+
+def test_a_log_axis_of_about_a_decade_labels_the_site_intensities_range():
+    """Cold read 5 (default figures, pp. 30-38): a PGA axis from 0.22 to 3.3 g labelled only 0.5, 1 and 2, so every
+    site intensity (0.24-0.67 g) sat where no tick was labelled. About a decade gets 1, 2, 3, 5 x 10^n."""
+    assert log_ticks(0.22, 3.3) == [0.3, 0.5, 1.0, 2.0, 3.0]
+    assert log_ticks(0.22, 3.3, most=3) == [0.5, 1.0, 2.0]  # a short axis keeps fewer

@@ -236,8 +236,10 @@ CAPTIONS = {
                      "rigid base good enough. Top axis: the study's soils. Lines that coincide hide each other. "
                      "These are the study's own runs: the recommended model's base has friction and its bed's "
                      "restitution is set within the experiments' range, so where its block slides instead of "
-                     "rocking (its kinetic friction below tan α: the limitations' 'Sliding') the ratio falls far "
-                     "below 1, which is sliding, not the bed's stiffness.",
+                     "rocking (it slides first where μ_s is below tan α, and cannot rock while it slides where μ_k "
+                     "is: the answer pages name those soils) the ratio falls far below 1, which is sliding, not the "
+                     "bed's stiffness. Where it lies above 1 inside the green band, the recommended model does not "
+                     "confirm the paper's 'rigid base good enough' for that block.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
@@ -431,7 +433,7 @@ def plan(results: Results) -> list[Page]:
                                caption=CAPTIONS["hazard"] + hazard_caption(results),
                                unit=results.answers[0].unit))
     if showcase is not None and "record_spectrum" in showcase:
-        planned.append(_figure("spectra", "Records", "Response spectra of the record set", pages.spectra_page,
+        planned.append(_figure("spectra", "Record spectra", "Response spectra of the record set", pages.spectra_page,
                                showcase, caption=CAPTIONS["spectra"]))
     if showcase is not None and "theta" in showcase:
         record = pages.record_words(showcase)

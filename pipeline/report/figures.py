@@ -511,9 +511,7 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
             edp = np.asarray(picked.edp.values, float)
             highest = float(ida.fractile.values.max())
             note = frame_note(edp, picked.edp_fractile.sel(fractile=highest).values, highest)
-            if note:  # every panel whose curves lie on the frame says so, the same way
-                empty_note(axis, note, x=0.6, width=0.75)
-                axis.rockfrag_empty = True
+            axis.rockfrag_note = note  # every panel whose curves lie on the frame says so, the same way (below)
             for curve in picked.edp.transpose("record", "im_level").values:
                 axis.plot(_finite_capped(curve), levels, color="0.65", lw=0.5, alpha=0.7)
             for q in ida.fractile.values:
@@ -536,8 +534,9 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     for axis in drawn:
         log_y_axis(axis, span)
     for axis in drawn:
-        if not getattr(axis, "rockfrag_empty", False):  # an empty panel's note stays clear of the marks
-            mark_intensities(axis, marks, along="y", soil=axis.rockfrag_soil)
+        mark_intensities(axis, marks, along="y", soil=axis.rockfrag_soil)  # on every panel (cold read 5)
+        if axis.rockfrag_note:  # placed above the marks, clear of them
+            empty_note(axis, axis.rockfrag_note, x=0.6, width=0.75, y=_above_the_marks(axis))
     drawn[0].plot([], [], color="0.65", lw=0.5, label="one record")
     drawn[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at θmax/α = {IDA_CAP})")
     outside_legend(figure, drawn)  # every panel: an empty first one has no marks
@@ -613,13 +612,31 @@ def _no_curve_note(axis, reasons, state: str, soil: str = "") -> None:
     axis.figure.rockfrag_notes = notes
 
 
-def empty_note(axis, text: str, x: float = 0.5, width: float = 1.0) -> None:
+def empty_note(axis, text: str, x: float = 0.5, width: float = 1.0, y: float = 0.5) -> None:
     """Say inside a panel with nothing drawn why it is empty ("not computed: the base is tied").
 
-    ``x`` is the note's centre and ``width`` its share of the panel's width (a note beside curves on the frame).
+    ``x``, ``y`` are the note's centre (axes fraction) and ``width`` its share of the panel's width (a note beside
+    curves on the frame).
     """
-    axis.text(x, 0.5, textwrap.fill(text, int(width * chars_across(axis, NOTE_SIZE)) - 4), transform=axis.transAxes,
+    axis.text(x, y, textwrap.fill(text, int(width * chars_across(axis, NOTE_SIZE)) - 4), transform=axis.transAxes,
               fontsize=NOTE_SIZE + 1, ha="center", va="center", color="0.3")
+
+
+def _above_the_marks(axis) -> float:
+    """The height (axes fraction) midway between a panel's highest horizontal reference line and its top.
+
+    An IDA panel's note sits there, clear of the site's return-period lines and the largest recorded intensity
+    below it (the lines lie at low intensities; the note would otherwise cover them, so they were not drawn).
+    """
+    heights = []
+    for line in axis.get_lines():
+        if line.get_transform() is axis.transData or not len(line.get_ydata()):
+            continue
+        value = float(np.asarray(line.get_ydata(), float)[0])
+        if np.isfinite(value) and value > 0:
+            heights.append(axis.transAxes.inverted().transform(axis.transData.transform((1.0, value)))[1])
+    inside = [h for h in heights if 0.0 <= h <= 1.0]
+    return (max(inside) + 1.0) / 2.0 if inside else 0.5
 
 
 def page_notes(figure) -> None:

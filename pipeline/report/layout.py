@@ -137,7 +137,10 @@ def add_footer(figure, left: str, number: int, total: int) -> None:
 
 
 def log_ticks(low: float, high: float, most: int = 8) -> list[float]:
-    """Tick values of a log axis from ``low`` to ``high``: 1, 2, 5 x 10^n, or every 1-9 x 10^n on a short range.
+    """Tick values of a log axis from ``low`` to ``high``: 1, 2, 3, 5 x 10^n, or 1, 2, 5 x 10^n, or all 1-9 x 10^n.
+
+    1, 2, 3, 5 x 10^n where four to six of them fit (about a decade: cold read 5, the fragility pages' 0.22-3.3 g
+    showed only 0.5, 1, 2), else 1, 2, 5 x 10^n, or every 1-9 x 10^n on a short range.
 
     Parameters
     ----------
@@ -153,6 +156,10 @@ def log_ticks(low: float, high: float, most: int = 8) -> list[float]:
     """
     low, high = sorted((float(low), float(high)))
     decades = range(math.floor(math.log10(low)) - 1, math.ceil(math.log10(high)) + 1)
+    denser = [float(f"{m}e{d}") for d in decades for m in (1, 2, 3, 5)]
+    denser = [v for v in denser if low * (1 - 1e-9) <= v <= high * (1 + 1e-9)]
+    if 4 <= len(denser) <= min(most, 6):  # a range of about a decade: 0.3 labelled too (site intensities sit there)
+        return denser
     for mantissas in ((1, 2, 5), (1, 2, 3, 5, 7), tuple(range(1, 10))):
         values = [float(f"{m}e{d}") for d in decades for m in mantissas]
         values = [v for v in values if low * (1 - 1e-9) <= v <= high * (1 + 1e-9)]

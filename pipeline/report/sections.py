@@ -218,6 +218,13 @@ def _level_units(dataset) -> str:
     return str(source.attrs.get("units", ""))
 
 
+def _median(value):
+    """A fitted median to three significant figures, trailing zeros kept: 0.200, 1.60, 0.0973 (cold read 5, C17)."""
+    if not np.isfinite(value):
+        return "-"
+    return _g(value) if abs(value) >= 100 else f"{value:#.3g}"
+
+
 def _g(value):
     """Three significant figures, without an exponent below a million: 0.364, 37.1, 3,500."""
     if not np.isfinite(value):
@@ -555,7 +562,7 @@ def fitted_items(results: Results) -> list[Item]:
                         + ("‡" if np.isfinite(gof) and gof < GOF_LEVEL else "")
                     row_marks.update(mark)
                     shown = results.facts.say("fitted median", (block, model.name, str(picked.soil.values), state),
-                                              _g(median))
+                                              _median(median))
                     cells.append(f"{shown}{mark} / {_beta(beta)}")
                 if all(text == "-" for text in cells):
                     dropped += 1
@@ -1249,9 +1256,9 @@ def limitations_items(results: Results) -> list[Item]:
             rows.append([block_name(config, row.block), short_label(model_info(row.model)),
                          "(any)" if (row.model, str(row.block)) in rigid else row.soil,
                          short_states.get(row.damage_state) or labels.get(row.damage_state, row.damage_state),
-                         _g(median), f"{levels.min():.2g} to {levels.max():.2g}",
+                         _median(median), f"{levels.min():.2g} to {levels.max():.2g}",
                          OUTSIDE["below" if median < levels.min() else "above"]])
-            said.append(((row.block, row.model, row.soil, row.damage_state), _g(median)))
+            said.append(((row.block, row.model, row.soil, row.damage_state), _median(median)))
         rows = _merged(rows, 1, every_model)
         if len(rows) <= EXTRAPOLATION_ROWS:  # every median is printed: the ledger has them
             for key, shown in said:

@@ -177,8 +177,9 @@ GLOSSARY = (
                         "bed stiffness) at the low or high end of its range, the others central; the spread of "
                         "their medians is the parameters' part of the model dispersion."),
     ("IM (intensity measure)", "the number that says how strong the shaking is: PGA (peak ground acceleration), "
-                               "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, the "
-                               "integral of the squared acceleration), D5-95 (the time between 5% and 95% of Ia)."),
+                               "PGV (peak ground velocity), Sa (spectral acceleration), Ia (Arias intensity, "
+                               "π/(2g) times the integral of the squared acceleration, in m/s), D5-95 (the time "
+                               "between 5% and 95% of Ia)."),
     ("G_s, E_d, ξ, k", "the soil's shear modulus, its constrained (oedometric) modulus, the damping ratio of the "
                        "foundation's dashpot, and the foundation's vertical stiffness under the block (the "
                        "paper's eq. 19)."),
