@@ -194,7 +194,8 @@ CAPTIONS = {
               "the reference site's it is carried from (black dashed; a soil's curve stops where the given one "
               "ends, at its rarest frequency); dotted, the frequencies of the return periods "
               "(where a curve crosses one, the site's intensity of that return period, as the answer pages print "
-              "it).",
+              "it). A soft soil's curve can fall below the reference site's at strong shaking: the site term's "
+              "nonlinear part de-amplifies it (Methods).",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled; the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
                "intensity level.",
@@ -224,7 +225,8 @@ CAPTIONS = {
     "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
                 "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
                 "bed); dashed, that it overturns; between them it rocks and stays up (shaded orange where a panel "
-                "has one pair of curves). Grey shading: extrapolation by scaling.",
+                "has one pair of curves). Grey shading: extrapolation by scaling. The intensity is the pair's "
+                "RotD50, which one component can exceed: a rigid base may lift off a little below g·tanα.",
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
@@ -235,11 +237,9 @@ CAPTIONS = {
                      "rigid base. Green shading: 300-1000 MPa, the soil stiffness above which the paper finds the "
                      "rigid base good enough. Top axis: the study's soils. Lines that coincide hide each other. "
                      "These are the study's own runs: the recommended model's base has friction and its bed's "
-                     "restitution is set within the experiments' range, so where its block slides instead of "
-                     "rocking (it slides first where μ_s is below tan α, and cannot rock while it slides where μ_k "
-                     "is: the answer pages name those soils) the ratio falls far below 1, which is sliding, not the "
-                     "bed's stiffness. Where it lies above 1 inside the green band, the recommended model does not "
-                     "confirm the paper's 'rigid base good enough' for that block.",
+                     "restitution is set within the experiments' range: where its block slides instead of rocking "
+                     "(the answer pages name those soils) the ratio falls far below 1, which is sliding, not the "
+                     "bed's stiffness; above 1 in the green band it does not confirm the paper's 'good enough'.",
     "applicability-sweep": "Read the soil stiffness above which the rigid base is good enough: the ratio of median "
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
@@ -249,7 +249,9 @@ CAPTIONS = {
                    "stiffness), the others central; the dashed line is the model-form β (FEMA P695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
-                   "marked 'no median' has no curve of this state below the highest intensity studied.",
+                   "marked 'no median' has no curve of this state below the highest intensity studied; a parameter "
+                   "without a bar on a soil had one run there (the bed cannot reach its range: the answer page "
+                   "says so), not a zero spread that is known.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does; the test of Luco & Cornell 2007).",
@@ -379,7 +381,8 @@ def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:
             model = short_label(model_info(test.model))
             failing.append(f"the {name}, {model}, {pages.soils_words(test.soils, list(efficiency.soil.values))}"
                            f" (against {' and '.join(failed)})")
-    text = (f" The curves are in {words} because the site's hazard is (a curve must share the hazard's measure)."
+    text = (f" The curves are in {words} because the site's hazard is (a curve must share the hazard's measure; "
+            "a site hazard in another measure would let the study use it)."
             if hazard else f" The curves are in {words}, the study's measure.")
     if better:
         text += f" Less scatter than {words}: {'; '.join(better)}; in {words} those curves are wider, not shifted."

@@ -243,10 +243,14 @@ def slides_first_words(results, answer) -> str:
     slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
     listed = ", ".join(f"{soil.name} {soil.friction_static:g}" for soil in soils)
     return (f"On {_where(results, soils)} the soil's base friction (μ_s {listed}) is below this "
-            f"block's b/h = {slender:.2f}: at rest it slides before it can rock (Shenton 1996), so its rocking and "
-            f"overturning there rest on the assumed friction (the values marked {FRICTION_MARK} in the design-life "
-            "table are friction-driven); a base that grips more (a grout bed, a keyed plinth) would rock instead, "
-            "and overturn more readily.")
+            f"block's b/h = {slender:.2f}: on a rigid base it would slide before it could rock (Shenton 1996). "
+            + ("" if model_info(answer.model).rigid_base else
+               "On the bed a corner can still lift: the block rocks on the bed's springs, and that motion can build "
+               "up over cycles beyond what the friction-capped base shear gives at rest, so its lift-off is "
+               "computed. ")
+            + "Its rocking and overturning there rest on the assumed friction (the values marked "
+            f"{FRICTION_MARK} in the design-life table are friction-driven); a base that grips more (a grout bed, "
+            "a keyed plinth) would rock instead, and overturn more readily.")
 
 
 KINETIC_SENSITIVE = 0.25
@@ -700,8 +704,9 @@ def below_floor_with_period(rows) -> bool:
                for cell in row[2:])
 
 
-FLOOR_WITH_PERIOD_WORDS = ("'< 0.1%, once in ... years': the fitted curve's value, computed but below the print "
-                           "floor of 0.1%; its return period says how far below.")
+FLOOR_WITH_PERIOD_WORDS = ("'< 0.1%, once in ... years': a computed value below the print floor of 0.1% (from the "
+                           "fitted curve, or, where the state has no curve, from the share of records that reached "
+                           "it at each level over the site's hazard); its return period says how far below.")
 """The note under the design-life table where a computed probability below the print floor has its return period."""
 
 

@@ -416,7 +416,9 @@ def verdict_settings(results: Results) -> list[list[str]]:
     source = results.hazard.source if results.hazard is not None else "none"
     rows = [["[hazard] file", _toml(hazard_file) + ("" if hazard_file else f" (the shipped example, {source})"),
              "the site's hazard curve: every probability at a return period and in the design life, so every "
-             "verdict; the shipped example is no site's"],
+             "verdict" + ("; the shipped example is no site's" if not hazard_file else
+                          "; a curve marked illustrative is to be replaced by the site's hazard study"
+                          if hazard_caveat(results) else "")],
             ["[hazard] design_life", _toml(float(hazard.get("design_life", config.design_life))),
              "the probability in the design life that the limits judge"],
             ["[hazard] return_periods", _toml([float(t) for t in results.return_periods]),
@@ -813,7 +815,10 @@ def methods_items(results: Results) -> list[Item]:
                            f"{block_levels(cube, b).min() * scale:.2g} to {block_levels(cube, b).max() * scale:.2g} "
                            f"{unit}" for b, row in zip(cube.block.values, levels))
         text += (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure} per block, "
-                 f"spacing {spacing}, from a multiple of the block's uplift intensity up ({ranges}).")
+                 f"spacing {spacing}, from a multiple of the block's uplift intensity up ({ranges}). The uplift "
+                 "intensity here is g·tanα in the measure of the levels: under RotD50, g·tanα times the records' "
+                 "median ratio of the pair's RotD50 to the component's own peak, close to "
+                 "g·tanα itself.")
     else:
         text += (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure}, "
                  f"{levels.min():.3g} to {levels.max():.3g}"
@@ -1177,10 +1182,11 @@ def limitations_items(results: Results) -> list[Item]:
             items.append(paragraph(f"{model.label}: the foundation never pulled on the block."))
             continue
         worst = fraction.where(fraction == fraction.max(), drop=True)
+        most = (f", most often for the {block_name(config, worst.block.values[0])} on {worst.soil.values[0]} "
+                f"({_percent(float(fraction.max()))})") if fraction.size > 2 else ""
         items.append(paragraph(
             f"{model.label}: the foundation pulled on the block (negative support force) in {_percent(overall)} of "
-            f"the runs, most often for the {block_name(config, worst.block.values[0])} on {worst.soil.values[0]} "
-            f"({_percent(float(fraction.max()))}). A soil cannot pull: after the first tension these runs are not "
+            f"the runs{most}. A soil cannot pull: after the first tension these runs are not "
             "physical, and the model is outside its validity there. Fraction of runs with tension:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
     if tensionless:

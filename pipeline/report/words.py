@@ -198,8 +198,8 @@ GLOSSARY = (
     ("restitution", "the share of rocking speed a block keeps at each impact; Housner's rigid base gives "
                     "r = 1 − 1.5 sin²α, and experiments on rigid bases find about that value or a few percent more "
                     "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
-    ("record sets", "the earthquake records the study runs; the far-field and near-field sets (with and without a "
-                    "velocity pulse) are those of FEMA P695."),
+    ("record sets", "the earthquake records the study runs: FEMA P695's far-field set, and its near-field set "
+                    "(records with and without a velocity pulse)."),
     ("flies, free flight", "the whole base leaves the ground, a corner at least the uplift size: after an "
                            "impact on a bed (the block bounces), or in free flight, where the ground drops faster "
                            "than gravity (g + a_v < 0 under the vertical component, only where a study applies "
