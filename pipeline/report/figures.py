@@ -448,11 +448,11 @@ def frame_note(edp, fractiles, q: float = 0.84) -> str:
     if not run.size:
         return "not run"
     if not (run >= VISIBLE_ROCKING).any():
-        return f"θmax/α below {VISIBLE_ROCKING:g} in every record at every level: the curves lie on the frame"
+        return f"θmax/α below {VISIBLE_ROCKING:g} in every record at every level: the curves lie on the left axis"
     highest = np.asarray(fractiles, float)
     if np.isfinite(highest).all() and (highest < VISIBLE_ROCKING).all():
         return (f"θmax/α below {VISIBLE_ROCKING:g} at every level in most records ({q:.0%} fractile): their curves lie "
-                f"on the frame; {int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs reach more")
+                f"on the left axis; {int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs reach more")
     return ""
 
 

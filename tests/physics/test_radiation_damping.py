@@ -25,12 +25,21 @@ def test_the_formula_by_hand():
 
 
 def test_default_blocks_on_clay_to_rock():
-    """Issue 18's numbers: about 0.23-0.27 for the paper block, 0.5-0.7 for the cabinet and the skid."""
+    """Issue 18's numbers: about 0.23-0.27 for the paper block, 0.5-0.7 for the cabinet and the skid (its footprint
+    then 3 m x 2 m). The skid is square in plan since cold read 5 (3 m x 3 m): the dashpot grows with the area and
+    the stiffness k with it too, so the ratio grows as the square root of the area, by sqrt(9/6)."""
+    import dataclasses
+
     blocks = {block.name: block for block in load_study().blocks}
-    expected = {"paper": (0.22, 0.28), "slender-cabinet": (0.5, 0.7), "squat-machinery": (0.5, 0.7)}
+    skid = blocks["squat-machinery"]
+    blocks["skid-issue-18"] = dataclasses.replace(skid, footprint_area=6.0)
+    expected = {"paper": (0.22, 0.28), "slender-cabinet": (0.5, 0.7), "skid-issue-18": (0.5, 0.7)}
     for name, (low, high) in expected.items():
         for soil in ("clay", "sand", "gravel", "rock"):
             assert low <= radiation_damping(blocks[name], SOILS[soil]) <= high, (name, soil)
+    for soil in ("clay", "sand", "gravel", "rock"):
+        assert radiation_damping(skid, SOILS[soil]) == pytest.approx(
+            radiation_damping(blocks["skid-issue-18"], SOILS[soil]) * math.sqrt(9.0 / 6.0), rel=1e-12)
 
 
 def test_steel_is_not_a_half_space():
