@@ -746,3 +746,67 @@ def test_the_run_time_says_when_the_simulations_were_reused():
     reused = run_time_line(9.0, {"cells": 10, "cells_reused": 10, "runs_computed": 0})
     assert "reused from the earlier run are not in it" in reused
     assert "reused" not in run_time_line(9.0, {"cells": 10, "cells_reused": 0, "runs_computed": 100})
+
+
+def _restitution_effect_study(limit: float):
+    """A box on clay (its bed reaches the restitution range's upper end) and on rock (it does not: the best-estimate
+    run sits at the lower end), overturning judged against ``limit``; the upper-end run on clay lowers the median
+    by 10 %. Returns the results and rock's probability in 50 years with its median and with 0.9 times it, each
+    integrated here over the hazard curve's drops (independent of rockfrag.fragility.capped_frequency)."""
+    from types import SimpleNamespace
+
+    from scipy.stats import norm
+
+    from rockfrag.answer import StateAnswer
+    from rockfrag.hazard import HazardCurve
+    from tests.test_report_answer import _restitution_cube
+
+    cube = _restitution_cube(np.array([[0.728, 0.746, 0.764]]), np.array([[0.728, 0.746, 0.764]]),
+                             np.array([[0.4, 0.2, 0.1]]), ["box"])
+    for name in ("restitution_target", "member_restitution_target"):
+        cube[name].loc[{"soil": "rock"}] = 0.728  # rock's bed reaches none above the range's lower end
+    coords = {"soil": ["clay", "rock"], "block": ["box"], "model": ["recommended"], "damage_state": ["overturning"],
+              "member": ["restitution_low", "restitution_high"]}
+    median = np.array([0.5, 0.6]).reshape(2, 1, 1, 1)
+    member = np.array([[0.55, 0.45], [0.6, 0.6]]).T.reshape(2, 2, 1, 1)  # (member, soil, block, state)
+    fragility = xr.Dataset({"median": (("soil", "block", "model", "damage_state"), median),
+                            "beta": (("soil", "block", "model", "damage_state"), np.full((2, 1, 1, 1), 0.5)),
+                            "member_median": (("member", "soil", "block", "damage_state"), member),
+                            "credible_max": (("block",), [3.0])}, coords=coords)
+    x = np.geomspace(0.01, 10.0, 400)
+    hazard = HazardCurve(x, 1e-3 * (x / 0.2) ** -2.5, "pga", None, "test")
+
+    def life(m):
+        mids, drops = np.sqrt(x[1:] * x[:-1]), -np.diff(hazard.annual_frequency)
+        keep = mids <= 3.0
+        rate = np.sum(drops[keep] * norm.cdf(np.log(mids[keep] / m) / 0.5)) + hazard.annual_frequency[x <= 3.0][-1]
+        return 1 - math.exp(-50 * rate)
+
+    p_rock, p_shifted = life(0.6), life(0.6 * 0.9)
+    soils = []
+    for soil, m in (("clay", 0.5), ("rock", 0.6)):
+        p = life(m)
+        soils.append(SimpleNamespace(soil=soil, states=(StateAnswer("overturning", (), -math.log(1 - p) / 50, p,
+                                                                    limit, None),)))
+    answer = SimpleNamespace(block="box", soils=tuple(soils), design_life=50.0)
+    results = SimpleNamespace(fragility=fragility, cube=cube, answers=[answer], site_hazards=None, hazard=hazard)
+    return results, p_rock, p_shifted
+
+
+def test_a_best_estimate_below_the_middle_of_the_range_says_what_the_missing_side_is_worth():
+    """Cold read 5, default B4: "On rock and steel the answering run uses r = 0.728, below the middle of the range,
+    0.746" said nothing of how much the left-out side matters. Now the page gives the median's change from the
+    best-estimate run to the upper-end run where a bed reached it (clay: 0.5 -> 0.45 g, 10 %), and whether the same
+    change on the soils below the middle takes a judged state across its limit."""
+    from rockfrag.report.answer_page import curve_reason
+
+    results, p_rock, p_shifted = _restitution_effect_study(limit=0.5)
+    assert p_shifted > p_rock  # a lower median: more likely; the limit below straddles them
+    text = curve_reason(results, "recommended", "box")
+    assert "On rock the best-estimate run uses r = 0.728, below the middle of the range, 0.746." in text, text
+    assert ("measured on clay, where the bed reaches r = 0.764: from the best-estimate run to that one the median of "
+            "overturning drops by 10%") in text, text
+    assert "the same change on rock takes no damage state across its limit, so no verdict changes." in text, text
+    straddled, _, _ = _restitution_effect_study(limit=math.sqrt(p_rock * p_shifted))
+    text = curve_reason(straddled, "recommended", "box")
+    assert "the same change on rock would take overturning on rock across its limit." in text, text

@@ -76,10 +76,11 @@ def _restitution_runs(cube, name):
     return parts
 
 
-def _band_reach(cube, block=None) -> str:
+def _band_reach(cube, block=None, results=None) -> str:
     """A sentence on the cells where the bed could not reach the restitution range's ends (empty when it did).
 
-    Of one block when ``block`` is given (its answer page), else of the whole study. Restitutions are the
+    Of one block when ``block`` is given (its answer page), else of the whole study; with ``results`` too, what
+    the best-estimate run leaves out where it runs below the middle (``restitution_effect_words``). Restitutions are the
     sample's inputs and targets; the damping ratio calibrated to them is not printed (the precision policy).
     """
     runs = None if cube is None else _restitution_runs(cube, RECOMMENDED)
@@ -107,7 +108,73 @@ def _band_reach(cube, block=None) -> str:
             runs = values[0] if len(set(values)) == 1 else _and(values)
             text += (f" On {_and(low)} the best-estimate run uses r = {runs}, below the middle of the range, "
                      f"{float(centre_asked.max()):.3f}.")
+            if results is not None and block is not None:
+                text += restitution_effect_words(results, block, low, target)
     return text
+
+
+def restitution_effect_words(results, block, low, target) -> str:
+    """What the upper half of the restitution range is worth where the best-estimate run could not reach it.
+
+    Measured on the soil whose bed reached furthest above the middle (``target``: the r each run reached, runs
+    centre and restitution_high): the ratio of the restitution_high run's median to the best estimate's, per
+    governing state of the soils in ``low``. The same ratio applied to those soils' medians (hazard, β and credible
+    cap unchanged, rockfrag.fragility.capped_frequency) says whether any judged state would cross its limit: the
+    size of what the best estimate leaves out and whether it could change a verdict (cold read 5, default B4).
+    "" where no soil reached above the middle or no governing state has a median on both runs.
+    """
+    from rockfrag.fragility import capped_frequency
+    from rockfrag.hazard import hazard_of
+    from rockfrag.report.summary import governing
+    from rockfrag.risk import probability_in_life
+
+    fragility = results.fragility
+    if "member_median" not in fragility or "restitution_high" not in fragility.member.values \
+            or "run" not in target.dims or "restitution_high" not in target.run.values:
+        return ""
+    gain = {str(s): float(target.sel(run="restitution_high", soil=s) - target.sel(run="centre", soil=s))
+            for s in target.soil.values if str(s) not in low}
+    gain = {soil: value for soil, value in gain.items() if np.isfinite(value) and value > 5e-4}
+    answer = next((a for a in (results.answers or ()) if a.block == str(block)), None)
+    if not gain or answer is None:
+        return ""
+    proxy = max(gain, key=gain.get)
+    reached = float(target.sel(run="restitution_high", soil=proxy))
+    row = fragility.sel(block=block, soil=proxy)
+    hazard = results.site_hazards or results.hazard
+    cap = float(fragility.credible_max.sel(block=block)) if "credible_max" in fragility else np.inf
+    labels, shifts, crossed = short_names(results), {}, []
+    for soil in answer.soils:
+        if soil.soil not in low or (state := governing(soil)) is None:
+            continue
+        centre = float(row["median"].sel(model=RECOMMENDED, damage_state=state.state))
+        high = float(row["member_median"].sel(member="restitution_high", damage_state=state.state))
+        if not (np.isfinite(centre) and np.isfinite(high) and centre > 0):
+            continue
+        ratio = high / centre
+        shifts.setdefault(state.state, ratio)
+        curve = hazard_of(hazard, soil.soil) if hazard is not None else None
+        for judged in soil.states:
+            if not judged.limit or not np.isfinite(judged.probability_in_life) or curve is None:
+                continue
+            fit = fragility.sel(block=block, soil=soil.soil, model=RECOMMENDED, damage_state=judged.state)
+            median, beta = float(fit["median"]), float(fit["beta"])
+            if not (np.isfinite(median) and np.isfinite(beta)):
+                continue  # a bound, not a curve: the restitution does not move it here
+            shifted = float(probability_in_life(capped_frequency(median * ratio, beta, curve, cap),
+                                                answer.design_life))
+            if (shifted > judged.limit) != judged.exceeds:
+                crossed.append(f"{labels.get(judged.state, judged.state)} on {soil.soil}")
+    if not shifts:
+        return ""
+    moves = _and([f"the median of {labels.get(state, state)} {'drops' if ratio < 1 else 'rises'} by "
+                  f"{abs(100 * (ratio - 1)):.0f}%" for state, ratio in shifts.items()])
+    same = "the same change" if len(shifts) == 1 else "the same changes"
+    takes = "takes" if len(shifts) == 1 else "take"
+    verdict = (f"{same} on {_and(low)} would take {_and(crossed)} across its limit." if crossed else
+               f"{same} on {_and(low)} {takes} no damage state across its limit, so no verdict changes.")
+    return (f" What that side is worth, measured on {proxy}, where the bed reaches r = {reached:.3f}: from the "
+            f"best-estimate run to that one {moves}; {verdict}")
 
 
 def _grouped(values: dict) -> str:
@@ -173,7 +240,7 @@ def curve_reason(results, model: str, block=None) -> str:
                 "each at both ends of its range) and FEMA P695's rating of the model's form (a planar rigid block: "
                 "no three-dimensional rocking, no flexible superstructure).")
         if block is not None:
-            return (_band_reach(getattr(results, "cube", None), block)
+            return (_band_reach(getattr(results, "cube", None), block, results)
                     + _band_collapse(getattr(results, "cube", None), block)).strip()
         models = {str(m) for m in results.fragility.model.values}
         if "housner" in models and any(m.startswith("ssi") for m in models):
