@@ -748,6 +748,25 @@ def test_the_run_time_says_when_the_simulations_were_reused():
     assert "reused" not in run_time_line(9.0, {"cells": 10, "cells_reused": 0, "runs_computed": 100})
 
 
+def _power_hazard():
+    """A hazard curve lambda = 1e-3 (x / 0.2 g)^-2.5 from 0.01 to 10 g."""
+    from rockfrag.hazard import HazardCurve
+
+    x = np.geomspace(0.01, 10.0, 400)
+    return HazardCurve(x, 1e-3 * (x / 0.2) ** -2.5, "pga", None, "test")
+
+
+def _life_by_hand(hazard, median: float, beta: float, cap: float, years: float = 50.0) -> float:
+    """P in ``years`` of a lognormal fragility over ``hazard``'s drops up to ``cap`` plus lambda(cap) (the bound)."""
+    from scipy.stats import norm
+
+    x, frequency = hazard.intensity, hazard.annual_frequency
+    mids, drops = np.sqrt(x[1:] * x[:-1]), -np.diff(frequency)
+    keep = mids <= cap
+    rate = np.sum(drops[keep] * norm.cdf(np.log(mids[keep] / median) / beta)) + frequency[x <= cap][-1]
+    return 1 - math.exp(-years * rate)
+
+
 def _restitution_effect_study(limit: float):
     """A box on clay (its bed reaches the restitution range's upper end) and on rock (it does not: the best-estimate
     run sits at the lower end), overturning judged against ``limit``; the upper-end run on clay lowers the median
@@ -755,10 +774,7 @@ def _restitution_effect_study(limit: float):
     integrated here over the hazard curve's drops (independent of rockfrag.fragility.capped_frequency)."""
     from types import SimpleNamespace
 
-    from scipy.stats import norm
-
     from rockfrag.answer import StateAnswer
-    from rockfrag.hazard import HazardCurve
     from tests.test_report_answer import _restitution_cube
 
     cube = _restitution_cube(np.array([[0.728, 0.746, 0.764]]), np.array([[0.728, 0.746, 0.764]]),
@@ -773,14 +789,10 @@ def _restitution_effect_study(limit: float):
                             "beta": (("soil", "block", "model", "damage_state"), np.full((2, 1, 1, 1), 0.5)),
                             "member_median": (("member", "soil", "block", "damage_state"), member),
                             "credible_max": (("block",), [3.0])}, coords=coords)
-    x = np.geomspace(0.01, 10.0, 400)
-    hazard = HazardCurve(x, 1e-3 * (x / 0.2) ** -2.5, "pga", None, "test")
+    hazard = _power_hazard()
 
     def life(m):
-        mids, drops = np.sqrt(x[1:] * x[:-1]), -np.diff(hazard.annual_frequency)
-        keep = mids <= 3.0
-        rate = np.sum(drops[keep] * norm.cdf(np.log(mids[keep] / m) / 0.5)) + hazard.annual_frequency[x <= 3.0][-1]
-        return 1 - math.exp(-50 * rate)
+        return _life_by_hand(hazard, m, 0.5, cap=3.0)
 
     p_rock, p_shifted = life(0.6), life(0.6 * 0.9)
     soils = []
@@ -810,3 +822,39 @@ def test_a_best_estimate_below_the_middle_of_the_range_says_what_the_missing_sid
     straddled, _, _ = _restitution_effect_study(limit=math.sqrt(p_rock * p_shifted))
     text = curve_reason(straddled, "recommended", "box")
     assert "the same change on rock would take overturning on rock across its limit." in text, text
+
+
+def test_the_high_friction_medians_say_what_they_give_in_the_design_life_and_against_the_limits():
+    """Cold read 5, user C6: the friction note gave the clay medians with the friction at the high end (0.98 / 1.5 /
+    2.1 g) but not what they mean for the verdict. Now it gives their probability in the design life over the soil's
+    hazard, with the largest β of the state's curves on the other soils (clay has none), and says whether each is
+    within its limit."""
+    from types import SimpleNamespace
+
+    from rockfrag.answer import StateAnswer
+    from rockfrag.report import numbers
+    from rockfrag.report.answer_page import _friction_high_verdict
+
+    coords = {"soil": ["clay", "sand", "rock"], "block": ["box"], "model": ["recommended"],
+              "damage_state": ["overturning"], "member": ["friction_high"]}
+    beta = np.array([np.nan, 0.6, 0.45]).reshape(3, 1, 1, 1)  # clay: no curve; sand's β is the largest
+    high = np.array([1.2, 3.5, 4.0]).reshape(1, 3, 1, 1)
+    fragility = xr.Dataset({"beta": (("soil", "block", "model", "damage_state"), beta),
+                            "median": (("soil", "block", "model", "damage_state"), beta * np.nan),
+                            "member_median": (("member", "soil", "block", "damage_state"), high),
+                            "credible_max": (("block",), [3.0])}, coords=coords)
+    hazard = _power_hazard()
+    expected = _life_by_hand(hazard, 1.2, 0.6, cap=3.0)
+
+    def text(limit):
+        states = (StateAnswer("overturning", (), np.nan, 1e-5, limit, 3.0),)
+        answer = SimpleNamespace(block="box", model="recommended", return_periods=(475.0,), design_life=50.0,
+                                 soils=tuple(SimpleNamespace(soil=s, states=states) for s in coords["soil"]))
+        results = SimpleNamespace(fragility=fragility, site_hazards=None, hazard=hazard)
+        return _friction_high_verdict(results, answer, ["clay"], ["overturning"])
+
+    assert 0.001 < expected < 0.05  # printed with its digits, and a limit on either side below is meaningful
+    within = text(0.05)
+    assert within == (f" In 50 years these medians give {numbers.probability(expected)} for overturning (each with "
+                      "the largest β of its state's curves on the other soils, 0.60): within the limits."), within
+    assert text(expected / 2).endswith("): above its limit: overturning."), text(expected / 2)

@@ -434,7 +434,58 @@ def friction_high_words(results, answer) -> str:
     nothing = "none below the highest intensity studied"
     said = "; ".join(f"on {soil}{friction}: " + (", ".join(shown) if shown else nothing)
                      for soil, friction, shown in parts)
-    return text + f" With the friction at the high end of its range (a sensitivity run) the medians are, {said}."
+    return (text + f" With the friction at the high end of its range (a sensitivity run) the medians are, {said}."
+            + _friction_high_verdict(results, answer, [soil.name for soil in soils], states))
+
+
+def _friction_high_verdict(results, answer, soils, states) -> str:
+    """What the high-friction medians give in the design life for the judged states, and whether within the limits.
+
+    The marked soils have no curve of these states (no record reached them, or a curve of a base that slides), so
+    the dispersion is borrowed: the largest β of the state's recommended curves on the block's other soils (a
+    median far above the hazard's intensities gives a larger probability with a larger β). Integrated over the
+    soil's hazard up to the credible cap like every row (rockfrag.fragility.capped_frequency); "" without a hazard
+    or a borrowed β (cold read 5, user C6: the medians alone did not say what they mean for the verdict).
+    """
+    from rockfrag.fragility import capped_frequency
+    from rockfrag.hazard import hazard_of
+    from rockfrag.risk import probability_in_life
+
+    fragility = results.fragility
+    hazard = getattr(results, "site_hazards", None) or getattr(results, "hazard", None)
+    if hazard is None or not answer.return_periods:
+        return ""
+    cap = float(fragility.credible_max.sel(block=answer.block)) if "credible_max" in fragility else np.inf
+    short, found, betas = short_names(results), [], []
+    for soil in answer.soils:
+        if soil.soil not in soils:
+            continue
+        for row in soil.states:
+            if row.state not in states or not row.limit:
+                continue
+            median = float(fragility.member_median.sel(member="friction_high", soil=soil.soil, block=answer.block,
+                                                       damage_state=row.state))
+            others = fragility["beta"].sel(model=answer.model, block=answer.block, damage_state=row.state)
+            others = others.sel(soil=[s for s in map(str, fragility.soil.values) if s not in soils]).values
+            if not np.isfinite(median) or not np.isfinite(others).any():
+                continue
+            beta = float(np.nanmax(others))
+            value = float(probability_in_life(capped_frequency(median, beta, hazard_of(hazard, soil.soil), cap),
+                                              answer.design_life))
+            found.append((soil.soil, row, value))
+            betas.append(beta)
+    if not found:
+        return ""
+    where = len({soil for soil, _, _ in found}) > 1
+    values = _and([f"{numbers.probability(value)} for {short[row.state]}" + (f" on {soil}" if where else "")
+                   for soil, row, value in found])
+    above = [f"{short[row.state]}" + (f" on {soil}" if where else "") for soil, row, value in found
+             if value > row.limit]
+    judged = f"above its limit: {_and(above)}" if above else "within the limits"
+    spread = f"{min(betas):.2f}" if round(min(betas), 2) == round(max(betas), 2) else \
+        f"{min(betas):.2f} to {max(betas):.2f}"
+    return (f" In {numbers.years(answer.design_life)} these medians give {values} (each with the largest β of its "
+            f"state's curves on the other soils, {spread}): {judged}.")
 
 
 SPECTRUM_BAND = 0.8
