@@ -858,3 +858,91 @@ def test_the_high_friction_medians_say_what_they_give_in_the_design_life_and_aga
     assert within == (f" In 50 years these medians give {numbers.probability(expected)} for overturning (each with "
                       "the largest β of its state's curves on the other soils, 0.60): within the limits."), within
     assert text(expected / 2).endswith("): above its limit: overturning."), text(expected / 2)
+
+
+def test_a_block_modelled_per_metre_of_its_length_is_not_said_to_have_a_less_stable_depth():
+    """Cold read 7, default B: the summary said 'Judged across the width only, not across a less stable depth: solid
+    block with the paper's proportions (b/h 0.059 across its 1 m depth)' while its description says 1 m is the plane
+    model per metre of a long block. A block 1 m deep (the plane model's default footprint, 2b x 1 m) is said to be
+    per metre of its length, not a weaker direction; a 2 m deep skid still is."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.summary import weaker_direction_words
+
+    strip = SimpleNamespace(name="wall", b=3.999, h=8.5, footprint_area=8.0)  # 1.0002 m deep: per metre
+    skid = SimpleNamespace(name="skid", b=1.5, h=2.0, footprint_area=6.0)
+    words = weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(strip, skid), raw={})))
+    assert words.startswith("Judged across the width only, not across a less stable depth: skid (b/h 0.5"), words
+    assert "wall (b/h" not in words and "less stable depth): wall." in words, words
+    alone = weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(strip,), raw={})))
+    assert alone.startswith("Per metre of a long block") and "Judged" not in alone, alone
+
+
+def test_a_probability_read_below_the_lowest_level_is_marked_as_the_fit_extrapolated():
+    """Cold read 7, default B (cold read 5, C4): the squat block's 475-year values ('3.8%' on clay) are read where
+    'no level run this low', and the cell had no mark. A fitted value there carries '*' with a note; a value at a
+    level run, 'not reached', a count, a bound from the records and '-' do not."""
+    from rockfrag.answer import StateAnswer
+    from rockfrag.report.answer_page import BELOW_LEVELS_MARK, BELOW_LEVELS_WORDS, _below_levels_mark
+
+    records = ((0, 44, float("nan")), (0, 44, 0.37), (1, 44, 0.44))  # (reached, of, level read; NaN: none this low)
+    row = StateAnswer("slip-0.05", ((0.038,), (0.075,), (0.15,)), 4e-4, 0.021, None, None, records)
+    assert _below_levels_mark("3.8%", row, 0) == f"3.8%{BELOW_LEVELS_MARK}"
+    assert _below_levels_mark("< 0.1%", row, 0) == f"< 0.1%{BELOW_LEVELS_MARK}"
+    assert _below_levels_mark("7.5%", row, 1) == "7.5%"
+    for cell in ("not reached", "0 of 44", "≥ 19%", "-"):
+        assert _below_levels_mark(cell, row, 0) == cell
+    assert BELOW_LEVELS_WORDS.startswith(f"{BELOW_LEVELS_MARK} read at a site intensity below the lowest level run")
+
+
+def test_a_soil_whose_site_term_lowers_the_reference_intensity_is_not_called_amplified():
+    """Cold read 7, default B: the methods' hazard table called rock (Vs30 1,080 m/s) 'amplified' beside site PGAs
+    below the reference's (0.24 / 0.32 / 0.47 g against 0.30 / 0.39 / 0.57 g). The word follows the curves at each
+    return period: amplified, de-amplified, or both with the return periods (a soft soil's nonlinear term)."""
+    from rockfrag.hazard import HazardCurve
+    from rockfrag.report.sections import site_term_words
+    from rockfrag.site_hazard import SiteHazards
+
+    x = np.geomspace(0.01, 10.0, 400)
+    frequency = 1e-3 * (x / 0.2) ** -2.5  # reference: 0.148 / 0.198 / 0.287 g at 475 / 975 / 2,475 years
+
+    def curve(intensity):
+        return HazardCurve(intensity, frequency, "pga", None, "test")
+
+    sites = SiteHazards({"stiff": curve(0.8 * x), "soft": curve(1.2 * x), "clay": curve(x * (x / 0.22) ** -0.3)},
+                        reference=curve(x), reference_vs30=760.0)
+    periods = (475.0, 975.0, 2475.0)
+    assert site_term_words(sites, "stiff", periods) == "de-amplified"
+    assert site_term_words(sites, "soft", periods) == "amplified"
+    # ratio (x / 0.22)^-0.3 at the reference's 0.148 / 0.198 / 0.287 g: 1.13, 1.03, 0.92
+    assert site_term_words(sites, "clay", periods) == "amplified at 475 and 975 years, de-amplified at 2,475 years"
+
+
+def test_the_paper_is_named_on_the_title_page_where_the_title_page_speaks_of_it(small_pipeline):
+    """Cold read 5, default C2: page 1 said "the paper's proportions" and "SSI, paper's model" while the paper was
+    named only in the methods and references. The title page names it (title, a preprint) where it speaks of it."""
+    from rockfrag.models.ssi import PAPER_TITLE
+    from rockfrag.report.sections import title_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    text = " ".join(item.text for item in title_items(results))
+    assert "paper" in text.replace(PAPER_TITLE, "")  # the small study's title page speaks of it: the test can fail
+    assert f"'The paper' on these pages: {PAPER_TITLE}, a preprint" in text, text
+
+
+def test_the_methods_say_which_damping_ratio_each_foundation_model_runs_with():
+    """Cold read 7, user B6: the methods said the recommended model runs 'on ... the soil's damping ratio' (0.05 in
+    the soils table) while cube.nc holds its calibrated ratio, 0.158 on both soils. A model with a calibrated ratio
+    is said to run with it, with its range; one without keeps the soil's."""
+    from rockfrag.report.sections import damping_words
+
+    calibrated = np.array([[[np.nan, 0.158]], [[np.nan, 0.0251]]])  # (soil, block, model): ssi none, recommended
+    cube = xr.Dataset({"damping_ratio_calibrated": (("soil", "block", "model"), calibrated)},
+                      coords={"soil": ["clay", "sand"], "block": ["box"], "model": ["ssi", "recommended"]})
+    words = damping_words(cube, "recommended")
+    assert "calibrated per block and soil" in words and "ξ 0.0251 to 0.158 in this study" in words, words
+    assert "not the soil's ξ" in words
+    assert damping_words(cube, "ssi") == "the soil's damping ratio"
+    single = cube.copy(deep=True)
+    single["damping_ratio_calibrated"].loc[{"model": "recommended"}] = 0.158
+    assert "ξ 0.158 in this study" in damping_words(single, "recommended")

@@ -404,8 +404,9 @@ def friction_high_words(results, answer) -> str:
     if not soils:
         return ""
     names = _where(results, soils)
-    how = "slides before it can rock" if not then else "cannot rock while it slides" if not first else \
-        f"slides before it can rock ({_and([soil.name for soil in first])}) or cannot rock while it slides " \
+    rigid = "would slide before it could rock on a rigid base"  # on the bed a corner can still lift (cold read 7)
+    how = rigid if not then else "cannot rock while it slides" if not first else \
+        f"{rigid} ({_and([soil.name for soil in first])}) or cannot rock while it slides " \
         f"({_and([soil.name for soil in then])})"
     text = f"{FRICTION_MARK} friction-driven: on {names} the block {how}, so these values rest on the assumed base " \
            "friction."
@@ -733,11 +734,14 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
             items.append(paragraph(edge))
     header = ["damage state", *(f"on {soil.soil}" for soil in answer.soils)]
     rows = [[short[state], *(_not_computed(results, answer, soil.soil, state)
-                             or _joined(say_p_at(results, answer, soil, soil.states[index], i)
+                             or _joined(_below_levels_mark(say_p_at(results, answer, soil, soil.states[index], i),
+                                                           soil.states[index], i)
                                         for i in range(len(periods)))
                              + _poor_fit_mark(results, answer, soil, soil.states[index]) for soil in answer.soils)]
             for index, state in enumerate(short)]
     items.append(table(header, rows))
+    if any(BELOW_LEVELS_MARK in cell for row in rows for cell in row[1:]):
+        items.append(note(BELOW_LEVELS_WORDS))
     if any(cell.endswith(POOR_FIT_MARK) for row in rows for cell in row[1:]):
         from rockfrag.report.sections import GOF_LEVEL
 
@@ -840,6 +844,28 @@ POOR_FIT_WORDS = ("‡ read from a fitted curve that fails its goodness-of-fit t
                   "table marks it): the lognormal follows the records' fractions poorly there; the records that "
                   "reached the state at each level (the table below) are the firmer evidence.")
 """The note under an answer page's probability table where a cell carries ``POOR_FIT_MARK`` (cold read 3, C5)."""
+
+
+BELOW_LEVELS_MARK = "*"
+"""Beside a probability read at a site intensity below the block's lowest level: the fit extrapolated, as the fitted
+table's '*' marks a median outside the studied range (cold read 7, default B: the squat block's 475-year values)."""
+
+BELOW_LEVELS_WORDS = ("* read at a site intensity below the lowest level run ('no level run this low' above): the "
+                      "fitted curve carried below the studied range, an extrapolation; the records say nothing there "
+                      "('-' in the table of records).")
+"""The note under an answer page's probability table where a cell carries ``BELOW_LEVELS_MARK``."""
+
+
+def _below_levels_mark(text: str, row, index: int) -> str:
+    """``text``, a probability cell's value at return period ``index``, marked where read below every level.
+
+    ``BELOW_LEVELS_MARK`` is added where the site's intensity there lies below every level run and the value is the
+    fitted curve's (a percentage, not "not reached", a count, a bound from the records or "-").
+    """
+    fitted = text.endswith("%") and (text[:1].isdigit() or text.startswith("<"))
+    if not fitted or not row.records or np.isfinite(row.records[index][2]):
+        return text
+    return text + BELOW_LEVELS_MARK
 
 
 def _poor_fit_mark(results, answer, soil, row) -> str:

@@ -65,10 +65,10 @@ from rockfrag.report.adapters import (
     vertical_applied,
 )
 from rockfrag.report.layout import pretty
-from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, hazard_caveat
+from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, hazard_caveat, per_metre
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
-from rockfrag.report.words import PAPER_CITATION, formulas, plain, state_short_label
+from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, formulas, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS
 from rockfrag.version import __version__
@@ -350,6 +350,9 @@ def title_items(results: Results) -> list[Item]:
                   f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
                   f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
                   f"{runs_words(results)}."),
+        *([paragraph(f"'The paper' on these pages: {PAPER_TITLE}, a preprint (Preprints.org, 2026; not "
+                     "peer-reviewed), the source of the SSI-rocking model (see References).")]
+          if any("paper" in text.lower() for text in (*names, *labels)) else []),
         *([paragraph(f"Results computed on {date}.")] if (date := results_date(results.output)) else []),
         *([strong(f"Hazard: {caveat}.")] if (caveat := hazard_caveat(results)) else []),
         paragraph("The next page is the summary: the action for each block on each soil, and why. Then the "
@@ -470,7 +473,8 @@ def _uncertainty_values(config) -> str:
 
 
 OPTIONAL_SETTINGS = (
-    ("hazard", "reference_vs30", "the Vs30 of the hazard file's site: each soil's site hazard is amplified from it"),
+    ("hazard", "reference_vs30", "the Vs30 of the hazard file's site: each soil's site hazard is carried from it "
+                                 "by the soil's site term (amplified or de-amplified)"),
     ("intensity", "credible_max", "the highest intensity studied: no level, fit or median above it, and the "
                                   "hazard's exceedance of it a stated bound"),
     ("intensity", "component", "which horizontal component the intensity is of: it must be the hazard's"),
@@ -614,7 +618,8 @@ def site_hazard_items(results: Results) -> list[Item]:
             rows.append([soil.name, f"{sites.reference_vs30:,.0f} (the reference site)", "-",
                          "the reference curve itself", under if is_soil(results.cube, soil.name) else "-"])
         else:
-            rows.append([soil.name, f"{soil.vs30:,.0f}", soil.site_class, "amplified", under])
+            rows.append([soil.name, f"{soil.vs30:,.0f}", soil.site_class,
+                         site_term_words(sites, soil.name, results.return_periods), under])
             if soil.vs30 > VS_GAP * math.sqrt(soil.shear_modulus / soil.density):
                 gaps.append(soil.name)
     if len(reference) == len(config.soils):
@@ -641,6 +646,33 @@ def site_hazard_items(results: Results) -> list[Item]:
                  "both, and its values replace these (the appendix names the settings).")
     return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class", "site hazard",
                                     "√(G/ρ) of the bed [m/s]"], rows)]
+
+
+def site_term_words(sites: SiteHazards, soil: str, periods) -> str:
+    """Whether the soil's site term raises or lowers the reference site's intensity at each return period.
+
+    "amplified", "de-amplified", or both with the return periods ("amplified at 475 years, de-amplified at 975 and
+    2,475 years": a soft soil's nonlinear term lowers strong shaking). Read from the curves the answer pages use
+    (cold read 7: rock, Vs30 1,080 m/s, was called "amplified" beside site PGAs below the reference's).
+    """
+    from rockfrag.answer import intensity_at_frequency
+
+    ratios = [intensity_at_frequency(sites[soil], 1.0 / period) / intensity_at_frequency(sites.reference, 1.0 / period)
+              for period in periods]
+    ups = [period for period, ratio in zip(periods, ratios) if ratio >= 1.0]
+    if len(ups) == len(periods):
+        return "amplified"
+    if not ups:
+        return "de-amplified"
+    downs = [period for period in periods if period not in ups]
+    return (f"amplified at {_and_words([numbers.years(t).removesuffix(' years') for t in ups])} years, "
+            f"de-amplified at {_and_words([numbers.years(t).removesuffix(' years') for t in downs])} years")
+
+
+def _and_words(words) -> str:
+    """"a", "a and b", "a, b and c"."""
+    words = list(words)
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 VS_GAP = 1.25
@@ -740,6 +772,27 @@ def _weakest_intensity(cube) -> float:
     return float(np.nanmin(np.asarray(cube.record_im.values, float)))
 
 
+def damping_words(cube, model: str) -> str:
+    """Which damping ratio a foundation model runs with, in words.
+
+    The soil's (the soils table), or the one calibrated per block and soil to the restitution (cube.nc
+    ``damping_ratio_calibrated``), with its range in this study.
+
+    Cold read 7, user B6: the methods said "the soil's damping ratio" (0.05 in the table) for the recommended model,
+    whose runs use the calibrated 0.158.
+    """
+    if "damping_ratio_calibrated" in cube and model in cube.model.values:
+        values = np.asarray(cube.damping_ratio_calibrated.sel(model=model).values, float)
+        values = values[np.isfinite(values)]
+        if values.size:
+            span = _g(values.min()) if _g(values.min()) == _g(values.max()) else \
+                f"{_g(values.min())} to {_g(values.max())}"
+            return (f"a damping ratio calibrated per block and soil so that its impacts keep the restitution of the "
+                    f"range (ξ {span} in this study, not the soil's ξ of the table below; the answer pages say where "
+                    "the bed cannot reach the range)")
+    return "the soil's damping ratio"
+
+
 def methods_items(results: Results) -> list[Item]:
     """The methods pages: models, soils and blocks, records and processing, scaling, fits, hazard and risk."""
     config, cube, fragility = results.config, results.cube, results.fragility
@@ -754,7 +807,8 @@ def methods_items(results: Results) -> list[Item]:
                     "'Sliding'); with a tied base, computed once per block")
         else:
             rule = f"the bed: {plain(bed)}" if model.uses_bed else plain(config.switch)
-            role = f"on a foundation of interface stiffness k (the paper's eq. 19) and the soil's damping ratio; {rule}"
+            role = (f"on a foundation of interface stiffness k (the paper's eq. 19) and "
+                    f"{damping_words(cube, model.name)}; {rule}")
         described.setdefault(f"{model.description}; {role}.", []).append(short_label(model))
     every_model = [short_label(m) for m in models_of(cube)]
     for text, labels in described.items():
@@ -1305,7 +1359,9 @@ def limitations_items(results: Results) -> list[Item]:
 
 PLANAR_WORDS = ("Each block rocks about one bottom edge, in the vertical plane across that edge, in which b is its "
                 "half-width: rocking in the other direction, twisting (wobbling) and three-dimensional rocking on a "
-                "corner are not modelled. Check the other direction as a block of its own b.")
+                "corner are not modelled. Check the other direction as a block of its own b; a block modelled per "
+                "metre of its length (depth 1 m, per metre) is a strip of a long block, whose length runs out of "
+                "plane.")
 """The planar model's limitation, said once (the table beside it gives each block's b)."""
 
 WHAT_A_CRANE_ADDS = ("A rail-mounted crane or ship-loader portal is not a solid block: it stands on wheels on rails "
@@ -1359,7 +1415,8 @@ def _depth_and_density(config, cube, block) -> list[str]:
                 None)
     if not area:
         return ["-", "-"]
-    return [f"{area / (2 * b):.3g}", f"{mass / (area * 2 * h):,.0f}"]
+    depth = area / (2 * b)
+    return [f"{depth:.3g}" + (" (per metre of length)" if per_metre(depth) else ""), f"{mass / (area * 2 * h):,.0f}"]
 
 
 def _soils_words(names, every_soil) -> str:

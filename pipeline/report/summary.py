@@ -294,18 +294,36 @@ def weaker_direction_words(results) -> str:
 
     "" where every block is at least as deep as it is wide (or its footprint is not stated).
     """
-    said = []
+    said, strips = [], []
     for block in getattr(results.config, "blocks", ()) or ():
         area = getattr(block, "footprint_area", None)
         if not area or not hasattr(block, "b") or not hasattr(block, "h"):
             continue
         depth = area / (2 * block.b)
-        if depth < 2 * block.b * (1 - 1e-9):
+        if per_metre(depth):
+            strips.append(block_name(results.config, block.name))
+        elif depth < 2 * block.b * (1 - 1e-9):
             said.append(f"{block_name(results.config, block.name)} (b/h {depth / (2 * block.h):.2g} across its "
                         f"{depth:.3g} m depth)")
-    if not said:
-        return ""
-    return "Judged across the width only, not across a less stable depth: " + "; ".join(said) + "."
+    text = ("Judged across the width only, not across a less stable depth: " + "; ".join(said) + ".") if said else ""
+    if strips:
+        text += (" " if text else "") + (f"Per metre of a long block (the plane model: its length runs out of plane, "
+                                         f"so it has no less stable depth): {'; '.join(strips)}.")
+    return text
+
+
+PLANE_DEPTH = 1.0
+"""[m] The out-of-plane depth of the plane model per metre of length (a block's footprint when none is given,
+rockfrag.blocks: 2b x 1 m): a block of this depth is a strip of a long block, not an object 1 m deep (cold read 7:
+the summary called the paper block's 1 m 'a less stable depth' while its description says per metre)."""
+
+
+def per_metre(depth: float) -> bool:
+    """Whether an out-of-plane ``depth`` [m] is the plane model's per metre of length (``PLANE_DEPTH``).
+
+    To 1 %: a footprint stated as 8.0 m² under b = R sin α = 3.999 m is 1.0002 m deep.
+    """
+    return abs(depth - PLANE_DEPTH) <= 0.01 * PLANE_DEPTH
 
 
 FRACTIONS_REASON = "no fit"
@@ -517,6 +535,7 @@ def _and(words) -> str:
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
-__all__ = ["ACTION_WORDS", "EXAMPLE_TAG", "GOVERNING_WORDS", "ILLUSTRATIVE_TAG", "STRUCTURAL_BASE_WORDS", "action",
-           "beta_words", "governing", "hazard_tag", "p_at_return_period", "p_in_life", "reason", "structural_bases",
-           "summary_items", "terminal_verdicts", "verdict_items", "verdict_rows"]
+__all__ = ["ACTION_WORDS", "EXAMPLE_TAG", "GOVERNING_WORDS", "ILLUSTRATIVE_TAG", "PLANE_DEPTH",
+           "STRUCTURAL_BASE_WORDS", "action", "beta_words", "governing", "hazard_tag", "p_at_return_period",
+           "p_in_life", "per_metre", "reason", "structural_bases", "summary_items", "terminal_verdicts",
+           "verdict_items", "verdict_rows"]
