@@ -374,6 +374,10 @@ def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:
                     if high[0] >= low[1]:  # the bands overlap: the records cannot tell the two apart
                         unresolved.append(f"{said[:-1]}, {test.records} records)")
                         continue
+                fails = [what.removeprefix("against ") for variable, _, _, what in pages.P_MARKERS
+                         if variable in cell and float(cell[variable].sel(measure=best)) < SUFFICIENCY_LEVEL]
+                if fails:  # less scatter is no reason to switch where the measure misses what the records carry
+                    said += f", though it fails the sufficiency test too (against {' and '.join(fails)})"
                 better.append(said)
         failed = [what.removeprefix("against ") for variable, _, _, what in pages.P_MARKERS if variable in cell
                   and float(cell[variable].sel(measure=study)) < SUFFICIENCY_LEVEL]

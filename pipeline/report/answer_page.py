@@ -1001,7 +1001,8 @@ def reading_items(results) -> list[Item]:
                        "design life: their fraction times the chance of exceeding that level, with the fitted curve's "
                        "own value beside it). "
                        f"{no_curve_words(answers[0])} '-': no level was run as low as that intensity, so the records "
-                       "say nothing there."),
+                       "say nothing there; a probability printed at such an intensity is the fitted curve's, "
+                       "extrapolated below the levels run."),
              paragraph("Beside the probabilities, how many records reached each state at those levels: a "
                        "probability where none did is the fitted curve's tail alone."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. On a bed "

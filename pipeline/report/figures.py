@@ -1152,7 +1152,7 @@ def sensitivity_page(fragility, caption, names: dict | None = None):
         if np.isfinite(form):
             axis.axhline(form, color="k", lw=0.9, ls="--", label=f"model-form β {form:.2f} (FEMA P695 rating)")
         if not np.isfinite(spread.values).any():
-            empty_note(axis, "no median: the state was not reached below the highest intensity studied")
+            empty_note(axis, "no median below the highest intensity studied (not reached, or its median lies above it)")
             axis.set_ylim(0.0, max(form, 0.1) * 1.3 if np.isfinite(form) else 1.0)
         missing = [not np.isfinite(spread.sel(soil=soil).values).any() for soil in soils]
         missing = missing if not all(missing) else [False] * len(soils)  # an empty panel says so once, inside
