@@ -1014,7 +1014,8 @@ def reading_items(results) -> list[Item]:
                        "motion table counts each record once, at its most severe motion; the records that rock, "
                        "slide and rock, fly or overturn there are the records that reach uplift. 'Flies' on a bed "
                        "is the block bouncing clear of its bed after an impact (the vertical ground motion is not "
-                       "applied), not a loss of support."),
+                       "applied), not a loss of support: often a series of short hops (tens of milliseconds) as the "
+                       "block chatters on the bed's springs, judged through the rocking states, not by itself."),
              paragraph(f"The probability in the design life of {life} is the fitted curve integrated over the site's "
                        f"hazard, with how often the state happens on average. {BOUND_WORDS} {CERTAINTY_WORDS} "
                        f"{BOUND_POLICY}"),
@@ -1106,8 +1107,8 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str, 
             soils = sorted({s for m, s in cells if m == name}, key=list(map(str, efficiency.soil.values)).index)
             on = "" if len(soils) == efficiency.sizes["soil"] else f" on {_and(soils)}"
             runs.append(f"{model_info(name).label}{on}")
-        where = (f" in the runs of {_and(runs)}, the only ones with enough overturning records to test it, not "
-                 "in the recommended model's")
+        where = (f" in the runs of {_and(runs)}, the only runs the test covers; the recommended model's were not "
+                 "tested, so whether they depend on it is not known")
     return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)}{where} (the "
             "measure-efficiency page; Luco & Cornell 2007): these curves hold for ground motions like the study's "
             "records. For a site whose motions differ in that (near a fault: velocity pulses), the study must run "
