@@ -125,7 +125,7 @@ def test_every_ida_panel_whose_curves_lie_on_the_frame_says_so():
     rocking = rng.uniform(0.0, 1.2, (44, 14))
     for edp in (clay, steel):
         note = figures.frame_note(edp, np.quantile(edp, 0.84, axis=0))
-        assert "the curves lie on the left axis" in note or "their curves lie on the left axis" in note
+        assert "the curves lie on the left axis" in note or "(84% fractile): on the left axis" in note
     assert figures.frame_note(rocking, np.quantile(rocking, 0.84, axis=0)) == ""
     assert figures.frame_note(np.full((2, 3), np.nan), np.full(3, np.nan)) == "not run"
 

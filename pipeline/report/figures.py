@@ -451,8 +451,8 @@ def frame_note(edp, fractiles, q: float = 0.84) -> str:
         return f"θmax/α below {VISIBLE_ROCKING:g} in every record at every level: the curves lie on the left axis"
     highest = np.asarray(fractiles, float)
     if np.isfinite(highest).all() and (highest < VISIBLE_ROCKING).all():
-        return (f"θmax/α below {VISIBLE_ROCKING:g} at every level in most records ({q:.0%} fractile): their curves lie "
-                f"on the left axis; {int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs reach more")
+        return (f"θmax/α below {VISIBLE_ROCKING:g} in most records ({q:.0%} fractile): on the left axis; "
+                f"{int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs reach more")
     return ""
 
 
@@ -536,7 +536,7 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     for axis in drawn:
         mark_intensities(axis, marks, along="y", soil=axis.rockfrag_soil)  # on every panel (cold read 5)
         if axis.rockfrag_note:  # placed above the marks, clear of them
-            empty_note(axis, axis.rockfrag_note, x=0.6, width=0.75, y=_above_the_marks(axis))
+            keep_inside(axis, empty_note(axis, axis.rockfrag_note, x=0.6, width=0.8, y=_above_the_marks(axis)))
     drawn[0].plot([], [], color="0.65", lw=0.5, label="one record")
     drawn[0].plot([], [], color="0.3", lw=0.6, ls=":", label=f"overturned (drawn at θmax/α = {IDA_CAP})")
     outside_legend(figure, drawn)  # every panel: an empty first one has no marks
@@ -612,14 +612,23 @@ def _no_curve_note(axis, reasons, state: str, soil: str = "") -> None:
     axis.figure.rockfrag_notes = notes
 
 
-def empty_note(axis, text: str, x: float = 0.5, width: float = 1.0, y: float = 0.5) -> None:
-    """Say inside a panel with nothing drawn why it is empty ("not computed: the base is tied").
+def empty_note(axis, text: str, x: float = 0.5, width: float = 1.0, y: float = 0.5):
+    """Say inside a panel with nothing drawn why it is empty ("not computed: the base is tied"); the text artist.
 
     ``x``, ``y`` are the note's centre (axes fraction) and ``width`` its share of the panel's width (a note beside
     curves on the frame).
     """
-    axis.text(x, y, textwrap.fill(text, int(width * chars_across(axis, NOTE_SIZE)) - 4), transform=axis.transAxes,
-              fontsize=NOTE_SIZE + 1, ha="center", va="center", color="0.3")
+    return axis.text(x, y, textwrap.fill(text, int(width * chars_across(axis, NOTE_SIZE)) - 4),
+                     transform=axis.transAxes, fontsize=NOTE_SIZE + 1, ha="center", va="center", color="0.3")
+
+
+def keep_inside(axis, text, margin: float = 0.02) -> None:
+    """Move a note placed by ``empty_note`` down so that its top stays inside the axes (below the panel's title)."""
+    renderer = axis.figure.canvas.get_renderer()
+    box = text.get_window_extent(renderer).transformed(axis.transAxes.inverted())
+    if box.y1 > 1.0 - margin:
+        x, y = text.get_position()
+        text.set_position((x, y - (box.y1 - (1.0 - margin))))
 
 
 def _above_the_marks(axis) -> float:
