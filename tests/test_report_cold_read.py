@@ -737,7 +737,7 @@ def test_a_block_less_deep_than_wide_is_said_on_the_summary_to_be_judged_across_
     config = SimpleNamespace(blocks=(skid, square), raw={})
     words = weaker_direction_words(SimpleNamespace(config=config))
     assert "skid (b/h 0.5 across its 2 m depth)" in words, words
-    assert "square" not in words and words.startswith("Not judged across its depth (planar model)")
+    assert "square" not in words and words.startswith("Judged across the width only")
     assert weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(square,), raw={}))) == ""
 
 
