@@ -1000,7 +1000,8 @@ def fragility_dataset(cube: xr.Dataset, states: list[DamageState] | None = None,
         "long_name": "fraction of records reaching the damage state (first-overturn convention)", "units": "1"})
     data_vars["outcome_probability"] = (("outcome_class", "im_level", *group_dims), three_outcomes(cube).values,
                                         {"long_name": "fraction of records in each outcome (a record is "
-                                                      "overturned from its first overturning level on)",
+                                                      "overturned from its first overturning level on; a tilt on "
+                                                      "a bed below the uplift size is no uplift)",
                                          "units": "1"})
     im_level = cube.im_level
     if parse_units(im_level.attrs.get("units", "")) == parse_units(unit):
@@ -1215,8 +1216,14 @@ def three_outcomes(cube: xr.Dataset) -> xr.DataArray:
 
     A record is overturned from its first overturning level on (``first_overturn_outcomes``). Failed runs and
     runs stopped in free flight before any overturning (their overturning is unknown) are left out of the total.
+    A run that only tilts on a bed (``tilts``: a corner lifted less than the uplift size) is no uplift, as the
+    uplift damage state and the report count it (cold read 7: the file counted 17 of 44 rocking where the report's
+    motion table and outcomes page, from the same runs, count 4).
     """
     outcome = first_overturn_outcomes(cube)
+    tilted = tilts(cube, outcome)
+    if isinstance(tilted, xr.DataArray):
+        outcome = outcome.where(~tilted, OUTCOME_NO_UPLIFT)
     valid = (outcome != OUTCOME_FAILED) & (outcome != OUTCOME_FREE_FLIGHT)
     counts = [((outcome == code) & valid).sum("record") for code in
               (OUTCOME_NO_UPLIFT, OUTCOME_ROCKING, OUTCOME_OVERTURNED)]

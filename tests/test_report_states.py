@@ -64,3 +64,18 @@ def test_the_motion_table_says_tilts_below_the_size_and_its_lifting_records_are_
                   if words in ("rocks", "slides and rocks", "flies", "overturns"))
     assert lifting == uplifted == 2
     assert "flies" not in shown and "rocks 3" not in shown
+
+
+def test_the_outcome_fractions_of_the_result_file_count_a_tilt_on_the_bed_as_no_uplift():
+    """Cold read 7 (default figures, finding 1): fragility.nc's outcome_probability counted runs that only tilt on
+    the bed (a corner lifted less than the uplift size) as rocking: 17 of 44 on rock at 0.234 g where the motion
+    table and the outcomes page, from the same runs, count 4. The file now counts as the uplift state does."""
+    from rockfrag.fragility import three_outcomes
+
+    lifts, outcomes = [0.1, 0.9, 1.1, 0.2, 0.0], [ROCKING, ROCKING, ROCKING, OVERTURNED, AT_REST]
+    fractions = three_outcomes(_cube(lifts, outcomes)).values[:, 0, 0, 0, 0]
+    np.testing.assert_allclose(fractions, [3 / 5, 1 / 5, 1 / 5])  # two tilts and the record at rest: no uplift
+    rigid = three_outcomes(_cube(lifts, outcomes, model="housner")).values[:, 0, 0, 0, 0]
+    np.testing.assert_allclose(rigid, [1 / 5, 3 / 5, 1 / 5])  # a pivot model has no tilt
+    uplift = exceedance(_cube(lifts, outcomes), DAMAGE_STATES["uplift"]).values.ravel()
+    assert uplift.mean() == pytest.approx(fractions[1] + fractions[2])  # the file agrees with the uplift state
