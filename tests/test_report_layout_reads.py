@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -134,9 +135,9 @@ def test_every_ida_panel_whose_curves_lie_on_the_frame_says_so():
 def test_the_outcomes_legend_lists_the_rocking_shading_only_where_it_shows(small_pipeline):
     """A panel with one pair of curves shades rocking without overturning between them; where uplift and
     overturning coincide nothing shows, and the legend then does not list the shading."""
-    from rockfrag.report import CAPTIONS
+    from rockfrag.report import CAPTIONS, OUTCOMES_SHADING
 
-    assert "shaded orange" in CAPTIONS["outcomes"]
+    assert "shaded orange" in OUTCOMES_SHADING and "{shading}" in CAPTIONS["outcomes"]
     fragility = xr.load_dataset(small_pipeline.output / "fragility.nc")
     block = str(fragility.block.values[0])
     changed = fragility.copy(deep=True)
@@ -243,3 +244,86 @@ def test_intensity_and_period_axes_are_labelled_in_plain_numbers():
             assert len(texts) >= 3 and all(t and "^" not in t and "$" not in t for t in texts), texts
     finally:
         plt.close(figure)
+
+
+# --- cold read 5 (issue 36): figures and captions the readers of /work/tmp/read5 found ---------------------------
+
+
+@pytest.mark.slow
+def test_a_panel_with_points_names_the_models_whose_base_is_tied(small_results):
+    """Default C (pp. 30, 35, 36) and user C1: a slip panel drew Housner's points but not the paper's model, whose
+    runs tie the base, and said nothing; the panel now names the tied models (an empty panel already said why)."""
+    fragility = small_results.fragility
+    block = str(fragility.block.values[0])
+    models = figures.models_of(fragility)
+    tied = {(str(state), str(soil)): figures.tied_models(fragility, block, str(state), models, str(soil))
+            for state in fragility.damage_state.values for soil in fragility.soil.values}
+    assert any(tied.values()), "the small study ties no base: the test needs a slip state of a tied model"
+    figure = figures.fragility_by_model_page(fragility, block, [str(fragility.soil.values[0])], "Read it.")
+    try:
+        notes = [text.get_text().replace("\n", " ") for text in figure.texts]
+        assert any("its base is tied" in note for note in notes), notes
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.slow
+def test_the_outcomes_caption_names_the_orange_band_only_where_it_shows(small_results):
+    """User C2: 'shaded orange where a panel has one pair of curves' stood in a caption whose page has no band."""
+    from rockfrag.report import OUTCOMES_SHADING, build_plan
+
+    fragility = small_results.fragility
+    planned = build_plan(_fresh(small_results))
+    for block in map(str, fragility.block.values):
+        caption = figures_caption(planned, f"outcomes-{block}")
+        assert (OUTCOMES_SHADING in caption) == figures.rocking_shaded(fragility, block), block
+    flat = fragility.copy(deep=True)  # uplift and overturning coincide: nothing to shade
+    probability = flat["outcome_probability"]
+    probability.loc[dict(outcome_class="no_uplift")] = 1 - probability.sel(outcome_class="overturned")
+    flat["empirical_fraction"].loc[dict(damage_state=[str(s) for s, edp in zip(
+        flat.damage_state.values, flat.damage_state_edp.values) if str(edp) == "uplifted"])] = np.nan
+    assert not figures.rocking_shaded(flat, str(flat.block.values[0]))
+
+
+def test_an_outcomes_panel_title_stays_on_one_line():
+    """User C5: on a page of three panels "SSI, paper's model (spring can pull)" wrapped to two lines and sat
+    above its neighbours' one-line titles."""
+    from rockfrag.report.layout import chars_across, new_page, panels
+
+    ssi = next(m for m in figures.models_of(xr.Dataset(coords={"model": ["housner", "ssi", "recommended"]}))
+               if m.name == "ssi")
+    figure = new_page("Outcomes", "Read it.")
+    try:
+        axis = panels(figure, 1, 3)[0, 1]
+        assert "\n" in textwrap.fill(figures.short_label(ssi), chars_across(axis, 9.5))  # the old title wrapped
+        assert "\n" not in figures.one_line_title(ssi, axis, 9.5)
+    finally:
+        plt.close(figure)
+
+
+def test_the_captions_say_what_the_drawing_shows():
+    """Default C: the by-soil page's model line was not named (dash-dot); the spectra caption did not say where
+    the records are listed; 'the processed displacement ends at rest' where the raw one did too."""
+    from rockfrag.report import CAPTIONS
+
+    assert "{lines}" in CAPTIONS["fragility-soils"]
+    assert "Records section" in CAPTIONS["spectra"]
+    assert "ends at rest" not in CAPTIONS["showcase-processing"]
+    coords = {"model": ["housner", "ssi", "recommended"]}
+    fragility = xr.Dataset(coords=coords)
+    by_name = {m.name: m for m in figures.models_of(fragility)}
+    assert figures.line_words(fragility, by_name["ssi"]) == "dash-dot"
+    assert figures.line_words(fragility, by_name["recommended"]) == "thick solid"
+
+
+def test_the_showcase_caption_says_which_soils_hardly_rock():
+    """Default C (p. 26): on steel both panels were flat at the page's θ scale and nothing said why."""
+    time = np.linspace(0.0, 10.0, 101)
+    theta = np.array([np.sin(time) * a for a in (0.0, 1e-3, 1e-2, 1e-4)])
+    showcase = xr.Dataset({"theta": (("case", "time"), theta)}, coords={
+        "time": time, "case_model": ("case", ["housner", "ssi", "ssi", "ssi"]),
+        "case_soil": ("case", ["", "clay", "sand", "steel"])})
+    assert figures.quiet_soils(showcase) == ["steel"]
+    assert "On steel the block hardly lifts off" in figures.quiet_words(showcase)
+    showcase["theta"][3] = np.sin(time) * 5e-3
+    assert figures.quiet_words(showcase) == ""

@@ -196,11 +196,14 @@ CAPTIONS = {
               "(where a curve crosses one, the site's intensity of that return period, as the answer pages print "
               "it). A soft soil's curve can fall below the reference site's at strong shaking: the site term's "
               "nonlinear part de-amplifies it (Methods).",
-    "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled; the 16% "
+    "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled (the "
+               "Records section lists them); the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
                "intensity level.",
-    "showcase-processing": "Read that processing keeps the record and removes only the drift: raw (grey) and "
-                           "processed (blue); the processed displacement ends at rest.",
+    "showcase-processing": "Read what processing changes: raw as published (grey) and processed (blue: band-pass "
+                           "filtered and baseline-corrected, Methods). The filter removes the long-period drift, "
+                           "which shows in the displacement; where grey is hidden under blue the two are the same "
+                           "at this scale.",
     "showcase-response": "Read how the soil changes the rocking under one real record, unscaled: θ (left, one scale "
                          "for all panels) and Δy (right), the vertical displacement from rest of the base's centre "
                          "on the tensionless bed, or of the active pivot in the paper's model, up +: a block rocking "
@@ -216,16 +219,17 @@ CAPTIONS = {
            "level on).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
-                       "the fitted lognormal, one colour per soil; light shading around a line, the confidence "
-                       "bounds of its median; {rigid}. Grey shading: extrapolation by scaling.",
+                       "the fitted lognormal, {lines}, one colour per soil (where soils' lines coincide, the last "
+                       "drawn shows); light shading around a line, the confidence bounds of its median; {rigid}. "
+                       "Grey shading: extrapolation by scaling.",
     "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil, bottom the "
                         "stiffest. Points: records; lines: fits, one style per model (legend); light shading around "
                         "a line: the confidence bounds of its median. Dotted: the site's return-period intensities; "
                         "grey shading: extrapolation by scaling.",
     "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
                 "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
-                "bed); dashed, that it overturns; between them it rocks and stays up (shaded orange where a panel "
-                "has one pair of curves). Grey shading: extrapolation by scaling. The intensity is the pair's "
+                "bed); dashed, that it overturns; between them it rocks and stays up{shading}. Grey shading: "
+                "extrapolation by scaling. The intensity is the pair's "
                 "RotD50, which one component can exceed: a rigid base may lift off a little below g·tanα.",
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
@@ -257,6 +261,9 @@ CAPTIONS = {
                   "below the dashed line it does; the test of Luco & Cornell 2007).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
+
+OUTCOMES_SHADING = " (shaded orange where a panel has one pair of curves)"
+"""The outcomes caption's words on the rocking band, on a page that shows it (``figures.rocking_shaded``)."""
 
 NOTES_WORDS = " The notes under the legend say which series have points but no curve, and why."
 """A fragility caption's last sentence, on a page whose notes list such series (``figures.has_page_notes``)."""
@@ -448,7 +455,8 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure("showcase-processing", "Showcase record", f"{record}: raw and processed",
                                pages.showcase_ground_page, showcase, caption=CAPTIONS["showcase-processing"]))
         planned.append(_figure("showcase-response", "Showcase record", f"{record}: rocking on each soil",
-                               pages.showcase_response_page, showcase, caption=CAPTIONS["showcase-response"],
+                               pages.showcase_response_page, showcase,
+                               caption=CAPTIONS["showcase-response"] + pages.quiet_words(showcase),
                                name=showcase_name))
     models = models_of(cube)
     soils = list(map(str, cube.soil.values))
@@ -461,7 +469,8 @@ def plan(results: Results) -> list[Page]:
             planned.append(_figure(f"fragility-soils-{block}-{model.name}", "Fragility",
                                    f"Fragility by soil: {names[block]}, {short_label(model)}",
                                    pages.fragility_by_soil_page, fragility, block, model,
-                                   caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block))
+                                   caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block),
+                                                                              lines=pages.line_words(fragility, model))
                                    + (NOTES_WORDS if pages.has_page_notes(
                                        fragility, block, [model, *(m for m in models_of(fragility) if m.rigid_base)])
                                       else ""),
@@ -476,7 +485,9 @@ def plan(results: Results) -> list[Page]:
                                pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names))
     for block in blocks:
         planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
-                               pages.outcomes_page, fragility, block, caption=CAPTIONS["outcomes"],
+                               pages.outcomes_page, fragility, block,
+                               caption=CAPTIONS["outcomes"].format(
+                                   shading=OUTCOMES_SHADING if pages.rocking_shaded(fragility, block) else ""),
                                marks=results.marks(block), name=names[block]))
     if results.vertical is not None:
         planned += _text_pages("vertical", "Vertical component", "Vertical component: medians with and without it",

@@ -350,6 +350,36 @@ def _time_window(showcase):
     return max(start, 0.0), min(end, float(showcase.time.values[-1]))
 
 
+def quiet_soils(showcase, share: float = 0.1) -> list[str]:
+    """The soils on which no model's rocking angle under the showcase record reaches ``share`` of the page's largest.
+
+    Their panels look flat at the page's one θ scale; the caption says so (a flat panel is a result, not a missing
+    run). A rigid base tied on every soil (case soil "") counts on each soil.
+    """
+    theta = np.abs(np.asarray(showcase.theta.values, float))
+    if not np.isfinite(theta).any():
+        return []
+    peak = np.nanmax(theta)
+    case_soils = np.asarray(list(map(str, showcase.case_soil.values)))
+    soils = [s for s in dict.fromkeys(case_soils) if s]
+    quiet = []
+    for soil in soils:
+        rows = theta[(case_soils == soil) | (case_soils == "")]
+        if peak > 0 and np.nanmax(rows, initial=0.0) < share * peak:
+            quiet.append(soil)
+    return quiet
+
+
+def quiet_words(showcase) -> str:
+    """The showcase caption's sentence on flat panels ("" where every soil's panel shows rocking)."""
+    quiet = quiet_soils(showcase)
+    if not quiet:
+        return ""
+    soils = " and ".join([", ".join(quiet[:-1]), quiet[-1]] if len(quiet) > 1 else quiet)
+    return (f" On {soils} the block hardly lifts off under this record (θ below a tenth of the page's largest): "
+            "the flat panels are a result, not a missing run.")
+
+
 def showcase_response_page(showcase, caption, name: str | None = None):
     """Ground motion on top, then per soil theta(t) (left) and the rise of the base centre or pivot, up + (right).
 
@@ -648,29 +678,53 @@ def _above_the_marks(axis) -> float:
     return (max(inside) + 1.0) / 2.0 if inside else 0.5
 
 
+def _panel_words(panels_of) -> str:
+    """The (state, soil) panels of a page's note in words.
+
+    "slip ≥ 0.05 m, slip ≥ 0.30 m on clay and sand" where every state is on every soil, else each panel as
+    "state on soil"; the states alone on a page of every soil (soil None).
+    """
+    states, soils = list(dict.fromkeys(s for s, _ in panels_of)), list(dict.fromkeys(o for _, o in panels_of if o))
+    if not soils:
+        return ", ".join(states)
+    if len(set(panels_of)) == len(states) * len(soils):
+        return f"{', '.join(states)} on {' and '.join(soils)}"
+    return ", ".join(f"{s} on {o}" for s, o in dict.fromkeys(panels_of))
+
+
 def page_notes(figure) -> None:
     """The page's notes (``_no_curve_note``) under its legend, in the legend's column.
 
     Which curves could not be fitted, and why, with the panels they concern.
     """
     notes = getattr(figure, "rockfrag_notes", {})
-    if not notes:
+    tied = getattr(figure, "rockfrag_tied", {})
+    if not notes and not tied:
         return
     renderer = figure.canvas.get_renderer()
     bottom = LEGEND_ANCHOR[1]
     if figure.legends:
         bottom = figure.transFigure.inverted().transform(figure.legends[0].get_window_extent(renderer))[0][1]
     width = int((0.99 - LEGEND_ANCHOR[0]) * figure.get_figwidth() * 72.0 / (0.62 * NOTE_SIZE)) - 1
-    lines = textwrap.wrap("No curve, points only (the limitations list each):", width)
+    # models whose runs tie the base have no slip series at all: said first, it is short and always fits
+    first = [line for model, panels_of in tied.items() for line in textwrap.wrap(
+        f"{model}: no points in the {_panel_words(panels_of)} panels: its base is tied (no sliding).", width)]
+    lines = textwrap.wrap("No curve, points only (the limitations list each):", width) if notes else []
     for reason, series in notes.items():
         lines += textwrap.wrap(f"{reason}: {'; '.join(series)}.", width, initial_indent="- ", subsequent_indent="  ")
     room = (bottom - 0.015 - (CAPTION_Y + 0.015)) * figure.get_figheight() * 72.0 / (1.2 * NOTE_SIZE)  # lines
-    if len(lines) > room:  # more than the column holds: the count, and where the list is
+    if notes and len(first) + len(lines) > room:  # more than the column holds: the count, and where the list is
         count = sum(len(series) for series in notes.values())
         lines = textwrap.wrap(f"No curve, points only: {count} series on this page; the limitations list each, with "
                               "why.", width)
-    figure.text(LEGEND_ANCHOR[0] + 0.005, bottom - 0.015, "\n".join(lines), fontsize=NOTE_SIZE, va="top", ha="left",
-                color="0.25")
+    top = bottom - 0.015
+    if lines:
+        listed = figure.text(LEGEND_ANCHOR[0] + 0.005, top, "\n".join(lines), fontsize=NOTE_SIZE, va="top",
+                             ha="left", color="0.25")
+        top = figure.transFigure.inverted().transform(listed.get_window_extent(renderer))[0][1] - 0.015
+    if first:
+        figure.text(LEGEND_ANCHOR[0] + 0.005, top, "\n".join(first), fontsize=NOTE_SIZE, va="top", ha="left",
+                    color="0.25")
 
 
 def short_states(fragility) -> dict:
@@ -680,15 +734,35 @@ def short_states(fragility) -> dict:
     return {str(s): state_short_label(str(s), str(d)) for s, d in zip(fragility.damage_state.values, descriptions)}
 
 
-def _empty_if_nothing(axis, fragility, block, state, models, soil=None) -> None:
-    """An empty panel's note: why no series of ``models`` has a point for ``state`` (else nothing)."""
+def tied_models(fragility, block, state, models, soil=None) -> list:
+    """The ``models`` whose runs tie the base, so ``state`` (a slip state) is not computed for them (on ``soil``)."""
+    if "status" not in fragility:
+        return []
+    where = dict(block=block, damage_state=state, **({} if soil is None else {"soil": soil}))
+    return [m for m in models if bool((fragility["status"].sel(where).sel(model=m.name) == NOT_APPLICABLE).all())]
+
+
+TIED_WORDS = "not computed: the base is tied (no sliding) in these runs"
+"""Why a slip panel, or one model's series in it, has nothing drawn."""
+
+
+def _empty_if_nothing(axis, fragility, block, state, models, soil=None, short: str = "") -> None:
+    """An empty panel's note: why no series of ``models`` has a point for ``state``.
+
+    In a panel with points, the models among ``models`` that tie the base there are kept for the page's notes
+    (``page_notes``: their series is missing by design, not lost); ``short`` is the state's short name.
+    """
     where = dict(block=block, damage_state=state, model=[m.name for m in models], **({} if soil is None
                                                                                      else {"soil": soil}))
     if np.isfinite(fragility.empirical_fraction.sel(where).values).any():
+        tied = getattr(axis.figure, "rockfrag_tied", {})
+        for model in tied_models(fragility, block, state, models, soil):
+            tied.setdefault(panel_label(model), []).append((short or state, soil))
+        axis.figure.rockfrag_tied = tied
         return
     status = fragility["status"].sel(where) if "status" in fragility else None
     tied = status is not None and bool((status == NOT_APPLICABLE).all())
-    empty_note(axis, "not computed: the base is tied (no sliding) in these runs" if tied else "no run to count")
+    empty_note(axis, TIED_WORDS if tied else "no run to count")
     axis.rockfrag_empty = True  # nothing to read against the site's intensities: no marks over the note
 
 
@@ -731,6 +805,18 @@ def _probability_axes(axes, levels, x_label: str, y_label: str, marks: CredibleM
             axis.set_xlabel(x_label, fontsize=8, labelpad=1)
 
 
+LINE_WORDS = {"-": "solid", "--": "dashed", "-.": "dash-dot", ":": "dotted"}
+"""A model's line style in a caption's words; other dash patterns are 'patterned (legend)'."""
+
+
+def line_words(fragility, model) -> str:
+    """How the fitted curves of ``model`` are drawn (its style in ``model_styles``): 'solid', 'dash-dot', ..."""
+    style = model_styles(models_of(fragility))[model.name]
+    words = LINE_WORDS.get(style.get("ls", "-"), "patterned (legend)") if isinstance(style.get("ls", "-"), str) \
+        else "patterned (legend)"
+    return ("thick " if style.get("lw", 1.5) >= 2.5 else "") + words
+
+
 def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMarks | None = None,
                            name: str | None = None):
     """Panels per damage state; the soils in colours, rigid-base models once as the black dashed reference."""
@@ -756,7 +842,8 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
                                                  state, style, label, span))
         title = state_title(labels[state])
         _no_curve_note(axis, reasons, short[state])
-        _empty_if_nothing(axis, fragility, block, state, [model, *(m for m in models if m.rigid_base)])
+        _empty_if_nothing(axis, fragility, block, state, [model, *(m for m in models if m.rigid_base)],
+                          short=short[state])
         axis.set_title(textwrap.fill(title, chars_across(axis, 9)), fontsize=9)
     figure.rockfrag_panels = len(states)
     _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
@@ -784,7 +871,7 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
                                          styles[model.name], short_label(model), span) for model in models]
             title = f"{state_title(labels[state])} on {soil}"
             _no_curve_note(axis, reasons, short[state], soil)
-            _empty_if_nothing(axis, fragility, block, state, models, soil)
+            _empty_if_nothing(axis, fragility, block, state, models, soil, short=short[state])
             axis.set_title(textwrap.fill(title, chars_across(axis, 8.5)), fontsize=8.5)
     figure.rockfrag_panels = len(soils) * len(states)
     _probability_axes(axes, levels, measure_label(fragility), "probability of the damage state [-]", marks)
@@ -808,34 +895,66 @@ def _uplift_fraction(fragility, model, block, soil) -> np.ndarray | None:
     return np.asarray(values, float) if np.isfinite(values).any() else None
 
 
-def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
-    """One panel per model: P(uplift) solid and P(overturning) dashed per soil; the gap is rocking."""
+def one_line_title(model, axis, size: float) -> str:
+    """A panel's title naming ``model`` on one line, level with its neighbours' (user C5).
+
+    The model's short label, or without its parenthesis where that would wrap ("SSI, paper's model"; the
+    fragility pages' legends give the whole label).
+    """
+    title = short_label(model) if len(short_label(model)) <= chars_across(axis, size) else panel_label(model)
+    return textwrap.fill(title, chars_across(axis, size))
+
+
+def _outcome_pairs(fragility, block) -> list:
+    """Per model drawn on the outcomes page: the model and its soils' (soil, index, uplift, overturning) fractions.
+
+    A rigid base the same on every soil has the one soil None.
+    """
     models = [m for m in models_of(fragility) if m.name in set(map(str, fragility.outcome_probability.model.values))
               and np.isfinite(fragility.outcome_probability.sel(model=m.name).values).any()]
-    rows, columns = _grid(len(models))
-    figure = new_page(f"Outcomes by intensity: {name or block}", caption)
-    axes = panels(figure, rows, columns, sharex=True, sharey=True)
-    for axis in axes.flat[len(models):]:
-        axis.set_visible(False)
-    levels = block_levels(fragility, block)
-    probability = fragility.outcome_probability
-    shaded = False
-    for axis, model in zip(axes.flat, models):
-        soils = soils_of(probability.to_dataset(name="p"), model, block, "p")
-        for index, soil in enumerate(soils):
-            picked = cell(probability.to_dataset(name="p"), model, block, soil)["p"]
-            colour = "black" if soil is None else soil_colour(soil, index)
+    probability = fragility.outcome_probability.to_dataset(name="p")
+    pairs = []
+    for model in models:
+        curves = []
+        for index, soil in enumerate(soils_of(probability, model, block, "p")):
+            picked = cell(probability, model, block, soil)["p"]
             uplift = _uplift_fraction(fragility, model, block, soil)
             if uplift is None:  # no uplift state: any lift of the outcome
                 uplift = 1 - picked.sel(outcome_class="no_uplift").values
-            overturn = picked.sel(outcome_class="overturned").values
+            curves.append((soil, index, uplift, picked.sel(outcome_class="overturned").values))
+        pairs.append((model, curves))
+    return pairs
+
+
+def rocking_shaded(fragility, block) -> bool:
+    """True when the outcomes page of ``block`` shades rocking without overturning somewhere visibly.
+
+    The band is drawn where a panel holds one pair of curves (a rigid base the same on every soil, or one soil)
+    and shows where uplift exceeds overturning by more than 1 %. The caption names the shading only then.
+    """
+    return any(len(curves) == 1 and np.nanmax(np.asarray(up, float) - np.asarray(over, float), initial=0.0) > 0.01
+               for _, curves in _outcome_pairs(fragility, block) for _, _, up, over in curves)
+
+
+def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None, name: str | None = None):
+    """One panel per model: P(uplift) solid and P(overturning) dashed per soil; the gap is rocking."""
+    pairs = _outcome_pairs(fragility, block)
+    rows, columns = _grid(len(pairs))
+    figure = new_page(f"Outcomes by intensity: {name or block}", caption)
+    axes = panels(figure, rows, columns, sharex=True, sharey=True)
+    for axis in axes.flat[len(pairs):]:
+        axis.set_visible(False)
+    levels = block_levels(fragility, block)
+    for axis, (model, curves) in zip(axes.flat, pairs):
+        for soil, index, uplift, overturn in curves:
+            colour = "black" if soil is None else soil_colour(soil, index)
             axis.plot(levels, uplift, color=colour, ls="-", lw=1.5,
                       label="any soil (rigid base)" if soil is None else soil)
             axis.plot(levels, overturn, color=colour, ls="--", lw=1.5)
-            if soil is None or len(soils) == 1:
+            if len(curves) == 1:
                 axis.fill_between(levels, overturn, uplift, color="#fdae6b", alpha=0.35, lw=0)
-                shaded |= bool(np.nanmax(np.asarray(uplift, float) - np.asarray(overturn, float), initial=0.0) > 0.01)
-        axis.set_title(textwrap.fill(short_label(model), chars_across(axis, 9.5)), fontsize=9.5)
+        axis.set_title(one_line_title(model, axis, 9.5), fontsize=9.5)
+    shaded = rocking_shaded(fragility, block)
     _probability_axes(axes, levels, measure_label(fragility), "probability [-]", marks)
     axes[0, 0].plot([], [], color="0.3", ls="-", label="P(uplift): lift-off, rocking or overturning")
     axes[0, 0].plot([], [], color="0.3", ls="--", label="P(overturning)")
