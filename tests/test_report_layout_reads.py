@@ -327,3 +327,22 @@ def test_the_showcase_caption_says_which_soils_hardly_rock():
     assert "On steel the block hardly lifts off" in figures.quiet_words(showcase)
     showcase["theta"][3] = np.sin(time) * 5e-3
     assert figures.quiet_words(showcase) == ""
+
+
+def test_the_hazard_legend_gives_each_carried_sites_vs30():
+    """Default C (p. 23): rock's curve lay below the reference site's (Vs30 760 m/s) it is carried from and nothing
+    said rock's site is stiffer; the legend now gives each carried site's Vs30 and the caption what it means."""
+    import dataclasses as dc
+
+    from rockfrag.report import CAPTIONS
+    from rockfrag.site_hazard import SiteHazards
+
+    given = np.geomspace(0.05, 3.0, 40)
+    reference = _hazard(given, 1e-4 * given ** -2.5 * 0.0185, "reference")
+    rock = dc.replace(_hazard(given, 0.7e-4 * given ** -2.5 * 0.0185, "rock"), notes={"site_vs30_m_s": 1080.0})
+    figure = figures.hazard_page(SiteHazards({"rock": rock}, reference, 760.0), [475], "Read it.")
+    try:
+        assert "rock (Vs30 1,080 m/s)" in [line.get_label() for line in figure.axes[0].get_lines()]
+    finally:
+        plt.close(figure)
+    assert "stiffer than the reference" in CAPTIONS["hazard"]

@@ -195,7 +195,8 @@ CAPTIONS = {
               "ends, at its rarest frequency); dotted, the frequencies of the return periods "
               "(where a curve crosses one, the site's intensity of that return period, as the answer pages print "
               "it). A soft soil's curve can fall below the reference site's at strong shaking: the site term's "
-              "nonlinear part de-amplifies it (Methods).",
+              "nonlinear part de-amplifies it (Methods); a site stiffer than the reference (a higher Vs30, "
+              "legend) lies below it: its ground amplifies the motion less.",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled (the "
                "Records section lists them); the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "

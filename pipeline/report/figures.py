@@ -265,6 +265,16 @@ def given_part(curve, reference=None) -> tuple[np.ndarray, np.ndarray]:
     return intensity[keep], frequency[keep]
 
 
+def site_label(soil: str, curve) -> str:
+    """A soil's hazard legend entry: its name, and its site's Vs30 where the curve was carried to it.
+
+    "rock (Vs30 1,080 m/s)": beside the reference site's, it says why a stiffer site's curve lies below the
+    reference's (default figures C, p. 23).
+    """
+    vs30 = (getattr(curve, "notes", None) or {}).get("site_vs30_m_s")
+    return f"{soil} (Vs30 {float(vs30):,.0f} m/s)" if vs30 is not None and np.isfinite(float(vs30)) else soil
+
+
 def hazard_page(sites, return_periods, caption, unit: str = "g"):
     """The hazard behind every probability: annual frequency of exceedance against the intensity, log-log.
 
@@ -286,7 +296,7 @@ def hazard_page(sites, return_periods, caption, unit: str = "g"):
         if soil in same:
             continue
         intensity, frequency = given_part(curve, reference)
-        axis.loglog(intensity, frequency, color=soil_colour(soil, index), lw=1.4, label=soil)
+        axis.loglog(intensity, frequency, color=soil_colour(soil, index), lw=1.4, label=site_label(soil, curve))
     periods = [float(t) for t in return_periods]
     for t in periods:
         axis.axhline(1.0 / t, color=MARK_COLOUR, ls=":", lw=0.9)
