@@ -346,3 +346,35 @@ def test_the_hazard_legend_gives_each_carried_sites_vs30():
     finally:
         plt.close(figure)
     assert "stiffer than the reference" in CAPTIONS["hazard"]
+
+
+def test_a_pages_notes_group_a_models_soils_so_ten_series_fit():
+    """Default C (pp. 30, 36): ten series without a curve were listed one by one, overflowed the legend's column
+    and fell back to 'No curve, points only: 10 series on this page; the limitations list each'. One model's soils
+    are now joined."""
+    soils = ["clay", "sand", "gravel", "rock", "steel"]
+    series = [f"SSI, paper's model on {soil}" for soil in soils] + [f"Housner (rigid base) on {soil}"
+                                                                   for soil in soils[2:]]
+    words = figures._series_words(series)
+    assert words == "SSI, paper's model on clay, sand, gravel, rock, steel; Housner (rigid base) on gravel, rock, steel"
+    assert len(words) < len("; ".join(series)) * 0.6
+    assert figures._series_words(["recommended", "recommended"]) == "recommended"
+
+
+@pytest.mark.slow
+def test_a_fitted_median_outside_the_levels_is_said_under_the_legend(small_results):
+    """Default C (p. 31): the recommended lift-off on gravel has its median (0.200 g) below the lowest level run
+    (fragility.csv 'extrapolated'); the figure showed the curve entering at 0.58 and said nothing."""
+    fragility = small_results.fragility.copy(deep=True)
+    block = next(str(b) for b in fragility.block.values if np.isfinite(fragility["median"].sel(block=b)).any())
+    model, soil, state = next((m, str(s), str(d)) for m in figures.models_of(fragility) if not m.rigid_base
+                              for s in fragility.soil.values for d in fragility.damage_state.values
+                              if np.isfinite(float(fragility["median"].sel(block=block, model=m.name, soil=s,
+                                                                           damage_state=d))))
+    fragility["status"].loc[dict(block=block, model=model.name, soil=soil, damage_state=state)] = "extrapolated"
+    figure = figures.fragility_by_soil_page(fragility, block, model, "Read it.")
+    try:
+        notes = " ".join(text.get_text().replace("\n", " ") for text in figure.texts)
+        assert "Median outside the levels run" in notes and soil in notes.split("Median outside")[1], notes
+    finally:
+        plt.close(figure)

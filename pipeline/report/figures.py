@@ -600,6 +600,11 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
               zorder=style.get("zorder", 2))
     if np.isfinite(median) and np.isfinite(beta):
         axis.plot(grid, lognormal_cdf(grid, median, beta), label=label, **style)
+        if "status" in values and str(values["status"].values) == "extrapolated":  # the page's notes say so
+            soil = getattr(axis, "rockfrag_soil", None)
+            outside = getattr(axis.figure, "rockfrag_outside", {})
+            outside.setdefault(str(values.damage_state.values), []).append(label + (f" on {soil}" if soil else ""))
+            axis.figure.rockfrag_outside = outside
         low, high = float(values.median_low), float(values.median_high)
         if np.isfinite(low) and np.isfinite(high) and beta > 0.05:
             axis.fill_between(grid, lognormal_cdf(grid, high, beta), lognormal_cdf(grid, low, beta),
@@ -702,6 +707,20 @@ def _panel_words(panels_of) -> str:
     return ", ".join(f"{s} on {o}" for s, o in dict.fromkeys(panels_of))
 
 
+def _series_words(series) -> str:
+    """Series labels in a note, one model's soils joined: "Housner (rigid base) on clay, sand, rock; recommended".
+
+    Ten series listed one by one overflowed the legend's column (default C, pp. 30, 36: the notes fell back to a
+    count); grouped by model they fit.
+    """
+    grouped: dict[str, list[str]] = {}
+    for label in series:
+        model, _, soil = label.rpartition(" on ") if " on " in label else (label, "", "")
+        grouped.setdefault(model, []).extend([soil] if soil else [])
+    return "; ".join(f"{model} on {', '.join(dict.fromkeys(soils))}" if soils else model
+                     for model, soils in grouped.items())
+
+
 def page_notes(figure) -> None:
     """The page's notes (``_no_curve_note``) under its legend, in the legend's column.
 
@@ -709,7 +728,8 @@ def page_notes(figure) -> None:
     """
     notes = getattr(figure, "rockfrag_notes", {})
     tied = getattr(figure, "rockfrag_tied", {})
-    if not notes and not tied:
+    outside = getattr(figure, "rockfrag_outside", {})
+    if not notes and not tied and not outside:
         return
     renderer = figure.canvas.get_renderer()
     bottom = LEGEND_ANCHOR[1]
@@ -719,9 +739,16 @@ def page_notes(figure) -> None:
     # models whose runs tie the base have no slip series at all: said first, it is short and always fits
     first = [line for model, panels_of in tied.items() for line in textwrap.wrap(
         f"{model}: no points in the {_panel_words(panels_of)} panels: its base is tied (no sliding).", width)]
+    # a fitted median outside the levels run: the curve there is the fit's tail, not the records' (default C, p. 31)
+    short = getattr(figure, "rockfrag_short", {})
+    if outside:
+        first += textwrap.wrap("Median outside the levels run (read the curve there as the fit's tail): " + "; ".join(
+            f"{', '.join(dict.fromkeys(series))} ({short.get(state, state)})" for state, series in outside.items())
+            + ".", width)
     lines = textwrap.wrap("No curve, points only (the limitations list each):", width) if notes else []
     for reason, series in notes.items():
-        lines += textwrap.wrap(f"{reason}: {'; '.join(series)}.", width, initial_indent="- ", subsequent_indent="  ")
+        lines += textwrap.wrap(f"{reason}: {_series_words(series)}.", width, initial_indent="- ",
+                               subsequent_indent="  ")
     room = (bottom - 0.015 - (CAPTION_Y + 0.015)) * figure.get_figheight() * 72.0 / (1.2 * NOTE_SIZE)  # lines
     if notes and len(first) + len(lines) > room:  # more than the column holds: the count, and where the list is
         count = sum(len(series) for series in notes.values())
@@ -835,6 +862,7 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
     figure = new_page(f"Fragility by soil: {name or block}, {short_label(model)}", caption)
     states, axes = _state_axes(figure, fragility)
     labels, short = state_labels(fragility), short_states(fragility)
+    figure.rockfrag_short = short
     levels = block_levels(fragility, block)
     span = curve_range(levels, marks)  # the curves; the axes get a margin
     for axis, state in zip(axes.flat, states):
@@ -870,6 +898,7 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
     figure = new_page(f"Fragility by model: {name or block}", caption)
     states, axes = _state_axes(figure, fragility, n_rows=len(soils))
     labels, short = state_labels(fragility), short_states(fragility)
+    figure.rockfrag_short = short
     levels = block_levels(fragility, block)
     span = curve_range(levels, marks)  # the curves; the axes get a margin
     for row, soil in enumerate(soils):
