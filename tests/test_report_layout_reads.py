@@ -268,6 +268,39 @@ def test_a_panel_with_points_names_the_models_whose_base_is_tied(small_results):
 
 
 @pytest.mark.slow
+def test_a_page_of_every_soil_names_the_soils_where_a_model_ties_the_base(small_results):
+    """figs6's closing report: on a page of every soil (fragility by soil) a model tied on some soils only was
+    named nowhere (``tied_models`` asked for every soil at once), so Housner's slip series on gravel, rock and steel
+    were missing from the default p. 32 without a word. Seeded: one model's slip runs tied on the first soil only."""
+    from rockfrag.fragility import NOT_APPLICABLE
+
+    fragility = small_results.fragility.copy(deep=True)
+    block = str(fragility.block.values[0])
+    models = figures.models_of(fragility)
+    slips = [str(s) for s, edp in zip(fragility.damage_state.values, fragility.damage_state_edp.values)
+             if str(edp) != "uplifted" and "slip" in str(s)]
+    assert slips and fragility.sizes["soil"] > 1, "the small study needs a slip state and two soils"
+    soil = str(fragility.soil.values[0])
+    reference = next(m for m in models if m.rigid_base)
+    other = [m for m in models if m.name != reference.name]
+    where = dict(block=block, damage_state=slips, model=reference.name)
+    fragility["status"] = fragility["status"].astype(object)
+    for state in slips:
+        fragility["status"].loc[dict(where, damage_state=state)] = [
+            NOT_APPLICABLE if str(s) == soil else "fitted" for s in fragility.soil.values]
+    fragility["empirical_fraction"].loc[dict(where, soil=soil)] = np.nan
+    for state in slips:  # another series has points in the panel, so the note is the page's, not the panel's
+        fragility["empirical_fraction"].loc[dict(block=block, damage_state=state, model=other[0].name)] = 0.5
+    assert figures.tied_soils(fragility, block, slips[0], reference) == [soil]
+    figure = figures.fragility_by_soil_page(fragility, block, other[0], "Read it.")
+    try:
+        notes = " ".join(text.get_text().replace("\n", " ") for text in figure.texts)
+        assert f"{figures.panel_label(reference)} on {soil}: no points in the" in notes, notes
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.slow
 def test_the_outcomes_caption_names_the_orange_band_only_where_it_shows(small_results):
     """User C2: 'shaded orange where a panel has one pair of curves' stood in a caption whose page has no band."""
     from rockfrag.report import OUTCOMES_SHADING, build_plan

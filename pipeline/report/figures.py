@@ -772,11 +772,19 @@ def short_states(fragility) -> dict:
 
 
 def tied_models(fragility, block, state, models, soil=None) -> list:
-    """The ``models`` whose runs tie the base, so ``state`` (a slip state) is not computed for them (on ``soil``)."""
-    if "status" not in fragility:
+    """The ``models`` whose runs tie the base on ``soil`` (on every soil if None): ``state`` (a slip state) has no
+    points for them there."""
+    return [m for m in models if tied_soils(fragility, block, state, m) and (
+        soil in tied_soils(fragility, block, state, m) if soil is not None
+        else len(tied_soils(fragility, block, state, m)) == fragility.sizes["soil"])]
+
+
+def tied_soils(fragility, block, state, model) -> list[str]:
+    """The soils on which ``model``'s runs tie the base, so ``state`` (a slip state) is not computed there."""
+    if "status" not in fragility or model.name not in fragility.model.values:
         return []
-    where = dict(block=block, damage_state=state, **({} if soil is None else {"soil": soil}))
-    return [m for m in models if bool((fragility["status"].sel(where).sel(model=m.name) == NOT_APPLICABLE).all())]
+    status = fragility["status"].sel(block=block, damage_state=state, model=model.name)
+    return [str(soil) for soil, value in zip(fragility.soil.values, status.values) if value == NOT_APPLICABLE]
 
 
 TIED_WORDS = "not computed: the base is tied (no sliding) in these runs"
@@ -793,8 +801,14 @@ def _empty_if_nothing(axis, fragility, block, state, models, soil=None, short: s
                                                                                      else {"soil": soil}))
     if np.isfinite(fragility.empirical_fraction.sel(where).values).any():
         tied = getattr(axis.figure, "rockfrag_tied", {})
-        for model in tied_models(fragility, block, state, models, soil):
-            tied.setdefault(panel_label(model), []).append((short or state, soil))
+        for model in models:
+            soils = tied_soils(fragility, block, state, model)
+            if soil is not None and soil in soils:
+                tied.setdefault(panel_label(model), []).append((short or state, soil))
+            elif soil is None and soils:  # a page of every soil: the series missing are this model's on ``soils``
+                every = len(soils) == fragility.sizes["soil"]
+                label = panel_label(model) + ("" if every else f" on {', '.join(soils)}")
+                tied.setdefault(label, []).append((short or state, None))
         axis.figure.rockfrag_tied = tied
         return
     status = fragility["status"].sel(where) if "status" in fragility else None
