@@ -286,13 +286,31 @@ def _hazard_intensity_at(hazard, frequency) -> float:
     return float(np.exp(np.interp(target, y[::-1], x[::-1])))
 
 
+def first_motion_ratio(config) -> np.ndarray:
+    """Each block's first motion over its uplift intensity, (n_block,) [-]: min(1, mu_s / tan(alpha)).
+
+    A block at rest on a soil whose static friction mu_s is below its b/h = tan(alpha) slides, at a component's
+    PGA mu_s g, before it can rock (Shenton 1996). Where the study lets that soil's bed slide, the relative level
+    grid starts at its fraction of this lower onset (the lowest mu_s of the study's soils): levels starting at half
+    the uplift left the squat skid's site intensities below its lowest level on four soils while it already slid
+    there (cold read 7). Relative listed levels stay as listed; "none" friction (every base tied) keeps 1.
+    """
+    ratios = []
+    for block in config.blocks:
+        frictions = [soil.friction_static for soil in config.soils
+                     if config.friction != "none" and soil.friction_static < block.b / block.h]
+        ratios.append(min(frictions, default=block.b / block.h) / (block.b / block.h))
+    return np.array(ratios)
+
+
 def level_intensities(config, record_im, record_pga, cap=None) -> np.ndarray:
     """The physical intensity of every (block, level), (n_block, n_level) [SI].
 
     With a credible ``cap`` [SI] (n_block,) a ``{ start, stop, count }`` grid whose top lies above it is re-spaced
     per block from its start to the cap, so all ``count`` levels lie in the credible range (``[intensity]
     beyond_credible = true`` keeps the grid as given). Listed levels stay as listed; those above the cap are
-    beyond credible (the fits leave them out).
+    beyond credible (the fits leave them out). A relative grid starts at ``start`` times the block's first motion,
+    its uplift or, where it slides first, its sliding onset (``first_motion_ratio``).
     """
     base = uplift_intensity(config, record_im, record_pga) if config.relative_levels \
         else np.ones(len(config.blocks))
@@ -300,7 +318,8 @@ def level_intensities(config, record_im, record_pga, cap=None) -> np.ndarray:
     if cap is None or config.level_range is None or config.beyond_credible:
         return base[:, None] * np.asarray(config.levels_si if not config.relative_levels else config.levels)[None, :]
     start, stop, count, spacing = config.level_range
-    low, high = start * scale * base, np.minimum(stop * scale * base, cap)
+    first = first_motion_ratio(config) if config.relative_levels else 1.0  # absolute levels are the user's
+    low, high = start * scale * base * first, np.minimum(stop * scale * base, cap)
     if np.any(high <= low):
         block = config.blocks[int(np.argmax(high <= low))].name
         raise PipelineError(f"[intensity] levels: block {block}'s lowest level lies at or above the credible cap "

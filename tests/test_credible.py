@@ -68,7 +68,11 @@ def test_the_grid_spans_from_below_uplift_to_the_cap_re_spaced_per_block():
     intensity = level_intensities(config, record_im, record_pga, cap)
     uplift = uplift_intensity(config, record_im, record_pga)
     assert intensity.shape == (len(config.blocks), 14)
-    np.testing.assert_allclose(intensity[:, 0], 0.5 * uplift)
+    # half the first motion: the uplift, or the sliding onset mu_s g on the lowest-friction soil where mu_s < b/h
+    lowest = min(soil.friction_static for soil in config.soils)
+    onset = {"paper": min(1.0, lowest / np.tan(0.44)), "slender-cabinet": 1.0, "squat-machinery": lowest / 0.75}
+    assert lowest == 0.35 and [b.name for b in config.blocks] == list(onset)  # clay, NAVFAC DM-7.02's upper end
+    np.testing.assert_allclose(intensity[:, 0], 0.5 * uplift * np.array(list(onset.values())), rtol=2e-3)
     np.testing.assert_allclose(intensity[:, -1], cap)  # the top level is the cap: none above it
     ratios = intensity[:, 1:] / intensity[:, :-1]
     np.testing.assert_allclose(ratios, ratios[:, :1] * np.ones_like(ratios))  # geometric within each block
@@ -76,6 +80,22 @@ def test_the_grid_spans_from_below_uplift_to_the_cap_re_spaced_per_block():
     beyond = level_intensities(config.__class__(**{**config.__dict__, "beyond_credible": True}), record_im,
                                record_pga, cap)
     np.testing.assert_allclose(beyond, uplift[:, None] * np.geomspace(0.5, 100.0, 14)[None, :])
+
+
+def test_a_block_that_slides_first_starts_below_its_sliding_onset_and_a_tied_study_at_its_uplift():
+    """Cold read 7: the squat skid (b/h 0.75) slides on every soil from about mu_s g = 0.35 g, but its levels
+    started at half its uplift, 0.37 g, so its 475-year values on four soils were the fitted curve carried below the
+    lowest level. Its grid now starts at half its sliding onset; with every base tied nothing slides first."""
+    config = load_study()
+    record_im, record_pga = _records()
+    record_im = np.repeat(record_im, len(config.blocks), axis=1)
+    cap = np.full(len(config.blocks), 3.0 * G)
+    squat = [b.name for b in config.blocks].index("squat-machinery")
+    onset_g = 0.35 * np.median(record_im[:, squat] / record_pga)  # clay's mu_s g, in the pair's RotD50
+    assert level_intensities(config, record_im, record_pga, cap)[squat, 0] / G <= 0.5 * onset_g * (1 + 1e-9)
+    tied = config.__class__(**{**config.__dict__, "friction": "none"})
+    np.testing.assert_allclose(level_intensities(tied, record_im, record_pga, cap)[:, 0],
+                               0.5 * uplift_intensity(config, record_im, record_pga))
 
 
 def test_the_capacity_hunt_stops_at_the_cap():

@@ -765,6 +765,20 @@ def intensity_definition(cube) -> str:
             "component.")
 
 
+def _sliding_first_levels(config) -> str:
+    """Why a block's levels start lower than its neighbours' multiple: it slides before it can rock."""
+    from rockfrag.study import first_motion_ratio
+
+    ratios = first_motion_ratio(config)
+    early = [block for block, ratio in zip(config.blocks, ratios) if ratio < 1]
+    if config.level_range is None or not early:
+        return ""
+    names = ", ".join(block_name(config, block.name) for block in early)
+    return (f" The levels of a block that slides before it can rock on one of the soils (static friction μ_s below its "
+            f"b/h) start at the same multiple of its sliding onset μ_s·g on the lowest-friction soil instead, so the "
+            f"site's intensities, where it already slides, lie inside its levels: {names}.")
+
+
 def _weakest_intensity(cube) -> float:
     """The smallest unscaled intensity of a record [the cube's unit] (the largest scale factor's denominator)."""
     if "record_im" not in cube.variables:
@@ -872,7 +886,7 @@ def methods_items(results: Results) -> list[Item]:
                  f"spacing {spacing}, from a multiple of the block's uplift intensity up ({ranges}). The uplift "
                  "intensity here is g·tanα in the measure of the levels: under RotD50, g·tanα times the records' "
                  "median ratio of the pair's RotD50 to the component's own peak, close to "
-                 "g·tanα itself.")
+                 "g·tanα itself." + _sliding_first_levels(config))
     else:
         text += (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure}, "
                  f"{levels.min():.3g} to {levels.max():.3g}"
