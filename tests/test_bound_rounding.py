@@ -28,3 +28,12 @@ def test_every_printed_bound_holds():
             text = bound(value, side)
             printed = float(re.search(r"([\d.]+)%", text).group(1)) / 100
             assert (printed <= value + 1e-12) if side == "≥" else (printed >= value - 1e-12), (value, side)
+
+
+@pytest.mark.parametrize("value, text", [(0.6, "0.60 g"), (0.606, "0.61 g"), (0.3, "0.30 g"), (0.0995, "0.10 g"),
+                                         (2.25, "2.2 g"), (3.0, "3.0 g"), (12.3, "12 g"), (1234.0, "1,200 g")])
+def test_a_computed_intensity_prints_both_significant_figures(value, text):
+    """Cold read 7: "0.6 g" and "0.3 g" stood beside "0.61 g" and "0.39 g" and read as coarser numbers."""
+    from rockfrag.report.numbers import intensity
+
+    assert intensity(value, "g") == text

@@ -436,7 +436,7 @@ def test_a_median_below_the_lowest_level_is_bounded_by_the_records_not_read_from
     judged = block_answers(fragility, _power_law(), limits={"rocking-0.5": 0.1})[0]
     assert "in 50 years at least " in verdict_sentence(judged, "cabinet")  # a lower bound is said so in the verdict
     assert reason(SimpleNamespace(facts=numbers.Facts()), judged, judged.soils[0]) == \
-        "10 of 10 records already at 0.1 g: a bound"
+        "10 of 10 records already at 0.10 g: a bound"
 
 
 def test_the_sample_paragraph_is_the_blocks_own_and_says_when_the_restitution_range_is_one_run():

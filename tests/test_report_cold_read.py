@@ -480,7 +480,7 @@ def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed
     gravel = next(soil for soil in config.soils if soil.name == "gravel")
     vertical, rocking, settlement = bed_frequencies(config, block, gravel)
     assert words.startswith("On gravel this block lifts off at a lower median than on sand and rock "
-                            "(0.2 g against 0.31 g and 0.33 g)")
+                            "(0.20 g against 0.31 g and 0.33 g)")
     assert f"a vertical frequency of {vertical:.2g} Hz" in words
     assert f"a rocking frequency (whole base down) of {rocking:.2g} Hz, {1 / rocking:.2g} s" in words
     assert f"the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s" in words
@@ -586,7 +586,7 @@ def test_a_site_intensity_just_below_a_level_that_prints_the_same_is_told_apart(
     answer = SimpleNamespace(soils=[soil], return_periods=(475.0, 975.0, 2475.0), unit="g", intensities=())
     assert knife_edge_words(answer, levels) == ("On clay the 975-year intensity, 0.3698 g, lies just below the level "
                                                 "0.3722 g (both print 0.37 g), so the tables read the level below "
-                                                "it, 0.3 g.")
+                                                "it, 0.30 g.")
     soil.intensities = (0.323, 0.36, 0.441)
     assert knife_edge_words(answer, levels) == ""
     soil.intensities = (0.323, 0.3721, 0.441)  # 0.03 % below: read as at the level (no note, no lower level)

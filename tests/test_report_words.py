@@ -338,6 +338,17 @@ def test_the_glossary_explains_flight_and_the_pulse_measures():
         assert word in terms, word
 
 
+def test_the_glossary_has_every_word_of_the_motion_tables_and_every_mark():
+    """Cold read 7: the motion tables' 'slides and rocks', 'at rest' and the marks §, ‡ were not in the glossary."""
+    from rockfrag.report.words import GLOSSARY
+
+    terms = " ".join(term for term, _ in GLOSSARY)
+    for word in ("at rest", "tilts on the bed", "slides", "slides and rocks", "rocks", "flies", "overturns"):
+        assert word in terms, word
+    for mark in ("*", "†", "‡", "§", "≥"):
+        assert mark in terms, mark
+
+
 def test_slip_states_carry_their_unit_in_table_headers():
     """Issue 20: the answer tables headed the slip states "slip 0.05" and "slip 0.30", with no unit."""
     from rockfrag.damage_states import DAMAGE_STATES, is_slip_state

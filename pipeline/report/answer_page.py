@@ -1005,7 +1005,9 @@ def reading_items(results) -> list[Item]:
                        "say nothing there; a probability printed at such an intensity is the fitted curve's, "
                        "extrapolated below the levels run."),
              paragraph("Beside the probabilities, how many records reached each state at those levels: a "
-                       "probability where none did is the fitted curve's tail alone."),
+                       "probability where none did is the fitted curve's tail alone. The recommended curve's β "
+                       "includes the model's uncertainty besides the records' scatter, so at low intensity its "
+                       "probability can exceed the share of records that reached the state."),
              paragraph(f"Uplift means lift-off: {DAMAGE_STATES['uplift'].description.split(': ', 1)[-1]}. On a bed "
                        "the lift is the corner's height above the bed's unloaded surface, where the tensionless bed "
                        "lets go (loss of contact), not a rise from rest: a corner first rises by the block's static "

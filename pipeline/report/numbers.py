@@ -85,10 +85,15 @@ def stated_probability(value) -> str:
 
 
 def intensity(value, unit: str) -> str:
-    """A computed intensity to 2 significant figures with its unit ("0.54 g"); "-" when unknown."""
+    """A computed intensity to 2 significant figures, both printed, with its unit ("0.54 g", "0.60 g", "12 m/s");
+    "-" when unknown. "0.6 g" beside "0.61 g" read as a coarser number (cold read 7)."""
     if value is None or not math.isfinite(float(value)):
         return "-"
-    return f"{float(value):.2g} {unit}".strip()
+    value = float(f"{float(value):.2g}")
+    if value == 0:
+        return f"0 {unit}".strip()
+    decimals = max(0, 1 - math.floor(math.log10(abs(value))))
+    return f"{value:,.{decimals}f} {unit}".strip()
 
 
 def dispersion(value) -> str:

@@ -448,6 +448,12 @@ def verdict_settings(results: Results) -> list[list[str]]:
             ["[uncertainty] restitution_range, friction_factor, stiffness_factor, model_quality",
              _uncertainty_values(config), "the sensitivity runs and the model part of every β of the recommended "
              "curve"],
+            ["[study] record_sets", _toml(list(config.record_sets)),
+             "the ground motions run: records like the site's (near a fault, \"near-field\" or "
+             "\"near-field-pulse\"; `rockfrag records --help` lists the sets)"],
+            ["[intensity] levels", _toml((raw.get("intensity") or {}).get("levels", {})),
+             "the intensities run per block (a relative start multiplies the block's first motion, its uplift "
+             "or its sliding onset): below a block's lowest level its probabilities are the fitted curve's tail"],
             ["[blocks.NAME] b, h, mass, E_b", "the blocks of the methods pages",
              "the block itself: its slenderness and size set when it rocks and overturns"],
             ["[damage_states.NAME] edp, threshold", "the shipped damage states",
@@ -832,8 +838,14 @@ def methods_items(results: Results) -> list[Item]:
         "let it (a block whose base friction coefficient is below its width over height slides before it can "
         "rock: Shenton 1996; the limitations' 'Sliding' says which runs include base friction); "
         f"overturning when |θ| reaches {config.overturn_angle:.3g} rad (terminal); {config.tail:g} s of free "
-        f"vibration after each record. Outcomes: no uplift, rocking without overturning, overturning, or a "
-        f"failed integration (excluded from the fits){_vertical_outcome(cube)}."))
+        f"vibration after each record. Outcomes counted by the fits: no uplift, rocking without overturning, "
+        f"overturning, or a failed integration (excluded from the fits){_vertical_outcome(cube)}; the answer "
+        "pages' motion tables split them further by what the block did (at rest, tilts on the bed, slides, "
+        "rocks, slides and rocks, flies, overturns: 'Reading the answer pages')."))
+    items.append(paragraph("G_s is the soil's small-strain shear modulus; E_d its constrained (oedometric) modulus, "
+                           "E_d = 2G_s(1 - ν)/(1 - 2ν), from which the interface stiffness k follows (the paper's "
+                           "eq. 19); ξ the soil's stated damping ratio (the recommended model's bed runs with a damping calibrated to the "
+                           "restitution instead: see 'Models and their assumptions')."))
     header = ["soil or base", "G_s [MPa]", "E_d [MPa]", "damping ratio ξ [-]"]
     rows = [[str(soil) if is_soil(cube, soil) else f"{soil} (structural base, not a soil)",
              _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
@@ -895,6 +907,9 @@ def methods_items(results: Results) -> list[Item]:
             ranges = "; ".join(f"{block_name(config, b)} {block_levels(cube, b).min() * scale:.2g} to "
                                f"{block_levels(cube, b).max() * scale:.2g} {unit}" for b in cube.block.values)
             text += f" Each block has its own levels ({ranges})."
+    reason = cube.attrs.get("credible_intensity_reason", "")
+    if reason:  # the glossary points here for the cap's value and reason
+        text += f" No fit or median lies above the highest intensity studied, {reason}."
     weakest = _weakest_intensity(cube) * scale
     text += (f" Scale factors (a level over the record's own unscaled intensity): median {median_factor:.2g}, "
              f"largest {largest_factor:.3g}" + (f" (the highest level over the weakest record's intensity, "
@@ -1390,7 +1405,11 @@ WHAT_A_CRANE_ADDS = ("A rail-mounted crane or ship-loader portal is not a solid 
 WHAT_EQUIPMENT_ADDS = ("Cabinets and machinery are modelled as rigid solid blocks of their outer size and mass, "
                        "with the mass at the centre of the section: a real cabinet is hollow and flexible, its mass "
                        "where its contents are; a machine skid has feet, pads or bolts, and its own modes. Where "
-                       "these matter, the curves are those of the rigid block, not of the equipment.")
+                       "these matter, the curves are those of the rigid block, not of the equipment. Which way they "
+                       "err: a centre of mass below mid-height widens the angle the object must tip through "
+                       "(tanα = b over the height of its centre of mass), so on that count it lifts off and overturns "
+                       "later than the block and these curves are on the safe side; its flexibility can make it more "
+                       "or less stable (Acikgoz & DeJong 2012), by an amount this study does not size.")
 """What real equipment adds to the rigid block the report models."""
 
 

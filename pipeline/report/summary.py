@@ -355,7 +355,8 @@ def reason(results, answer, soil) -> str:
         return f"{numbers.count(reached, total)} records already at {numbers.intensity(level, unit)}: a bound"
     censored = _censored_at_cap(results, answer, soil, row)
     if censored is not None:
-        return f"{FRACTIONS_REASON} (median above {numbers.intensity(censored, unit)})"  # no fit: the note says
+        # the cap is a stated input: "3 g" as everywhere else, not the computed "3.0 g"
+        return f"{FRACTIONS_REASON} (median above {numbers.as_stated(round(censored, 6))} {unit})"  # the note says
     if row.tail_only:
         first = numbers.intensity(row.first_reached, unit) if row.first_reached is not None else "any level"
         return f"fitted tail only: no record below {first}"

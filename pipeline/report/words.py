@@ -58,7 +58,8 @@ SWITCH_WORDS = {
 
 BED_WORDS = {
     "continuous": "springs and dashpots over the whole footprint",
-    "two-spring": "the bed's stiffness as one spring and dashpot under each corner",
+    "two-spring": "the bed's stiffness k (the whole bed's, as tabulated) as two springs and dashpots, k/2 under each "
+                  "corner",
     "hunt-crossley": "springs over the footprint with impact damping that vanishes with the penetration",
 }
 """The tensionless bed's contact law in words."""
@@ -115,6 +116,9 @@ REFERENCES = {
                                  "to uplift. Earthquake Engineering & Structural Dynamics 11(1), 57-76.",
     "Chopra & Yim 1985": "Chopra, A. K., Yim, S. C.-S. (1985). Simplified earthquake analysis of structures with "
                          "foundation uplift. Journal of Structural Engineering 111(4), 906-930.",
+    "Acikgoz & DeJong 2012": "Acikgoz, S., DeJong, M. J. (2012). The interaction of elasticity and rocking in "
+                             "flexible structures allowed to uplift. Earthquake Engineering & Structural Dynamics "
+                             "41(15), 2177-2194.",
     "Shenton 1996": "Shenton, H. W. (1996). Criteria for initiation of slide, rock, and slide-rock rigid-body modes. "
                     "Journal of Engineering Mechanics 122(7), 690-693.",
     "Luco & Cornell 2007": "Luco, N., Cornell, C. A. (2007). Structure-specific scalar intensity measures for "
@@ -161,6 +165,15 @@ GLOSSARY = (
     (TILT_WORDS, "a base corner parts from a compliant bed by less than the uplift size: the bed gives under the "
                  "toe and the block leans, but it does not rock about its edge."),
     ("rocks", "the block pivots about a bottom edge with a base corner lifted at least the uplift size."),
+    ("at rest, slides, slides and rocks, overturns", "the other words of the answer pages' motion tables: no "
+     "corner lifts and the base does not slip (at rest); the base slips on the ground without rocking (slides); it "
+     "slips and rocks in the same record (slides and rocks); the rocking angle reaches the overturning angle "
+     "(overturns). Each record is counted once, under the most severe motion it made."),
+    ("marks *, †, ‡, §, ≥, <", "the marks of the tables, each explained under its table and in 'Reading the "
+     "answer pages': * a median outside the intensities run, or a probability at a site intensity below the lowest "
+     "level run (the fitted curve's tail); † a median above the largest intensity any record reached unscaled "
+     "(extrapolation by scaling); ‡ a fitted curve that fails its goodness-of-fit test; § a value driven by the "
+     "base friction; '≥ X', '< X' a bound where the records give no fitted value."),
     ("anchor (verdict)", "the block must not stand free; the report does not size the anchorage, which is designed "
                          "as a nonstructural component fixed to its support (ASCE 7-22 Chapter 13) or to the "
                          "equipment's own qualification standard (IEEE 693 for substation equipment)."),
