@@ -772,8 +772,10 @@ def short_states(fragility) -> dict:
 
 
 def tied_models(fragility, block, state, models, soil=None) -> list:
-    """The ``models`` whose runs tie the base on ``soil`` (on every soil if None): ``state`` (a slip state) has no
-    points for them there."""
+    """The ``models`` whose runs tie the base on ``soil`` (on every soil if None).
+
+    ``state`` (a slip state) has no points for them there.
+    """
     return [m for m in models if tied_soils(fragility, block, state, m) and (
         soil in tied_soils(fragility, block, state, m) if soil is not None
         else len(tied_soils(fragility, block, state, m)) == fragility.sizes["soil"])]

@@ -85,8 +85,10 @@ def stated_probability(value) -> str:
 
 
 def intensity(value, unit: str) -> str:
-    """A computed intensity to 2 significant figures, both printed, with its unit ("0.54 g", "0.60 g", "12 m/s");
-    "-" when unknown. "0.6 g" beside "0.61 g" read as a coarser number (cold read 7)."""
+    """A computed intensity to 2 significant figures, both printed, with its unit; "-" when unknown.
+
+    "0.54 g", "0.60 g", "12 m/s": "0.6 g" beside "0.61 g" read as a coarser number (cold read 7).
+    """
     if value is None or not math.isfinite(float(value)):
         return "-"
     value = float(f"{float(value):.2g}")

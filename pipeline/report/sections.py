@@ -844,8 +844,8 @@ def methods_items(results: Results) -> list[Item]:
         "rocks, slides and rocks, flies, overturns: 'Reading the answer pages')."))
     items.append(paragraph("G_s is the soil's small-strain shear modulus; E_d its constrained (oedometric) modulus, "
                            "E_d = 2G_s(1 - ν)/(1 - 2ν), from which the interface stiffness k follows (the paper's "
-                           "eq. 19); ξ the soil's stated damping ratio (the recommended model's bed runs with a damping calibrated to the "
-                           "restitution instead: see 'Models and their assumptions')."))
+                           "eq. 19); ξ the soil's stated damping ratio (the recommended model's bed runs with a "
+                           "damping calibrated to the restitution instead: see 'Models and their assumptions')."))
     header = ["soil or base", "G_s [MPa]", "E_d [MPa]", "damping ratio ξ [-]"]
     rows = [[str(soil) if is_soil(cube, soil) else f"{soil} (structural base, not a soil)",
              _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
