@@ -28,7 +28,8 @@ FIT_METHODS = {
     "mle-binomial-shared-beta": "maximum likelihood with one dispersion shared by the states (no crossing)",
     "exact-g-tan-alpha": "the exact uplift threshold g·tanα (a step)",
     "exact-thresholds": "a lognormal fit of each record's exact uplift intensity (g·tanα × its pair's RotD50 / its own "
-                        "PGA)",
+                        "PGA), for the rigid base and the paper's model alike (its spring sits under the pivot, so "
+                        "the block lifts off where the rigid block does: the same median on every soil)",
     "step-between-levels": "a step between two levels (every record changed state there)",
     "none": "no fit (the state was not reached, or reached by most records at the lowest level)",
 }
