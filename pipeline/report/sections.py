@@ -559,6 +559,7 @@ def fitted_items(results: Results) -> list[Item]:
         for model in _ordered_models(results):
             once = soils_of(fragility, model, block, "median") == [None]
             soils = ["(any)"] if once else list(fragility.soil.values)
+            same: dict[tuple, list[str]] = {}  # soils whose printed curves are identical share one row
             for soil in soils:
                 picked = cell(fragility, model, block, None if once else soil)
                 cells, row_marks = [], set()
@@ -580,13 +581,16 @@ def fitted_items(results: Results) -> list[Item]:
                     dropped += 1
                     continue
                 marks |= row_marks
-                rows.append([block_name(results.config, block), short_label(model), str(soil), *cells])
+                same.setdefault(tuple(cells), []).append(str(soil))
+            rows += [[block_name(results.config, block), short_label(model), ", ".join(names), *cells]
+                     for cells, names in same.items()]
     dashes = (f" {dropped} curves' rows with no fitted state at all are left out (the limitations say why no "
               "median)." if dropped else "")
     items = [paragraph(f"Fitted lognormal fragility functions: each cell is the median in {unit} / the dispersion "
                        "β, for every damage state the answer pages and verdicts use, the recommended model first. A "
                        "rigid-base model has one row per block (soil '(any)') unless base friction lets the block "
-                       "slide on some soils: then one row per soil. '-': no curve for that state (the limitations "
+                       "slide on some soils: then one row per soil, soils with the same curves sharing a row. "
+                       "'-': no curve for that state (the limitations "
                        f"say why).{dashes} These are each curve's own fit; the answer pages print a slip state no "
                        "less likely than overturning, which it counts too. The probabilities these curves give at "
                        "the site are on the answer pages."),
