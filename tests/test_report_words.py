@@ -378,3 +378,21 @@ def test_the_records_table_says_station_names_are_the_sources_own(small_pipeline
         stations = {row["id"]: row["station"] for row in csv.DictReader(handle)}
     for record, station in zip(results.cube.record.values, results.cube.record_station.values):
         assert str(station) == stations[str(record)]
+
+
+def test_the_other_direction_of_a_deep_block_is_checked_not_handed_to_the_client():
+    """Cold read 7, user C13: 'Check the other direction as a block of its own b' for a block the report could check
+    itself (the enclosure across its 1.5 m depth: b/h 0.50, stockier than the 0.40 studied)."""
+    import xarray as xr
+
+    from rockfrag.config import load_study
+    from rockfrag.report.sections import _other_direction_words
+
+    config = load_study()
+    cube = xr.Dataset(coords={"block": [b.name for b in config.blocks]})
+    words = _other_direction_words(config, cube)
+    cabinet = next(b for b in config.blocks if b.name == "slender-cabinet")
+    depth = cabinet.footprint_area / (2 * cabinet.b)  # 0.8 m: b/h (0.4 / 1.5) = 0.27 against 0.20 across its width
+    assert f"b/h {depth / 2 / cabinet.h:.2g} across its {depth:.3g} m depth, stockier than the 0.2 studied" in words
+    assert "b/h 0.75 across its 3 m depth, the same as the 0.75 studied" in words  # the square skid
+    assert "paper" not in words and "R = 9.39" not in words  # a strip per metre of length has no other direction

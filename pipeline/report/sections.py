@@ -1295,6 +1295,9 @@ def limitations_items(results: Results) -> list[Item]:
                       "density: the mass over the solid block's volume (footprint area × height 2h), the density a "
                       "solid block of that mass would have. A hollow object of the same mass and size (a cabinet, "
                       "an enclosure) has its mass elsewhere than this block's: see below."))
+    other = _other_direction_words(config, cube)
+    if other:
+        items.append(paragraph(other))
     items += what_the_blocks_are_not(results)
     coefficient = f"the soil's μ_s ({results.friction_text})"
     items.append(heading("Sliding"))
@@ -1336,7 +1339,9 @@ def limitations_items(results: Results) -> list[Item]:
         if "damage_state_description" in fragility.coords else {}
     scale, unit = display_scale(_level_units(fragility))
     if outside.empty:
-        items.append(paragraph("Every fitted median lies inside the studied intensity range."))
+        items.append(paragraph("Every fitted median lies inside the intensities run. A median marked † in the table "
+                               "of fitted functions lies above the largest intensity any record reached unscaled: it "
+                               "is inside the levels, but from records scaled up (extrapolation by scaling)."))
     else:
         items.append(paragraph(
             f"{len(outside)} fitted medians lie outside the studied intensity range: they extrapolate the "
@@ -1372,7 +1377,8 @@ def limitations_items(results: Results) -> list[Item]:
         rows = _no_median_rows(fragility, config, unfitted, rigid, short_states, n_records)
         items.append(paragraph(f"{len(unfitted)} curves have no median. The records that reached the state at the "
                                "lowest and the highest level of the block say why; a state no record reached at any "
-                               "level is one row per block and state, naming its models and soils:"))
+                               "level is one row per block and state, naming its models and soils (the slip states "
+                               "of runs whose base is tied have no curve by design: see 'Sliding'):"))
         items.append(table(["model", "soil", "damage state", "records reaching it: lowest, highest level",
                             "why no median"], by_block(rows)))
 
@@ -1392,9 +1398,9 @@ def limitations_items(results: Results) -> list[Item]:
 
 PLANAR_WORDS = ("Each block rocks about one bottom edge, in the vertical plane across that edge, in which b is its "
                 "half-width: rocking in the other direction, twisting (wobbling) and three-dimensional rocking on a "
-                "corner are not modelled. Check the other direction as a block of its own b; a block modelled per "
-                "metre of its length (depth 1 m, per metre) is a strip of a long block, whose length runs out of "
-                "plane.")
+                "corner are not modelled. A block less stable across its depth is named in the summary; one at least "
+                "as deep as it is wide is checked below the table; a block modelled per metre of its length (depth "
+                "1 m, per metre) is a strip of a long block, whose length runs out of plane.")
 """The planar model's limitation, said once (the table beside it gives each block's b)."""
 
 WHAT_A_CRANE_ADDS = ("A rail-mounted crane or ship-loader portal is not a solid block: it stands on wheels on rails "
@@ -1439,6 +1445,34 @@ def _stands_for_a_crane(results: Results) -> bool:
         if any(word in words for word in CRANE_WORDS):
             return True
     return False
+
+
+def _other_direction_words(config, cube) -> str:
+    """The other direction of each block at least as deep as it is wide, checked here, not left to the client.
+
+    Across its depth D a block rocks with b/h = (D/2)/h: at least the b/h studied, so the plane studied governs its
+    rocking and overturning (cold read 7, user C13: 'check the other direction' was handed to the client for a
+    block the report could check). A shallower block is named by the summary (``weaker_direction_words``); a strip
+    per metre of length has no other direction.
+    """
+    from rockfrag.report.summary import per_metre
+
+    said = []
+    for item in getattr(config, "blocks", ()) or ():
+        area = getattr(item, "footprint_area", None)
+        if not area or str(item.name) not in map(str, cube.block.values):
+            continue
+        depth = area / (2 * item.b)
+        if per_metre(depth) or depth < 2 * item.b * (1 - 1e-9):
+            continue
+        across, studied = depth / (2 * item.h), item.b / item.h
+        way = "the same as" if np.isclose(across, studied, rtol=1e-3) else "stockier than"
+        said.append(f"{block_name(config, item.name)} b/h {across:.2g} across its {depth:.3g} m depth, {way} the "
+                    f"{studied:.2g} studied")
+    if not said:
+        return ""
+    return ("Checked here, the other direction: " + "; ".join(said) + ". The plane studied therefore governs their "
+            "rocking and overturning; the base friction, and so the sliding, is the same in every direction.")
 
 
 def _depth_and_density(config, cube, block) -> list[str]:
