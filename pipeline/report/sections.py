@@ -1472,7 +1472,7 @@ def _other_direction_words(config, cube) -> str:
     if not said:
         return ""
     return ("Checked here, the other direction: " + "; ".join(said) + ". The plane studied therefore governs their "
-            "rocking and overturning; the base friction, and so the sliding, is the same in every direction.")
+            "rocking and overturning (the base friction that decides sliding is the same in every direction).")
 
 
 def _depth_and_density(config, cube, block) -> list[str]:
