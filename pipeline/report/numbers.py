@@ -91,11 +91,16 @@ def intensity(value, unit: str) -> str:
     """
     if value is None or not math.isfinite(float(value)):
         return "-"
+    return f"{two_figures(value)} {unit}".strip()
+
+
+def two_figures(value) -> str:
+    """A computed number to 2 significant figures, both printed: 0.6 -> "0.60", 2 -> "2.0", 12.3 -> "12"."""
     value = float(f"{float(value):.2g}")
     if value == 0:
-        return f"0 {unit}".strip()
+        return "0"
     decimals = max(0, 1 - math.floor(math.log10(abs(value))))
-    return f"{value:,.{decimals}f} {unit}".strip()
+    return f"{value:,.{decimals}f}"
 
 
 def dispersion(value) -> str:

@@ -507,6 +507,11 @@ def reproduce_items(results: Results) -> list[Item]:
             ["run time", run_time_line(results.runtime_s, results.run)],
             ["result files read", ", ".join(_result_files(results))],
             ["tables of every fitted curve", "fragility.csv (confidence bounds, goodness of fit, fit warnings)"]]
+    for model in models_of(cube):
+        damping = calibrated_damping(cube, model.name)
+        if damping:  # the methods say the bed's damping is calibrated; its value is an operator's number
+            rows.append([f"bed damping ratio of {short_label(model)} (calibrated to the restitution)",
+                         f"ξ {damping} (cube.nc damping_ratio_calibrated, per block and soil)"])
     return [paragraph("The commands, the study file and the settings behind this report. The other pages speak of "
                       "the blocks and the site; this appendix names what an operator types."),
             heading("Commands"),
@@ -796,24 +801,32 @@ def _weakest_intensity(cube) -> float:
     return float(np.nanmin(np.asarray(cube.record_im.values, float)))
 
 
+def calibrated_damping(cube, model: str) -> str:
+    """The range of the damping ratio calibrated to the restitution for ``model`` ("0.158", "0.0251 to 0.158"), "".
+
+    From cube.nc ``damping_ratio_calibrated``; "" where the model runs with the soil's ratio.
+    """
+    if "damping_ratio_calibrated" not in cube or model not in cube.model.values:
+        return ""
+    values = np.asarray(cube.damping_ratio_calibrated.sel(model=model).values, float)
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return ""
+    return _g(values.min()) if _g(values.min()) == _g(values.max()) else f"{_g(values.min())} to {_g(values.max())}"
+
+
 def damping_words(cube, model: str) -> str:
     """Which damping ratio a foundation model runs with, in words.
 
     The soil's (the soils table), or the one calibrated per block and soil to the restitution (cube.nc
-    ``damping_ratio_calibrated``), with its range in this study.
-
-    Cold read 7, user B6: the methods said "the soil's damping ratio" (0.05 in the table) for the recommended model,
-    whose runs use the calibrated 0.158.
+    ``damping_ratio_calibrated``). Cold read 7, user B6: the methods said "the soil's damping ratio" (0.05 in the
+    table) for the recommended model, whose runs use the calibrated 0.158. Its value is the appendix's (an operator's
+    number: issue 36 keeps calibrated ratios out of the client's pages), ``calibrated_damping``.
     """
-    if "damping_ratio_calibrated" in cube and model in cube.model.values:
-        values = np.asarray(cube.damping_ratio_calibrated.sel(model=model).values, float)
-        values = values[np.isfinite(values)]
-        if values.size:
-            span = _g(values.min()) if _g(values.min()) == _g(values.max()) else \
-                f"{_g(values.min())} to {_g(values.max())}"
-            return (f"a damping ratio calibrated per block and soil so that its impacts keep the restitution of the "
-                    f"range (ξ {span} in this study, not the soil's ξ of the table below; the answer pages say where "
-                    "the bed cannot reach the range)")
+    if calibrated_damping(cube, model):
+        return ("a damping ratio calibrated per block and soil so that its impacts keep the restitution of the range "
+                "(not the soil's ξ of the table below; the appendix 'How to reproduce this report' gives its values; "
+                "the answer pages say where the bed cannot reach the range)")
     return "the soil's damping ratio"
 
 
@@ -915,7 +928,7 @@ def methods_items(results: Results) -> list[Item]:
     if reason:  # the glossary points here for the cap's value and reason
         text += f" No fit or median lies above the highest intensity studied, {reason}."
     weakest = _weakest_intensity(cube) * scale
-    text += (f" Scale factors (a level over the record's own unscaled intensity): median {median_factor:.2g}, "
+    text += (f" Scale factors (a level over the record's own unscaled intensity): median {numbers.two_figures(median_factor)}, "
              f"largest {largest_factor:.3g}" + (f" (the highest level over the weakest record's intensity, "
                                                  f"{weakest:.2g} {unit})" if np.isfinite(weakest) else "") + ".")
     largest = ", ".join(f"{v:.2g} {unit}" for v in dict.fromkeys(results.largest_recorded.values()))
@@ -1471,8 +1484,9 @@ def _other_direction_words(config, cube) -> str:
                     f"{studied:.2g} studied")
     if not said:
         return ""
-    return ("Checked here, the other direction: " + "; ".join(said) + ". The plane studied therefore governs their "
-            "rocking and overturning (the base friction that decides sliding is the same in every direction).")
+    return ("Checked here, the other direction: " + "; ".join(said) + f". The plane studied therefore governs "
+            f"{'their' if len(said) > 1 else 'its'} rocking and overturning (the base friction that decides sliding "
+            "is the same in every direction).")
 
 
 def _depth_and_density(config, cube, block) -> list[str]:
