@@ -928,7 +928,8 @@ def methods_items(results: Results) -> list[Item]:
     if reason:  # the glossary points here for the cap's value and reason
         text += f" No fit or median lies above the highest intensity studied, {reason}."
     weakest = _weakest_intensity(cube) * scale
-    text += (f" Scale factors (a level over the record's own unscaled intensity): median {numbers.two_figures(median_factor)}, "
+    text += (" Scale factors (a level over the record's own unscaled intensity): median "
+             f"{numbers.two_figures(median_factor)}, "
              f"largest {largest_factor:.3g}" + (f" (the highest level over the weakest record's intensity, "
                                                  f"{weakest:.2g} {unit})" if np.isfinite(weakest) else "") + ".")
     largest = ", ".join(f"{v:.2g} {unit}" for v in dict.fromkeys(results.largest_recorded.values()))
