@@ -17,7 +17,7 @@ TOOL_SYNTAX = {
     "path": r"\b(?:pipeline|shared|reports|studies|tests)/",
     "setting": r"\b[a-z]{2,}(?:_[a-z]+)* = ",
     "call": r"\b[a-z_]+\(\)",
-    "calibrated ξ": r"ξ = \d",
+    "calibrated ξ": r"ξ =? ?\d",
     "jargon": r"\b(?:central member|answering (?:run|model|curve)s?|designed sample|credible cap)\b",
 }
 """What an operator types and a client should never read: study keys, names of variables and functions, files,
@@ -41,6 +41,8 @@ def test_the_check_finds_tool_syntax():
                         '[solver] friction = "all"; see pipeline/hazard_example.csv and fragility.csv; ξ = 0.158')
     kinds = {entry.split(":")[0] for entry in found}
     assert kinds == {"study key", "snake_case name", "file", "path", "setting", "calibrated ξ"}
+    assert tool_syntax("a damping ratio calibrated to the restitution (ξ 0.158 in this study)") == [
+        "calibrated ξ: ξ 0"]  # cold read 8's methods: text6 had printed it without '='
     assert tool_syntax("the central member's answering run, a designed sample below the credible cap") == [
         "jargon: central member", "jargon: answering run", "jargon: designed sample", "jargon: credible cap"]
     assert tool_syntax("PGA [g], mass [kg], Housner's r = 1 − 1.5 sin²α, μ_s, a_p = 2π·PGV/T_p") == []
