@@ -464,7 +464,7 @@ def test_the_sensitivity_page_wraps_its_titles_and_marks_a_soil_without_a_median
         for other in titles[index + 1:]:
             assert not box.overlaps(other)
     squat = figure.axes[2]
-    assert [t.get_text() for t in squat.get_xticklabels()][0] == "clay\n(no median)"
+    assert [t.get_text() for t in squat.get_xticklabels()][0] == "clay\n(no\nmedian)"
     assert "beta_form" not in " ".join(t.get_text() for axis in figure.axes for t in axis.texts) + " ".join(
         text.get_text() for legend in figure.legends for text in legend.get_texts())
     plt.close(figure)
@@ -504,3 +504,37 @@ def test_the_applicability_legend_says_why_a_block_or_soil_has_no_point(small_pi
     for label in blocks:
         assert "no run rocked without overturning in both models" not in label or "no point" in label, label
     plt.close(figure)
+
+
+def test_the_sensitivity_page_draws_each_soils_governing_state():
+    """Cold read 7 (user B5, default item 4): the page drew overturning only, so clay, whose verdict rests on slip
+    >= 0.30 m, was an empty 'no median' column although fragility.nc has that state's spread. Each soil's bars are
+    now of its governing state, named under the panel."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report.figures import sensitivity_page
+
+    soils, parameters, states = ["clay", "sand"], ["restitution", "friction", "stiffness"], ["slip-0.30", "overturning"]
+    spread = np.full((3, 2, 1, 2), np.nan)
+    spread[:, 0, 0, 0] = [0.01, 0.08, 0.02]  # clay: slip only (overturning not reached)
+    spread[:, 1, 0, 1] = [0.03, 0.01, 0.02]  # sand: overturning
+    fragility = xr.Dataset(
+        {"median_sensitivity": (("parameter", "soil", "block", "damage_state"), spread),
+         "beta_form": (("model", "block", "damage_state"), np.full((1, 1, 2), 0.35))},
+        coords={"parameter": parameters, "soil": soils, "block": ["box"], "damage_state": states,
+                "model": ["recommended"]})
+    old = sensitivity_page(fragility, "")  # overturning everywhere: clay has no median
+    assert [t.get_text() for t in old.axes[0].get_xticklabels()][0] == "clay\n(no\nmedian)"
+    plt.close(old)
+    figure = sensitivity_page(fragility, "", governing={("box", "clay"): "slip-0.30", ("box", "sand"): "overturning"})
+    try:
+        axis = figure.axes[0]
+        assert [t.get_text() for t in axis.get_xticklabels()] == ["clay", "sand"]
+        heights = sorted(round(patch.get_height(), 3) for patch in axis.patches)
+        assert heights == [0.01, 0.01, 0.02, 0.02, 0.03, 0.08]  # clay's slip spread is drawn
+        label = axis.get_xlabel().replace("\n", " ")
+        assert "on clay" in label and "on sand" in label and "governing state" in label, label
+        assert "governing damage state" in figure.texts[0].get_text() or any(
+            "governing damage state" in t.get_text() for t in figure.texts)
+    finally:
+        plt.close(figure)

@@ -64,7 +64,7 @@ from rockfrag.report.sections import (  # noqa: E402
     reproduce_items,
     title_items,
 )
-from rockfrag.report.summary import summary_items  # noqa: E402
+from rockfrag.report.summary import governing, summary_items  # noqa: E402
 from rockfrag.report.text import Item, draw_text_page, items_html, note, paginate, table  # noqa: E402
 from rockfrag.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
 from rockfrag.report.words import glossary_items, references_items  # noqa: E402
@@ -136,6 +136,17 @@ def title_page(results: Results) -> Page:
 
     body = "".join(f"<p><strong>{html.escape(text)}</strong></p>" for text, _ in people)
     return Page("title", "Title", results.title, draw, "", body + items_html(items))
+
+
+def governing_states(results: Results) -> dict:
+    """{(block, soil): the damage state that governs its verdict} (the summary's), for the pages that draw it."""
+    states = {}
+    for answer in results.answers:
+        for soil in answer.soils:
+            row = governing(soil)
+            if row is not None:
+                states[(str(answer.block), str(soil.soil))] = str(row.state)
+    return states
 
 
 def _figure(page, section, title, function, *args, caption="", **options):
@@ -249,8 +260,9 @@ CAPTIONS = {
                            "peak angles (model over rigid base) against the soil's shear modulus; grey: ±10%; "
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
                            "enough; colours: the intensity level; solid concrete block, dashed steel block.",
-    "sensitivity": "Read which uncertain parameter of the recommended model moves its median most on each soil: "
-                   "each bar is the σ of ln median over that parameter's range (restitution, friction, bed "
+    "sensitivity": "Read which uncertain parameter of the recommended model moves its median most on each soil, "
+                   "for the damage state that governs that soil's verdict (named under the soil): each bar is "
+                   "the σ of ln median over that parameter's range (restitution, friction, bed "
                    "stiffness), the others central; the dashed line is the model-form β (FEMA P695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
@@ -483,7 +495,8 @@ def plan(results: Results) -> list[Page]:
                                marks=results.marks(block), name=names[block]))
     if "median_sensitivity" in fragility:
         planned.append(_figure("sensitivity", "Fragility", "Model uncertainty: sensitivity of the median",
-                               pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names))
+                               pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names,
+                               governing=governing_states(results)))
     for block in blocks:
         planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
                                pages.outcomes_page, fragility, block,

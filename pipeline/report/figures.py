@@ -1308,39 +1308,53 @@ def sensitivity_state(fragility) -> str:
     return "overturning" if "overturning" in states else states[-1]
 
 
-def sensitivity_page(fragility, caption, names: dict | None = None):
+def sensitivity_page(fragility, caption, names: dict | None = None, governing: dict | None = None):
     """Which sampled parameter moves the recommended median most, per block and soil (``median_sensitivity``).
 
     One panel per block: for each soil, a bar per parameter (restitution, friction, bed stiffness) of the sigma of
     ln(median) over its range, and the model-form term beta_form as a dashed line (beta_model is the larger of it
-    and the parameters' combined spread).
+    and the parameters' combined spread). ``governing`` {(block, soil): state} draws each soil's governing damage
+    state (the summary's), named under the soil; without it, ``sensitivity_state`` on every soil (cold read 7: clay's
+    panel was empty for overturning while its verdict rests on slip >= 0.30 m, whose spread the file has).
     """
-    names = names or {}
-    state = sensitivity_state(fragility)
+    names, governing = names or {}, governing or {}
+    default = sensitivity_state(fragility)
     blocks = list(map(str, fragility.block.values))
-    figure = new_page(f"Model uncertainty: which parameter moves the recommended median ({state})", caption)
+    what = "each soil's governing damage state" if governing else default
+    figure = new_page(f"Model uncertainty: which parameter moves the recommended median ({what})", caption)
     rows, columns = _grid(len(blocks))
-    axes = panels(figure, rows, columns, gridspec_kw=dict(hspace=0.55, wspace=0.3)).ravel()
+    axes = panels(figure, rows, columns, gridspec_kw=dict(hspace=0.7 if governing else 0.55, wspace=0.3)).ravel()
     parameters = [str(p) for p in fragility.parameter.values]
     soils = list(map(str, fragility.soil.values))
+    short = short_states(fragility)
     width = 0.8 / max(len(parameters), 1)
     x = np.arange(len(soils))
     for axis, block in zip(axes, blocks):
-        spread = fragility.median_sensitivity.sel(block=block, damage_state=state)
+        states = [governing.get((block, soil), default) for soil in soils]
+        spread = np.array([fragility.median_sensitivity.sel(block=block, soil=soil, damage_state=state,
+                                                            parameter=parameters).values
+                           for soil, state in zip(soils, states)])  # (soil, parameter)
         for index, parameter in enumerate(parameters):
-            values = spread.sel(parameter=parameter, soil=soils).values
-            axis.bar(x + (index - (len(parameters) - 1) / 2) * width, np.nan_to_num(values), width,
+            axis.bar(x + (index - (len(parameters) - 1) / 2) * width, np.nan_to_num(spread[:, index]), width,
                      label=f"{parameter}", color=f"C{index % 10}")
-        form = fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()
+        form = np.nanmax([fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()
+                          for state in set(states)] + [np.nan]) if "beta_form" in fragility else np.nan
         if np.isfinite(form):
             axis.axhline(form, color="k", lw=0.9, ls="--", label=f"model-form β {form:.2f} (FEMA P695 rating)")
-        if not np.isfinite(spread.values).any():
+        if not np.isfinite(spread).any():
             empty_note(axis, "no median below the highest intensity studied (not reached, or its median lies above it)")
             axis.set_ylim(0.0, max(form, 0.1) * 1.3 if np.isfinite(form) else 1.0)
-        missing = [not np.isfinite(spread.sel(soil=soil).values).any() for soil in soils]
+        missing = [not np.isfinite(row).any() for row in spread]
         missing = missing if not all(missing) else [False] * len(soils)  # an empty panel says so once, inside
-        axis.set_xticks(x, [f"{soil}\n(no median)" if gone else soil for soil, gone in zip(soils, missing)],
-                        fontsize=8)
+        axis.set_xticks(x, [f"{soil}\n(no\nmedian)" if gone else soil for soil, gone in zip(soils, missing)],
+                        fontsize=7.5)  # "(no median)" on one line ran into its neighbour's
+        if governing:  # which state each soil's bars are of, under the soils (a tick label per soil overlapped)
+            by_state: dict[str, list[str]] = {}
+            for soil, state in zip(soils, states):
+                by_state.setdefault(short.get(state, state), []).append(soil)
+            words = "; ".join(f"{state} on {', '.join(names_)}" if len(names_) < len(soils) else
+                              f"{state} on every soil" for state, names_ in by_state.items())
+            axis.set_xlabel(textwrap.fill(f"governing state: {words}", chars_across(axis, 7)), fontsize=7)
         axis.set_ylabel("σ of ln median [-]", fontsize=9)
         axis.set_title(textwrap.fill(names.get(block, block), chars_across(axis, 10)), fontsize=10)
         axis.grid(alpha=0.3, axis="y")
