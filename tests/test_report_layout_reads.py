@@ -301,6 +301,31 @@ def test_a_page_of_every_soil_names_the_soils_where_a_model_ties_the_base(small_
 
 
 @pytest.mark.slow
+def test_a_fragility_page_marks_a_fit_that_fails_its_goodness_of_fit_test(small_results):
+    """Cold read 7 (default pp. 32-33): the answer table marked the paper block's lift-off on steel ‡ (gof p 0.0034,
+    beta 1.12, its points well above the curve), its fragility pages said nothing. Seeded: one fitted series fails."""
+    fragility = small_results.fragility.copy(deep=True)
+    block = str(fragility.block.values[0])
+    fitted = np.isfinite(fragility["median"].sel(block=block)) & np.isfinite(fragility["beta"].sel(block=block))
+    model, soil, state = next((m, str(s), str(d)) for m in figures.models_of(fragility) if not m.rigid_base
+                              for s in fragility.soil.values for d in fragility.damage_state.values
+                              if bool(fitted.sel(model=m.name, soil=s, damage_state=d)))
+    fragility["gof_p_value"] = xr.full_like(fragility["median"], 0.5)
+    clean = figures.fragility_by_soil_page(fragility, block, model, "Read it.")
+    try:
+        assert "goodness-of-fit" not in " ".join(text.get_text() for text in clean.texts)
+    finally:
+        plt.close(clean)
+    fragility["gof_p_value"].loc[dict(block=block, model=model.name, soil=soil, damage_state=state)] = 0.003
+    figure = figures.fragility_by_soil_page(fragility, block, model, "Read it.")
+    try:
+        notes = " ".join(text.get_text().replace("\n", " ") for text in figure.texts)
+        assert "‡ The fit fails its goodness-of-fit test" in notes and f"on {soil}" in notes, notes
+    finally:
+        plt.close(figure)
+
+
+@pytest.mark.slow
 def test_the_outcomes_caption_names_the_orange_band_only_where_it_shows(small_results):
     """User C2: 'shaded orange where a panel has one pair of curves' stood in a caption whose page has no band."""
     from rockfrag.report import OUTCOMES_SHADING, build_plan

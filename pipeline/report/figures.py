@@ -600,11 +600,15 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
               zorder=style.get("zorder", 2))
     if np.isfinite(median) and np.isfinite(beta):
         axis.plot(grid, lognormal_cdf(grid, median, beta), label=label, **style)
+        soil = getattr(axis, "rockfrag_soil", None)
         if "status" in values and str(values["status"].values) == "extrapolated":  # the page's notes say so
-            soil = getattr(axis, "rockfrag_soil", None)
             outside = getattr(axis.figure, "rockfrag_outside", {})
             outside.setdefault(str(values.damage_state.values), []).append(label + (f" on {soil}" if soil else ""))
             axis.figure.rockfrag_outside = outside
+        if poor_fit(values):  # the tables mark it ‡; the page's notes say so where the curve is read
+            failing = getattr(axis.figure, "rockfrag_poor_fit", {})
+            failing.setdefault(str(values.damage_state.values), []).append(label + (f" on {soil}" if soil else ""))
+            axis.figure.rockfrag_poor_fit = failing
         low, high = float(values.median_low), float(values.median_high)
         if np.isfinite(low) and np.isfinite(high) and beta > 0.05:
             axis.fill_between(grid, lognormal_cdf(grid, high, beta), lognormal_cdf(grid, low, beta),
@@ -613,6 +617,16 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
     axis.plot([], [], label=label, **style)  # listed once in the legend; the page's notes say why there is no curve
     reason = no_curve_reason(values)
     return (label, reason) if reason else ""
+
+
+def poor_fit(values) -> bool:
+    """Whether one series' fitted curve fails its goodness-of-fit test (p below the tables' ‡ level)."""
+    from rockfrag.report.sections import GOF_LEVEL
+
+    if "gof_p_value" not in values:
+        return False
+    p = float(values["gof_p_value"])
+    return bool(np.isfinite(p) and p < GOF_LEVEL)
 
 
 def no_curve_reason(values) -> str:
@@ -729,7 +743,8 @@ def page_notes(figure) -> None:
     notes = getattr(figure, "rockfrag_notes", {})
     tied = getattr(figure, "rockfrag_tied", {})
     outside = getattr(figure, "rockfrag_outside", {})
-    if not notes and not tied and not outside:
+    failing = getattr(figure, "rockfrag_poor_fit", {})
+    if not notes and not tied and not outside and not failing:
         return
     renderer = figure.canvas.get_renderer()
     bottom = LEGEND_ANCHOR[1]
@@ -745,6 +760,11 @@ def page_notes(figure) -> None:
         first += textwrap.wrap("Median outside the levels run (read the curve there as the fit's tail): " + "; ".join(
             f"{', '.join(dict.fromkeys(series))} ({short.get(state, state)})" for state, series in outside.items())
             + ".", width)
+    if failing:  # default p. 32-33: the answer table marked steel's lift-off ‡, its figure said nothing
+        first += textwrap.wrap("‡ The fit fails its goodness-of-fit test (as the tables mark it): read the points, "
+                               "not the curve: " + "; ".join(f"{', '.join(dict.fromkeys(series))} "
+                                                             f"({short.get(state, state)})"
+                                                             for state, series in failing.items()) + ".", width)
     lines = textwrap.wrap("No curve, points only (the limitations list each):", width) if notes else []
     for reason, series in notes.items():
         lines += textwrap.wrap(f"{reason}: {_series_words(series)}.", width, initial_indent="- ",
