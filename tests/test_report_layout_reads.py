@@ -436,3 +436,15 @@ def test_a_fitted_median_outside_the_levels_is_said_under_the_legend(small_resul
         assert "Median outside the levels run" in notes and soil in notes.split("Median outside")[1], notes
     finally:
         plt.close(figure)
+
+
+def test_a_by_soil_title_names_the_references_it_draws():
+    """Cold read 7, user C4: 'Fragility by soil: ..., SSI, paper's model (spring can pull)' over panels that draw
+    Housner (rigid base) too."""
+    fragility = xr.Dataset(coords={"model": ["housner", "ssi", "recommended"]})
+    models = {m.name: m for m in figures.models_of(fragility)}
+    title = figures.fragility_by_soil_title(fragility, "box", models["ssi"], "enclosure E-1")
+    assert title == (f"Fragility by soil: enclosure E-1, {figures.short_label(models['ssi'])}, with "
+                     f"{figures.short_label(models['housner'])} for reference")
+    alone = xr.Dataset(coords={"model": ["recommended"]})
+    assert "for reference" not in figures.fragility_by_soil_title(alone, "box", models["recommended"])

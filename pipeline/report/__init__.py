@@ -480,7 +480,7 @@ def plan(results: Results) -> list[Page]:
     for block in blocks:
         for model in (m for m in models_of(fragility) if not m.rigid_base):
             planned.append(_figure(f"fragility-soils-{block}-{model.name}", "Fragility",
-                                   f"Fragility by soil: {names[block]}, {short_label(model)}",
+                                   pages.fragility_by_soil_title(fragility, block, model, names[block]),
                                    pages.fragility_by_soil_page, fragility, block, model,
                                    caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block),
                                                                               lines=pages.line_words(fragility, model))

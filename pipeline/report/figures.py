@@ -890,12 +890,22 @@ def line_words(fragility, model) -> str:
     return ("thick " if style.get("lw", 1.5) >= 2.5 else "") + words
 
 
+def fragility_by_soil_title(fragility, block, model, name: str | None = None) -> str:
+    """The by-soil page's title: the block, the page's model and the rigid-base references it draws beside it.
+
+    Cold read 7, user C4: "..., SSI, paper's model" over panels that draw Housner too.
+    """
+    references = [short_label(m) for m in models_of(fragility) if m.rigid_base and m.name != model.name]
+    return (f"Fragility by soil: {name or block}, {short_label(model)}"
+            + (f", with {' and '.join(references)} for reference" if references else ""))
+
+
 def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMarks | None = None,
                            name: str | None = None):
     """Panels per damage state; the soils in colours, rigid-base models once as the black dashed reference."""
     models = models_of(fragility)
     styles = model_styles(models)
-    figure = new_page(f"Fragility by soil: {name or block}, {short_label(model)}", caption)
+    figure = new_page(fragility_by_soil_title(fragility, block, model, name), caption)
     states, axes = _state_axes(figure, fragility)
     labels, short = state_labels(fragility), short_states(fragility)
     figure.rockfrag_short = short
