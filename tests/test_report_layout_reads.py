@@ -448,3 +448,18 @@ def test_a_by_soil_title_names_the_references_it_draws():
                      f"{figures.short_label(models['housner'])} for reference")
     alone = xr.Dataset(coords={"model": ["recommended"]})
     assert "for reference" not in figures.fragility_by_soil_title(alone, "box", models["recommended"])
+
+
+def test_the_outcomes_page_says_which_soils_lines_coincide():
+    """Cold read 7, default p. 41: in the Housner and SSI panels the gravel, rock and steel curves coincide, so one
+    line showed for three soils without a word."""
+    models = {m.name: m for m in figures.models_of(xr.Dataset(coords={"model": ["housner", "ssi", "recommended"]}))}
+    rise, flat = np.array([0.0, 0.5, 1.0]), np.zeros(3)
+    pairs = [(models["housner"], [("clay", 0, flat, flat), ("gravel", 2, rise, flat), ("rock", 3, rise, flat)]),
+             (models["ssi"], [("clay", 0, rise, flat), ("gravel", 2, rise, rise * 0.1)]),
+             (models["recommended"], [("clay", 0, rise, flat), ("gravel", 2, rise * 0.9, flat * 0.5 + 0.1)])]
+    words = figures.coinciding_words(pairs)
+    assert words == ("Lines that coincide (the last drawn hides the others): "
+                     f"{figures.panel_label(models['housner'])}: gravel = rock; "
+                     f"{figures.panel_label(models['ssi'])}: P(uplift) on every soil.")
+    assert figures.coinciding_words([(models["recommended"], [("clay", 0, rise, flat)])]) == ""

@@ -1049,7 +1049,38 @@ def outcomes_page(fragility, block, caption, marks: CredibleMarks | None = None,
         if axis.get_visible():
             axis.tick_params(labelbottom=True)
     outside_legend(figure, list(axes.flat))
+    coinciding = coinciding_words(pairs)
+    if coinciding:  # under the legend, off the data (cold read 7, default p. 41: one line showed for three soils)
+        renderer = figure.canvas.get_renderer()
+        bottom = figure.transFigure.inverted().transform(figure.legends[0].get_window_extent(renderer))[0][1] \
+            if figure.legends else LEGEND_ANCHOR[1]
+        width = int((0.99 - LEGEND_ANCHOR[0]) * figure.get_figwidth() * 72.0 / (0.62 * NOTE_SIZE)) - 1
+        figure.text(LEGEND_ANCHOR[0] + 0.005, bottom - 0.015, textwrap.fill(coinciding, width), fontsize=NOTE_SIZE,
+                    va="top", ha="left", color="0.25")
     return figure
+
+
+def coinciding_words(pairs) -> str:
+    """The soils whose outcome curves coincide in a panel, so that only the last drawn shows; "" where none do.
+
+    "Lines that coincide (the last drawn hides the others): Housner: clay = sand, gravel = rock = steel; SSI, paper's
+    model: P(uplift) on every soil."
+    """
+    said = []
+    for model, curves in pairs:
+        if len(curves) < 2:
+            continue
+        for what, position in (("", None), ("P(uplift) ", 2), ("P(overturning) ", 3)):
+            groups: dict[bytes, list[str]] = {}
+            for curve in curves:
+                values = np.asarray(curve[2:4] if position is None else curve[position], float)
+                groups.setdefault(np.round(np.nan_to_num(values, nan=-1.0), 6).tobytes(), []).append(str(curve[0]))
+            same = [soils for soils in groups.values() if len(soils) > 1]
+            if same:
+                words = ", ".join("every soil" if len(soils) == len(curves) else " = ".join(soils) for soils in same)
+                said.append(f"{panel_label(model)}: {what}{'on ' if what and words == 'every soil' else ''}{words}")
+                break  # both curves coincide: the pair is said once, not again per curve
+    return ("Lines that coincide (the last drawn hides the others): " + "; ".join(said) + ".") if said else ""
 
 
 def no_ratio_reason(cube, block, soil, models, band) -> str:
