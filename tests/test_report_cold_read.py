@@ -608,8 +608,8 @@ def test_a_probability_read_from_a_curve_that_fails_its_fit_test_is_marked_on_th
     """Cold read 3, default C5: the paper block's uplift on steel (β 1.12, the fitted table's ‡: it fails its
     goodness-of-fit test) gave the answer page 7.2% / 11% / 19% and 8.4% in 50 years without a word. Its cells
     there carry ‡ and a note says what it means; a curve that passes the test carries none."""
+    from rockfrag.report.adapters import GOF_LEVEL
     from rockfrag.report.answer_page import POOR_FIT_MARK, answer_items
-    from rockfrag.report.sections import GOF_LEVEL
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     answer = results.answers[0]

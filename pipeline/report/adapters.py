@@ -452,3 +452,8 @@ class CredibleMarks:
         """The marks of a panel of one soil: that soil's own site intensities (unchanged for an unknown soil)."""
         own = dict(self.by_soil).get(None if soil is None else str(soil))
         return self if own is None else CredibleMarks(self.return_periods, tuple(own), self.largest)
+
+
+GOF_LEVEL = 0.05
+"""Below this goodness-of-fit p-value (fragility.nc ``gof_p_value``) a fitted curve is marked ‡: in the tables, on
+the answer pages and on its fragility pages."""

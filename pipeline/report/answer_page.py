@@ -24,6 +24,7 @@ from rockfrag.fragility import exceedance, first_overturn_outcomes  # the fits' 
 from rockfrag.models.base import Outcome
 from rockfrag.report import numbers
 from rockfrag.report.adapters import (
+    GOF_LEVEL,
     block_description,
     block_name,
     intensity_name,
@@ -743,8 +744,6 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
     if any(BELOW_LEVELS_MARK in cell for row in rows for cell in row[1:]):
         items.append(note(BELOW_LEVELS_WORDS))
     if any(cell.endswith(POOR_FIT_MARK) for row in rows for cell in row[1:]):
-        from rockfrag.report.sections import GOF_LEVEL
-
         items.append(note(POOR_FIT_WORDS.format(level=GOF_LEVEL)))
     counts = [[short[state], *(_joined(results.facts.say("records reaching", (answer.block, soil.soil, state, t),
                                                          _records_cell(soil.states[index], i))
@@ -870,8 +869,6 @@ def _below_levels_mark(text: str, row, index: int) -> str:
 
 def _poor_fit_mark(results, answer, soil, row) -> str:
     """" ‡" where the cell's probabilities come from a curve that fails its goodness-of-fit test, else ""."""
-    from rockfrag.report.sections import GOF_LEVEL
-
     fragility = results.fragility
     if "gof_p_value" not in fragility or row.not_reached_below is not None or row.below_lowest is not None:
         return ""

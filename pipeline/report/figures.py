@@ -18,6 +18,7 @@ from rockfrag.damage_states import NOT_APPLICABLE
 from rockfrag.fragility import lognormal_cdf
 from rockfrag.measures import MEASURES
 from rockfrag.report.adapters import (
+    GOF_LEVEL,
     OUTCOME_ROCKING,
     CredibleMarks,
     block_levels,
@@ -621,8 +622,6 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
 
 def poor_fit(values) -> bool:
     """Whether one series' fitted curve fails its goodness-of-fit test (p below the tables' ‡ level)."""
-    from rockfrag.report.sections import GOF_LEVEL
-
     if "gof_p_value" not in values:
         return False
     p = float(values["gof_p_value"])

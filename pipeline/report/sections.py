@@ -38,6 +38,7 @@ from rockfrag.hazard import HazardCurve, study_hazard
 from rockfrag.models.variants import split_variant
 from rockfrag.report import numbers
 from rockfrag.report.adapters import (
+    GOF_LEVEL,
     OUTCOME_FAILED,
     OUTCOME_FREE_FLIGHT,
     CredibleMarks,
@@ -536,9 +537,6 @@ def _ordered_models(results: Results):
     models = models_of(results.fragility)
     return [m for m in models if m.name == first] + [m for m in models if m.name != first]
 
-
-GOF_LEVEL = 0.05
-"""Below this goodness-of-fit p-value (fragility.nc ``gof_p_value``) the fitted table marks the curve ‡."""
 
 
 def fitted_items(results: Results) -> list[Item]:
