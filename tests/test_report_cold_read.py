@@ -949,3 +949,34 @@ def test_the_methods_say_which_damping_ratio_each_foundation_model_runs_with():
     single = cube.copy(deep=True)
     single["damping_ratio_calibrated"].loc[{"model": "recommended"}] = 0.158
     assert calibrated_damping(single, "recommended") == "0.158"
+
+
+def test_an_answer_page_says_what_flying_is_where_many_records_fly(monkeypatch):
+    """Cold read 7 (user B1): 38 of 44 records made the enclosure 'fly' on sand at the 2,475-year level while 3
+    reached θmax/α 0.2, and nothing said what the hops are or whether they move a verdict. Where more than a quarter
+    of the records fly, a note says they are the bed's rebound (not a damage state), likely high (radiation damping),
+    and compares the overturning median with the rigid base's, which cannot hop."""
+    from types import SimpleNamespace
+
+    from rockfrag.report import answer_page
+
+    def tallies(cube, block, model, soil, intensities, scale):
+        flies = {"clay": 0, "sand": 38}[soil]
+        return [{motion: 0 for motion in answer_page.MOTIONS} | {"flies": flies, "at rest": 44 - flies}]
+
+    monkeypatch.setattr(answer_page, "motion_tallies", tallies)
+    median = xr.DataArray(np.array([[[[2.0]], [[1.85]]], [[[2.0]], [[1.85]]]]),
+                          dims=("soil", "model", "block", "damage_state"), attrs={"units": "g"},
+                          coords={"soil": ["clay", "sand"], "model": ["recommended", "housner"], "block": ["box"],
+                                  "damage_state": ["overturning"]})
+    results = SimpleNamespace(cube=xr.Dataset(), fragility=xr.Dataset({"median": median}))
+    answer = SimpleNamespace(block="box", model="recommended", unit="g", intensities=(0.5,),
+                             soils=[SimpleNamespace(soil="clay", intensities=(0.5,)),
+                                    SimpleNamespace(soil="sand", intensities=(0.5,))])
+    words = answer_page.flight_words(results, answer, 1.0)
+    assert words.startswith("'Flies' on sand: after an impact the block rebounds"), words
+    assert "Gazetas 1991" in words and "not a damage state" in words
+    assert "the overturning median, 2.00 g, lies 8% above the rigid base's 1.85 g" in words
+    monkeypatch.setattr(answer_page, "motion_tallies", lambda *args: [{m: 0 for m in answer_page.MOTIONS} |
+                                                                       {"at rest": 44}])
+    assert answer_page.flight_words(results, answer, 1.0) == ""

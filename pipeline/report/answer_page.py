@@ -27,9 +27,11 @@ from rockfrag.report.adapters import (
     GOF_LEVEL,
     block_description,
     block_name,
+    cell,
     intensity_name,
     measure_label,
     model_info,
+    models_of,
     sliding_at,
     sliding_candidates,
 )
@@ -661,6 +663,55 @@ def motion_counts(cube, block: str, model: str, soil: str, intensities, scale: f
             for tally in motion_tallies(cube, block, model, soil, intensities, scale)]
 
 
+FLIGHT_SHARE = 0.25
+"""Above this share of the records flying at a return period's level, the answer page says what the hops are."""
+
+
+def flight_words(results, answer, scale: float) -> str:
+    """What 'flies' is where many records make the block fly, and whether it moves the verdict; "" elsewhere.
+
+    Cold reads 7 (user B1, default B): 38 of 44 records made the enclosure 'fly' on sand at the 2,475-year level
+    while 3 reached θmax/α 0.2; a client asks whether the hops are real. They are the bed's rebound after an impact,
+    set by the damping calibrated to the rocking restitution, not by a measured property of the ground; a real
+    footing's radiation damping (Gazetas 1991) would damp them more. Where the rigid base (which cannot hop) has an
+    overturning median, the page compares the recommended one with it on the soil where most records fly.
+    """
+    cube = getattr(results, "cube", None)
+    if cube is None:
+        return ""
+    most = {}
+    for soil in answer.soils:
+        tallies = motion_tallies(cube, answer.block, answer.model, soil.soil, soil_intensities(answer, soil), scale)
+        shares = [tally["flies"] / max(sum(tally.values()), 1) for tally in tallies if isinstance(tally, dict)]
+        if shares and max(shares) > FLIGHT_SHARE:
+            most[soil.soil] = (max(shares), [tally["flies"] for tally in tallies if isinstance(tally, dict)])
+    if not most:
+        return ""
+    soils = ", ".join(most)
+    text = (f"'Flies' on {soils}: after an impact the block rebounds off the bed's springs in short hops, how much "
+            "set by the bed damping calibrated to keep the rocking restitution, not by a measured property of the "
+            "ground; a real footing also radiates energy into the ground (radiation damping, Gazetas 1991), which "
+            "would damp the rebound more, so these counts are likely high. The hops are not a damage state: the "
+            "verdicts count lift-off, the rocking angle and overturning.")
+    fragility = results.fragility
+    worst = max(most, key=lambda name: most[name][0])
+    rigid = next((m for m in models_of(fragility) if m.rigid_base), None)
+    if rigid is None or "overturning" not in map(str, fragility.damage_state.values):
+        return text
+    ours = float(fragility["median"].sel(model=answer.model, block=answer.block, soil=worst,
+                                         damage_state="overturning"))
+    theirs = float(cell(fragility, rigid, answer.block, worst)["median"].sel(damage_state="overturning"))
+    own = display_scale(fragility["median"].attrs.get("units", ""))[0]  # the fits' unit, not the cube's
+    ours, theirs = ours * own, theirs * own
+    if np.isfinite(ours) and np.isfinite(theirs) and theirs > 0:
+        change = ours / theirs - 1
+        side = "below" if change < 0 else "above"
+        text += (f" On {worst}, where most records hop, the overturning median, "
+                 f"{ours:#.3g} {answer.unit}, lies {abs(change):.0%} {side} the rigid base's {theirs:#.3g} "
+                 f"{answer.unit} (the fitted table's medians), which cannot hop.")
+    return text
+
+
 def motion_table(cube, answer, scale: float) -> Item | None:
     """The motions of the records per soil: a column per motion any record enters, the return periods in a cell.
 
@@ -760,6 +811,9 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(paragraph("What the records make the block do at those levels, each record at its most severe "
                                "motion:"))
         items.append(motions)
+        flights = flight_words(results, answer, scale)
+        if flights:
+            items.append(note(flights))
     sliding = sliding_rows(cube, answer, scale)
     if any(cell not in ("-", NO_LEVEL) for row in sliding for cell in row[1:]):
         items.append(paragraph("Records whose tied base would slide (it needs more friction than the soil "

@@ -120,6 +120,8 @@ REFERENCES = {
     "Acikgoz & DeJong 2012": "Acikgoz, S., DeJong, M. J. (2012). The interaction of elasticity and rocking in "
                              "flexible structures allowed to uplift. Earthquake Engineering & Structural Dynamics "
                              "41(15), 2177-2194.",
+    "Gazetas 1991": "Gazetas, G. (1991). Formulas and charts for impedances of surface and embedded foundations. "
+                    "Journal of Geotechnical Engineering 117(9), 1363-1381.",
     "Shenton 1996": "Shenton, H. W. (1996). Criteria for initiation of slide, rock, and slide-rock rigid-body modes. "
                     "Journal of Engineering Mechanics 122(7), 690-693.",
     "Luco & Cornell 2007": "Luco, N., Cornell, C. A. (2007). Structure-specific scalar intensity measures for "
