@@ -980,3 +980,34 @@ def test_an_answer_page_says_what_flying_is_where_many_records_fly(monkeypatch):
     monkeypatch.setattr(answer_page, "motion_tallies", lambda *args: [{m: 0 for m in answer_page.MOTIONS} |
                                                                        {"at rest": 44}])
     assert answer_page.flight_words(results, answer, 1.0) == ""
+
+
+def test_a_sliding_blocks_lift_off_by_soil_is_explained():
+    """Cold read 7 (default B): the squat skid lifted off on sand and rock, on clay in 2 of 44 and never on gravel or
+    steel, against the soils' stiffness order, with no word why. The page says what it goes with: the bed damping
+    calibrated per soil (gravel's and steel's 1.6 times) and the lowest friction (clay)."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.answer_page import lift_off_by_soil_words
+
+    names = ["clay", "sand", "gravel", "rock", "steel"]
+    top = {"clay": 0.05, "sand": 0.48, "gravel": 0.0, "rock": 0.8, "steel": 0.0}
+    fraction = np.array([[[[[0.0, top[s]]]]] for s in names])  # (soil, model, block, state, level)
+    fragility = xr.Dataset({"empirical_fraction": (("soil", "model", "block", "damage_state", "im_level"), fraction)},
+                           coords={"soil": names, "model": ["recommended"], "block": ["skid"],
+                                   "damage_state": ["uplift"]})
+    xi = {"clay": 0.0995, "sand": 0.0995, "gravel": 0.1575, "rock": 0.0995, "steel": 0.1575}
+    cube = xr.Dataset({"damping_ratio_calibrated": (("soil", "model", "block"),
+                                                    np.array([[[xi[s]]] for s in names]))},
+                      coords={"soil": names, "model": ["recommended"], "block": ["skid"]})
+    soils = [SimpleNamespace(name=s, friction_static=mu) for s, mu in zip(names, (0.35, 0.45, 0.55, 0.7, 0.5))]
+    results = SimpleNamespace(fragility=fragility, cube=cube, config=SimpleNamespace(soils=soils))
+    answer = SimpleNamespace(model="recommended", block="skid")
+    words = lift_off_by_soil_words(results, answer, soils)
+    assert "lifts off on sand and rock (at most 48% and 80% of the records" in words, words
+    assert "hardly on clay (its friction, μ_s 0.35, is the lowest" in words
+    assert "never on gravel and steel, whose bed damping, calibrated to the restitution on each soil, is 1.6 times" \
+        in words
+    every = xr.Dataset({"empirical_fraction": fragility.empirical_fraction * 0 + 1.0})
+    assert lift_off_by_soil_words(SimpleNamespace(fragility=every, cube=cube, config=results.config), answer,
+                                  soils) == ""

@@ -320,7 +320,61 @@ def slides_first_words(results, answer) -> str:
                "computed. ")
             + "Its rocking and overturning there rest on the assumed friction (the values marked "
             f"{FRICTION_MARK} in the design-life table are friction-driven); a base that grips more (a grout bed, "
-            "a keyed plinth) would rock instead, and overturn more readily.")
+            "a keyed plinth) would rock instead, and overturn more readily."
+            + lift_off_by_soil_words(results, answer, soils))
+
+
+LIFTS = 0.25
+"""Of the soils where a block slides first, those where at least this share of the records lifts off at some level
+'lift off'; below it, but above none, 'hardly'."""
+
+
+def lift_off_by_soil_words(results, answer, soils) -> str:
+    """Where a block that slides first lifts off on the bed on some of those soils and never on others, why.
+
+    Cold read 7 (default B): the squat skid lifts off on sand (48 % of the records at 3 g) and rock (80 %), on clay
+    in 2 of 44, never on gravel and steel, which did not follow the soils' stiffness. It follows the bed's damping,
+    calibrated per soil to the restitution (gravel's and steel's 1.6 times sand's and rock's), and the friction
+    (clay's the lowest, so its base shear is capped lowest). Observed, not a proof: the page says what goes with what.
+    """
+    fragility, cube = results.fragility, getattr(results, "cube", None)
+    if cube is None or "damping_ratio_calibrated" not in cube or model_info(answer.model).rigid_base:
+        return ""
+    share = {}
+    for soil in soils:
+        values = fragility.empirical_fraction.sel(model=answer.model, block=answer.block, soil=soil.name,
+                                                  damage_state="uplift").values
+        share[soil.name] = float(np.nanmax(values)) if np.isfinite(values).any() else np.nan
+    lifts = [s for s in soils if share[s.name] >= LIFTS]
+    never = [s for s in soils if share[s.name] == 0]
+    hardly = [s for s in soils if 0 < share[s.name] < LIFTS]
+    if not lifts or not (never or hardly):
+        return ""
+
+    def damping(group):
+        return np.mean([float(cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block,
+                                                                soil=s.name)) for s in group])
+
+    text = (f" On the bed it lifts off on {_and([s.name for s in lifts])} (at most "
+            f"{_and([numbers.probability(share[s.name]) for s in lifts])} of the records, at the highest levels)")
+    if hardly:
+        lowest = min(s.friction_static for s in config_soils(results))
+        text += (f", hardly on {_and([s.name for s in hardly])}"
+                 + (f" (its friction, μ_s {hardly[0].friction_static:g}, is the lowest: the friction caps the base "
+                    "shear that builds the rocking)" if len(hardly) == 1 and hardly[0].friction_static == lowest
+                    else ""))
+    if never:
+        ratio = damping(never) / damping(lifts)
+        text += (f", and never on {_and([s.name for s in never])}"
+                 + (f", whose bed damping, calibrated to the restitution on each soil, is {ratio:.1f} times that of "
+                    f"{_and([s.name for s in lifts])}: the rocking that builds up on the springs dies out sooner"
+                    if ratio >= 1.2 else ": the bed's stiffness and damping do not single these soils out"))
+    return text + "."
+
+
+def config_soils(results) -> list:
+    """The study's soils (``SoilClass``)."""
+    return list(results.config.soils)
 
 
 KINETIC_SENSITIVE = 0.25
