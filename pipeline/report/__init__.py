@@ -266,7 +266,7 @@ CAPTIONS = {
                    "stiffness), the others central; the dashed line is the model-form β (FEMA P695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
-                   "marked 'no median' has no curve of this state below the highest intensity studied; a parameter "
+                   "marked * ('no median') has no curve of its state below the highest intensity studied; a parameter "
                    "without a bar on a soil had one run there (the bed cannot reach its range: the answer page "
                    "says so), not a zero spread that is known.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "

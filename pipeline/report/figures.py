@@ -1383,7 +1383,10 @@ def sensitivity_page(fragility, caption, names: dict | None = None, governing: d
     what = "each soil's governing damage state" if governing else default
     figure = new_page(f"Model uncertainty: which parameter moves the recommended median ({what})", caption)
     rows, columns = _grid(len(blocks))
-    axes = panels(figure, rows, columns, gridspec_kw=dict(hspace=0.7 if governing else 0.55, wspace=0.3)).ravel()
+    grid = dict(hspace=0.7 if governing else 0.55, wspace=0.3)
+    if governing:  # the governing states' words under each panel need room above the caption
+        grid["bottom"] = GRID["bottom"] + 0.05
+    axes = panels(figure, rows, columns, gridspec_kw=grid).ravel()
     parameters = [str(p) for p in fragility.parameter.values]
     soils = list(map(str, fragility.soil.values))
     short = short_states(fragility)
@@ -1406,15 +1409,18 @@ def sensitivity_page(fragility, caption, names: dict | None = None, governing: d
             axis.set_ylim(0.0, max(form, 0.1) * 1.3 if np.isfinite(form) else 1.0)
         missing = [not np.isfinite(row).any() for row in spread]
         missing = missing if not all(missing) else [False] * len(soils)  # an empty panel says so once, inside
-        axis.set_xticks(x, [f"{soil}\n(no\nmedian)" if gone else soil for soil, gone in zip(soils, missing)],
-                        fontsize=7.5)  # "(no median)" on one line ran into its neighbour's
         if governing:  # which state each soil's bars are of, under the soils (a tick label per soil overlapped)
+            axis.set_xticks(x, [f"{soil}*" if gone else soil for soil, gone in zip(soils, missing)], fontsize=8)
             by_state: dict[str, list[str]] = {}
             for soil, state in zip(soils, states):
                 by_state.setdefault(short.get(state, state), []).append(soil)
             words = "; ".join(f"{state} on {', '.join(names_)}" if len(names_) < len(soils) else
                               f"{state} on every soil" for state, names_ in by_state.items())
+            words += "; * no median" if any(missing) else ""
             axis.set_xlabel(textwrap.fill(f"governing state: {words}", chars_across(axis, 7)), fontsize=7)
+        else:
+            axis.set_xticks(x, [f"{soil}\n(no median)" if gone else soil for soil, gone in zip(soils, missing)],
+                            fontsize=8)
         axis.set_ylabel("σ of ln median [-]", fontsize=9)
         axis.set_title(textwrap.fill(names.get(block, block), chars_across(axis, 10)), fontsize=10)
         axis.grid(alpha=0.3, axis="y")
