@@ -366,7 +366,8 @@ def lift_off_by_soil_words(results, answer, soils) -> str:
     if never:
         ratio = damping(never) / damping(lifts)
         text += (f", and never on {_and([s.name for s in never])}"
-                 + (f", whose bed damping, calibrated to the restitution on each soil, is {ratio:.1f} times that of "
+                 + (f", whose bed damping, set per soil by its calibration to the restitution, is {ratio:.1f} times "
+                    "that of "
                     f"{_and([s.name for s in lifts])}: the rocking that builds up on the springs dies out sooner"
                     if ratio >= 1.2 else ": the bed's stiffness and damping do not single these soils out"))
     return text + "."
