@@ -194,3 +194,20 @@ def test_a_verdict_whose_sliding_was_not_computed_says_it_covers_rocking_only():
     assert action(NO_ACTION, SimpleNamespace(tied=False, verdict=NO_ACTION)) == "no action"
     assert action(CHECK_SLIDING, SimpleNamespace(tied=True, verdict=CHECK_SLIDING)) == "specialist check"
     assert action(NO_ACTION) == "no action"
+
+
+def test_cold_read_8_default_text_corrections(small_pipeline):
+    """Cold read 8 (default text B1, C3, C11): the design-life value above the 475-year one on clay unexplained; the
+    blocks' k in software notation ("1.5e+08"); the exact-threshold uplift rows' beta 0.15 read as a response's."""
+    from rockfrag.report.answer_page import reading_items
+    from rockfrag.report.sections import fitted_items, methods_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    reading = _texts(reading_items(results))
+    assert "it can exceed the probability at the 475-year intensity" in reading
+    methods = methods_items(results)
+    blocks = next(item for item in methods if item.kind == "table" and "b [m]" in item.header)
+    assert any("[MN/m]" in head for head in blocks.header)
+    assert not any("e+" in cell for row in blocks.rows for cell in row), blocks.rows
+    fitted = _texts(fitted_items(results))
+    assert "a β of about 0.15: the scatter of the records' own uplift intensities" in fitted

@@ -1125,7 +1125,11 @@ def reading_items(results) -> list[Item]:
                        "applied), not a loss of support: often a series of short hops (tens of milliseconds) as the "
                        "block chatters on the bed's springs, judged through the rocking states, not by itself."),
              paragraph(f"The probability in the design life of {life} is the fitted curve integrated over the site's "
-                       f"hazard, with how often the state happens on average. {BOUND_WORDS} {CERTAINTY_WORDS} "
+                       f"hazard, with how often the state happens on average. It weighs every intensity by how often "
+                       "it comes, not only the return periods' intensities: on a soil whose hazard curve is flat "
+                       "(the soft soils' site term lifts the frequent, weaker shaking most) it can exceed the "
+                       "probability at the 475-year intensity, and on a steeper one fall below it. "
+                       f"{BOUND_WORDS} {CERTAINTY_WORDS} "
                        f"{BOUND_POLICY}"),
              heading("The verdicts"),
              paragraph(f"'Anchor or restrain' where a probability in {life} exceeds the study's limit ({judged}; "

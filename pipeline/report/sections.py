@@ -454,7 +454,8 @@ def verdict_settings(results: Results) -> list[list[str]]:
              "\"near-field-pulse\"; `rockfrag records --help` lists the sets)"],
             ["[intensity] levels", _toml((raw.get("intensity") or {}).get("levels", {})),
              "the intensities run per block (a relative start multiplies the block's first motion, its uplift "
-             "or its sliding onset): below a block's lowest level its probabilities are the fitted curve's tail"],
+             "or its sliding onset; a stop above the highest intensity studied is replaced by it, the levels "
+             "re-spaced up to it): below a block's lowest level its probabilities are the fitted curve's tail"],
             ["[blocks.NAME] b, h, mass, E_b", "the blocks of the methods pages",
              "the block itself: its slenderness and size set when it rocks and overturns"],
             ["[damage_states.NAME] edp, threshold", "the shipped damage states",
@@ -464,6 +465,12 @@ def verdict_settings(results: Results) -> list[list[str]]:
         if isinstance(values, dict) and key in values:
             rows.append([f"[{table_name}] {key}", _toml(values[key]), what])
     return rows
+
+
+def _three_figures(value: float) -> str:
+    """A computed number to 3 significant figures in plain digits: 149, 1,200, 232,000 (never "1.2e+03")."""
+    value = float(f"{value:.3g}")
+    return f"{value:,.0f}" if abs(value) >= 100 else f"{value:.3g}"
 
 
 def _mpa(modulus: float) -> str:
@@ -508,11 +515,17 @@ def reproduce_items(results: Results) -> list[Item]:
             ["run time", run_time_line(results.runtime_s, results.run)],
             ["result files read", ", ".join(_result_files(results))],
             ["tables of every fitted curve", "fragility.csv (confidence bounds, goodness of fit, fit warnings)"]]
+    damping_items = []
     for model in models_of(cube):
-        damping = calibrated_damping(cube, model.name)
-        if damping:  # the methods say the bed's damping is calibrated; its value is an operator's number
-            rows.append([f"bed damping ratio of {short_label(model)} (calibrated to the restitution)",
-                         f"ξ {damping} (cube.nc damping_ratio_calibrated, per block and soil)"])
+        if calibrated_damping(cube, model.name):  # the methods say it is calibrated; its values are an operator's
+            values = cube.damping_ratio_calibrated.sel(model=model.name)
+            damping_items += [
+                paragraph(f"Bed damping ratio ξ of {short_label(model)}, per block and soil (cube.nc "
+                          "damping_ratio_calibrated): set by the calibration to the restitution range, a device of "
+                          "the model, not a property of the soil (whose own ξ the methods tabulate):"),
+                table(["block", *map(str, cube.soil.values)],
+                      [[block_name(config, b), *(_g(float(values.sel(block=b, soil=soil)))
+                                                  for soil in cube.soil.values)] for b in cube.block.values])]
     return [paragraph("The commands, the study file and the settings behind this report. The other pages speak of "
                       "the blocks and the site; this appendix names what an operator types."),
             heading("Commands"),
@@ -528,7 +541,7 @@ def reproduce_items(results: Results) -> list[Item]:
             heading("What this report was computed from"),
             paragraph("The configuration fingerprint changes with any setting of the study; the same fingerprint, "
                       "software version and records give the same numbers."),
-            table(["item", "value"], rows)]
+            table(["item", "value"], rows), *damping_items]
 
 
 def _ordered_models(results: Results):
@@ -605,6 +618,11 @@ def fitted_items(results: Results) -> list[Item]:
         items.append(note(f"‡ the fit fails its goodness-of-fit test (p < {GOF_LEVEL:g}): the lognormal does not "
                           "follow the records' fractions well; read the points on its fragility page beside the "
                           "curve."))
+    if any("exact-thresholds" == str(m) for m in np.unique(fragility.fit_method.values)):
+        items.append(note("An uplift row of the rigid base or the paper's model has the same median on every soil, "
+                          "g·tanα in the measure of the levels, and a β of about 0.15: the scatter of the records' own "
+                          "uplift intensities (each record's pair RotD50 over its own peak; Methods, 'Fragility "
+                          "fits'), not a record-to-record dispersion of a response like the other cells' β."))
     if "†" in marks:
         largest = ", ".join(f"{block_name(results.config, b)} {v:.2g} {shown_unit}"
                             for b, v in results.largest_recorded.items())
@@ -870,19 +888,20 @@ def methods_items(results: Results) -> list[Item]:
     stiffness = cube.interface_stiffness
     modulus = {block.name: block.E_b for block in config.blocks}
     header = ["block", "b [m]", "h [m]", "α [rad]", "mass [kg]", "E_b [GPa]", "uplift g·tanα [g]"] + \
-        [f"k on {soil} [N/m]" for soil in cube.soil.values]
+        [f"k on {soil} [MN/m]" for soil in cube.soil.values]
     rows = [[block_name(config, b), _g(float(cube.block_b.sel(block=b))), _g(float(cube.block_h.sel(block=b))),
              _g(float(cube.block_alpha.sel(block=b))), _g(float(cube.block_mass.sel(block=b))),
              _g(modulus[str(b)] / 1e9) if str(b) in modulus else "-",
              _g(math.tan(float(cube.block_alpha.sel(block=b))))]
-            + [f"{float(stiffness.sel(soil=soil, block=b)):.2g}" for soil in cube.soil.values]
+            + [_three_figures(float(stiffness.sel(soil=soil, block=b)) / 1e6) for soil in cube.soil.values]
             for b in cube.block.values]
     items.append(table(header, rows))
     items.append(note("b, h: half-width and half-height; E_b: the block's Young's modulus, which with the soil's "
                       "modulus sets the interface stiffness k (the paper's eq. 19); uplift: the ground acceleration "
                       "at which the block starts to rock on a rigid base. Each block is a rigid solid block of "
                       "uniform mass; the limitations' planar-model table gives its depth out of plane and the "
-                      "density its mass implies. Its base friction is the soil's, whatever the block's own base "
+                      "density its mass implies; k is the whole footprint's (a block modelled per metre of its "
+                      "length: per metre). Its base friction is the soil's, whatever the block's own base "
                       "(see 'Reading the answer pages')."))
 
     pga = record_pga_g(cube)
@@ -1315,6 +1334,15 @@ def limitations_items(results: Results) -> list[Item]:
     items.append(heading("Sliding"))
     items.append(paragraph("Each soil's base friction and where it comes from: the page 'Reading the answer pages' "
                            "and the methods. It is the soil class's, not the block's own base."))
+    clays = [str(soil) for soil in cube.soil.values if "clay" in str(soil).lower()]
+    if clays:  # cold read 8: a base on clay slides, in fast loading, on the clay's undrained strength
+        items.append(paragraph(
+            f"On {', '.join(clays)} the friction is a drained friction factor (Coulomb: the shear the base can take "
+            "grows with the block's weight). In the fast loading of an earthquake a base on saturated clay slides on "
+            "the clay's undrained adhesion instead, bounded by its undrained shear strength whatever the weight, "
+            "which can be lower than μ_s times the contact pressure under a heavy block; the sensitivity runs' "
+            "lower friction covers only part of that. A site investigation's undrained strength says which governs; "
+            "this study does not model adhesion."))
     items += [paragraph(text) for text in friction_runs_words(results)]
     flag = friction_flag(cube)
     for model in models:
