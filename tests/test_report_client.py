@@ -211,3 +211,21 @@ def test_cold_read_8_default_text_corrections(small_pipeline):
     assert not any("e+" in cell for row in blocks.rows for cell in row), blocks.rows
     fitted = _texts(fitted_items(results))
     assert "a β of about 0.15: the scatter of the records' own uplift intensities" in fitted
+
+
+def test_the_fitted_table_says_why_a_rigid_bases_slip_rows_repeat_across_blocks():
+    """Cold read 8 (default text C2): Housner's slip rows of the paper block and the squat skid on clay and sand were
+    identical (0.779 / 0.25, 1.58 / 0.38) and read as a copy error; a rigid base sliding without lifting off slides
+    alike whatever its size. The note is said where rows repeat, not elsewhere."""
+    import numpy as np
+    import xarray as xr
+
+    from rockfrag.report.sections import _same_rigid_slips
+
+    median = np.array([[[[0.78, 1.58]], [[0.78, 1.58]]]])  # (soil, block, model, state)
+    fragility = xr.Dataset({"median": (("soil", "block", "model", "damage_state"), median)},
+                           coords={"soil": ["clay"], "block": ["paper", "skid"], "model": ["housner"],
+                                   "damage_state": ["slip-0.05", "slip-0.30"]})
+    assert _same_rigid_slips(fragility)
+    fragility["median"].loc[dict(block="skid")] = [[[0.80, 1.58]]]
+    assert not _same_rigid_slips(fragility)

@@ -877,7 +877,7 @@ def test_a_block_modelled_per_metre_of_its_length_is_not_said_to_have_a_less_sta
     assert words.startswith("Judged across the width only, not across a less stable depth: skid (b/h 0.5"), words
     assert "wall (b/h" not in words and "less stable depth): wall." in words, words
     alone = weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(strip,), raw={})))
-    assert alone.startswith("Per metre of a long block") and "Judged" not in alone, alone
+    assert alone.startswith("Computed per metre of a long wall-like block") and "Judged" not in alone, alone
 
 
 def test_a_probability_read_below_the_lowest_level_is_marked_as_the_fit_extrapolated():

@@ -32,7 +32,7 @@ from rockfrag.answer import (
 from rockfrag.checkpoints import FOLDER as CHECKPOINT_FOLDER
 from rockfrag.checkpoints import SUFFIX as CHECKPOINT_SUFFIX
 from rockfrag.config import StudyConfig
-from rockfrag.damage_states import DAMAGE_STATES, NOT_APPLICABLE, STUDY_CHOICE
+from rockfrag.damage_states import DAMAGE_STATES, NOT_APPLICABLE, STUDY_CHOICE, is_slip_state
 from rockfrag.errors import PipelineError
 from rockfrag.hazard import HazardCurve, study_hazard
 from rockfrag.models.variants import split_variant
@@ -618,6 +618,10 @@ def fitted_items(results: Results) -> list[Item]:
         items.append(note(f"‡ the fit fails its goodness-of-fit test (p < {GOF_LEVEL:g}): the lognormal does not "
                           "follow the records' fractions well; read the points on its fragility page beside the "
                           "curve."))
+    if _same_rigid_slips(fragility):
+        items.append(note("A rigid base that slides without lifting off slides alike whatever its size and mass (only "
+                          "the friction and the ground motion matter), so its slip rows can repeat from block to "
+                          "block."))
     if any("exact-thresholds" == str(m) for m in np.unique(fragility.fit_method.values)):
         items.append(note("An uplift row of the rigid base or the paper's model has the same median on every soil, "
                           "g·tanα in the measure of the levels, and a β of about 0.15: the scatter of the records' own "
@@ -629,6 +633,24 @@ def fitted_items(results: Results) -> list[Item]:
         items.append(note(f"† the median lies above the largest intensity any record reached unscaled ({largest}): "
                           "it comes from records scaled up beyond what they recorded (extrapolation by scaling)."))
     return items
+
+
+def _same_rigid_slips(fragility) -> bool:
+    """Whether a rigid-base model's fitted slip medians repeat between two blocks on one soil (cold read 8, C2)."""
+    if fragility.sizes.get("block", 0) < 2:
+        return False
+    slips = [str(s) for s in fragility.damage_state.values
+             if DAMAGE_STATES.get(str(s)) is not None and is_slip_state(DAMAGE_STATES[str(s)])]
+    if not slips:
+        return False
+    for model in (m for m in models_of(fragility) if m.rigid_base):
+        for soil in fragility.soil.values:
+            medians = fragility["median"].sel(model=model.name, soil=soil, damage_state=slips).transpose(
+                "block", ...).values
+            rows = [np.round(row, 6).tobytes() for row in medians if np.isfinite(row).all()]
+            if len(rows) != len(set(rows)):
+                return True
+    return False
 
 
 def site_hazard_items(results: Results) -> list[Item]:

@@ -307,8 +307,8 @@ def weaker_direction_words(results) -> str:
                         f"{depth:.3g} m depth)")
     text = ("Judged across the width only, not across a less stable depth: " + "; ".join(said) + ".") if said else ""
     if strips:
-        text += (" " if text else "") + (f"Per metre of a long block (the plane model: its length runs out of plane, "
-                                         f"so it has no less stable depth): {'; '.join(strips)}.")
+        text += (" " if text else "") + (f"Computed per metre of a long wall-like block (the plane model: its length "
+                                         f"runs out of plane, so it has no less stable depth): {'; '.join(strips)}.")
     return text
 
 
