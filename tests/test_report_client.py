@@ -229,3 +229,20 @@ def test_the_fitted_table_says_why_a_rigid_bases_slip_rows_repeat_across_blocks(
     assert _same_rigid_slips(fragility)
     fragility["median"].loc[dict(block="skid")] = [[[0.80, 1.58]]]
     assert not _same_rigid_slips(fragility)
+
+
+def test_a_bullet_list_ends_with_space_before_the_paragraph_that_follows():
+    """Cold read 8 (default text C9): a paragraph ran on straight after the last bullet of the verdict list."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report.text import LINE, bullet, draw_text_page, paragraph
+
+    def gap(items):
+        figure = draw_text_page("t", items)
+        tops = [text.get_position()[1] for text in figure.texts if text.get_text() in ("last bullet", "after")]
+        plt.close(figure)
+        return tops[0] - tops[1]
+
+    spaced = gap([bullet("first"), bullet("last bullet"), paragraph("after")])
+    assert spaced > 1.5 * LINE  # one line of the bullet, and the space
+    assert gap([bullet("first"), bullet("last bullet"), bullet("after")]) < 1.1 * LINE

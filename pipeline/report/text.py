@@ -311,14 +311,22 @@ def table_layout(item) -> tuple[list[list[str]], list[float], float]:
     return wrapped, positions, size
 
 
+LIST_GAP = 0.6
+"""Lines of space after a bullet list, before the paragraph, note or table that follows it."""
+
+
 def draw_text_page(title, items, caption="", top=TOP, figure=None):
     """One page figure with the items drawn top-down from ``top``."""
     figure = figure or new_page(title, caption)
     items = [part for item in items for part in fit_table(item)]  # a no-op on the items paginate returned
     y = top
-    lines = sum(_lines(item) for item in items)
+    # a bullet list ends with half a line of space before the text that follows (cold read 8, C9: a paragraph ran on
+    # straight after the last bullet); counted here, so a full page sets its lines a little closer instead
+    list_ends = [index for index, item in enumerate(items[:-1])
+                 if item.kind == "bullet" and items[index + 1].kind not in ("bullet", "heading")]
+    lines = sum(_lines(item) for item in items) + LIST_GAP * len(list_ends)
     line = min(LINE, (top - BOTTOM) / lines) if lines else LINE  # a stretched last page: lines set closer
-    for item in items:
+    for index, item in enumerate(items):
         if item.kind == "heading":
             y -= 0.4 * line
             figure.text(LEFT, y, item.text, fontsize=11, weight="bold", va="top")
@@ -353,7 +361,10 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
                 y -= line
             if item.kind in ("paragraph", "strong"):
                 y -= line
+            if index in list_ends:
+                y -= LIST_GAP * line
     return figure
+
 
 
 def _rule(y, right):
