@@ -1011,3 +1011,36 @@ def test_a_sliding_blocks_lift_off_by_soil_is_explained():
     every = xr.Dataset({"empirical_fraction": fragility.empirical_fraction * 0 + 1.0})
     assert lift_off_by_soil_words(SimpleNamespace(fragility=every, cube=cube, config=results.config), answer,
                                   soils) == ""
+
+
+def test_a_value_under_the_floor_without_a_curve_has_no_return_period(small_pipeline):
+    """Cold read 8, user B2: '< 0.1%, once in 7,800,000 years' for overturning on clay, where no record reached the
+    state near the site and no curve was fitted: the return period read as spurious precision. Without a curve the
+    cell says '< 0.1%' alone; a fitted curve's value under the floor keeps its return period."""
+    import dataclasses
+
+    from rockfrag.report.answer_page import answer_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    answer = results.answers[0]
+    soil = answer.soils[0]
+    index = next(i for i, row in enumerate(soil.states) if row.state == "overturning")
+    tiny = dataclasses.replace(soil.states[index], probability_in_life=1e-5, annual_frequency=2e-7,
+                               not_reached_below=None, below_lowest=None)
+    states = list(soil.states)
+    states[index] = tiny
+    soils = list(answer.soils)
+    soils[0] = dataclasses.replace(soil, states=type(soil.states)(states))
+    answer = dataclasses.replace(answer, soils=type(answer.soils)(soils))
+
+    def cell(median):
+        results.fragility["median"].loc[dict(model=answer.model, block=answer.block, soil=soil.soil,
+                                             damage_state="overturning")] = median
+        items = answer_items(results, answer)
+        life = next(i for i, item in enumerate(items) if item.kind == "heading" and item.text.startswith("In the"))
+        table = next(item for item in items[life:] if item.kind == "table")
+        row = next(row for row in table.rows if row[0] == "overturning")
+        return row[table.header.index(f"on {soil.soil}")]
+
+    assert cell(np.nan).startswith("< 0.1%") and "once in" not in cell(np.nan)
+    assert "< 0.1%, once in 5,000,000 years" in cell(9.0)

@@ -886,7 +886,10 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         for soil in answer.soils:
             row = soil.states[index]
             text = _not_computed(results, answer, soil.soil, state) or say_p_in_life(results, answer, soil, row)
-            if row.not_reached_below is None and row.below_lowest is None and np.isfinite(row.probability_in_life):
+            if row.not_reached_below is None and row.below_lowest is None and np.isfinite(row.probability_in_life) \
+                    and (row.probability_in_life >= numbers.FLOOR or _has_curve(results, answer, soil.soil, state)):
+                # a value under the floor from the records' shares alone (no curve) gets no return period: "once
+                # in 7,800,000 years" from 0 of 44 near the site read as spurious precision (cold read 8, user B2)
                 text += f", {_years(row.annual_frequency)}" if _years(row.annual_frequency) else ""
             if row.below_lowest is not None and _fitted_beside_bound(results, answer, soil.soil, state) != \
                     f" (fitted curve: {text.lstrip('≥ ')})":
@@ -928,15 +931,25 @@ def _fitted_beside_bound(results, answer, soil: str, state: str) -> str:
     return f" (fitted curve: {numbers.probability(fitted)})" if np.isfinite(fitted) else ""
 
 
+def _has_curve(results, answer, soil: str, state: str) -> bool:
+    """Whether the answering model has a fitted curve (a median) of ``state`` on ``soil``."""
+    try:
+        return bool(np.isfinite(float(results.fragility["median"].sel(model=answer.model, block=answer.block,
+                                                                      soil=soil, damage_state=state))))
+    except KeyError:
+        return False
+
+
 def below_floor_with_period(rows) -> bool:
     """True where a design-life cell prints a computed value under the print floor with its return period."""
     return any(cell.startswith(f"{numbers.probability(numbers.FLOOR / 2)}, once in") for row in rows
                for cell in row[2:])
 
 
-FLOOR_WITH_PERIOD_WORDS = ("'< 0.1%, once in ... years': a computed value below the print floor of 0.1% (from the "
-                           "fitted curve, or, where the state has no curve, from the share of records that reached "
-                           "it at each level over the site's hazard); its return period says how far below.")
+FLOOR_WITH_PERIOD_WORDS = ("'< 0.1%, once in ... years': a value of the fitted curve below the print floor of 0.1%; "
+                           "its return period says how far below. '< 0.1%' alone where the state has no curve: "
+                           "the share of records that reached it at each level, over the site's hazard, gives no "
+                           "more than that.")
 """The note under the design-life table where a computed probability below the print floor has its return period."""
 
 
