@@ -396,3 +396,13 @@ def test_the_other_direction_of_a_deep_block_is_checked_not_handed_to_the_client
     assert f"b/h {depth / 2 / cabinet.h:.2g} across its {depth:.3g} m depth, stockier than the 0.2 studied" in words
     assert "b/h 0.75 across its 3 m depth, the same as the 0.75 studied" in words  # the square skid
     assert "paper" not in words and "R = 9.39" not in words  # a strip per metre of length has no other direction
+
+
+def test_the_methods_give_the_sliding_first_levels_start_in_numbers():
+    """Cold read 8, user B1: 'start at the same multiple of its sliding onset' beside '0.44 to 7.54 times' read as
+    a contradiction; the sentence now gives the start per block (0.5 × 0.35 g, about 0.44 times its uplift)."""
+    from rockfrag.config import load_study
+    from rockfrag.report.sections import _sliding_first_levels
+
+    words = _sliding_first_levels(load_study("studies/user-site.toml"))
+    assert "0.5 × 0.35 g, about 0.44 times its uplift intensity" in words, words

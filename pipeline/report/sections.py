@@ -826,10 +826,13 @@ def _sliding_first_levels(config) -> str:
     early = [block for block, ratio in zip(config.blocks, ratios) if ratio < 1]
     if config.level_range is None or not early:
         return ""
-    names = ", ".join(block_name(config, block.name) for block in early)
-    return (f" The levels of a block that slides before it can rock on one of the soils (static friction μ_s below its "
-            f"b/h) start at the same multiple of its sliding onset μ_s·g on the lowest-friction soil instead, so the "
-            f"site's intensities, where it already slides, lie inside its levels: {names}.")
+    start = config.level_range[0]
+    said = "; ".join(f"{block_name(config, block.name)}: {start:g} × {ratio * block.b / block.h:.2g} g, about "
+                     f"{ratio * start:.2g} times its uplift intensity" for block, ratio in zip(config.blocks, ratios)
+                     if ratio < 1)
+    return (f" A block that slides before it can rock on one of the soils (static friction μ_s below its b/h) starts "
+            f"its levels at {start:g} times its sliding onset μ_s·g on the lowest-friction soil instead of {start:g} "
+            f"times its uplift, so the site's intensities, where it already slides, lie inside its levels ({said}).")
 
 
 def _weakest_intensity(cube) -> float:
