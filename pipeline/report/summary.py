@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT
+from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT, display_scale
 from rockfrag.report import numbers
 from rockfrag.report.adapters import block_name, is_soil, state_labels
 from rockfrag.report.text import Item, bullet, note, paragraph, strong, table
@@ -175,8 +175,8 @@ BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a pr
 """How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
-STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level, under the reference site's ground motion, not one "
-                         "on a structure (a floor's amplified motion, a floor spectrum, is not modelled).")
+STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level under the reference site's motion, not a floor of a "
+                         "structure (no floor spectrum).")
 """What a structural base of the study (steel) stands for, said once, in the summary's note (cold read 3, A2)."""
 
 
@@ -307,8 +307,8 @@ def weaker_direction_words(results) -> str:
                         f"{depth:.3g} m depth)")
     text = ("Judged across the width only, not across a less stable depth: " + "; ".join(said) + ".") if said else ""
     if strips:
-        text += (" " if text else "") + (f"Computed per metre of a long wall-like block (the plane model: its length "
-                                         f"runs out of plane, so it has no less stable depth): {'; '.join(strips)}.")
+        text += (" " if text else "") + ("Per metre of a long wall-like block (the plane model; no less stable "
+                                         f"depth): {'; '.join(strips)}.")
     return text
 
 
@@ -443,12 +443,44 @@ def summary_items(results) -> list[Item]:
                    if " of " in cells else " 'No fit' (reason): the state's median lies above the highest intensity "
                    "studied, so no curve is fitted; its probabilities come from the records' share at each level.")
     items.append(note(" ".join(filter(None, [
-        said, GOVERNING_WORDS, bounds, structural_base_words(results), weaker_direction_words(results),
+        said, GOVERNING_WORDS, bounds, scaled_medians_words(results), structural_base_words(results),
+        weaker_direction_words(results),
         "Reason: the records at the level run at or below the largest return period's intensity; where none "
-        "reach the state there, its probabilities are the fitted curve's tail (fitted to the higher levels). "
-        "β: records, the variability from record to record; model, the model's own uncertainty. The answer pages "
-        "give every damage state and the records behind each number."]))))
+        "reach the state there, its probabilities are the fitted curve's tail. β: records, the variability from "
+        "record to record; model, the model's own uncertainty. The answer pages give every state and its records."
+    ]))))
     return items
+
+
+def scaled_medians_words(results) -> str:
+    """How many governing curves have their median above the largest recorded intensity, "" where none.
+
+    Cold read 8, user B6: both 'no action' verdicts of the user study rest on medians (1.56 g, 2.00 g) from records
+    scaled up to 15.9 times beyond the largest unscaled 0.78 g, which only the fitted table's dagger said.
+    """
+    fragility = results.fragility
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    scaled, total, largest = 0, 0, []
+    for answer in results.answers:
+        recorded = results.largest_recorded.get(str(answer.block), np.inf)
+        for soil in answer.soils:
+            row = governing(soil)
+            if row is None or row.not_reached_below is not None:
+                continue
+            median = float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.soil,
+                                                   damage_state=row.state)) * scale
+            if not np.isfinite(median):
+                continue
+            total += 1
+            if median > recorded:
+                scaled += 1
+                largest.append(recorded)
+    if not scaled:
+        return ""
+    every = "All" if scaled == total else f"{scaled} of {total}"
+    unit = results.answers[0].unit
+    return (f"{every} governing medians exceed the largest recorded intensity, "
+            f"{numbers.intensity(max(largest), unit)} (extrapolation by scaling, † in the fitted table).")
 
 
 def verdict_rows(results, answer) -> list[dict]:
