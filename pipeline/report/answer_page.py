@@ -947,9 +947,9 @@ def below_floor_with_period(rows) -> bool:
 
 
 FLOOR_WITH_PERIOD_WORDS = ("'< 0.1%, once in ... years': a value computed from the fitted curve, below the print floor "
-                           "of 0.1%; its return period says how far below. '< 0.1%' alone where the state has no curve: "
-                           "the share of records that reached it at each level, over the site's hazard, gives no "
-                           "more than that.")
+                           "of 0.1%; its return period says how far below. '< 0.1%' alone where the state has no "
+                           "curve: the share of records that reached it at each level, over the site's hazard, gives "
+                           "no more than that.")
 """The note under the design-life table where a computed probability below the print floor has its return period."""
 
 
