@@ -211,6 +211,11 @@ def test_cold_read_8_default_text_corrections(small_pipeline):
     assert not any("e+" in cell for row in blocks.rows for cell in row), blocks.rows
     fitted = _texts(fitted_items(results))
     assert "a β of about 0.15: the scatter of the records' own uplift intensities" in fitted
+    # user B4: the static settlement the reading guide counts a lift from, referred to but never printed
+    block, soil = str(results.cube.block.values[0]), str(results.cube.soil.values[0])
+    settlement = float(results.cube.block_mass.sel(block=block)) * 9.80665 / float(
+        results.cube.interface_stiffness.sel(block=block, soil=soil)) * 1e3
+    assert f"{soil} {settlement:.3g}" in _texts(methods), settlement
 
 
 def test_the_fitted_table_says_why_a_rigid_bases_slip_rows_repeat_across_blocks():

@@ -72,6 +72,7 @@ from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, formulas, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS
+from rockfrag.units import STANDARD_GRAVITY
 from rockfrag.version import __version__
 
 EXTRAPOLATION_ROWS = 30
@@ -928,6 +929,15 @@ def methods_items(results: Results) -> list[Item]:
                       "density its mass implies; k is the whole footprint's (a block modelled per metre of its "
                       "length: per metre). Its base friction is the soil's, whatever the block's own base "
                       "(see 'Reading the answer pages')."))
+    def settles(block, soil) -> str:  # m g / k [mm]
+        weight = float(cube.block_mass.sel(block=block)) * STANDARD_GRAVITY
+        return _g(weight / float(stiffness.sel(soil=soil, block=block)) * 1e3)
+
+    settlement = "; ".join(f"{block_name(config, b)}: " + ", ".join(f"{soil} {settles(b, soil)}"
+                                                                     for soil in cube.soil.values)
+                           for b in cube.block.values)
+    items.append(note(f"Static settlement m·g/k of each block on its bed [mm], from which a lift is counted ('Reading "
+                      f"the answer pages'): {settlement}."))  # cold read 8, user B4: referred to, never printed
 
     pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
