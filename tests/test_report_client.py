@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import re
 
+import xarray as xr
+
 from tests.helpers import pipeline_results
 
 TABLES = ("study", "intensity", "solver", "hazard", "decision", "fragility", "damage_states", "applicability",
@@ -104,8 +106,30 @@ def test_the_summary_is_page_two_with_every_asset_and_soil_and_the_contents_foll
     expected = {(block_name(results.config, b), str(s)) for b in results.cube.block.values
                 for s in results.cube.soil.values}
     assert rows == expected
-    for head in ("governing damage state", "P in 50 years (limit)", "β (dominated by)", "reason"):
+    for head in ("governing damage state", "P in 50 years (limit)", "β (records / model)", "reason"):
         assert head in table.header, head
+
+
+def test_the_summary_beta_prints_both_parts_that_add_to_the_total(small_pipeline):
+    """Cold read 8, user B3: "0.53 (records)" hid a model part of 0.35 beside the records' 0.39. Each summary β
+    prints its two parts, and they add in squares to the total (to the printed rounding)."""
+    from rockfrag.report.summary import summary_items
+
+    import numpy as np
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    fragility = results.fragility.copy()  # the small study samples no model: give every row a model part
+    fragility["beta_record_to_record"] = fragility["beta"]
+    fragility["beta_model"] = xr.full_like(fragility["beta"], 0.35)
+    fragility["beta"] = np.hypot(fragility["beta_record_to_record"], fragility["beta_model"])
+    results.__dict__["fragility"] = fragility
+    table = next(item for item in summary_items(results) if item.kind == "table")
+    column = table.header.index("β (records / model)")
+    cells = [row[column] for row in table.rows if re.fullmatch(r"[\d.]+ \([\d.]+ / [\d.]+\)", row[column] or "")]
+    assert cells, [row[column] for row in table.rows]
+    for cell in cells:
+        total, records, model = map(float, re.findall(r"[\d.]+", cell))
+        assert model == 0.35 and abs(total - (records ** 2 + model ** 2) ** 0.5) <= 0.011, cell
 
 
 def test_a_site_hazard_removes_the_warning(small_pipeline, tmp_path):

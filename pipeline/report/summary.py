@@ -26,12 +26,9 @@ ACTION_WORDS = {ANCHOR: "anchor or restrain", CHECK_SLIDING: "specialist check",
                 NO_ACTION: "no action", NO_VERDICT: "no verdict"}
 """The verdicts of rockfrag.answer as the client reads them (a verdict not listed prints as it is named)."""
 
-BETA_PARTS = (("beta_record_to_record", "records"),
-              ("beta_parameters", "parameters"),
-              ("beta_form", "model form"),
-              ("beta_model", "model"))
-"""The parts of a fitted row's total dispersion β that fragility.nc may hold, and their words. ``beta_model`` is
-the whole model part: it is named only when the file does not split it into parameters and form."""
+BETA_PARTS = ("beta_record_to_record", "beta_model")
+"""The two parts of a fitted row's total dispersion β, in the order the report prints them (records / model):
+β = √(records² + model²), the model part the larger of the parameters' spread and the model form's rating."""
 
 EXAMPLE_WARNING = ("The hazard of this report is the example hazard curve that comes with the tool, not a site's: "
                    "no verdict in this report applies to a real site. The probabilities show how the method reads a "
@@ -266,7 +263,12 @@ def say_p_at(results, answer, soil, row, index: int) -> str:
 
 
 def beta_words(results, answer, soil: str, state: str) -> str:
-    """The total dispersion β of the answering row and the part that dominates it: "0.52 (records)"."""
+    """The total dispersion β of the answering row and its two parts: "0.53 (0.39 / 0.35)".
+
+    The parts are the record-to-record β and the model's (``beta_model``), whose root sum of squares is the
+    total; a row without a model part (a reference model's) prints its total alone. Cold read 8, user B3: naming
+    only the larger part hid a model part nearly as large (0.39 records, 0.35 model).
+    """
     fragility = results.fragility
     try:
         row = fragility.sel(model=answer.model, block=answer.block, soil=soil, damage_state=state)
@@ -275,14 +277,10 @@ def beta_words(results, answer, soil: str, state: str) -> str:
     total = float(row["beta"]) if "beta" in row else np.nan
     if not np.isfinite(total):
         return "-"
-    present = {name for name, _ in BETA_PARTS if name in row and np.isfinite(float(row[name]))}
-    parts = [(float(row[name]), words) for name, words in BETA_PARTS if name in present
-             and not (name == "beta_model" and {"beta_parameters", "beta_form"} & present)]
+    parts = [float(row[name]) if name in row else np.nan for name in BETA_PARTS]
     text = numbers.dispersion(total)
-    if parts:
-        largest, words = max(parts)
-        if largest > 0:
-            text += f" ({words})"
+    if all(np.isfinite(parts)) and parts[1] > 0:
+        text += " (" + " / ".join(numbers.dispersion(part) for part in parts) + ")"
     return results.facts.say("total beta", (answer.block, soil, state), text)
 
 
@@ -412,7 +410,7 @@ def summary_items(results) -> list[Item]:
     periods = first.return_periods
     life = numbers.years(first.design_life)
     header = ["asset, soil", "action", "governing damage state", *(f"P at {numbers.years(t)}" for t in periods),
-              f"P in {life} (limit)", "β (dominated by)", "reason"]
+              f"P in {life} (limit)", "β (records / model)", "reason"]
     rows = []
     for answer in answers:
         rows.append([block_name(results.config, answer.block)] + [""] * (len(header) - 1))
@@ -422,7 +420,7 @@ def summary_items(results) -> list[Item]:
     items.append(paragraph(
         f"Per asset and soil: the action, the damage state that governs it, that state's probability at the site's "
         f"intensity of each return period and in the design life of {life}, with {hazard_words(results, first)}; the "
-        "dispersion β of its fragility curve with the part that dominates it; and what the verdict rests on."))
+        "dispersion β of its fragility curve with its two parts; and what the verdict rests on."))
     items.append(table(header, rows))
     used = {line[1] for line in rows}
     legend = [("anchor or restrain", "'Anchor or restrain': a probability in the design life is above its limit; the "
@@ -446,8 +444,8 @@ def summary_items(results) -> list[Item]:
         said, GOVERNING_WORDS, bounds, scaled_medians_words(results), structural_base_words(results),
         weaker_direction_words(results),
         "Reason: the records at the level run at or below the largest return period's intensity; where none "
-        "reach the state there, its probabilities are the fitted curve's tail. β: records, the variability from "
-        "record to record; model, the model's own uncertainty. The answer pages give every state and its records."
+        "reach the state there, its probabilities are the fitted curve's tail. β (records / model): the total, "
+        "√(records² + model²), of the variability from record to record and the model's own uncertainty. The answer pages give every state and its records."
     ]))))
     return items
 
