@@ -113,9 +113,9 @@ def test_the_summary_is_page_two_with_every_asset_and_soil_and_the_contents_foll
 def test_the_summary_beta_prints_both_parts_that_add_to_the_total(small_pipeline):
     """Cold read 8, user B3: "0.53 (records)" hid a model part of 0.35 beside the records' 0.39. Each summary β
     prints its two parts, and they add in squares to the total (to the printed rounding)."""
-    from rockfrag.report.summary import summary_items
-
     import numpy as np
+
+    from rockfrag.report.summary import summary_items
 
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     fragility = results.fragility.copy()  # the small study samples no model: give every row a model part

@@ -445,7 +445,8 @@ def summary_items(results) -> list[Item]:
         weaker_direction_words(results),
         "Reason: the records at the level run at or below the largest return period's intensity; where none "
         "reach the state there, its probabilities are the fitted curve's tail. β (records / model): the total, "
-        "√(records² + model²), of the variability from record to record and the model's own uncertainty. The answer pages give every state and its records."
+        "√(records² + model²), of the variability from record to record and the model's own uncertainty. The "
+        "answer pages give every state and its records."
     ]))))
     return items
 
