@@ -558,3 +558,29 @@ def test_a_log_axis_of_about_a_decade_labels_the_site_intensities_range():
     site intensity (0.24-0.67 g) sat where no tick was labelled. About a decade gets 1, 2, 3, 5 x 10^n."""
     assert log_ticks(0.22, 3.3) == [0.3, 0.5, 1.0, 2.0, 3.0]
     assert log_ticks(0.22, 3.3, most=3) == [0.5, 1.0, 2.0]  # a short axis keeps fewer
+
+
+def test_the_shipped_soils_colours_differ_in_hue_not_shade():
+    """Cold read 8, user C3: clay (#8c510a) and sand (#d8a03a) were two browns; a two-soil study could not tell its
+    curves apart. Each pair of soil colours differs by at least 40 degrees of hue, or one of them is a grey; none is
+    the recommended curve's red or the rigid base's black."""
+    import colorsys
+    import itertools
+
+    from matplotlib.colors import to_rgb
+
+    from rockfrag.report.layout import RECOMMENDED_STYLE, RIGID_STYLE, SOIL_COLOURS
+
+    def hue_saturation(colour):
+        hue, _, saturation = colorsys.rgb_to_hls(*to_rgb(colour))
+        return hue * 360, saturation
+
+    for (soil_a, a), (soil_b, b) in itertools.combinations(SOIL_COLOURS.items(), 2):
+        (hue_a, sat_a), (hue_b, sat_b) = hue_saturation(a), hue_saturation(b)
+        if min(sat_a, sat_b) < 0.1:  # a grey against a colour: told apart by saturation
+            assert max(sat_a, sat_b) > 0.3, (soil_a, soil_b)
+            continue
+        apart = min(abs(hue_a - hue_b), 360 - abs(hue_a - hue_b))
+        assert apart >= 40, (soil_a, a, soil_b, b, apart)
+    assert not {c.lower() for c in SOIL_COLOURS.values()} & {RECOMMENDED_STYLE["color"], RIGID_STYLE["color"],
+                                                             "#000000", "black"}

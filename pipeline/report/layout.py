@@ -38,8 +38,10 @@ FOOTER_ID = "footer"  # the footer's artists carry it (gid): a layout check tell
 TITLE_SIZE = 13
 TITLE_CHARS = 95  # characters of a bold 13 pt title across the page; a longer title is set smaller
 
-SOIL_COLOURS = {"clay": "#8c510a", "sand": "#d8a03a", "gravel": "#35978f", "rock": "#01665e",
-                "steel": "#5e3c99"}
+SOIL_COLOURS = {"clay": "#8c510a", "sand": "#56b4e9", "gravel": "#4d9221", "rock": "#5e3c99",
+                "steel": "#666666"}
+"""Five hues apart (brown, sky blue, green, purple, grey): cold read 8 could not tell the user study's clay and sand
+apart when they were two shades of brown; no soil is red (the recommended curve's) or black (the rigid base's)."""
 RIGID_STYLE = dict(color="black", ls="--", lw=1.5, zorder=4)  # on top: its dashes stay visible
 RECOMMENDED_STYLE = dict(color="#d62728", ls="-", lw=2.8, zorder=5)  # the only solid coloured line: the answer
 MODEL_STYLES = [dict(color="#1f77b4", ls="-.", lw=1.4), dict(color="#2ca02c", ls=":", lw=1.6),
