@@ -324,7 +324,10 @@ def test_the_kinetic_friction_ratio_is_read_from_the_soils_not_written_twice():
     words = _kinetic_words(list(SOILS.values()))
     ratio = rockfrag.soils.KINETIC_OVER_STATIC
     usual = [s.name for s in SOILS.values() if round(ratio * s.friction_static, 2) == s.friction_kinetic]
-    assert usual and f"{ratio:g} × static (rounded to 0.01) on {', '.join(usual)}" in words
+    assert usual and f"{ratio:g} × static (rounded to 0.01" in words and f") on {', '.join(usual)}" in words
+    # cold read 8: rock's 0.7 x 0.85 = 0.595 printed 0.59 read as a rounding slip; the text says what was taken
+    assert SOILS["rock"].friction_static == 0.7 and "rock's 0.595 taken as 0.59" in words
+    assert "sand's" not in words  # 0.3825: no half to say
     for soil in SOILS.values():
         if soil.name not in usual:
             assert f"on {soil.name} {soil.friction_kinetic / soil.friction_static:.2g} × static" in words

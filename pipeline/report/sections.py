@@ -1067,7 +1067,13 @@ def _kinetic_words(soils) -> str:
              if round(KINETIC_OVER_STATIC * soil.friction_static, 2) == soil.friction_kinetic]
     own = [f"on {soil.name} {soil.friction_kinetic / soil.friction_static:.2g} × static" for soil in soils
            if soil.name not in usual]
-    words = [f"{KINETIC_OVER_STATIC:g} × static (rounded to 0.01) on {', '.join(usual)}"] if usual else []
+    # A product ending in 5 at the third decimal reads as rounded the wrong way (cold read 8: rock's 0.7 × 0.85 =
+    # 0.595 printed 0.59): say which value was taken.
+    halves = [f"{soil.name}'s {KINETIC_OVER_STATIC * soil.friction_static:.3f} taken as {soil.friction_kinetic:g}"
+              for soil in soils if soil.name in usual
+              and abs((KINETIC_OVER_STATIC * soil.friction_static * 100) % 1 - 0.5) < 1e-6]
+    words = [f"{KINETIC_OVER_STATIC:g} × static (rounded to 0.01{'; ' + ', '.join(halves) if halves else ''}) on "
+             f"{', '.join(usual)}"] if usual else []
     return "Kinetic friction " + "; ".join(words + own)
 
 
