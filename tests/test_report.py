@@ -269,9 +269,36 @@ def test_text_pages_split_long_tables_with_their_header():
 
     items = [heading("h"), paragraph("p"), table(["a", "b"], [[str(i), str(i)] for i in range(100)])]
     pages = paginate(items, capacity=30)
-    rows = [row for page in pages for item in page if item.kind == "table" for row in item.rows]
+    tables = [item for page in pages for item in page if item.kind == "table"]
+    rows = [row for item in tables for row in item.rows if row[0] != "(continued)"]
     assert len(rows) == 100 and len(pages) == 4
     assert all(page[0].kind != "heading" or len(page) > 1 for page in pages)
+    # cold read 8, user C11: the header came back on the next page with nothing saying the table went on
+    assert [item.rows[0] for item in tables[1:]] == [["(continued)", ""]] * 3
+
+
+def test_a_split_table_says_which_group_continues():
+    """A table with group headings (an asset, a soil) opens its next page with the group it cuts, "(continued)";
+    where the next page opens with a group of its own, its heading says where it starts. No row is lost, none is
+    doubled, and the balancing of the last two pages (which joins and re-splits) keeps one continuation row."""
+    from rockfrag.report.text import paginate, table
+
+    rows = []
+    for group in ("clay", "sand", "gravel"):
+        rows += [[group, "", ""]] + [[f"{group} {i}", "x", "y"] for i in range(20)]
+    for capacity in range(18, 40):
+        pages = paginate([table(["key", "value", "more"], rows)], capacity=capacity)
+        tables = [item for page in pages for item in page if item.kind == "table"]
+        kept = [row for item in tables for row in item.rows if not row[0].endswith("(continued)")]
+        assert kept == rows, capacity
+        for before, after in zip(tables, tables[1:]):
+            first = after.rows[0]
+            group = next(row[0] for row in reversed(before.rows) if not any(row[1:]))
+            if any(first[1:]):
+                raise AssertionError(f"{capacity}: a page opens without a group heading: {first}")
+            assert first[0] in (f"{group} (continued)", "clay", "sand", "gravel"), (capacity, first)
+            if first[0] in ("clay", "sand", "gravel"):
+                assert before.rows[-1][0] == f"{group} 19" or not any(before.rows[-1][1:]), capacity
 
 
 def test_a_wrapped_cell_is_not_split_across_two_pages():
@@ -284,7 +311,8 @@ def test_a_wrapped_cell_is_not_split_across_two_pages():
     for capacity in range(28, 34):  # wherever the page break falls
         pages = paginate([table(["key", "value"], rows)], capacity=capacity)
         tables = [item for page in pages for item in page if item.kind == "table"]
-        assert sum(len(t.rows) for t in tables) == len(rows)
+        assert sum(len(t.rows) for t in tables if t.rows[0][0] != "(continued)") + sum(
+            len(t.rows) - 1 for t in tables if t.rows[0][0] == "(continued)") == len(rows)
         assert all(t.rows[0][0] for t in tables), capacity  # no page starts with a continuation line
 
 

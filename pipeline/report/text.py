@@ -124,7 +124,8 @@ def _joined_tables(items) -> list[Item]:
         last = joined[-1] if joined else None
         if last is not None and item.kind == last.kind == "table" and item.header == last.header \
                 and item.part == last.part:
-            joined[-1] = replace(last, rows=last.rows + item.rows)
+            rows = item.rows[1:] if item.rows and _is_continued(item.rows[0]) else item.rows
+            joined[-1] = replace(last, rows=last.rows + rows)
         else:
             joined.append(item)
     return joined
@@ -157,7 +158,9 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
             while 1 < room < len(item.rows) and (not item.rows[room][0] or is_span(item.rows[room - 1])):
                 room -= 1  # a wrapped cell's lines stay on one page, and a group heading with its first row
             head = replace(item, rows=item.rows[:room])
-            tail = replace(item, rows=item.rows[room:])
+            rest = item.rows[room:]
+            opens = [] if not rest or is_span(rest[0]) else [_continued_row(item.rows[:room], len(item.header))]
+            tail = replace(item, rows=opens + rest)
             current.append(head)
             pages.append(current)
             current, used = [], 0
@@ -184,6 +187,25 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
     if current or not pages:
         pages.append(current)
     return pages
+
+
+CONTINUED = " (continued)"
+
+
+def _continued_row(rows_before, columns: int) -> list[str]:
+    """The group heading that opens the rest of a split table: the last group's name, "(continued)" after it.
+
+    Not added where the rest opens with a group of its own (its heading says where the page starts).
+
+    A table split across pages repeats its header; this row says the page goes on with the table (cold read 8,
+    user C11), and with which group (an asset or a soil) where the table has groups.
+    """
+    group = next((row[0] for row in reversed(rows_before) if is_span(row)), "").removesuffix(CONTINUED.strip())
+    return [(group + CONTINUED).strip() if group else CONTINUED.strip()] + [""] * (columns - 1)
+
+
+def _is_continued(row) -> bool:
+    return is_span(row) and row[0].endswith(CONTINUED.strip())
 
 
 def _leads_to_table(item) -> bool:
