@@ -1069,3 +1069,20 @@ def test_the_summary_says_how_many_governing_medians_rest_on_scaled_records():
         "fitted table).")
     results.largest_recorded = {"box": 2.0}
     assert summary.scaled_medians_words(results) == ""
+
+
+def test_the_title_page_lists_blocks_and_models_without_parentheses_inside_parentheses(small_pipeline):
+    """Cold read 8, user C2: "1 block (enclosure E-1 (a solid block 1.2 m x 3.0 m, 4.5 t)) and 3 models (Housner
+    (rigid base); ...)". The run's size names its blocks and models after colons; no parenthesis opens inside
+    another."""
+    from rockfrag.report.sections import models_of, title_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    first = title_items(results)[0].text
+    depth, deepest = 0, 0
+    for character in first:
+        depth += {"(": 1, ")": -1}.get(character, 0)
+        deepest = max(deepest, depth)
+    assert depth == 0 and deepest == 1, first
+    assert any("(" in model.label for model in models_of(results.cube)), "the test needs a label with parentheses"
+    assert " models: " in first and (" block: " in first or " blocks: " in first), first

@@ -348,10 +348,11 @@ def title_items(results: Results) -> list[Item]:
     names = [block_name(config, b) for b in cube.block.values]
     labels = [m.label for m in models_of(cube)]
     items = [
-        paragraph(f"{cube.sizes['record']} record components, {cube.sizes['im_level']} intensity levels, "
-                  f"{grounds(cube)}, {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''} "
-                  f"({'; '.join(names)}) and {cube.sizes['model']} models ({'; '.join(labels)}): "
-                  f"{runs_words(results)}."),
+        # colons and semicolons, not parentheses: a block's or model's name has its own (cold read 8, user C2)
+        paragraph(f"{cube.sizes['record']} record components, {cube.sizes['im_level']} intensity levels and "
+                  f"{grounds(cube)}. {cube.sizes['block']} block{'s' if cube.sizes['block'] != 1 else ''}: "
+                  f"{'; '.join(names)}. {cube.sizes['model']} models: {'; '.join(labels)}. "
+                  f"{runs_words(results)[:1].upper()}{runs_words(results)[1:]}."),
         *([paragraph(f"'The paper' on these pages: {PAPER_TITLE}, a preprint (Preprints.org, 2026; not "
                      "peer-reviewed), the source of the SSI-rocking model (see References).")]
           if any("paper" in text.lower() for text in (*names, *labels)) else []),
