@@ -275,3 +275,28 @@ def test_a_bullet_list_ends_with_space_before_the_paragraph_that_follows():
     spaced = gap([bullet("first"), bullet("last bullet"), paragraph("after")])
     assert spaced > 1.5 * LINE  # one line of the bullet, and the space
     assert gap([bullet("first"), bullet("last bullet"), bullet("after")]) < 1.1 * LINE
+
+
+def test_the_contents_list_each_figure_page_by_the_title_it_draws(small_pipeline):
+    """Cold read 8, user C7/C13: the contents called p. 24 "Model uncertainty: sensitivity of the median" while its
+    title read "Model uncertainty: which parameter moves the recommended median (...)"; the applicability and
+    efficiency pages differed too. Every figure page's drawn title is the title the contents list."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report import build_plan
+    from rockfrag.report.layout import TITLE_SIZE
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    checked = []
+    for page in build_plan(results):
+        if page.html is not None or page.name == "contents":
+            continue
+        figure = page.draw()
+        try:
+            bold = [text.get_text() for text in figure.texts if text.get_weight() == "bold"
+                    and text.get_position()[1] > 0.95 and text.get_fontsize() >= 9.0 - 1e-9]
+        finally:
+            plt.close(figure)
+        assert bold == [page.title], (page.name, bold, page.title)
+        checked.append(page.name)
+    assert {"sensitivity", "applicability", "efficiency"} & set(checked) and TITLE_SIZE >= 9, checked

@@ -584,3 +584,24 @@ def test_the_shipped_soils_colours_differ_in_hue_not_shade():
         assert apart >= 40, (soil_a, a, soil_b, b, apart)
     assert not {c.lower() for c in SOIL_COLOURS.values()} & {RECOMMENDED_STYLE["color"], RIGID_STYLE["color"],
                                                              "#000000", "black"}
+
+
+def test_the_contents_column_break_never_cuts_an_entry():
+    """Cold read 8, user C13: a wrapped contents entry ("Fragility by model: enclosure E-1 (a solid block 1.2 m ×
+    3.0" / "m, 4.5 t)") was cut by the column break. Wherever the break falls, each entry's lines, and a section
+    heading with the page row under it, stay in one column; every line is placed once, in order."""
+    from rockfrag.report import CONTENTS_LINES, contents_layout
+
+    long = "Fragility by model: enclosure E-1 (a solid block 1.2 m × 3.0 m, 4.5 t), with a title that wraps"
+    for lead in range(CONTENTS_LINES - 4, CONTENTS_LINES + 1):
+        rows = [("page", f"page {i}", i) for i in range(lead)] + [("section", "Fragility", lead),
+                                                                  ("page", long, lead), ("page", long, lead + 1)]
+        placed = contents_layout(rows)
+        order = [column * CONTENTS_LINES + line for column, line, *_ in placed]
+        assert order == sorted(set(order)) and all(line < CONTENTS_LINES for _, line, *_ in placed)
+        section = next(p for p in placed if p[3] == "Fragility")
+        first_entry = [p for p in placed if p[2] == "page" and not p[3].startswith("page ")]
+        wraps = len(first_entry) // 2
+        assert wraps >= 2, first_entry  # the long title wraps: the test can fail
+        assert {p[0] for p in first_entry[:wraps]} == {section[0]}, (lead, placed[-8:])
+        assert len({p[0] for p in first_entry[wraps:]}) == 1, (lead, placed[-8:])

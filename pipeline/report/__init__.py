@@ -467,7 +467,8 @@ def plan(results: Results) -> list[Page]:
         showcase_name = names.get(str(showcase.attrs.get("showcase_block", "")))
         planned.append(_figure("showcase-processing", "Showcase record", f"{record}: raw and processed",
                                pages.showcase_ground_page, showcase, caption=CAPTIONS["showcase-processing"]))
-        planned.append(_figure("showcase-response", "Showcase record", f"{record}: rocking on each soil",
+        planned.append(_figure("showcase-response", "Showcase record",
+                               pages.showcase_response_title(showcase, showcase_name),
                                pages.showcase_response_page, showcase,
                                caption=CAPTIONS["showcase-response"] + pages.quiet_words(showcase),
                                name=showcase_name))
@@ -494,9 +495,10 @@ def plan(results: Results) -> list[Page]:
                                + (NOTES_WORDS if pages.has_page_notes(fragility, block, soils=extremes) else ""),
                                marks=results.marks(block), name=names[block]))
     if "median_sensitivity" in fragility:
-        planned.append(_figure("sensitivity", "Fragility", "Model uncertainty: sensitivity of the median",
+        governing_by_soil = governing_states(results)
+        planned.append(_figure("sensitivity", "Fragility", pages.sensitivity_title(fragility, governing_by_soil),
                                pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names,
-                               governing=governing_states(results)))
+                               governing=governing_by_soil))
     for block in blocks:
         planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
                                pages.outcomes_page, fragility, block,
@@ -511,20 +513,20 @@ def plan(results: Results) -> list[Page]:
                                    vertical_page, results.vertical, block, caption=CAPTIONS["vertical"],
                                    marks=results.marks(block), name=names[block]))
     if any(m.rigid_base for m in models) and any(not m.rigid_base for m in models):
-        planned.append(_figure("applicability", "Applicability", "Applicability of the rigid-base model",
+        planned.append(_figure("applicability", "Applicability", pages.applicability_title(cube),
                                pages.applicability_page, cube, caption=CAPTIONS["applicability"]
                                + (SWEEP_NEXT if results.applicability is not None
                                   and "peak_angle_ratio_to_housner" in results.applicability else ""),
                                names=names))
     if results.applicability is not None and "peak_angle_ratio_to_housner" in results.applicability:
-        planned.append(_figure("applicability-sweep", "Applicability", "Rigid-base error against soil stiffness",
+        planned.append(_figure("applicability-sweep", "Applicability", pages.sweep_title(results.applicability),
                                pages.sweep_page, results.applicability,
                                caption=CAPTIONS["applicability-sweep"] + sweep_words(results.applicability)
                                        + f" Median over "
                                        f"{results.applicability.attrs.get('n_records', '?')} records that survived "
                                        "in both models.", names=names))
     if results.efficiency is not None and "dispersion" in results.efficiency:
-        planned.append(_figure("efficiency", "Measure efficiency", "Efficiency of intensity measures",
+        planned.append(_figure("efficiency", "Measure efficiency", pages.EFFICIENCY_TITLE,
                                pages.efficiency_page, results.efficiency,
                                caption=CAPTIONS["efficiency"] + _twins_words(results.efficiency)
                                + measure_choice_words(results.efficiency, names, results.hazard is not None),
@@ -574,27 +576,50 @@ def contents_rows(planned: list[Page], position: int = 2) -> list[tuple[str, str
     return rows
 
 
+def contents_layout(rows) -> list[tuple[int, int, str, str, int | None]]:
+    """Where each line of the contents goes: (column, line, kind, text, page number or None), in order.
+
+    Titles wrap at ``CONTENTS_WIDTH``; an entry's lines (and a section heading with the page row below it) stay
+    in one column: the column break never cuts an entry (cold read 8, user C13: "... 1.2 m × 3.0" ended one
+    column and "m, 4.5 t)" began the next).
+    """
+    entries = []  # the lines of each entry; a section heading without a number joins the page row below it
+    for index, (kind, text, number) in enumerate(rows):
+        heads = kind == "section" and index + 1 < len(rows) and rows[index + 1][0] == "page"
+        if heads:
+            number = None  # the page row below carries it
+        wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" or number is not None else 0)) or [""]
+        lines = [(kind, line, number if index == 0 else None) for index, line in enumerate(wrapped)]
+        if entries and entries[-1][1]:
+            entries[-1][0].extend(lines)
+            entries[-1][1] = False
+        else:
+            entries.append([lines, heads])
+    placed, slot = [], 0
+    for lines, _ in entries:
+        column, line = divmod(slot, CONTENTS_LINES)
+        if line + len(lines) > CONTENTS_LINES and line:
+            slot = (column + 1) * CONTENTS_LINES
+        placed += [(*divmod(slot + offset, CONTENTS_LINES), *entry) for offset, entry in enumerate(lines)]
+        slot += len(lines)
+    return placed
+
+
 def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
     """The contents: every section and page title with its page number (the contents itself is page ``position``).
 
     Titles are wrapped, never cut; the HTML links every page and every section.
     """
-    rows = contents_rows(planned, position)
-    lines = []
-    for index, (kind, text, number) in enumerate(rows):
-        if kind == "section" and index + 1 < len(rows) and rows[index + 1][0] == "page":
-            number = None  # the page row below carries it
-        wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" or number is not None else 0)) or [""]
-        lines += [(kind, line, number if index == 0 else None) for index, line in enumerate(wrapped)]
+    placed = contents_layout(contents_rows(planned, position))
+    slot = placed[-1][0] * CONTENTS_LINES + placed[-1][1] + 1 if placed else 0
 
     def draw():
         figure = new_page("Contents")
-        columns = max(1, -(-len(lines) // CONTENTS_LINES))
+        columns = max(1, -(-slot // CONTENTS_LINES))
         size = 8.5 if columns <= 2 else 7
-        step = min(0.85 / min(len(lines), CONTENTS_LINES) if lines else 0.02, 0.024)
+        step = min(0.85 / min(slot, CONTENTS_LINES) if placed else 0.02, 0.024)
         width = 0.97 / columns
-        for index, (kind, text, number) in enumerate(lines):
-            column, line = divmod(index, CONTENTS_LINES)
+        for column, line, kind, text, number in placed:
             x, y = 0.02 + column * width, 0.925 - line * step
             indent = 0.0 if kind == "section" else 0.012
             figure.text(x + indent, y, text, fontsize=size, weight="bold" if kind == "section" else "normal",

@@ -391,16 +391,24 @@ def quiet_words(showcase) -> str:
             "the flat panels are a result, not a missing run.")
 
 
+def showcase_response_title(showcase, name: str | None = None) -> str:
+    """The showcase response page's title, as drawn and as the contents lists it.
+
+    "<record>: the <block>, rocking on each soil", the block's R and α after a name that does not give them.
+    """
+    block = showcase.attrs["showcase_block"]
+    size = f"R = {float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g}"
+    shown = name or block
+    return (f"{record_words(showcase)}: the {shown}" + ("" if "R = " in shown else f" ({size} rad)")
+            + ", rocking on each soil")
+
+
 def showcase_response_page(showcase, caption, name: str | None = None):
     """Ground motion on top, then per soil theta(t) (left) and the rise of the base centre or pivot, up + (right).
 
     One y-scale per column, time cropped to the strong motion.
     """
-    block = showcase.attrs["showcase_block"]
-    size = f"R = {float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g}"
-    shown = name or block
-    figure = new_page(f"{record_words(showcase)}: the {shown}" + ("" if "R = " in shown else f" ({size} rad)")
-                      + ", rocking on each soil", caption)
+    figure = new_page(showcase_response_title(showcase, name), caption)
     soils = [s for s in dict.fromkeys(map(str, showcase.case_soil.values)) if s] or [""]
     models = models_of(xr.Dataset(coords={"model": list(dict.fromkeys(map(str, showcase.case_model.values)))}))
     styles = model_styles(models)
@@ -1103,6 +1111,12 @@ def no_ratio_reason(cube, block, soil, models, band) -> str:
     return "no run rocked without overturning in both models there"
 
 
+def applicability_title(cube) -> str:
+    """The applicability page's title, as drawn and as the contents lists it."""
+    reference = next(m for m in models_of(cube) if m.rigid_base)
+    return f"Applicability of the rigid base: each foundation model over {panel_label(reference)}"
+
+
 def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     """Median peak angle of each foundation model over the rigid-base reference against G_s, per block.
 
@@ -1116,8 +1130,7 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     founded = [m for m in models if not m.rigid_base]
     styles = model_styles(models)
     names = names or {}
-    figure = new_page(f"Applicability of the rigid base: each foundation model over {panel_label(reference)}",
-                      caption)
+    figure = new_page(applicability_title(cube), caption)
     axis = panels(figure, gridspec_kw=dict(top=0.85))[0, 0]
     shear = cube.soil_shear_modulus.values / 1e6
     order = np.argsort(shear)
@@ -1179,13 +1192,18 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
     return figure
 
 
+def sweep_title(dataset) -> str:
+    """The stiffness sweep page's title, as drawn and as the contents lists it."""
+    tolerance = float(dataset.attrs.get("tolerance", 0.1))
+    return f"Rigid-base error against soil stiffness (grey: ±{tolerance:.0%}; green: paper's 300-1000 MPa)"
+
+
 def sweep_page(dataset, caption, names: dict | None = None):
     """The fine G_s sweep of `rockfrag applicability`: rows are the compliant models, columns the blocks."""
     tolerance = float(dataset.attrs.get("tolerance", 0.1))
     blocks = list(dataset.block.values)
     models = list(dataset.model.values)
-    figure = new_page(f"Rigid-base error against soil stiffness (grey: ±{tolerance:.0%}; green: paper's "
-                      "300-1000 MPa)", caption)
+    figure = new_page(sweep_title(dataset), caption)
     axes = panels(figure, len(models), len(blocks), sharey=True, gridspec_kw=dict(hspace=0.6, top=0.8))  # 3-line titles
     shear = dataset.shear_modulus.values / 1e6
     dash = ["-", "--", ":", "-."]
@@ -1286,6 +1304,9 @@ def test_words(test, dataset, names: dict | None = None) -> str:
             f"{soils_words(test.soils, list(dataset.soil.values))}{records}")
 
 
+EFFICIENCY_TITLE = "Efficiency of intensity measures: which one predicts overturning best"
+
+
 def efficiency_page(dataset, caption, names: dict | None = None):
     """Which intensity measure predicts overturning best, from ``efficiency.nc``: one bar per independent test.
 
@@ -1299,7 +1320,7 @@ def efficiency_page(dataset, caption, names: dict | None = None):
     from rockfrag.efficiency import CONFIDENCE, dispersion_interval
 
     names = names or {}
-    figure = new_page("Efficiency of intensity measures: which one predicts overturning best", caption,
+    figure = new_page(EFFICIENCY_TITLE, caption,
                       caption_lines=EFFICIENCY_CAPTION_LINES)
     room = caption_room(EFFICIENCY_CAPTION_LINES)
     top, bottom = panels(figure, 2, 1, gridspec_kw=dict(hspace=0.45, left=0.085, bottom=GRID["bottom"] + room))[:, 0]
@@ -1368,6 +1389,12 @@ def sensitivity_state(fragility) -> str:
     return "overturning" if "overturning" in states else states[-1]
 
 
+def sensitivity_title(fragility, governing: dict | None = None) -> str:
+    """The model-uncertainty page's title, as drawn and as the contents lists it."""
+    what = "each soil's governing damage state" if governing else sensitivity_state(fragility)
+    return f"Model uncertainty: which parameter moves the recommended median ({what})"
+
+
 def sensitivity_page(fragility, caption, names: dict | None = None, governing: dict | None = None):
     """Which sampled parameter moves the recommended median most, per block and soil (``median_sensitivity``).
 
@@ -1380,8 +1407,7 @@ def sensitivity_page(fragility, caption, names: dict | None = None, governing: d
     names, governing = names or {}, governing or {}
     default = sensitivity_state(fragility)
     blocks = list(map(str, fragility.block.values))
-    what = "each soil's governing damage state" if governing else default
-    figure = new_page(f"Model uncertainty: which parameter moves the recommended median ({what})", caption)
+    figure = new_page(sensitivity_title(fragility, governing), caption)
     rows, columns = _grid(len(blocks))
     grid = dict(hspace=0.7 if governing else 0.55, wspace=0.3)
     if governing:  # the governing states' words under each panel need room above the caption
