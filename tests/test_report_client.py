@@ -298,5 +298,20 @@ def test_the_contents_list_each_figure_page_by_the_title_it_draws(small_pipeline
         finally:
             plt.close(figure)
         assert bold == [page.title], (page.name, bold, page.title)
+        assert ") (" not in page.title, page.title  # "enclosure E-1 (a solid block ...) (R = 1.62 m, ...)"
         checked.append(page.name)
     assert {"sensitivity", "applicability", "efficiency"} & set(checked) and TITLE_SIZE >= 9, checked
+
+
+def test_the_showcase_title_gives_r_and_alpha_without_a_second_pair_of_parentheses():
+    """Cold read 8: "the enclosure E-1 (a solid block 1.2 m × 3.0 m, 4.5 t) (R = 1.62 m, α = 0.381 rad)"."""
+    from rockfrag.report.figures import showcase_response_title
+
+    showcase = xr.Dataset(attrs={"showcase_block": "enclosure", "block_R_m": 1.6155, "block_alpha_rad": 0.3805,
+                                 "showcase_event": "Duzce, Turkey", "showcase_station": "Bolu",
+                                 "showcase_component": "BOL090"})
+    title = showcase_response_title(showcase, "enclosure E-1 (a solid block 1.2 m × 3.0 m, 4.5 t)")
+    assert title == ("Duzce, Turkey, Bolu station, component 090: the enclosure E-1 (a solid block 1.2 m × 3.0 m, "
+                     "4.5 t), R = 1.62 m, α = 0.381 rad, rocking on each soil"), title
+    named = showcase_response_title(showcase, "block (R = 1.62 m, α = 0.381)")
+    assert named.endswith(": the block (R = 1.62 m, α = 0.381) rocking on each soil"), named

@@ -394,13 +394,14 @@ def quiet_words(showcase) -> str:
 def showcase_response_title(showcase, name: str | None = None) -> str:
     """The showcase response page's title, as drawn and as the contents lists it.
 
-    "<record>: the <block>, rocking on each soil", the block's R and α after a name that does not give them.
+    "<record>: the <block> rocking on each soil", the block's R and α after a name that does not give them (commas,
+    not a second pair of parentheses after a name with its own).
     """
     block = showcase.attrs["showcase_block"]
     size = f"R = {float(showcase.attrs['block_R_m']):.3g} m, α = {float(showcase.attrs['block_alpha_rad']):.3g}"
     shown = name or block
-    return (f"{record_words(showcase)}: the {shown}" + ("" if "R = " in shown else f" ({size} rad)")
-            + ", rocking on each soil")
+    return (f"{record_words(showcase)}: the {shown}" + ("" if "R = " in shown else f", {size} rad,")
+            + " rocking on each soil")
 
 
 def showcase_response_page(showcase, caption, name: str | None = None):
