@@ -315,3 +315,22 @@ def test_the_showcase_title_gives_r_and_alpha_without_a_second_pair_of_parenthes
                      "4.5 t), R = 1.62 m, α = 0.381 rad, rocking on each soil"), title
     named = showcase_response_title(showcase, "block (R = 1.62 m, α = 0.381)")
     assert named.endswith(": the block (R = 1.62 m, α = 0.381) rocking on each soil"), named
+
+
+def test_running_text_names_a_block_without_its_sizes(small_pipeline):
+    """Cold read 8, user C1: "enclosure E-1 (a solid block 1.2 m × 3.0 m, 4.5 t)" stood whole about 30 times, inside
+    sentences too. Titles, tables and the summary keep the whole name; running text drops the closing sizes."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.adapters import block_name, short_block_name
+    from rockfrag.report.sections import methods_items
+
+    config = SimpleNamespace(raw={"report": {"block_names": {
+        "enclosure": "enclosure E-1 (a solid block 1.2 m × 3.0 m, 4.5 t)", "bare": "(2 t)"}}})
+    assert short_block_name(config, "enclosure") == "enclosure E-1"
+    assert short_block_name(config, "bare") == "(2 t)" and short_block_name(config, "other") == "other"
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    settlement = next(item.text for item in methods_items(results) if "m g / k" in item.text or "m·g/k" in item.text)
+    for block in map(str, results.cube.block.values):
+        short, whole = short_block_name(results.config, block), block_name(results.config, block)
+        assert short != whole and f"{short}: " in settlement and f"{whole}: " not in settlement, settlement

@@ -11,7 +11,7 @@ import re
 import numpy as np
 import xarray as xr
 
-from rockfrag.report.adapters import block_name
+from rockfrag.report.adapters import block_name, short_block_name
 from tests.helpers import ROOT, pipeline_results
 
 
@@ -49,7 +49,7 @@ def test_sliding_limitation_says_which_runs_slide(small_pipeline):
         assert "runs with base friction" in sentence
         for block in map(str, cube.block.values):
             soils = [str(s) for s in cube.soil.values if bool(on.sel(block=block, soil=s))]
-            name = block_name(config, block)
+            name = short_block_name(config, block)  # running text: the name without its sizes
             if not soils:
                 assert f"the {name} on" not in sentence
             elif len(soils) == cube.sizes["soil"]:
@@ -170,7 +170,7 @@ def test_levels_are_stated_per_block_as_multiples_of_its_uplift(small_pipeline):
     for index, block in enumerate(map(str, cube.block.values)):
         row = np.asarray(multiples.sel(block=block).values, float)
         levels = np.asarray(cube.intensity.sel(block=block).values, float)
-        assert f"{block_name(results.config, block)} {row.min():.2g} to {row.max():.3g} times, " \
+        assert f"{short_block_name(results.config, block)} {row.min():.2g} to {row.max():.3g} times, " \
                f"{levels.min():.2g} to {levels.max():.2g} g" in text
     overall = np.asarray(multiples.values, float)
     assert f"{overall.min():.3g} to {overall.max():.3g} times the uplift intensity of each block" not in text

@@ -406,6 +406,17 @@ def block_name(config, block) -> str:
     return str(names.get(str(block)) or block)
 
 
+def short_block_name(config, block) -> str:
+    """The block's name in running text: ``block_name`` without a closing parenthesis of sizes.
+
+    "enclosure E-1 (a solid block 1.2 m × 3.0 m, 4.5 t)" reads "enclosure E-1" inside a sentence; titles, tables
+    and the summary keep the whole name, which says what is modelled (cold read 8, user C1: the whole name stood
+    about 30 times, inside sentences too). A name that is only a parenthesis stays whole.
+    """
+    name = block_name(config, block)
+    return re.sub(r"\s*\([^()]*\)$", "", name) or name
+
+
 def block_description(config, block) -> str:
     """The study's description of the block (its ``why``), or ""."""
     for item in getattr(config, "blocks", ()) or ():

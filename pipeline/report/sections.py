@@ -56,6 +56,7 @@ from rockfrag.report.adapters import (
     record_pga_g,
     run_fraction,
     scale_factor_summary,
+    short_block_name,
     short_label,
     sliding_candidates,
     sliding_share,
@@ -630,7 +631,7 @@ def fitted_items(results: Results) -> list[Item]:
                           "uplift intensities (each record's pair RotD50 over its own peak; Methods, 'Fragility "
                           "fits'), not a record-to-record dispersion of a response like the other cells' β."))
     if "†" in marks:
-        largest = ", ".join(f"{block_name(results.config, b)} {v:.2g} {shown_unit}"
+        largest = ", ".join(f"{short_block_name(results.config, b)} {v:.2g} {shown_unit}"
                             for b, v in results.largest_recorded.items())
         items.append(note(f"† the median lies above the largest intensity any record reached unscaled ({largest}): "
                           "it comes from records scaled up beyond what they recorded (extrapolation by scaling)."))
@@ -829,7 +830,7 @@ def _sliding_first_levels(config) -> str:
     if config.level_range is None or not early:
         return ""
     start = config.level_range[0]
-    said = "; ".join(f"{block_name(config, block.name)}: {start:g} × {ratio * block.b / block.h:.2g} g, about "
+    said = "; ".join(f"{short_block_name(config, block.name)}: {start:g} × {ratio * block.b / block.h:.2g} g, about "
                      f"{ratio * start:.2g} times its uplift intensity" for block, ratio in zip(config.blocks, ratios)
                      if ratio < 1)
     return (f" A block that slides before it can rock on one of the soils (static friction μ_s below its b/h) starts "
@@ -934,7 +935,7 @@ def methods_items(results: Results) -> list[Item]:
         weight = float(cube.block_mass.sel(block=block)) * STANDARD_GRAVITY
         return _g(weight / float(stiffness.sel(soil=soil, block=block)) * 1e3)
 
-    settlement = "; ".join(f"{block_name(config, b)}: " + ", ".join(f"{soil} {settles(b, soil)}"
+    settlement = "; ".join(f"{short_block_name(config, b)}: " + ", ".join(f"{soil} {settles(b, soil)}"
                                                                      for soil in cube.soil.values)
                            for b in cube.block.values)
     items.append(note(f"Static settlement m·g/k of each block on its bed [mm], from which a lift is counted ('Reading "
@@ -961,7 +962,7 @@ def methods_items(results: Results) -> list[Item]:
     text = intensity_definition(cube) + " "
     per_block = "intensity" in cube.variables and "block" in cube["intensity"].dims
     if relative and per_block and "level_multiple" in cube.variables:  # each block's own multiples of its uplift
-        ranges = "; ".join(f"{block_name(config, b)} {row.min():.2g} to {row.max():.3g} times, "
+        ranges = "; ".join(f"{short_block_name(config, b)} {row.min():.2g} to {row.max():.3g} times, "
                            f"{block_levels(cube, b).min() * scale:.2g} to {block_levels(cube, b).max() * scale:.2g} "
                            f"{unit}" for b, row in zip(cube.block.values, levels))
         text += (f"Each processed record is scaled linearly to {levels.shape[1]} levels of {measure} per block, "
@@ -974,7 +975,7 @@ def methods_items(results: Results) -> list[Item]:
                  f"{levels.min():.3g} to {levels.max():.3g}"
                  f"{' times the uplift intensity of each block' if relative else ''}, spacing {spacing}.")
         if per_block:
-            ranges = "; ".join(f"{block_name(config, b)} {block_levels(cube, b).min() * scale:.2g} to "
+            ranges = "; ".join(f"{short_block_name(config, b)} {block_levels(cube, b).min() * scale:.2g} to "
                                f"{block_levels(cube, b).max() * scale:.2g} {unit}" for b in cube.block.values)
             text += f" Each block has its own levels ({ranges})."
     reason = cube.attrs.get("credible_intensity_reason", "")
@@ -1270,7 +1271,7 @@ def _cells_words(config, cells, blocks, soils) -> str:
     for block in blocks:
         on = [soil for soil in soils if (block, soil) in cells]
         if on:
-            parts.append(f"the {block_name(config, block)} on {_soils_words(on, soils)}")
+            parts.append(f"the {short_block_name(config, block)} on {_soils_words(on, soils)}")
     return "; ".join(parts)
 
 
@@ -1342,7 +1343,7 @@ def limitations_items(results: Results) -> list[Item]:
             items.append(paragraph(f"{model.label}: the foundation never pulled on the block."))
             continue
         worst = fraction.where(fraction == fraction.max(), drop=True)
-        most = (f", most often for the {block_name(config, worst.block.values[0])} on {worst.soil.values[0]} "
+        most = (f", most often for the {short_block_name(config, worst.block.values[0])} on {worst.soil.values[0]} "
                 f"({_percent(float(fraction.max()))})") if fraction.size > 2 else ""
         items.append(paragraph(
             f"{model.label}: the foundation pulled on the block (negative support force) in {_percent(overall)} of "
@@ -1549,7 +1550,7 @@ def _other_direction_words(config, cube) -> str:
             continue
         across, studied = depth / (2 * item.h), item.b / item.h
         way = "the same as" if np.isclose(across, studied, rtol=1e-3) else "stockier than"
-        said.append(f"{block_name(config, item.name)} b/h {across:.2g} across its {depth:.3g} m depth, {way} the "
+        said.append(f"{short_block_name(config, item.name)} b/h {across:.2g} across its {depth:.3g} m depth, {way} the "
                     f"{studied:.2g} studied")
     if not said:
         return ""

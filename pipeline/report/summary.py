@@ -19,7 +19,7 @@ import numpy as np
 
 from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT, display_scale
 from rockfrag.report import numbers
-from rockfrag.report.adapters import block_name, is_soil, state_labels
+from rockfrag.report.adapters import block_name, is_soil, short_block_name, state_labels
 from rockfrag.report.text import Item, bullet, note, paragraph, strong, table
 
 ACTION_WORDS = {ANCHOR: "anchor or restrain", CHECK_SLIDING: "specialist check",
@@ -301,7 +301,7 @@ def weaker_direction_words(results) -> str:
         if per_metre(depth):
             strips.append(block_name(results.config, block.name))
         elif depth < 2 * block.b * (1 - 1e-9):
-            said.append(f"{block_name(results.config, block.name)} (b/h {depth / (2 * block.h):.2g} across its "
+            said.append(f"{short_block_name(results.config, block.name)} (b/h {depth / (2 * block.h):.2g} across its "
                         f"{depth:.3g} m depth)")
     text = ("Judged across the width only, not across a less stable depth: " + "; ".join(said) + ".") if said else ""
     if strips:
@@ -540,7 +540,7 @@ def terminal_verdicts(results) -> str:
 
 def verdict_items(results, answer) -> list[Item]:
     """The answer page's verdict: the summary's rows of this block, as a sentence per soil group."""
-    name = block_name(results.config, answer.block)
+    name = short_block_name(results.config, answer.block)
     groups: dict[str, list] = {}
     for soil in answer.soils:
         groups.setdefault(soil.verdict, []).append(soil)
