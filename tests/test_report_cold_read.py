@@ -11,6 +11,7 @@ import re
 import numpy as np
 import xarray as xr
 
+from rockfrag.report import numbers
 from rockfrag.report.adapters import block_name, short_block_name
 from tests.helpers import ROOT, pipeline_results
 
@@ -481,8 +482,9 @@ def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed
     vertical, rocking, settlement = bed_frequencies(config, block, gravel)
     assert words.startswith("On gravel this block lifts off at a lower median than on sand and rock "
                             "(0.20 g against 0.31 g and 0.33 g)")
-    assert f"a vertical frequency of {vertical:.2g} Hz" in words
-    assert f"a rocking frequency (whole base down) of {rocking:.2g} Hz, {1 / rocking:.2g} s" in words
+    two = numbers.two_figures
+    assert f"a vertical frequency of {two(vertical)} Hz" in words
+    assert f"a rocking frequency (whole base down) of {two(rocking)} Hz, {two(1 / rocking)} s" in words
     assert f"the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s" in words
     assert "damping, calibrated to the impact restitution, is the study's lowest on gravel" in words
     assert words.index("damping") < words.index("vertical frequency")  # the likely reason comes first
@@ -1086,3 +1088,43 @@ def test_the_title_page_lists_blocks_and_models_without_parentheses_inside_paren
     assert depth == 0 and deepest == 1, first
     assert any("(" in model.label for model in models_of(results.cube)), "the test needs a label with parentheses"
     assert " models: " in first and (" block: " in first or " blocks: " in first), first
+
+
+def test_a_lift_off_well_below_g_tan_alpha_is_explained_by_the_beds_rocking_mode():
+    """Cold read 8, default C7: the cabinet lifted off at 0.097 g on clay, half its rigid-base g·tanα = 0.20 g, and
+    the page said only "earlier on a compliant bed". The answer page names the soils below 0.8 g·tanα with their
+    shares, the bed's rocking frequency on each (rockfrag's closed form, bed_frequencies) and the records' band,
+    and bounds the static part, h·δ/b² (two-spring bed: (k b² − m g h) θ = m a h, lift at θ = δ/b)."""
+    from types import SimpleNamespace
+
+    import xarray as xr
+
+    from rockfrag.config import load_study
+    from rockfrag.report.answer_page import EARLY_LIFT, bed_frequencies, early_lift_words
+    from tests.helpers import ROOT
+
+    config = load_study(ROOT / "pipeline" / "defaults.toml")
+    soils = [soil.name for soil in config.soils]
+    block = next(block for block in config.blocks if block.name == "slender-cabinet")
+    rigid = block.b / block.h
+    assert abs(rigid - 0.2) < 1e-9 and config.calibrates_bed
+    medians = xr.DataArray([[[[0.097, 0.099, 0.12, 0.17, 0.24]]]], dims=("model", "block", "damage_state", "soil"),
+                           coords={"model": ["recommended"], "block": [block.name], "damage_state": ["uplift"],
+                                   "soil": soils}, attrs={"units": "9.80665 m s-2"})
+    results = SimpleNamespace(fragility=xr.Dataset({"median": medians}), config=config, showcase=None,
+                              cube=xr.Dataset(attrs={"intensity_measure": "pga"}))
+    answer = SimpleNamespace(model="recommended", block=block.name, unit="g")
+    words = early_lift_words(results, answer)
+    assert words.startswith("Below the rigid base's g·tanα = 0.20 g: this block lifts off at a median of 0.097 g on "
+                            "clay, 0.099 g on sand and 0.12 g on gravel (0.49, 0.50 and 0.60 times g·tanα)"), words
+    assert "rock" not in words.split("(rocking")[0].replace("rocks", "")  # 0.17 g is 0.85 of it: not early
+    for soil in config.soils[:3]:
+        rocking = bed_frequencies(config, block, soil)[1]
+        assert f"{soil.name} {numbers.two_figures(rocking)} Hz, {numbers.two_figures(1 / rocking)} s" in words
+    clay = config.soils[0]
+    static = block.h * bed_frequencies(config, block, clay)[2] / block.b ** 2
+    assert f"{numbers.two_figures(100 * static)}% at most" in words and static < 0.02
+    medians[:] = [[[[0.2, 0.2, 0.12, 0.2, 0.2]]]]  # an early dip below its neighbours: bed_resonance_words' case
+    assert 0.12 < EARLY_LIFT * rigid and early_lift_words(results, answer) == ""
+    medians[:] = [[[[0.19, 0.19, 0.19, 0.2, 0.21]]]]
+    assert early_lift_words(results, answer) == ""

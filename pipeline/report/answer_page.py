@@ -627,9 +627,10 @@ def bed_resonance_words(results, answer) -> str:
             if "soil" in xi.dims and str(xi.idxmin("soil").values) == soil.name:
                 text += (f" A likely reason: the bed's damping, calibrated to the impact restitution, is the "
                          f"study's lowest on {soil.name}, and a less damped bed lets the block rebound off it sooner.")
-        text += (f" The bed on {soil.name} has a vertical frequency of {vertical:.2g} Hz and a rocking frequency "
-                 f"(whole base down) of {rocking:.2g} Hz, {1.0 / rocking:.2g} s "
-                 f"({'; '.join(f'{n} {f:.2g} Hz, {1.0 / f:.2g} s' for n, f in grounds[1:])})")
+        hz = numbers.two_figures  # "2.0 Hz", not "2 Hz": both figures (cold read 8)
+        text += (f" The bed on {soil.name} has a vertical frequency of {hz(vertical)} Hz and a rocking frequency "
+                 f"(whole base down) of {hz(rocking)} Hz, {hz(1.0 / rocking)} s "
+                 f"({'; '.join(f'{n} {hz(f)} Hz, {hz(1.0 / f)} s' for n, f in grounds[1:])})")
         if band is not None:
             inner = [name for name, frequency in grounds if inside(frequency)]
             said = ("all within" if len(inner) == len(grounds) else f"{_and(inner)} within" if inner
@@ -642,6 +643,65 @@ def bed_resonance_words(results, answer) -> str:
                  f"rises by the static settlement, {settlement * 1000:.2g} mm on {soil.name}.")
         texts.append(text)
     return " ".join(texts)
+
+
+EARLY_LIFT = 0.8
+"""A lift-off median below this share of the rigid base's g·tanα is explained on the answer page (early_lift_words)."""
+
+
+def early_lift_words(results, answer) -> str:
+    """A sentence on the soils where the block lifts off well below g·tanα, the rigid base's uplift acceleration.
+
+    Cold read 8 (default C7): the cabinet lifted off at 0.097 g on clay, half its 0.20 g, and the page said only
+    "earlier on a compliant bed". On the two-spring bed the static give lowers lift-off by g·tanα·h·δ/b² (δ the
+    static settlement: under 2 % for every shipped block and soil), so the reason is dynamic: the block rocks on the
+    springs before a corner lifts, and where that mode's period lies in the records' strongest band the ground
+    builds the rocking up. Soils ``bed_resonance_words`` explains (a median below both neighbours') are left to
+    it. "" for a PGA-less measure, a model without a bed, or where every median is at least ``EARLY_LIFT`` of it.
+    """
+    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
+    if (answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None
+            or str(cube.attrs.get("intensity_measure", "")).lower() != "pga" or answer.unit != "g"
+            or not getattr(config, "calibrates_bed", False)):
+        return ""
+    block = next((block for block in config.blocks if block.name == answer.block), None)
+    if block is None:
+        return ""
+    rigid = block.b / block.h  # g tan(alpha), in g
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    soils = sorted((soil for soil in config.soils if soil.name in fragility.soil.values),
+                   key=lambda soil: soil.shear_modulus)
+    medians = {soil.name: float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name,
+                                                        damage_state="uplift")) * scale for soil in soils}
+    explained = {soils[i].name for i in range(1, len(soils) - 1)
+                 if np.isfinite([medians[s.name] for s in soils[i - 1:i + 2]]).all()
+                 and medians[soils[i].name] < min(medians[soils[i - 1].name], medians[soils[i + 1].name])}
+    early = [soil for soil in soils if np.isfinite(medians[soil.name]) and medians[soil.name] < EARLY_LIFT * rigid
+             and soil.name not in explained]
+    if not early:
+        return ""
+    band = records_band(getattr(results, "showcase", None))
+    values = _and([f"{numbers.intensity(medians[soil.name], answer.unit)} on {soil.name}" for soil in early])
+    shares = _and([f"{medians[soil.name] / rigid:.2f}" for soil in early])
+    modes = []
+    for soil in early:
+        _, rocking, _ = bed_frequencies(config, block, soil)
+        if np.isfinite(rocking):
+            inside = band is not None and band[0] <= 1.0 / rocking <= band[1]
+            outside = "" if inside or band is None else ", outside the band"
+            modes.append(f"{soil.name} {numbers.two_figures(rocking)} Hz, {numbers.two_figures(1.0 / rocking)} s"
+                         f"{outside}")
+    give = max(block.h * bed_frequencies(config, block, soil)[2] / block.b ** 2 for soil in early)
+    text = (f"Below the rigid base's g·tanα = {numbers.intensity(rigid, answer.unit)}: this block lifts off at a "
+            f"median of {values} ({shares} times g·tanα). On its bed it rocks on the springs before a corner lifts")
+    if modes:
+        text += f" (rocking frequency with the whole base down: {'; '.join(modes)}"
+        text += (f"; the records' strongest band {band[0]:.2g} to {band[1]:.2g} s)" if band is not None else ")")
+    text += (", and ground motion near that period builds the rocking up until a corner loses contact; on a rigid "
+             "base the block does not move before the ground reaches g·tanα. The bed's static give alone lowers "
+             f"the lift-off by the share h·δ/b² of it (δ the static settlement), {numbers.two_figures(100 * give)}% "
+             "at most here.")
+    return text
 
 
 MOTIONS = ("at rest", TILT_WORDS, "slides", "rocks", "slides and rocks", "flies", "overturns")
@@ -814,7 +874,8 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                     if cube is not None else measure, answer.model)
     # one paragraph per subject (restitution, friction, the bed's lift-off, the measure): not one wall of text
     for text in (curve_reason(results, answer.model, answer.block), slides_first_words(results, answer),
-                 slides_then_words(results, answer), bed_resonance_words(results, answer), sufficiency):
+                 slides_then_words(results, answer), bed_resonance_words(results, answer),
+                 early_lift_words(results, answer), sufficiency):
         if text:
             items.append(paragraph(text.strip()))
     if not answer.return_periods:
