@@ -53,6 +53,21 @@ geometric mean of the class bounds in ft/s (D: sqrt(600 x 1200) x 0.3048 = 259 m
 Vs30 of the NGA-West2 site term's data (rockfrag.site_amplification.VS30_DATA)."""
 
 
+EC8_GROUND_TYPES = {"A": (800.0, math.inf), "B": (360.0, 800.0), "C": (180.0, 360.0), "D": (0.0, 180.0)}
+"""Ground types by Vs30 [m/s], (lower, upper], EN 1998-1:2004 (Eurocode 8) Table 3.1: A rock > 800; B very dense
+sand, gravel or very stiff clay 360-800; C dense or medium-dense sand, gravel or stiff clay 180-360; D loose-to-
+medium cohesionless or soft-to-firm cohesive soil < 180. E, S1 and S2 are defined by the profile (a 5-20 m alluvium
+layer over rock; soft high-plasticity clays; liquefiable soils), not by Vs30 alone: a site investigation names them.
+A Vs30 on a bound is given the softer type, as ``site_class`` does."""
+
+
+def ec8_ground_type(vs30: float | None) -> str:
+    """The Eurocode 8 ground type ("A"-"D", ``EC8_GROUND_TYPES``) of a site's Vs30 [m/s]; "" for None."""
+    if vs30 is None:
+        return ""
+    return next(name for name, (low, high) in EC8_GROUND_TYPES.items() if low < vs30 <= high)
+
+
 def site_class(vs30: float | None) -> str:
     """The ASCE 7-16 site class ("A"-"E", ``SITE_CLASSES``) of a site's Vs30 [m/s]; "" for None (the reference site).
 

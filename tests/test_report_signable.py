@@ -276,7 +276,10 @@ def test_the_methods_say_how_each_soils_site_hazard_is_made(small_pipeline):
     assert f"Vs30 {results.config.reference_vs30:,.0f}" in text
     rows = {row[0]: row for row in items[1].rows}
     for soil in results.config.soils:
-        assert rows[soil.name][1] == f"{soil.vs30:,.0f}" and rows[soil.name][2] == soil.site_class
+        assert rows[soil.name][1] == f"{soil.vs30:,.0f}" and rows[soil.name][2].split(" / ")[0] == soil.site_class
+    # cold read 8, user C12: a European site's engineer reads Eurocode 8 ground types beside the ASCE classes
+    assert items[1].header[2] == "site class: ASCE 7 / EC8" and "EN 1998-1 Table 3.1" in text
+    assert rows["sand"][2] == "D / C"  # Vs30 260 m/s: ASCE 7 D (180-360), EC8 C (180-360)
 
 
 def test_the_limitations_give_each_blocks_depth_and_density_and_speak_of_cranes_only_for_one(small_pipeline):

@@ -52,6 +52,16 @@ def test_the_shipped_soils_stand_for_site_classes():
         ["E", "D", "D", "C", "B", "B", "A"]
 
 
+def test_eurocode_8_ground_types_follow_en_1998_1_table_3_1():
+    """EN 1998-1:2004 Table 3.1 by Vs30 [m/s]: A > 800, B 360-800, C 180-360, D < 180 (a bound: the softer type)."""
+    from rockfrag.soils import ec8_ground_type
+
+    assert [ec8_ground_type(v) for v in (100.0, 180.0, 180.1, 360.0, 360.1, 800.0, 800.1, 3000.0)] == \
+        ["D", "D", "C", "C", "B", "B", "A", "A"]
+    assert {name: ec8_ground_type(soil.vs30) for name, soil in SOILS.items()} == {
+        "clay": "D", "sand": "C", "gravel": "B", "rock": "A", "steel": ""}
+
+
 def test_the_user_states_a_sites_vs30(tmp_path):
     path = study_file(tmp_path, '[hazard]\nvs30 = { steel = 400.0, sand = 200.0 }\n'
                       '[soils_custom.loam]\nshear_modulus = 50e6\nvs30 = 300.0\n', '["sand", "steel", "loam"]')

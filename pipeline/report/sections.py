@@ -72,7 +72,7 @@ from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong,
 from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, formulas, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
-from rockfrag.soils import SOILS
+from rockfrag.soils import SOILS, ec8_ground_type
 from rockfrag.units import STANDARD_GRAVITY
 from rockfrag.version import __version__
 
@@ -671,10 +671,11 @@ def site_hazard_items(results: Results) -> list[Item]:
         under = f"{math.sqrt(soil.shear_modulus / soil.density):,.0f}"  # the bed's own shear-wave speed
         if soil.vs30 is None or soil.vs30 == sites.reference_vs30:
             reference.append(soil.name)
-            rows.append([soil.name, f"{sites.reference_vs30:,.0f} (the reference site)", "-",
+            rows.append([soil.name, f"{sites.reference_vs30:,.0f} (the reference site)",
+                         f"- / {ec8_ground_type(sites.reference_vs30)}",
                          "the reference curve itself", under if is_soil(results.cube, soil.name) else "-"])
         else:
-            rows.append([soil.name, f"{soil.vs30:,.0f}", soil.site_class,
+            rows.append([soil.name, f"{soil.vs30:,.0f}", f"{soil.site_class} / {ec8_ground_type(soil.vs30)}",
                          site_term_words(sites, soil.name, results.return_periods), under])
             if soil.vs30 > VS_GAP * math.sqrt(soil.shear_modulus / soil.density):
                 gaps.append(soil.name)
@@ -687,7 +688,9 @@ def site_hazard_items(results: Results) -> list[Item]:
             f"soil's Vs30 within its site class (a standard deviation of ln Vs30 of {config.vs30_sigma:g}) "
             "convolved into the curve (Bazzurro & Cornell 2004). Each soil's Vs30 is the value that stands for its "
             "site class in the USGS hazard tools (ASCE 7-16 Table 20.3-1's classes), not a measurement: a site's "
-            "measured Vs30 replaces it (the appendix names the setting).")
+            "measured Vs30 replaces it (the appendix names the setting). Beside each class, the Eurocode 8 ground "
+            "type of the same Vs30 (EN 1998-1 Table 3.1, by Vs30 alone: types E, S1 and S2 depend on the profile, "
+            "which a site investigation gives).")
     if steel:
         text += (f" A structural base ({', '.join(steel)}) keeps the reference curve: a plate at ground level "
                  "under the reference site's ground motion, not a floor or deck of a structure, whose motion (a "
@@ -700,7 +703,7 @@ def site_hazard_items(results: Results) -> list[Item]:
         text += (f" On {', '.join(gaps)} the Vs30 is more than {VS_GAP:g} times the bed's own speed: the hazard's "
                  "site is stiffer ground than the bed (for rock, another site class); a site investigation gives "
                  "both, and its values replace these (the appendix names the settings).")
-    return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class", "site hazard",
+    return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class: ASCE 7 / EC8", "site hazard",
                                     "√(G/ρ) of the bed [m/s]"], rows)]
 
 
