@@ -108,9 +108,9 @@ REFERENCES = {
                  "ASCE/SEI 7-22 (risk-targeted ground motions: 1% probability of collapse in 50 years).",
     "ASCE 7-16": "ASCE (2017). Minimum Design Loads and Associated Criteria for Buildings and Other Structures, "
                  "ASCE/SEI 7-16 (Table 20.3-1: site classes by Vs30).",
-    "EN 1998-1": "CEN (2004). Eurocode 8: Design of structures for earthquake resistance, Part 1: General rules, "
-                 "seismic actions and rules for buildings, EN 1998-1:2004 (Table 3.1: ground types, by Vs30 A > 800, "
-                 "B 360-800, C 180-360, D < 180 m/s; E, S1 and S2 by the profile).",
+    "EN 1998": "CEN (2004). Eurocode 8: Design of structures for earthquake resistance, Part 1: General rules, "
+               "seismic actions and rules for buildings, EN 1998-1:2004 (Table 3.1: ground types, by Vs30 A > 800, "
+               "B 360-800, C 180-360, D < 180 m/s; E, S1 and S2 by the profile).",
     "ASCE 4-16": "ASCE (2017). Seismic Analysis of Safety-Related Nuclear Structures, ASCE/SEI 4-16 (the range of "
                  "soil stiffness to analyse, G(1 + C_v) to G/(1 + C_v)).",
     "USGS hazard tools": "U.S. Geological Survey, National Seismic Hazard Model project: the nshmp-haz code and the "
