@@ -409,3 +409,19 @@ def test_the_methods_give_the_sliding_first_levels_start_in_numbers():
 
     words = _sliding_first_levels(load_study("studies/user-site.toml"))
     assert "0.5 × 0.35 g, about 0.44 times its uplift intensity" in words, words
+
+
+def test_the_dagger_note_gives_one_largest_intensity_once_when_every_block_shares_it(small_pipeline):
+    """Cold read 8's default fitted table: "(solid block ... 0.78 g, slender ... 0.78 g, squat ... 0.78 g)": one
+    record set, one value, said three times. Said once ("0.78 g, every block"); per block only where they differ."""
+    from rockfrag.report.sections import fitted_items
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    blocks = list(map(str, results.cube.block.values))
+    assert len(blocks) > 1
+    results.largest_recorded = dict.fromkeys(blocks, 0.01)  # below every median: every cell gets its dagger
+    dagger = next(item.text for item in fitted_items(results) if item.text.startswith("† "))
+    assert "(0.01 g, every block)" in dagger, dagger
+    results.largest_recorded = {block: 0.01 * (index + 1) for index, block in enumerate(blocks)}
+    dagger = next(item.text for item in fitted_items(results) if item.text.startswith("† "))
+    assert "every block" not in dagger and "0.02 g" in dagger, dagger

@@ -631,8 +631,11 @@ def fitted_items(results: Results) -> list[Item]:
                           "uplift intensities (each record's pair RotD50 over its own peak; Methods, 'Fragility "
                           "fits'), not a record-to-record dispersion of a response like the other cells' β."))
     if "†" in marks:
-        largest = ", ".join(f"{short_block_name(results.config, b)} {v:.2g} {shown_unit}"
-                            for b, v in results.largest_recorded.items())
+        values = {f"{v:.2g} {shown_unit}" for v in results.largest_recorded.values()}
+        largest = (f"{values.pop()}{', every block' if len(results.largest_recorded) > 1 else ''}"
+                   if len(values) == 1 else  # one record set for all: said once, not per block
+                   ", ".join(f"{short_block_name(results.config, b)} {v:.2g} {shown_unit}"
+                             for b, v in results.largest_recorded.items()))
         items.append(note(f"† the median lies above the largest intensity any record reached unscaled ({largest}): "
                           "it comes from records scaled up beyond what they recorded (extrapolation by scaling)."))
     return items

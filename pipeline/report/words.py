@@ -59,8 +59,7 @@ SWITCH_WORDS = {
 
 BED_WORDS = {
     "continuous": "springs and dashpots over the whole footprint",
-    "two-spring": "the bed's stiffness k (the whole bed's, as tabulated) as two springs and dashpots, k/2 under each "
-                  "corner",
+    "two-spring": "two springs and dashpots, k/2 under each corner (k the whole bed's stiffness, as tabulated)",
     "hunt-crossley": "springs over the footprint with impact damping that vanishes with the penetration",
 }
 """The tensionless bed's contact law in words."""
