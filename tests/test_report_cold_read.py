@@ -877,9 +877,11 @@ def test_a_block_modelled_per_metre_of_its_length_is_not_said_to_have_a_less_sta
     skid = SimpleNamespace(name="skid", b=1.5, h=2.0, footprint_area=6.0)
     words = weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(strip, skid), raw={})))
     assert words.startswith("Judged across the width only, not across a less stable depth: skid (b/h 0.5"), words
-    assert "wall (b/h" not in words and "less stable depth): wall." in words, words
+    assert "wall (b/h" not in words and "The wall is computed per metre of a long wall-like block" in words, words
     alone = weaker_direction_words(SimpleNamespace(config=SimpleNamespace(blocks=(strip,), raw={})))
-    assert alone.startswith("Per metre of a long wall-like block") and "Judged" not in alone, alone
+    # cold read 9: the sentence had no verb ("Per metre of a long wall-like block (...): wall.")
+    assert alone == ("The wall is computed per metre of a long wall-like block (the plane model; no less stable "
+                     "depth)."), alone
 
 
 def test_a_probability_read_below_the_lowest_level_is_marked_as_the_fit_extrapolated():
@@ -894,7 +896,7 @@ def test_a_probability_read_below_the_lowest_level_is_marked_as_the_fit_extrapol
     assert _below_levels_mark("3.8%", row, 0) == f"3.8%{BELOW_LEVELS_MARK}"
     assert _below_levels_mark("< 0.1%", row, 0) == f"< 0.1%{BELOW_LEVELS_MARK}"
     assert _below_levels_mark("7.5%", row, 1) == "7.5%"
-    for cell in ("not reached", "0 of 44", "≥ 19%", "-"):
+    for cell in ("not reached", "≈ 0 (0/44)", "≥ 19%", "-"):
         assert _below_levels_mark(cell, row, 0) == cell
     assert BELOW_LEVELS_WORDS.startswith(f"{BELOW_LEVELS_MARK} read at a site intensity below the lowest level run")
 

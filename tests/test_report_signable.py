@@ -64,14 +64,15 @@ def test_the_answers_say_a_slip_state_counts_overturning(small_pipeline):
     assert "so a milder state is never less likely than a more severe one." not in text
 
 
-def test_a_state_without_a_curve_prints_the_records_count_not_zero_percent():
+def test_a_state_without_a_curve_prints_the_records_share_not_zero_percent():
     """The default report printed '0%' at a return period for states whose median lies above the credible cap
-    (no curve: the records' fraction at the level, none of 44): a client reads it as impossible. It prints the
-    count; a fitted curve's value below 0.1% stays '< 0.1%'."""
+    (no curve: the records' fraction at the level, none of 44): a client reads it as impossible. Then it printed
+    the count, '0 of 44', which cold read 9 read as a count in a probability column. It prints the share, about
+    zero: '≈ 0 (0/44)'; a fitted curve's value below 0.1% stays '< 0.1%'."""
     from rockfrag.report.summary import p_at_return_period
 
     no_curve = _row("overturning", 4e-4, at=0.0, records=((0, 44, 0.35),) * 3)
-    assert [p_at_return_period(no_curve, i, (0.35, 0.47, 0.67)) for i in range(3)] == ["0 of 44"] * 3
+    assert [p_at_return_period(no_curve, i, (0.35, 0.47, 0.67)) for i in range(3)] == ["≈ 0 (0/44)"] * 3
     fitted = _row("overturning", 4e-4, at=2e-5, records=((0, 44, 0.35),) * 3)
     assert p_at_return_period(fitted, 0, (0.35, 0.47, 0.67)) == "< 0.1%"
 
@@ -570,5 +571,33 @@ def test_the_sensitivity_page_of_five_soils_and_mixed_states_keeps_its_words_off
     try:
         assert layout_defects(figure) == []
         assert "* no median" in figure.axes[0].get_xlabel().replace("\n", " ")
+    finally:
+        plt.close(figure)
+
+
+def test_the_site_hazard_page_ends_at_the_highest_level_and_marks_the_site_intensities(small_pipeline):
+    """Cold read 9 (default B5): the site hazard's axis ran to 10 g while the study stops at 3 g, and it marked no
+    intensity although the methods say every intensity axis does. The axis ends at the highest level run; beyond
+    the largest unscaled record it is shaded; each soil's site intensity at each return period is a point on its
+    curve at 1/T, the values the answer pages print."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report import build_plan, hazard_marks
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    marks = hazard_marks(results)
+    page = next(page for page in build_plan(results) if page.name == "hazard")
+    figure = page.draw()
+    try:
+        axis = figure.axes[0]
+        assert axis.get_xlim()[1] <= marks["highest"] * (1 + 1e-9) and marks["highest"] < 10
+        shaded = [patch for patch in axis.patches if patch.get_label().startswith("beyond the largest")]
+        assert shaded and shaded[0].get_x() == pytest.approx(marks["largest"])
+        points = {(round(float(x), 9), round(float(y), 12)) for line in axis.get_lines() if line.get_marker() == "o"
+                  for x, y in zip(line.get_xdata(), line.get_ydata())}
+        answer = results.answers[0]
+        expected = {(round(float(im), 9), round(1.0 / t, 12)) for soil in answer.soils
+                    for im, t in zip(soil.intensities, answer.return_periods)}
+        assert expected and expected <= points, (expected - points)
     finally:
         plt.close(figure)

@@ -425,3 +425,63 @@ def test_the_dagger_note_gives_one_largest_intensity_once_when_every_block_share
     results.largest_recorded = {block: 0.01 * (index + 1) for index, block in enumerate(blocks)}
     dagger = next(item.text for item in fitted_items(results) if item.text.startswith("† "))
     assert "every block" not in dagger and "0.02 g" in dagger, dagger
+
+
+def test_survivals_above_a_first_overturning_level_are_sized_on_the_recommended_curves():
+    """Cold read 9 (default B8): "131 times here a record survived a level above its first overturning level" did
+    not say how many fall on the verdicts' curves nor what they are worth. Synthetic records overturn from a level
+    on; some survive the level above. Counted as survivals the median can only rise (fewer exceedances at every
+    level), and a cell without survivals is not refitted; the sentence gives the count and the rise."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    import xarray as xr
+
+    from rockfrag.cube import OUTCOME_NO_UPLIFT, OUTCOME_OVERTURNED, OUTCOME_ROCKING
+    from rockfrag.report.sections import _survivals, survival_shifts
+
+    rng = np.random.default_rng(7)
+    levels = np.geomspace(0.2, 3.0, 10)
+    capacity = np.exp(rng.normal(np.log(0.8), 0.4, 60))
+    first = (levels[None, :] >= capacity[:, None])
+    outcome = np.where(first, OUTCOME_OVERTURNED, OUTCOME_ROCKING).astype(float)
+    survivors = np.flatnonzero(first.any(1))[:9]
+    for record in survivors:  # the level above the first overturning one: survived
+        level = int(np.argmax(first[record]))
+        if level + 1 < levels.size:
+            outcome[record, level + 1] = OUTCOME_ROCKING
+    outcome[:, 0] = np.where(first[:, 0], OUTCOME_OVERTURNED, OUTCOME_NO_UPLIFT)
+    soils, models = ["clay", "sand"], ["housner", "recommended"]
+    cube_outcome = np.broadcast_to(outcome[:, :, None, None, None], (60, 10, 2, 1, 2)).copy()
+    cube_outcome[:, :, 1, :, :] = np.where(first, OUTCOME_OVERTURNED, OUTCOME_ROCKING)[:, :, None, None]  # sand: none
+    cube = xr.Dataset({"outcome": (("record", "im_level", "soil", "block", "model"), cube_outcome),
+                       "intensity": (("block", "im_level"), levels[None])},
+                      coords={"soil": soils, "block": ["box"], "model": models})
+    resurrected = np.array([[[len(survivors), len(survivors)]], [[0, 0]]])  # (soil, block, model)
+    fragility = xr.Dataset({"n_resurrected": (("soil", "block", "model"), resurrected)},
+                           coords={"soil": soils, "block": ["box"], "model": models})
+    results = SimpleNamespace(cube=cube, fragility=fragility, config=SimpleNamespace(raw={}, blocks=()))
+    answering, changes = survival_shifts(results)
+    assert answering == len(survivors) and set(changes) == {("box", "clay")}, changes
+    assert 0 < changes[("box", "clay")] < 0.5
+    text = _survivals(results, 2 * len(survivors))
+    assert text.startswith(f"{2 * len(survivors)} times here a record survived") and \
+        f"; {len(survivors)} of them on the recommended curves: counted as survivals instead" in text, text
+    assert "(box)" in text
+
+
+def test_one_meaning_of_the_star_and_the_dash_between_the_reading_guide_and_the_glossary(small_pipeline):
+    """Cold read 9 (default B7): the glossary gave '*' to a probability read below the lowest level, the reading guide
+    spoke only of '-' there. '*' marks the fitted curve carried outside the levels (a median, or a probability read
+    below them); '-' is the records' table's cell there; both pages say so."""
+    from rockfrag.report.answer_page import BELOW_LEVELS_MARK, reading_items
+    from rockfrag.report.summary import GOVERNING_WORDS
+    from rockfrag.report.words import GLOSSARY
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    guide = " ".join(item.text for item in reading_items(results))
+    assert f"extrapolated below the levels run, and carries '{BELOW_LEVELS_MARK}'" in guide
+    marks = next(text for key, text in GLOSSARY if key.startswith("marks"))
+    assert "* the fitted curve carried outside the intensities run" in marks and "shows '-'" in marks
+    # cold read 9 (default B6): the ranking of two states under the print floor was invisible
+    assert "nearest its limit as a share of it, a value under the print floor at its own value" in GOVERNING_WORDS

@@ -204,8 +204,10 @@ CAPTIONS = {
     "hazard": "Read how often each intensity is exceeded at the site, per year: each soil's curve (its colour) and "
               "the reference site's it is carried from (black dashed; a soil's curve stops where the given one "
               "ends, at its rarest frequency); dotted, the frequencies of the return periods "
-              "(where a curve crosses one, the site's intensity of that return period, as the answer pages print "
-              "it). A soft soil's curve can fall below the reference site's at strong shaking: the site term's "
+              "(a point where a curve crosses one: the site's intensity of that return period, as the answer pages "
+              "print it); grey shading: beyond the largest recorded intensity; the axis ends at the highest "
+              "intensity studied. A soft soil's curve can fall below the reference site's at strong shaking: the "
+              "site term's "
               "nonlinear part de-amplifies it (Methods); a site stiffer than the reference (a higher Vs30, "
               "legend) lies below it: its ground amplifies the motion less.",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled (the "
@@ -458,7 +460,7 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure("hazard", "Site hazard", "Site hazard: the hazard curve of each soil's site",
                                pages.hazard_page, results.site_hazards, results.return_periods,
                                caption=CAPTIONS["hazard"] + hazard_caption(results),
-                               unit=results.answers[0].unit))
+                               unit=results.answers[0].unit, **hazard_marks(results)))
     if showcase is not None and "record_spectrum" in showcase:
         planned.append(_figure("spectra", "Record spectra", "Response spectra of the record set", pages.spectra_page,
                                showcase, caption=CAPTIONS["spectra"]))
@@ -539,6 +541,20 @@ def plan(results: Results) -> list[Page]:
                               ("reproduce", "How to reproduce this report", "How to reproduce this report",
                                reproduce)])
     return planned
+
+
+def hazard_marks(results) -> dict:
+    """The site hazard page's marks (``hazard_page``), in the answer pages' unit.
+
+    The highest level run, the largest unscaled record, each soil's site intensity at each return period.
+    """
+    answer = results.answers[0]
+    scale = display_scale(str(results.cube["intensity"].attrs.get("units", "")))[0] \
+        if "intensity" in results.cube else 1.0
+    highest = float(results.cube["intensity"].max()) * scale if "intensity" in results.cube else None
+    largest = max(results.largest_recorded.values()) if results.largest_recorded else None
+    by_soil = {soil.soil: tuple(soil.intensities) for soil in answer.soils if soil.intensities}
+    return {"highest": highest, "largest": largest, "site_intensities": by_soil}
 
 
 def _slug(text: str) -> str:

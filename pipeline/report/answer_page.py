@@ -1183,7 +1183,8 @@ def reading_items(results) -> list[Item]:
                        "own value beside it). "
                        f"{no_curve_words(answers[0])} '-': no level was run as low as that intensity, so the records "
                        "say nothing there; a probability printed at such an intensity is the fitted curve's, "
-                       "extrapolated below the levels run."),
+                       f"extrapolated below the levels run, and carries '{BELOW_LEVELS_MARK}' (as a median outside the "
+                       "levels does in the fitted table)."),
              paragraph("Beside the probabilities, how many records reached each state at those levels: a "
                        "probability where none did is the fitted curve's tail alone. The recommended curve's β "
                        "includes the model's uncertainty besides the records' scatter, so at low intensity its "

@@ -276,12 +276,17 @@ def site_label(soil: str, curve) -> str:
     return f"{soil} (Vs30 {float(vs30):,.0f} m/s)" if vs30 is not None and np.isfinite(float(vs30)) else soil
 
 
-def hazard_page(sites, return_periods, caption, unit: str = "g"):
+def hazard_page(sites, return_periods, caption, unit: str = "g", highest: float | None = None,
+                largest: float | None = None, site_intensities: dict | None = None):
     """The hazard behind every probability: annual frequency of exceedance against the intensity, log-log.
 
     ``sites`` is the study's ``rockfrag.site_hazard.SiteHazards`` (each soil's curve, and the reference site's it
     was carried from, if any); the return periods' frequencies 1/T are dotted. A soil whose curve is the reference
-    one is named in the reference curve's legend entry.
+    one is named in the reference curve's legend entry. In the unit of the curves: ``highest`` the highest
+    intensity the study ran (the axis ends there: no verdict reads the curve beyond it), ``largest`` the largest
+    intensity of the unscaled records (shaded beyond, as on every intensity axis), ``site_intensities`` {soil:
+    its intensity at each return period}, drawn as points on its curve (cold read 9: the axis ran to 10 g and
+    marked no intensity).
     """
     figure = new_page("Site hazard: the hazard curve of each soil's site", caption)
     axis = panels(figure)[0, 0]
@@ -312,7 +317,23 @@ def hazard_page(sites, return_periods, caption, unit: str = "g"):
     axis.set_ylim(bottom, top)
     inside = np.concatenate([intensity[(frequency >= bottom) & (frequency <= 0.1)] for intensity, frequency in drawn])
     if inside.size:  # the intensities between 0.1/yr and the rarest frequency shown: the range a verdict reads
-        axis.set_xlim(inside.min(), inside.max())
+        right = min(inside.max(), highest) if highest else inside.max()
+        axis.set_xlim(inside.min(), right)
+    low, high = axis.get_xlim()
+    if largest is not None and np.isfinite(largest) and low < largest < high:
+        axis.axvspan(largest, high, **EXTRAPOLATION, label="beyond the largest recorded intensity: extrapolation "
+                                                           "by scaling")
+        axis.axvline(largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
+    points = [(soil, values) for soil, values in (site_intensities or {}).items() if soil in sites]
+    for index, (soil, values) in enumerate(points):
+        soils = list(sites)
+        colour = "black" if soil in same else soil_colour(soil, soils.index(soil))
+        axis.plot(list(values), [1.0 / t for t in periods][:len(values)], ls="none", marker="o", ms=4.5,
+                  color=colour, zorder=6)
+    if points:
+        axis.plot([], [], ls="none", marker="o", ms=4.5, color="0.3",
+                  label="points: each soil's site intensity at those return periods (the answer pages' site "
+                        f"{shown.label.split(' [')[0]})")
     axis.set_xlabel(f"{shown.label} [{unit}]")
     axis.set_ylabel("annual frequency of exceedance [1/yr]")
     finish_log_log(figure, axis, plain_y=False)

@@ -1005,8 +1005,8 @@ def methods_items(results: Results) -> list[Item]:
               paragraph(f"Damage states: {'; '.join(labels.values())}. Each soil × block × model × state is fitted by "
                         "maximum likelihood on the binomial counts per level (Baker 2015). A record counts as "
                         "overturned, and beyond every damage state, from its first overturning level on (Vamvatsikos "
-                        f"& Cornell 2002); {_survivals(resurrected)} The overturning capacities refined between the "
-                        "levels are fitted too, as a "
+                        f"& Cornell 2002); {_survivals(results, resurrected)} The overturning capacities refined "
+                        "between the levels are fitted too, as a "
                         "check (in the result tables: see 'How to reproduce this report'). "
                         f"Confidence bounds ({config.confidence:.0%}) from "
                         f"{fragility.attrs.get('bootstrap_samples', '?')} "
@@ -1046,12 +1046,65 @@ def soil_source_words(names: str, soils) -> str:
             f"names the setting). {xi}").strip()
 
 
-def _survivals(count: int) -> str:
-    """How often a record survived a level above its first overturning level, in words ("" when never)."""
+def _survivals(results, count: int) -> str:
+    """How often a record survived a level above its first overturning level, in words, and what it is worth.
+
+    Cold read 9 (default B8): "131 times ... counts as overturned there all the same" did not say how many fall on
+    the curves that give the verdicts, nor whether counting them as survivals would move a median. The answering
+    model's overturning curves are refitted both ways (maximum likelihood on the counts per level, Baker 2015);
+    the medians inside the studied range are compared.
+    """
     if not count:
         return "no record survived a level above its first overturning level."
-    return (f"{count} times here a record survived a level above its first overturning level, and it counts as "
-            "overturned there all the same.")
+    text = (f"{count} times here a record survived a level above its first overturning level, and it counts as "
+            "overturned there all the same")
+    shifts = survival_shifts(results)
+    if shifts is None:
+        return text + "."
+    answering, changes = shifts
+    text += f"; {answering} of them on the recommended curves"
+    if changes:
+        low, high = min(changes.values()), max(changes.values())
+        span = (f"by {numbers.two_figures(100 * high)}%" if numbers.two_figures(100 * low)
+                == numbers.two_figures(100 * high) else
+                f"by {numbers.two_figures(100 * low)}% to {numbers.two_figures(100 * high)}%")
+        names = sorted({short_block_name(results.config, block) for block, _ in changes})
+        text += (f": counted as survivals instead, their overturning medians inside the levels would rise {span} "
+                 f"({'; '.join(names)})")
+    return text + "."
+
+
+def survival_shifts(results) -> tuple[int, dict] | None:
+    """(survivals on the recommended model, {(block, soil): relative rise of its overturning median}) or None.
+
+    The rise is the median fitted with each run's own outcome over the median fitted with the first-overturning
+    convention (rockfrag.fragility.first_overturn_outcomes), both by ``fit_binomial``, for the (block, soil) cells
+    with survivals whose convention median lies inside the levels run. None without the recommended model.
+    """
+    from rockfrag.fragility import OUTCOME_OVERTURNED, first_overturn_outcomes
+    from rockfrag.lognormal_fit import fit_binomial
+
+    cube, fragility = results.cube, results.fragility
+    if RECOMMENDED not in cube.model.values or "n_resurrected" not in fragility \
+            or RECOMMENDED not in fragility.model.values:
+        return None
+    answering = int(fragility.n_resurrected.sel(model=RECOMMENDED).sum())
+    convention = first_overturn_outcomes(cube).sel(model=RECOMMENDED)
+    raw = cube.outcome.sel(model=RECOMMENDED)
+    changes = {}
+    for block in map(str, cube.block.values):
+        levels = cube.intensity.sel(block=block).values
+        for soil in map(str, cube.soil.values):
+            own, first = raw.sel(block=block, soil=soil), convention.sel(block=block, soil=soil)
+            total = np.isfinite(own).sum("record").values
+            kept, counted = ((outcome == OUTCOME_OVERTURNED).sum("record").values for outcome in (own, first))
+            if np.array_equal(kept, counted):
+                continue
+            median, _ = fit_binomial(levels, counted, total)
+            survived, _ = fit_binomial(levels, kept, total)
+            if np.isfinite(median) and np.isfinite(survived) and levels.min() <= median <= levels.max():
+                changes[(block, soil)] = survived / median - 1.0
+    return answering, changes
 
 
 def client_words(text: str) -> str:

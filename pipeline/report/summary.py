@@ -208,7 +208,8 @@ def governing(soil) -> object | None:
 
 
 GOVERNING_WORDS = ("Governing: the state furthest above its limit; where none is above, the computed state nearest "
-                   "its limit (a state no record reached has only a bound, '< X', and governs only where all do).")
+                   "its limit as a share of it, a value under the print floor at its own value (a state no record "
+                   "reached has only a bound, '< X', and governs only where all do).")
 """How the summary picks the state it prints (``governing``), said in its note."""
 
 
@@ -236,9 +237,18 @@ def p_at_return_period(row, index: int, intensities) -> str:
         return "not reached"
     if row.below_lowest is not None:
         return numbers.bound(p, "≥") if np.isfinite(p) else "-"
-    if p == 0 and row.records and row.records[index][0] == 0:  # no curve, no record at the level: say the count
-        return numbers.count(0, row.records[index][1])
+    if p == 0 and row.records and row.records[index][0] == 0:  # no curve, no record at the level: the share
+        return no_curve_cell(row.records[index][1])
     return numbers.probability(p)
+
+
+def no_curve_cell(total: int) -> str:
+    """The probability cell of a state without a curve that no record reached at the level: "≈ 0 (0/44)".
+
+    Cold read 6 read '0%' as impossible, so the cell gave the count, "0 of 44"; cold read 9 read a count in a
+    probability column. The cell is the records' share, 0/44, said to be about zero, not zero.
+    """
+    return f"≈ 0 (0/{int(total)})"
 
 
 def say_p_in_life(results, answer, soil, row) -> str:
@@ -247,12 +257,12 @@ def say_p_in_life(results, answer, soil, row) -> str:
 
 
 def no_curve_words(answer) -> str:
-    """What a count in a probability cell means ("0 of 44": ``p_at_return_period`` of a state without a curve)."""
+    """What a share of no records in a probability cell means ("≈ 0 (0/44)": ``no_curve_cell``)."""
     total = next((record[1] for soil in answer.soils for row in soil.states for record in row.records), None)
-    example = f"'0 of {total}'" if total else "'0 of n'"
-    return (f"{example} in a probability cell: the state has no fitted curve (its median lies above the highest "
-            "intensity studied) and no record reached it at that level, so the records give no probability there, "
-            "only that it is small; the probability in the design life bounds it.")
+    example = f"'{no_curve_cell(total)}'" if total else "'≈ 0 (0/n)'"
+    return (f"{example}: no fitted curve (its median lies above the highest intensity studied) and none of the "
+            f"{total or 'n'} records reached the state at that level: small, not zero; the design-life value bounds "
+            "it.")
 
 
 def say_p_at(results, answer, soil, row, index: int) -> str:
@@ -299,14 +309,15 @@ def weaker_direction_words(results) -> str:
             continue
         depth = area / (2 * block.b)
         if per_metre(depth):
-            strips.append(block_name(results.config, block.name))
+            strips.append(short_block_name(results.config, block.name))
         elif depth < 2 * block.b * (1 - 1e-9):
             said.append(f"{short_block_name(results.config, block.name)} (b/h {depth / (2 * block.h):.2g} across its "
                         f"{depth:.3g} m depth)")
     text = ("Judged across the width only, not across a less stable depth: " + "; ".join(said) + ".") if said else ""
     if strips:
-        text += (" " if text else "") + ("Per metre of a long wall-like block (the plane model; no less stable "
-                                         f"depth): {'; '.join(strips)}.")
+        # a sentence with its verb (cold read 9: "Per metre of a long wall-like block (...): solid block ..." had none)
+        text += (" " if text else "") + (f"The {_and(strips)} {'is' if len(strips) == 1 else 'are'} computed per "
+                                         "metre of a long wall-like block (the plane model; no less stable depth).")
     return text
 
 
@@ -434,11 +445,11 @@ def summary_items(results) -> list[Item]:
                                  "verdict.")]
     said = " ".join(words for key, words in legend if any(key in cell for cell in used))
     cells = " ".join(cell for row in rows for cell in row[3:3 + len(periods) + 1])
-    bounds = " ".join(words for words, shown in ((BOUND_WORDS, "< "), (no_curve_words(first), " of "))
+    bounds = " ".join(words for words, shown in ((BOUND_WORDS, "< "), (no_curve_words(first), "≈ 0 ("))
                       if shown in cells)
     if any(row[-1].startswith(FRACTIONS_REASON) for row in rows):
         bounds += (" 'No fit' (reason): the same, with the design-life value from the records' share at each level."
-                   if " of " in cells else " 'No fit' (reason): the state's median lies above the highest intensity "
+                   if "≈ 0 (" in cells else " 'No fit' (reason): the state's median lies above the highest intensity "
                    "studied, so no curve is fitted; its probabilities come from the records' share at each level.")
     items.append(note(" ".join(filter(None, [
         said, GOVERNING_WORDS, bounds, scaled_medians_words(results), structural_base_words(results),

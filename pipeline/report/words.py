@@ -175,8 +175,9 @@ GLOSSARY = (
      "slips and rocks in the same record (slides and rocks); the rocking angle reaches the overturning angle "
      "(overturns). Each record is counted once, under the most severe motion it made."),
     ("marks *, †, ‡, §, ≥, <", "the marks of the tables, each explained under its table and in 'Reading the "
-     "answer pages': * a median outside the intensities run, or a probability at a site intensity below the lowest "
-     "level run (the fitted curve's tail); † a median above the largest intensity any record reached unscaled "
+     "answer pages': * the fitted curve carried outside the intensities run: a median outside them, or a "
+     "probability read at a site intensity below the lowest level run (where the records' table shows '-'); "
+     "† a median above the largest intensity any record reached unscaled "
      "(extrapolation by scaling); ‡ a fitted curve that fails its goodness-of-fit test; § a value driven by the "
      "base friction; '≥ X', '< X' a bound where the records give no fitted value."),
     ("anchor (verdict)", "the block must not stand free; the report does not size the anchorage, which is designed "
