@@ -99,7 +99,8 @@ REFERENCES = {
                            "for 2000 SAC Federal Emergency Management Agency steel moment frame guidelines. "
                            "Journal of Structural Engineering 128(4), 526-533.",
     "FEMA P695": "FEMA (2009). Quantification of Building Seismic Performance Factors, FEMA P695. Federal "
-                 "Emergency Management Agency, Washington DC (the far-field and near-field record sets).",
+                 "Emergency Management Agency, Washington DC (its far-field and near-field record sets; the methods "
+                 "name the one this study runs).",
     "FEMA P-58": "FEMA (2018). Seismic Performance Assessment of Buildings, FEMA P-58, 2nd ed. Federal Emergency "
                  "Management Agency, Washington DC (fragility functions, combined dispersion of record-to-record "
                  "and model uncertainty).",
@@ -217,8 +218,8 @@ GLOSSARY = (
     ("restitution", "the share of rocking speed a block keeps at each impact; Housner's rigid base gives "
                     "r = 1 − 1.5 sin²α, and experiments on rigid bases find about that value or a few percent more "
                     "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
-    ("record sets", "the earthquake records the study runs: FEMA P695's far-field set, and its near-field set "
-                    "(records with and without a velocity pulse)."),
+    ("record sets", "the sets of earthquake records the tool ships: FEMA P695's far-field set, and its near-field "
+                    "set (records with and without a velocity pulse); the methods name the set this study runs."),
     ("flies, free flight", "the whole base leaves the ground, a corner at least the uplift size: after an "
                            "impact on a bed (the block bounces), or in free flight, where the ground drops faster "
                            "than gravity (g + a_v < 0 under the vertical component, only where a study applies "
