@@ -269,6 +269,10 @@ class StateAnswer:
         The probability in the design life from the intensities at and above ``first_reached`` only (0
         when no record reached the state, NaN when unknown): what is left when the fitted curve's tail
         below the data is cut off.
+    above_cap_share : float
+        The share of ``annual_frequency`` that is the bound for the hazard above the highest intensity studied
+        (every stronger motion counted as reaching the state: fragility.nc ``annual_frequency_above_cap``); a
+        value that is mostly this term is a bound, not a computed probability (cold read 9).
     below_lowest : tuple of (float, int, int) or None
         Where the fitted median lies below the lowest level run (the records reached the state already
         there): that level (shown unit) and how many of how many records reached the state at it. The
@@ -287,6 +291,7 @@ class StateAnswer:
     first_reached: float | None = None
     supported_probability: float = float("nan")
     below_lowest: tuple | None = None
+    above_cap_share: float = 0.0
 
     @property
     def exceeds(self) -> bool:
@@ -582,8 +587,11 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | Mapping[str, Haza
                         frequency = float(empirical[0] * hazard_frequency(site, float(levels[0])))
                         probability = float(risk_probability_in_life(frequency, design_life))
                         supported = probability
+                above = float(row["annual_frequency_above_cap"]) if "annual_frequency_above_cap" in row else 0.0
+                cap_share = above / frequency if np.isfinite(above) and frequency > 0 and below is None \
+                    and not_reached is None else 0.0
                 rows.append(StateAnswer(state, at, frequency, probability, limits.get(state), not_reached, records,
-                                        first, supported, below))
+                                        first, supported, below, cap_share))
             rows = nested(rows, families)
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:

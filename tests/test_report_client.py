@@ -334,3 +334,10 @@ def test_running_text_names_a_block_without_its_sizes(small_pipeline):
     for block in map(str, results.cube.block.values):
         short, whole = short_block_name(results.config, block), block_name(results.config, block)
         assert short != whole and f"{short}: " in settlement and f"{whole}: " not in settlement, settlement
+
+
+def test_no_page_speaks_of_how_the_report_was_reviewed(small_pipeline):
+    """The developers' notes ('cold read 9', 'finding 30') belong in the code, not on a page: the whole report,
+    appendix included, names none."""
+    html = (small_pipeline.output / "report.html").read_text()
+    assert not re.findall(r"(?i)\bcold read\b|\bfindings? \d", html)

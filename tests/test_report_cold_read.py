@@ -7,6 +7,7 @@ from __future__ import annotations
 import html as html_module
 import math
 import re
+from types import SimpleNamespace
 
 import numpy as np
 import xarray as xr
@@ -674,7 +675,9 @@ def test_the_sufficiency_sentence_names_the_runs_its_test_rests_on():
     words = sufficiency_words(efficiency, "box", "pga", "PGA", "recommended")
     assert words.startswith("At a given PGA this block's overturning still depends on the records' pulse period in "
                             "the runs of Housner (rigid base) on sand, the only runs the test covers; the recommended "
-                            "model's were not tested, so whether they depend on it is not known (the "
+                            "model's were not tested (its base slides, and the study refines overturning capacities, "
+                            "which the test needs, only where the base is tied), so whether they depend on it is not "
+                            "known (the "
                             "measure-efficiency page"), words  # cold read 7: 'not in' read as 'tested, no dependence'
 
     p[0, 0, 0, 0] = 1e-3  # the same on every soil (a tied rigid base): no soil named
@@ -1130,3 +1133,67 @@ def test_a_lift_off_well_below_g_tan_alpha_is_explained_by_the_beds_rocking_mode
     assert 0.12 < EARLY_LIFT * rigid and early_lift_words(results, answer) == ""
     medians[:] = [[[[0.19, 0.19, 0.19, 0.2, 0.21]]]]
     assert early_lift_words(results, answer) == ""
+
+
+def test_a_friction_just_above_b_over_h_says_what_the_low_friction_run_does():
+    """Cold read 9, user B2: sand's μ_s 0.45 is 12.5% above the enclosure's b/h 0.40, inside the sample's friction
+    factor 1.2; its low-friction run (μ_s 0.375) slides first, and its rocking median moved from 0.97 g to 2.97 g
+    while the page spoke of clay's friction only. Such a soil gets a sentence with the medians that move; clay
+    (below b/h: slides_first_words' case) and a soil far above b/h do not."""
+    from types import SimpleNamespace
+
+    import xarray as xr
+
+    from rockfrag.config import load_study
+    from rockfrag.report.answer_page import friction_margin_words
+    from rockfrag.report.summary import short_names
+    from tests.helpers import ROOT
+
+    config = load_study(ROOT / "studies" / "user-site.toml")
+    assert [soil.name for soil in config.soils] == ["clay", "sand"] and config.design.friction_factor == 1.2
+    states = ["uplift", "slip-0.05", "slip-0.30", "rocking-0.2", "rocking-0.5", "overturning"]
+    central = [[[[0.31, 0.69, 1.56, np.nan, np.nan, np.nan], [0.36, 0.98, 1.77, 0.97, 1.44, 2.0]]]]
+    low = [[[[0.33, 0.60, 1.40, np.nan, np.nan, np.nan]], [[0.43, 0.74, 1.70, 2.97, np.nan, np.nan]]]]
+    fragility = xr.Dataset(
+        {"median": (("model", "block", "soil", "damage_state"), central, {"units": "9.80665 m s-2"}),
+         "member_median": (("member", "soil", "block", "damage_state"), low)},
+        coords={"model": ["recommended"], "block": ["enclosure"], "soil": ["clay", "sand"], "damage_state": states,
+                "member": ["friction_low"]})
+    cube = xr.Dataset(coords={"block": ["enclosure"], "block_b": ("block", [0.6]), "block_h": ("block", [1.5])})
+    results = SimpleNamespace(fragility=fragility, cube=cube, config=config)
+    words = friction_margin_words(results, SimpleNamespace(model="recommended", block="enclosure", unit="g"))
+    assert words.startswith("On sand the base friction (μ_s 0.45) is only 13% above this block's b/h = 0.40: at the "
+                            "low end of its range (μ_s 0.375, a sensitivity run) the block slides before it can "
+                            "rock"), words
+    short = short_names(results)
+    assert f"{short['rocking-0.2']} from 0.97 g to 3.0 g" in words
+    assert f"{short['slip-0.05']} from 0.98 g to 0.74 g" in words
+    assert f"{short['rocking-0.5']} and {short['overturning']} lose their medians" in words
+    assert short["slip-0.30"] not in words  # 1.77 to 1.70 g: under 10%
+    assert "clay" not in words
+    fragility["member_median"][:] = fragility["median"].values.transpose(0, 2, 1, 3)  # the low run moves nothing
+    assert friction_margin_words(results, SimpleNamespace(model="recommended", block="enclosure", unit="g")) == ""
+
+
+def test_a_state_whose_value_is_mostly_the_bound_above_the_cap_does_not_govern_a_computed_one(small_pipeline):
+    """Cold read 9 (default text B1): overturning governed the paper block on gravel at 4.7% of its 1% limit, 93% of
+    it the bound for the shaking above 3 g (every stronger motion counted as overturning), over a computed slip at
+    3.0% of its limit; the summary printed three '≈ 0' and hid the slip row. Such a value ranks as a bound."""
+    from rockfrag.answer import StateAnswer
+    from rockfrag.report.summary import BOUND_SHARE, governing
+
+    def state(name, probability, limit, share):
+        return StateAnswer(name, ((0.0, np.nan, np.nan),) * 3, probability, probability, limit, None,
+                           above_cap_share=share)
+
+    slip = state("slip-0.30", 0.0030, 0.10, 0.0)
+    bounded = state("overturning", 0.00047, 0.01, 0.93)
+    soil = SimpleNamespace(states=[slip, bounded])
+    assert governing(soil) is slip
+    computed = state("overturning", 0.00047, 0.01, 0.2)
+    assert governing(SimpleNamespace(states=[slip, computed])) is computed  # mostly computed: nearer its limit
+    alone = SimpleNamespace(states=[bounded])
+    assert governing(alone) is bounded and BOUND_SHARE == 0.5  # only bounds: the nearest bound governs
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    shares = [row.above_cap_share for answer in results.answers for soil in answer.soils for row in soil.states]
+    assert shares and all(0.0 <= share <= 1.0 + 1e-9 for share in shares) and max(shares) > 0

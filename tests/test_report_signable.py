@@ -601,3 +601,20 @@ def test_the_site_hazard_page_ends_at_the_highest_level_and_marks_the_site_inten
         assert expected and expected <= points, (expected - points)
     finally:
         plt.close(figure)
+
+
+def test_a_calibrated_bed_damping_at_its_floor_is_marked_in_the_appendix():
+    """Cold read 9, user B1: the appendix gave 0.158 on clay and on sand, which read as a floor, not a calibration,
+    and nothing said so. A cell whose restitution is the most the bed reaches (the target at or above it) or whose
+    block's rocking dies (asked, none reached) is the least admissible damping: marked '(floor)'."""
+    from rockfrag.report.sections import at_damping_floor
+
+    soils, blocks = ["clay", "sand", "rock"], ["box"]
+    cube = xr.Dataset({
+        "restitution_requested": (("soil", "block", "model"), [[[0.813]], [[0.813]], [[0.46]]]),
+        "restitution_target": (("soil", "block", "model"), [[[0.813]], [[0.790]], [[np.nan]]]),
+        "restitution_reachable": (("soil", "block", "bound"), [[[0.788, 0.8129]], [[0.70, 0.802]], [[np.nan, np.nan]]]),
+    }, coords={"soil": soils, "block": blocks, "model": ["recommended"], "bound": ["low", "high"]})
+    assert at_damping_floor(cube, "recommended", "box", "clay")  # hits its target at the bed's most restitution
+    assert not at_damping_floor(cube, "recommended", "box", "sand")  # 0.790 inside 0.70-0.802: calibrated
+    assert at_damping_floor(cube, "recommended", "box", "rock")  # rocking dies: the least admissible damping

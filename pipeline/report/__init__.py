@@ -358,7 +358,9 @@ def tested_cells_words(efficiency, names: dict | None = None) -> str:
     copies = any(len(test.soils) > 1 for test in tests)
     return (f" Each bar is one independent test{drawn}, named in the legend with the records that overturned in it"
             + ("; a tied rigid base's same runs on several soils count once" if copies else "")
-            + "; no other block, model or soil had enough overturning records.")
+            + "; a test needs the overturning capacities refined between the levels, which the study computes only "
+              "where the base is tied and the foundation cannot pull (not for a base that slides, nor for the "
+              "paper's model), and enough records that overturn.")  # cold read 9, user B3: not 'too few records'
 
 
 def measure_choice_words(efficiency, names: dict, hazard: bool = True) -> str:

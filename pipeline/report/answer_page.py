@@ -98,8 +98,12 @@ def _band_reach(cube, block=None, results=None) -> str:
     soils = [str(s) for s in cube.soil.values if bool(short.sel(soil=s).any())]
     asked = float(requested.where(short).max())
     reached = _grouped({soil: float(target.sel(soil=soil).where(short.sel(soil=soil)).max()) for soil in soils})
+    # cold read 9, user B1: "a bed can always dissipate less" -- say what bounds its damping from below
     text = (f" On {_and(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
-            f"(r up to {asked:.3f}; it reaches at most {reached}): those runs use the nearest r it reaches, so "
+            f"(r up to {asked:.3f}; it reaches at most {reached}): its damping has a floor, the least at which the "
+            "block's free rocking on the bed is reproducible (below it the block bounces on a ringing bed and the "
+            "measured r jumps between neighbouring dampings), and that floor already dissipates more. Those runs "
+            "use the nearest r it reaches, so "
             "the restitution part of the model dispersion there leaves out the less dissipative side of the range, "
             "the side on which a block rocks more.")
     if "run" in requested.dims and "centre" in requested.run.values:
@@ -218,6 +222,15 @@ def _band_collapse(cube, block) -> str:
             f"restitutions apart ({asked}), so restitution adds nothing to the model dispersion there because there "
             "is one run, not because it is known; the model part of β there rests on FEMA P695's model-quality "
             "rating.")
+    low = float(requested.sel(soil=collapsed).min())
+    if bool(reached.notnull().any()) and low < float(reached.max()) - 5e-4:
+        # cold read 9, user B1: the low end is within reach, so why one run?
+        from rockfrag.models.restitution import LOSS_TOLERANCE, tolerance
+
+        text += (f" The range's low end, r {low:.3f}, lies within the calibration's tolerance of the "
+                 f"{float(reached.max()):.3f} the least damping gives (± {tolerance(low):.3f}: {LOSS_TOLERANCE:.0%} "
+                 "of the loss 1 − r), so the calibration, which takes the least damping that hits a target, runs it "
+                 "at that damping too.")
     if not bool(reached.notnull().any()) and "block_alpha" in cube.coords:
         from types import SimpleNamespace
 
@@ -322,6 +335,57 @@ def slides_first_words(results, answer) -> str:
             f"{FRICTION_MARK} in the design-life table are friction-driven); a base that grips more (a grout bed, "
             "a keyed plinth) would rock instead, and overturn more readily."
             + lift_off_by_soil_words(results, answer, soils))
+
+
+MARGIN_MOVE = 0.10
+"""A median that moves by more than this share between the central run and the low-friction run is named."""
+
+
+def friction_margin_words(results, answer) -> str:
+    """A sentence on the soils whose friction lies above b/h but within the sample's friction factor of it.
+
+    There the block rocks at the stated friction and slides first at the low end of its range (cold read 9, user
+    B2: sand's μ_s 0.45 is 12% above the enclosure's b/h 0.40, and its low-friction run, μ_s 0.375, moved the
+    rocking median from 0.97 g to 2.97 g while only clay's friction dependence was said). The medians that move by
+    more than ``MARGIN_MOVE`` are named, from the central run to the low-friction run. "" where no soil is that near.
+    """
+    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
+    design = getattr(config, "design", None)
+    if (answer.model != RECOMMENDED or cube is None or design is None or "member_median" not in fragility
+            or "friction_low" not in fragility.member.values):
+        return ""
+    slender = float(cube.block_b.sel(block=answer.block)) / float(cube.block_h.sel(block=answer.block))
+    factor = float(design.friction_factor)
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    short = short_names(results)
+    texts = []
+    for soil in config.soils:
+        if soil.name not in fragility.soil.values or not slender <= soil.friction_static < slender * factor:
+            continue
+        central = fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name)
+        low = fragility["member_median"].sel(member="friction_low", block=answer.block, soil=soil.name)
+        moves, lost = [], []
+        for state in short:
+            before, after = float(central.sel(damage_state=state)) * scale, float(low.sel(damage_state=state)) * scale
+            if not np.isfinite(before):
+                continue
+            if not np.isfinite(after):
+                lost.append(short[state])
+            elif abs(after / before - 1.0) > MARGIN_MOVE:
+                moves.append(f"{short[state]} from {numbers.intensity(before, answer.unit)} to "
+                             f"{numbers.intensity(after, answer.unit)}")
+        if lost:
+            moves.append(f"{_and(lost)} {'loses its median' if len(lost) == 1 else 'lose their medians'} (above "
+                         "the highest intensity studied)")
+        if not moves:
+            continue
+        texts.append(f"On {soil.name} the base friction (μ_s {soil.friction_static:g}) is only "
+                     f"{numbers.two_figures(100 * (soil.friction_static / slender - 1))}% above this block's b/h = "
+                     f"{slender:.2f}: at the low end of its range (μ_s {soil.friction_static / factor:.3g}, a "
+                     f"sensitivity run) the block slides before it can rock, and its medians move: {'; '.join(moves)}. "
+                     "Which side of b/h the real base friction falls on decides whether it rocks or slides there; a "
+                     "measured friction settles it.")
+    return " ".join(texts)
 
 
 LIFTS = 0.25
@@ -874,6 +938,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                     if cube is not None else measure, answer.model)
     # one paragraph per subject (restitution, friction, the bed's lift-off, the measure): not one wall of text
     for text in (curve_reason(results, answer.model, answer.block), slides_first_words(results, answer),
+                 friction_margin_words(results, answer),
                  slides_then_words(results, answer), bed_resonance_words(results, answer),
                  early_lift_words(results, answer), sufficiency):
         if text:
@@ -1213,7 +1278,10 @@ def reading_items(results) -> list[Item]:
                        "run at or below the largest return period's intensity need more base friction than the "
                        "soil offers on a base whose sliding was not "
                        "computed; where the base runs with friction, its slip damage states judge it. Else 'no "
-                       "action'. States without a limit are reported, not judged.")]
+                       "action'. States without a limit are reported, not judged. 'No action' is a verdict on the "
+                       "computed risk only: it does not replace an anchorage that the governing code requires (ASCE "
+                       "7-22 Chapter 13 does not count on friction from gravity to resist seismic forces) or that the "
+                       "equipment's qualification standard asks for (IEEE 693 for substation equipment).")]
     if any(soil.verdict == ANCHOR for answer in answers for soil in answer.soils):
         items.append(paragraph(ANCHOR_DESIGN))
     return items
@@ -1295,7 +1363,8 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str, 
             on = "" if len(soils) == efficiency.sizes["soil"] else f" on {_and(soils)}"
             runs.append(f"{model_info(name).label}{on}")
         where = (f" in the runs of {_and(runs)}, the only runs the test covers; the recommended model's were not "
-                 "tested, so whether they depend on it is not known")
+                 "tested (its base slides, and the study refines overturning capacities, which the test needs, only "
+                 "where the base is tied), so whether they depend on it is not known")
     return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)}{where} (the "
             "measure-efficiency page; Luco & Cornell 2007): these curves hold for ground motions like the study's "
             "records. For a site whose motions differ in that (near a fault: velocity pulses), the study must run "

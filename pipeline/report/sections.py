@@ -335,6 +335,23 @@ def grounds(cube) -> str:
     return " and ".join(parts)
 
 
+def at_damping_floor(cube, model: str, block, soil) -> bool:
+    """Whether a model's calibrated bed damping on (block, soil) is its floor, the least admissible damping.
+
+    There the bed's restitution is the most it reaches (``restitution_reachable``'s upper bound): the target was
+    at or above it, or the block's free rocking dies below the measure's resolution (no restitution reached).
+    """
+    if "restitution_reachable" not in cube or "restitution_target" not in cube:
+        return False
+    target = float(cube.restitution_target.sel(model=model, block=block, soil=soil))
+    requested = float(cube.restitution_requested.sel(model=model, block=block, soil=soil)) \
+        if "restitution_requested" in cube else np.nan
+    highest = float(cube.restitution_reachable.sel(block=block, soil=soil).max())
+    if not np.isfinite(target):
+        return np.isfinite(requested)  # asked, none reached: it runs at the least admissible damping
+    return np.isfinite(highest) and target >= highest - 5e-4
+
+
 def _result_files(results: Results) -> list[str]:
     """The result files this report read: the optional ones only when the run wrote them."""
     optional = {"showcase.nc": results.showcase, "applicability.nc": results.applicability,
@@ -528,7 +545,14 @@ def reproduce_items(results: Results) -> list[Item]:
                           "the model, not a property of the soil (whose own ξ the methods tabulate):"),
                 table(["block", *map(str, cube.soil.values)],
                       [[block_name(config, b), *(_g(float(values.sel(block=b, soil=soil)))
+                                                  + (" (floor)" if at_damping_floor(cube, model.name, b, soil) else "")
                                                   for soil in cube.soil.values)] for b in cube.block.values])]
+            if any(at_damping_floor(cube, model.name, b, soil) for b in cube.block.values
+                   for soil in cube.soil.values):
+                damping_items.append(note(
+                    "(floor): the least damping at which the block's free rocking on that bed is reproducible, the "
+                    "bed's most restitution; it cannot dissipate less. The floor is found on a grid of dampings, so "
+                    "two soils can share it."))
     return [paragraph("The commands, the study file and the settings behind this report. The other pages speak of "
                       "the blocks and the site; this appendix names what an operator types."),
             heading("Commands"),
