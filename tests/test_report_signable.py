@@ -618,3 +618,25 @@ def test_a_calibrated_bed_damping_at_its_floor_is_marked_in_the_appendix():
     assert at_damping_floor(cube, "recommended", "box", "clay")  # hits its target at the bed's most restitution
     assert not at_damping_floor(cube, "recommended", "box", "sand")  # 0.790 inside 0.70-0.802: calibrated
     assert at_damping_floor(cube, "recommended", "box", "rock")  # rocking dies: the least admissible damping
+
+
+def test_a_class_e_soil_is_a_limitation_of_the_generic_site_term(small_pipeline):
+    """Cold read 9, user B5: the class-E clay's hazard came from the generic site term, which lowers its strong
+    shaking below the reference's, and the limitations did not say a site response analysis is what it needs."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.sections import site_response_items
+    from rockfrag.site_hazard import SiteHazards
+    from rockfrag.soils import SOILS
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    sites = results.site_hazards
+    assert SOILS["clay"].site_class == "E" and SOILS["sand"].site_class == "D"
+    carried = SiteHazards({"clay": sites["sand"], "sand": sites["sand"]}, sites.reference, sites.reference_vs30)
+    study = SimpleNamespace(site_hazards=carried, return_periods=results.return_periods,
+                            config=SimpleNamespace(soils=(SOILS["clay"], SOILS["sand"])))
+    items = site_response_items(study)
+    assert items[0].text == "Site response" and items[1].text.startswith("On clay (site class E, soft soil)")
+    assert "ASCE 7-16 Section 11.4.8" in items[1].text and "sand" not in items[1].text
+    study.config = SimpleNamespace(soils=(SOILS["sand"],))
+    assert site_response_items(study) == []

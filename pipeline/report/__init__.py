@@ -244,7 +244,9 @@ CAPTIONS = {
                 "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
                 "bed); dashed, that it overturns; between them it rocks and stays up{shading}. Grey shading: "
                 "extrapolation by scaling. The intensity is the pair's "
-                "RotD50, which one component can exceed: a rigid base may lift off a little below g·tanα.",
+                "RotD50, which one component can exceed: a rigid base may lift off a little below g·tanα. Sliding is "
+                "not drawn here: a block that slides without lifting off stays at zero on these panels, and its slip "
+                "states are on its fragility pages and answer page.",
     "vertical": "Read whether the vertical ground motion matters: solid with it, dashed without, the same records "
                 "at the same levels. Top: median θmax/α (not drawn where most runs flew); bottom: fraction "
                 "overturned and the fitted curves. Dotted: return-period intensities; shaded: extrapolation.",
@@ -269,8 +271,9 @@ CAPTIONS = {
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
                    "marked * ('no median') has no curve of its state below the highest intensity studied; a parameter "
-                   "without a bar on a soil had one run there (the bed cannot reach its range: the answer page "
-                   "says so), not a zero spread that is known.",
+                   "without a bar had one run there (the answer page says so). A bar whose one end has no median "
+                   "below the highest intensity studied comes from the other end alone and can understate the "
+                   "spread (for friction, the answer page names such soils).",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does; the test of Luco & Cornell 2007).",

@@ -335,6 +335,14 @@ def grounds(cube) -> str:
     return " and ".join(parts)
 
 
+def _any_per_metre(config) -> bool:
+    """Whether a block of the study is modelled per metre of its length (the plane model's 1 m depth)."""
+    from rockfrag.report.summary import per_metre
+
+    return any(per_metre(block.footprint_area / (2 * block.b)) for block in getattr(config, "blocks", ()) or ()
+               if getattr(block, "footprint_area", None))
+
+
 def at_damping_floor(cube, model: str, block, soil) -> bool:
     """Whether a model's calibrated bed damping on (block, soil) is its floor, the least admissible damping.
 
@@ -651,9 +659,10 @@ def fitted_items(results: Results) -> list[Item]:
                           "block."))
     if any("exact-thresholds" == str(m) for m in np.unique(fragility.fit_method.values)):
         items.append(note("An uplift row of the rigid base or the paper's model has the same median on every soil, "
-                          "g·tanα in the measure of the levels, and a β of about 0.15: the scatter of the records' own "
-                          "uplift intensities (each record's pair RotD50 over its own peak; Methods, 'Fragility "
-                          "fits'), not a record-to-record dispersion of a response like the other cells' β."))
+                          "the lognormal median of the records' own uplift intensities (each g·tanα × the record's "
+                          "pair RotD50 over its own peak; Methods, 'Fragility fits'), close to the uplift intensity "
+                          "the levels are set from (g·tanα × the records' median ratio), and a β of about 0.15: their "
+                          "scatter, not a record-to-record dispersion of a response like the other cells' β."))
     if "†" in marks:
         values = {f"{v:.2g} {shown_unit}" for v in results.largest_recorded.values()}
         largest = (f"{values.pop()}{', every block' if len(results.largest_recorded) > 1 else ''}"
@@ -732,6 +741,32 @@ def site_hazard_items(results: Results) -> list[Item]:
                  "both, and its values replace these (the appendix names the settings).")
     return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class: ASCE 7 / EC8", "site hazard",
                                     "√(G/ρ) of the bed [m/s]"], rows)]
+
+
+def site_response_items(results: Results) -> list[Item]:
+    """A limitation for the soft soils (ASCE 7-16 site class E) whose hazard the generic site term carries.
+
+    Cold read 9, user B5: a class-E clay (Vs30 150 m/s) took the generic site term at 0.3-0.45 g, whose nonlinear
+    part lowers its strong shaking below the reference site's, and the limitations did not say that a site response
+    analysis is what such a site needs (ASCE 7-16 Section 11.4.8). [] where no soil's site is class E.
+    """
+    sites = results.site_hazards
+    if sites is None or sites.reference is None:
+        return []
+    soft = [soil for soil in results.config.soils if soil.vs30 is not None and soil.vs30 != sites.reference_vs30
+            and soil.site_class == "E" and soil.name in sites]
+    if not soft:
+        return []
+    names = ", ".join(soil.name for soil in soft)
+    behaviour = "; ".join(f"{soil.name}: {site_term_words(sites, soil.name, results.return_periods)}"
+                          for soil in soft)
+    return [heading("Site response"),
+            paragraph(f"On {names} (site class E, soft soil) the hazard is the reference curve carried by a generic "
+                      f"site term ({behaviour}), a stand-in for a site response analysis: its nonlinear part can "
+                      "lower the strong shaking of a soft site below the reference's, which a site response analysis "
+                      "may not confirm. ASCE 7-16 Section 11.4.8 asks for a site-specific ground motion analysis on "
+                      "class E sites where S_S is 1.0 or more; the verdicts on this soil are to be read again with "
+                      "the site's own analysis.")]
 
 
 def site_term_words(sites: SiteHazards, soil: str, periods) -> str:
@@ -958,9 +993,10 @@ def methods_items(results: Results) -> list[Item]:
                       "modulus sets the interface stiffness k (the paper's eq. 19); uplift: the ground acceleration "
                       "at which the block starts to rock on a rigid base. Each block is a rigid solid block of "
                       "uniform mass; the limitations' planar-model table gives its depth out of plane and the "
-                      "density its mass implies; k is the whole footprint's (a block modelled per metre of its "
-                      "length: per metre). Its base friction is the soil's, whatever the block's own base "
-                      "(see 'Reading the answer pages')."))
+                      "density its mass implies; k is the whole footprint's"
+                      + (" (a block modelled per metre of its length: per metre)" if _any_per_metre(config) else "")
+                      + ". Its base friction is the soil's, whatever the block's own base (see 'Reading the answer "
+                      "pages')."))
     def settles(block, soil) -> str:  # m g / k [mm]
         weight = float(cube.block_mass.sel(block=block)) * STANDARD_GRAVITY
         return _g(weight / float(stiffness.sel(soil=soil, block=block)) * 1e3)
@@ -1549,6 +1585,7 @@ def limitations_items(results: Results) -> list[Item]:
                             "why no median"], by_block(rows)))
 
     items += free_flight_items(cube, models)
+    items += site_response_items(results)
     items.append(heading("Solver"))
     failed = (cube.outcome == OUTCOME_FAILED)
     if int(failed.sum()) == 0:
