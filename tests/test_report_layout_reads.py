@@ -463,3 +463,38 @@ def test_the_outcomes_page_says_which_soils_lines_coincide():
                      f"{figures.panel_label(models['housner'])}: gravel = rock; "
                      f"{figures.panel_label(models['ssi'])}: P(uplift) on every soil.")
     assert figures.coinciding_words([(models["recommended"], [("clay", 0, rise, flat)])]) == ""
+
+
+def test_the_ida_rigid_row_of_a_block_that_slides_on_every_soil_says_so(small_pipeline):
+    """Cold read 9 (default figures B4): the squat skid's shared rigid-base row read 'its rocking is the same on every
+    soil', flat at zero, while it slides on every soil (μ_s below its b/h 0.75). A rigid row that never rocked on a
+    block whose every soil's friction is below its b/h says that it slides; otherwise the row keeps its heading."""
+    import matplotlib.pyplot as plt
+    import numpy as np
+    import xarray as xr
+
+    from rockfrag.report import figures
+
+    ida = xr.open_dataset(small_pipeline.output / "ida.nc").load()
+    block = str(ida.block.values[0])
+
+    def headings(dataset):
+        figure = figures.ida_page(dataset, block, "Read it.")
+        try:
+            return [t.get_text() for t in figure.texts]
+        finally:
+            plt.close(figure)
+
+    ratio = float(ida.block_b.sel(block=block)) / float(ida.block_h.sel(block=block))
+    still = ida.copy()
+    rigid = [str(m) for m in ida.model.values if str(m) == "housner"]
+    assert rigid, ida.model.values
+    edp = still.edp.values.copy()
+    index = list(map(str, ida.model.values)).index("housner")
+    axis = still.edp.dims.index("model")
+    np.moveaxis(edp, axis, 0)[index] = 0.0
+    still["edp"] = still.edp.copy(data=edp)
+    still = still.assign_coords(soil_friction_static=("soil", np.full(ida.sizes["soil"], 0.9 * ratio)))
+    assert figures.RIGID_SLIDES in headings(still)
+    tied = still.assign_coords(soil_friction_static=("soil", np.full(ida.sizes["soil"], 1.1 * ratio)))
+    assert figures.RIGID_SLIDES not in headings(tied)

@@ -527,7 +527,14 @@ def frame_note(edp, fractiles, q: float = 0.84) -> str:
     return ""
 
 
-def _ida_rows(models, soils, per_soil=(), most_columns=5):
+RIGID_SAME = "rigid base: its rocking is the same on every soil"
+RIGID_SLIDES = ("rigid base: it slides on every soil (μ_s below b/h), so it does not rock: its slip is on its "
+                "fragility pages")
+"""The IDA page's heading of the shared rigid-base row: a block that slides on every soil never rocks there, and
+'the same on every soil' alone hid its sliding (cold read 9, the squat skid)."""
+
+
+def _ida_rows(models, soils, per_soil=(), most_columns=5, slides_everywhere=False):
     """The IDA page's rows: (heading, [(model, soil or None), ...]).
 
     The rigid-base models share the first row, except those in ``per_soil`` (their runs differ by soil:
@@ -539,7 +546,7 @@ def _ida_rows(models, soils, per_soil=(), most_columns=5):
     columns = min(max(len(soils) if founded else 1, len(rigid), 1), most_columns)
     rows = []
     for start in range(0, len(rigid), columns):
-        rows.append(("rigid base: its rocking is the same on every soil",
+        rows.append((RIGID_SLIDES if slides_everywhere else RIGID_SAME,
                      [(m, None) for m in rigid[start:start + columns]]))
     for model in founded:
         heading = panel_label(model)
@@ -559,7 +566,14 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     models = models_of(ida)
     soils = list(map(str, ida.soil.values))
     per_soil = [m.name for m in models if m.rigid_base and soils_of(ida, m, block, "edp") != [None]]
-    rows, columns = _ida_rows(models, soils, per_soil)
+    slides = False
+    if "soil_friction_static" in ida.coords and "block_b" in ida.coords:
+        ratio = float(ida.block_b.sel(block=block)) / float(ida.block_h.sel(block=block))
+        rigid = [m.name for m in models if m.rigid_base and m.name not in per_soil]
+        still = all(np.nan_to_num(np.asarray(ida.edp.sel(model=m, block=block).values, float)).max() <= 1e-9
+                    for m in rigid) if rigid and "edp" in ida else False  # it never rocked: its base slid (or not)
+        slides = still and bool((np.asarray(ida.soil_friction_static.values, float) < ratio).all())
+    rows, columns = _ida_rows(models, soils, per_soil, slides_everywhere=slides)
     figure = new_page(f"IDA curves: {name or block}", caption)
     top, bottom = 0.86, GRID["bottom"]
     height = (top - bottom) * figure.get_figheight()
