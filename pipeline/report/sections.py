@@ -1504,7 +1504,9 @@ def limitations_items(results: Results) -> list[Item]:
             "the clay's undrained adhesion instead, bounded by its undrained shear strength whatever the weight, "
             "which can be lower than μ_s times the contact pressure under a heavy block; the sensitivity runs' "
             "lower friction covers only part of that. A site investigation's undrained strength says which governs; "
-            "this study does not model adhesion."))
+            "this study does not model adhesion. Where the adhesion governs, the base slides more easily: the slip "
+            "probabilities of this report are then low (and its rocking ones, if anything, high: a base that slides "
+            "rocks less)."))
     items += [paragraph(text) for text in friction_runs_words(results)]
     flag = friction_flag(cube)
     for model in models:
