@@ -652,6 +652,23 @@ def bed_frequencies(config, block, soil) -> tuple[float, float, float]:
     return found.vertical_frequency / (2 * np.pi), omega_r / (2 * np.pi), found.settlement
 
 
+def uplift_by_stiffness(results, answer) -> tuple[list, dict]:
+    """The study's soils by shear modulus and the answering curve's lift-off median on each [shown unit]."""
+    fragility = results.fragility
+    soils = sorted((soil for soil in results.config.soils if soil.name in fragility.soil.values),
+                   key=lambda soil: soil.shear_modulus)
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    return soils, {soil.name: float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name,
+                                                            damage_state="uplift")) * scale for soil in soils}
+
+
+def lift_off_dips(soils, medians) -> list[int]:
+    """The indices of the soils whose lift-off median lies below both its neighbours' in stiffness."""
+    return [index for index in range(1, len(soils) - 1)
+            if np.isfinite(values := [medians[soil.name] for soil in soils[index - 1:index + 2]]).all()
+            and values[1] < min(values[0], values[2])]
+
+
 def bed_resonance_words(results, answer) -> str:
     """A sentence for each soil where the block lifts off at a lower median than on both its neighbours in stiffness.
 
@@ -664,19 +681,13 @@ def bed_resonance_words(results, answer) -> str:
     fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
     if answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None:
         return ""
-    soils = sorted((soil for soil in config.soils if soil.name in fragility.soil.values),
-                   key=lambda soil: soil.shear_modulus)
-    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
-    medians = {soil.name: float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name,
-                                                        damage_state="uplift")) * scale for soil in soils}
+    soils, medians = uplift_by_stiffness(results, answer)
     band = records_band(getattr(results, "showcase", None))
     block = next(block for block in config.blocks if block.name == answer.block)
     texts = []
-    for index in range(1, len(soils) - 1):
+    for index in lift_off_dips(soils, medians):
         low, soil, high = soils[index - 1], soils[index], soils[index + 1]
         values = [medians[low.name], medians[soil.name], medians[high.name]]
-        if not np.isfinite(values).all() or not values[1] < min(values[0], values[2]):
-            continue
         vertical, rocking, settlement = bed_frequencies(config, block, soil)
 
         def inside(frequency):
@@ -732,14 +743,8 @@ def early_lift_words(results, answer) -> str:
     if block is None:
         return ""
     rigid = block.b / block.h  # g tan(alpha), in g
-    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
-    soils = sorted((soil for soil in config.soils if soil.name in fragility.soil.values),
-                   key=lambda soil: soil.shear_modulus)
-    medians = {soil.name: float(fragility["median"].sel(model=answer.model, block=answer.block, soil=soil.name,
-                                                        damage_state="uplift")) * scale for soil in soils}
-    explained = {soils[i].name for i in range(1, len(soils) - 1)
-                 if np.isfinite([medians[s.name] for s in soils[i - 1:i + 2]]).all()
-                 and medians[soils[i].name] < min(medians[soils[i - 1].name], medians[soils[i + 1].name])}
+    soils, medians = uplift_by_stiffness(results, answer)
+    explained = {soils[i].name for i in lift_off_dips(soils, medians)}
     early = [soil for soil in soils if np.isfinite(medians[soil.name]) and medians[soil.name] < EARLY_LIFT * rigid
              and soil.name not in explained]
     if not early:
@@ -748,14 +753,15 @@ def early_lift_words(results, answer) -> str:
     values = _and([f"{numbers.intensity(medians[soil.name], answer.unit)} on {soil.name}" for soil in early])
     shares = _and([f"{medians[soil.name] / rigid:.2f}" for soil in early])
     modes = []
+    frequencies = {soil.name: bed_frequencies(config, block, soil) for soil in early}
     for soil in early:
-        _, rocking, _ = bed_frequencies(config, block, soil)
+        _, rocking, _ = frequencies[soil.name]
         if np.isfinite(rocking):
             inside = band is not None and band[0] <= 1.0 / rocking <= band[1]
             outside = "" if inside or band is None else ", outside the band"
             modes.append(f"{soil.name} {numbers.two_figures(rocking)} Hz, {numbers.two_figures(1.0 / rocking)} s"
                          f"{outside}")
-    give = max(block.h * bed_frequencies(config, block, soil)[2] / block.b ** 2 for soil in early)
+    give = max(block.h * frequencies[soil.name][2] / block.b ** 2 for soil in early)
     text = (f"Below the rigid base's g·tanα = {numbers.intensity(rigid, answer.unit)}: this block lifts off at a "
             f"median of {values} ({shares} times g·tanα). On its bed it rocks on the springs before a corner lifts")
     if modes:

@@ -319,11 +319,8 @@ def hazard_page(sites, return_periods, caption, unit: str = "g", highest: float 
     if inside.size:  # the intensities between 0.1/yr and the rarest frequency shown: the range a verdict reads
         right = min(inside.max(), highest) if highest else inside.max()
         axis.set_xlim(inside.min(), right)
-    low, high = axis.get_xlim()
-    if largest is not None and np.isfinite(largest) and low < largest < high:
-        axis.axvspan(largest, high, **EXTRAPOLATION, label="beyond the largest recorded intensity: extrapolation "
-                                                           "by scaling")
-        axis.axvline(largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
+    if largest is not None:  # the shading and line every intensity axis has (no return-period lines: 1/T is)
+        mark_intensities(axis, CredibleMarks(largest=largest))
     points = [(soil, values) for soil, values in (site_intensities or {}).items() if soil in sites]
     for index, (soil, values) in enumerate(points):
         soils = list(sites)
