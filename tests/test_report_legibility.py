@@ -605,3 +605,35 @@ def test_the_contents_column_break_never_cuts_an_entry():
         assert wraps >= 2, first_entry  # the long title wraps: the test can fail
         assert {p[0] for p in first_entry[:wraps]} == {section[0]}, (lead, placed[-8:])
         assert len({p[0] for p in first_entry[wraps:]}) == 1, (lead, placed[-8:])
+
+
+def test_a_contents_title_never_runs_into_its_page_number():
+    """Cold read 12 (coordinator's look at the default report's three-column contents): the bold answer headings
+    wrapped at the two-column width, so "... (0.6 m × 3.0 m, 2" ran up to its page number "9". In two and in three
+    columns, every title line ends at least two character widths before the page number on its line."""
+    from rockfrag.report import contents_page
+    from rockfrag.report.layout import Page
+
+    long_block = "slender solid block, cabinet-sized (0.6 m × 3.0 m, 2 t)"
+    for count in (12, 24):  # two columns; three columns
+        planned = [Page("title", "Title", "Seismic fragility of unanchored rocking blocks", draw=lambda: None)]
+        planned += [Page(f"answer-{i}", f"Answer: {long_block} number {i}", f"Answer {i}", draw=lambda: None,
+                         heading=f"Answer: {long_block} number {i}") for i in range(count // 4)]
+        planned += [Page(f"fig-{i}", "Fragility", f"Fragility by soil: {long_block}, recommended, with Housner "
+                                                  f"(rigid base) for reference {i}", draw=lambda: None)
+                    for i in range(count)]
+        figure = contents_page(planned, 2).draw()
+        try:
+            shown = _shown_texts(figure)
+            numbers = [(t, box) for t, box in shown if t.get_text().isdigit() and t.get_ha() == "right"]
+            titles = [(t, box) for t, box in shown if not t.get_text().isdigit() and t.get_text() != "Contents"]
+            assert len(numbers) >= count
+            em = figure.dpi * 8.5 / 72 * 0.6  # about one character of the contents' largest type, in pixels
+            for number, box in numbers:
+                same_line = [other for _, other in titles
+                             if abs(other.y1 - box.y1) < 2 and other.x0 < box.x0 and box.x0 - other.x0 < figure.bbox.width / 2]
+                assert same_line, number.get_text()
+                gap = box.x0 - max(other.x1 for other in same_line)
+                assert gap >= 2 * em, (count, number.get_text(), gap)
+        finally:
+            plt.close(figure)

@@ -568,6 +568,8 @@ def _slug(text: str) -> str:
 
 CONTENTS_LINES = 36  # lines per column of the contents page
 CONTENTS_WIDTH = 62  # characters per line of a contents column (two columns); longer titles wrap, never cut
+CONTENTS_WIDTH_THREE = 52  # the same in three columns of smaller type (a long study: the default has 54 pages)
+BOLD_NUMBERED_NARROWER = 8  # a bold section title with its page number on its line wraps this much earlier
 
 
 def contents_rows(planned: list[Page], position: int = 2) -> list[tuple[str, str, int]]:
@@ -597,10 +599,20 @@ def contents_rows(planned: list[Page], position: int = 2) -> list[tuple[str, str
     return rows
 
 
-def contents_layout(rows) -> list[tuple[int, int, str, str, int | None]]:
-    """Where each line of the contents goes: (column, line, kind, text, page number or None), in order.
+def contents_width(columns: int) -> int:
+    """Characters per line of a contents column when the contents has ``columns`` columns."""
+    if columns <= 2:
+        return CONTENTS_WIDTH
+    three = 0.97 / 3 - 0.03  # a column's text width (page fractions) in three columns, as drawn
+    return int(CONTENTS_WIDTH_THREE * (0.97 / columns - 0.03) / three)
 
-    Titles wrap at ``CONTENTS_WIDTH``; an entry's lines (and a section heading with the page row below it) stay
+
+def contents_layout(rows, width: int = CONTENTS_WIDTH) -> list[tuple[int, int, str, str, int | None, bool]]:
+    """Where each line of the contents goes: (column, line, kind, text, page number or None, whether the line
+    continues a wrapped title), in order.
+
+    Titles wrap at ``width`` characters, a bold section title with its page number a little shorter (bold is wider
+    and the number sits on its line: cold read 12, the number ran into "... (R = 9.39"); an entry's lines (and a section heading with the page row below it) stay
     in one column: the column break never cuts an entry (cold read 8, user C13: "... 1.2 m × 3.0" ended one
     column and "m, 4.5 t)" began the next).
     """
@@ -609,8 +621,9 @@ def contents_layout(rows) -> list[tuple[int, int, str, str, int | None]]:
         heads = kind == "section" and index + 1 < len(rows) and rows[index + 1][0] == "page"
         if heads:
             number = None  # the page row below carries it
-        wrapped = textwrap.wrap(text, CONTENTS_WIDTH - (2 if kind == "page" or number is not None else 0)) or [""]
-        lines = [(kind, line, number if index == 0 else None) for index, line in enumerate(wrapped)]
+        narrower = 2 if kind == "page" else (BOLD_NUMBERED_NARROWER if number is not None else 0)
+        wrapped = textwrap.wrap(text, width - narrower, break_on_hyphens=False) or [""]
+        lines = [(kind, line, number if index == 0 else None, index > 0) for index, line in enumerate(wrapped)]
         if entries and entries[-1][1]:
             entries[-1][0].extend(lines)
             entries[-1][1] = False
@@ -631,7 +644,11 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
 
     Titles are wrapped, never cut; the HTML links every page and every section.
     """
-    placed = contents_layout(contents_rows(planned, position))
+    rows = contents_rows(planned, position)
+    placed, columns = contents_layout(rows), 2
+    while placed and placed[-1][0] + 1 > columns and columns < 4:  # more columns: narrower, smaller type, wrap earlier
+        columns = placed[-1][0] + 1
+        placed = contents_layout(rows, contents_width(columns))
     slot = placed[-1][0] * CONTENTS_LINES + placed[-1][1] + 1 if placed else 0
 
     def draw():
@@ -640,9 +657,9 @@ def contents_page(planned: list[Page], title: str, position: int = 2) -> Page:
         size = 8.5 if columns <= 2 else 7
         step = min(0.85 / min(slot, CONTENTS_LINES) if placed else 0.02, 0.024)
         width = 0.97 / columns
-        for column, line, kind, text, number in placed:
+        for column, line, kind, text, number, continues in placed:
             x, y = 0.02 + column * width, 0.925 - line * step
-            indent = 0.0 if kind == "section" else 0.012
+            indent = (0.0 if kind == "section" else 0.012) + (0.012 if continues else 0.0)  # a hanging indent
             figure.text(x + indent, y, text, fontsize=size, weight="bold" if kind == "section" else "normal",
                         va="top")
             if number is not None:
