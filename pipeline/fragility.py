@@ -1053,7 +1053,9 @@ MODEL_UNCERTAINTY = (
     "recommended = the central member of the recommended model's designed sample (rockfrag.models.variants): "
     "median and beta_record_to_record are its fit. beta_parameters is the spread of the median over the sample: "
     "each parameter's range (restitution, friction, bed stiffness) read as uniform in ln(median) between its ends' "
-    "medians, sigma_i = |ln(m_high / m_low)| / (2 sqrt 3) (one end missing: twice its distance to the centre), "
+    "medians, sigma_i = |ln(m_high / m_low)| / (2 sqrt 3) (one end with no median by the highest intensity "
+    "studied: at least the other end's distance to that intensity, and at least twice its distance to the centre: "
+    "a lower bound), "
     "beta_parameters = sqrt(sum sigma_i^2). beta_form is FEMA P-695's model-quality rating (Section 5.7; "
     "superior 0.10, good 0.20, fair 0.35, poor 0.50) for what the sample cannot represent: a planar rigid block, "
     "no three-dimensional rocking, no flexible superstructure. That rating covers a model's parameters too, so it "
@@ -1063,14 +1065,21 @@ MODEL_UNCERTAINTY = (
 UNIFORM_SPREAD = 2.0 * np.sqrt(3.0)  # the standard deviation of a uniform variable is its range / (2 sqrt 3)
 
 
-def parameter_spread(low: np.ndarray, centre: np.ndarray, high: np.ndarray) -> np.ndarray:
+def parameter_spread(low: np.ndarray, centre: np.ndarray, high: np.ndarray,
+                     highest: np.ndarray | float = np.nan) -> np.ndarray:
     """The sigma of ln(median) over one parameter's range, from its ends' medians.
 
-    One end missing: twice its distance to the centre; both missing: NaN.
+    An end without a median never reached the state by the highest intensity studied (``highest``, same unit):
+    its median lies beyond it, so the range is at least from the other end to ``highest``, and it is taken as no
+    less than twice the other end's distance to the centre either (a lower bound, not an estimate: cold read 9,
+    user B4, a friction end below the cap read 0.04 where the range to the cap gives 0.14). Both missing: NaN.
     """
     with np.errstate(invalid="ignore", divide="ignore"):
         both = np.abs(np.log(high / low)) / UNIFORM_SPREAD
-        one = 2.0 * np.abs(np.log(np.where(np.isfinite(low), low, high) / centre)) / UNIFORM_SPREAD
+        known = np.where(np.isfinite(low), low, high)
+        twice = 2.0 * np.abs(np.log(known / centre)) / UNIFORM_SPREAD
+        to_highest = np.abs(np.log(highest / known)) / UNIFORM_SPREAD
+        one = np.where(np.isfinite(to_highest), np.fmax(twice, to_highest), twice)
     return np.where(np.isfinite(low) & np.isfinite(high), both, one)
 
 
@@ -1116,8 +1125,11 @@ def with_recommended(dataset: xr.Dataset, members: xr.Dataset | None = None,
     roles = [split_variant(str(m))[1] for m in member_median.model.values]
     median_of = dict(zip(roles, member_median.values))
     nan = np.full_like(centre, np.nan)
+    highest = (dataset["studied_im_max"].broadcast_like(dataset["median"].sel(model=RECOMMENDED))
+               .transpose("soil", "block", "damage_state").values if "studied_im_max" in dataset else np.nan)
     spreads = np.stack([np.where(np.isfinite(centre), parameter_spread(
-        median_of.get(f"{p}_low", nan), centre, median_of.get(f"{p}_high", nan)), np.nan) for p in PARAMETERS])
+        median_of.get(f"{p}_low", nan), centre, median_of.get(f"{p}_high", nan), highest), np.nan)
+        for p in PARAMETERS])
     known = np.isfinite(spreads)
     beta_parameters = np.where(np.isfinite(centre), np.sqrt((np.where(known, spreads, 0.0) ** 2).sum(0)), np.nan)
     beta_form = np.where(np.isfinite(centre), FORM_RATINGS[quality], np.nan)

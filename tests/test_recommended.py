@@ -298,6 +298,26 @@ def test_a_member_that_never_reaches_the_state_leaves_its_spread_to_the_other_en
     fit = fragility_dataset(cube, n_bootstrap=0)
     row = overturning(fit)
     low = float(fit.member_median.sel(member="restitution_low", damage_state="overturning").squeeze())
-    expected = 2 * abs(math.log(low / float(row["median"]))) / (2 * math.sqrt(3))
+    highest = float(fit.studied_im_max.squeeze())
+    expected = max(2 * abs(math.log(low / float(row["median"]))), abs(math.log(highest / low))) / (2 * math.sqrt(3))
     sensitivity = fit.median_sensitivity.sel(parameter="restitution", damage_state="overturning").squeeze()
     assert float(sensitivity) == pytest.approx(expected)
+
+
+def test_a_missing_end_bounds_the_spread_from_below_by_the_highest_intensity():
+    """Cold read 9, user B4: an end with no median below the highest intensity studied has its median beyond it, so
+    the range is at least from the other end to that intensity. The user study's sand overturning: friction's high
+    end 1.873 g, centre 1.995 g, low end none by 3.00 g: at least ln(3.00 / 1.873) / (2 sqrt 3) = 0.136, where twice
+    the high end's distance to the centre gave 0.036. Where twice the distance is larger it stays (the default's
+    squat block on sand: 1.088 g against 2.877 g, 0.561)."""
+    from rockfrag.fragility import parameter_spread
+
+    nan = np.nan
+    assert float(parameter_spread(np.array(nan), np.array(1.995), np.array(1.873), 3.0)) == pytest.approx(
+        math.log(3.0 / 1.873) / (2 * math.sqrt(3)), rel=1e-12)
+    assert math.log(3.0 / 1.873) / (2 * math.sqrt(3)) == pytest.approx(0.136, abs=0.001)
+    assert float(parameter_spread(np.array(nan), np.array(2.877), np.array(1.088), 3.0)) == pytest.approx(
+        0.561, abs=0.001)
+    assert float(parameter_spread(np.array(1.2), np.array(1.5), np.array(nan))) == pytest.approx(
+        2 * math.log(1.5 / 1.2) / (2 * math.sqrt(3)))  # no highest given: the old rule
+    assert np.isnan(parameter_spread(np.array(nan), np.array(1.5), np.array(nan), 3.0))

@@ -272,8 +272,9 @@ CAPTIONS = {
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
                    "marked * ('no median') has no curve of its state below the highest intensity studied; a parameter "
                    "without a bar had one run there (the answer page says so). A bar whose one end has no median "
-                   "below the highest intensity studied comes from the other end alone and can understate the "
-                   "spread (for friction, the answer page names such soils).",
+                   "below the highest intensity studied is a lower bound: that end's median lies beyond it, so the "
+                   "bar spans at least from the other end to that intensity (for friction, the answer page names "
+                   "such soils).",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does; the test of Luco & Cornell 2007).",
