@@ -640,3 +640,31 @@ def test_a_class_e_soil_is_a_limitation_of_the_generic_site_term(small_pipeline)
     assert "ASCE 7-16 Section 11.4.8" in items[1].text and "sand" not in items[1].text
     study.config = SimpleNamespace(soils=(SOILS["sand"],))
     assert site_response_items(study) == []
+
+
+def test_the_sensitivity_page_marks_a_lower_bound_and_a_zero_bar():
+    """Cold read 9, user B4 (and the coordinator's look at the user study's page): a bar from one end of its range
+    alone is a lower bound, and the sand's restitution bar of 0 (both ends gave the same median) looked like a
+    parameter with no run. The first is marked ≥, the second 0, and no other bar is marked."""
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report import CAPTIONS
+    from rockfrag.report.figures import SPREAD_BOUND_MARK, SPREAD_ZERO_MARK, sensitivity_page
+
+    parameters = ["restitution", "friction", "stiffness"]
+    spread = np.array([0.0, 0.136, 0.015])[:, None, None, None]
+    members = [f"{p}_{end}" for p in parameters for end in ("low", "high")]
+    member_median = np.array([1.995, 1.995, np.nan, 1.873, 1.898, 1.999])[:, None, None, None]
+    fragility = xr.Dataset(
+        {"median_sensitivity": (("parameter", "soil", "block", "damage_state"), spread),
+         "member_median": (("member", "soil", "block", "damage_state"), member_median),
+         "beta_form": (("model", "block", "damage_state"), np.full((1, 1, 1), 0.35))},
+        coords={"parameter": parameters, "member": members, "soil": ["sand"], "block": ["box"],
+                "damage_state": ["overturning"], "model": ["recommended"]})
+    figure = sensitivity_page(fragility, "")
+    try:
+        marks = {(round(text.xy[1], 3), text.get_text()) for text in figure.axes[0].texts if hasattr(text, "xy")}
+        assert marks == {(0.0, SPREAD_ZERO_MARK), (0.136, SPREAD_BOUND_MARK)}, marks
+    finally:
+        plt.close(figure)
+    assert "marked ≥ is a lower bound" in CAPTIONS["sensitivity"] and "marked 0" in CAPTIONS["sensitivity"]

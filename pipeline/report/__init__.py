@@ -271,10 +271,11 @@ CAPTIONS = {
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
                    "marked * ('no median') has no curve of its state below the highest intensity studied; a parameter "
-                   "without a bar had one run there (the answer page says so). A bar whose one end has no median "
-                   "below the highest intensity studied is a lower bound: that end's median lies beyond it, so the "
-                   "bar spans at least from the other end to that intensity (for friction, the answer page names "
-                   "such soils).",
+                   "without a bar had one run there (the answer page says so). A bar marked ≥ is a lower bound: one "
+                   "end of its range has no median below the highest intensity studied, so that end's median lies "
+                   "beyond it and the bar spans at least from the other end to that intensity (for friction, the "
+                   "answer page names such soils). A bar marked 0 has no height: both ends of its range gave the "
+                   "same median.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does; the test of Luco & Cornell 2007).",

@@ -1428,6 +1428,27 @@ def sensitivity_title(fragility, governing: dict | None = None) -> str:
     return f"Model uncertainty: which parameter moves the recommended median ({what})"
 
 
+SPREAD_BOUND_MARK = "≥"
+"""Above a sensitivity bar that is a lower bound (one end of the range has no median by the highest intensity)."""
+SPREAD_ZERO_MARK = "0"
+"""Above a sensitivity bar of zero height: both ends of the range gave the same median."""
+
+
+def _one_end_missing(fragility, block: str, soils: list[str], states: list[str], parameters: list[str]) -> np.ndarray:
+    """(soil, parameter): whether that bar rests on one end of the range alone (a lower bound, ``parameter_spread``)."""
+    bounds = np.zeros((len(soils), len(parameters)), dtype=bool)
+    if "member_median" not in fragility:
+        return bounds
+    members = [str(m) for m in fragility.member.values]
+    for row, (soil, state) in enumerate(zip(soils, states)):
+        medians = fragility.member_median.sel(block=block, soil=soil, damage_state=state)
+        for column, parameter in enumerate(parameters):
+            ends = [float(medians.sel(member=f"{parameter}_{end}")) if f"{parameter}_{end}" in members else np.nan
+                    for end in ("low", "high")]
+            bounds[row, column] = int(np.isfinite(ends).sum()) == 1
+    return bounds
+
+
 def sensitivity_page(fragility, caption, names: dict | None = None, governing: dict | None = None):
     """Which sampled parameter moves the recommended median most, per block and soil (``median_sensitivity``).
 
@@ -1456,9 +1477,15 @@ def sensitivity_page(fragility, caption, names: dict | None = None, governing: d
         spread = np.array([fragility.median_sensitivity.sel(block=block, soil=soil, damage_state=state,
                                                             parameter=parameters).values
                            for soil, state in zip(soils, states)])  # (soil, parameter)
+        bounds = _one_end_missing(fragility, block, soils, states, parameters)  # (soil, parameter)
         for index, parameter in enumerate(parameters):
-            axis.bar(x + (index - (len(parameters) - 1) / 2) * width, np.nan_to_num(spread[:, index]), width,
-                     label=f"{parameter}", color=f"C{index % 10}")
+            centres = x + (index - (len(parameters) - 1) / 2) * width
+            axis.bar(centres, np.nan_to_num(spread[:, index]), width, label=f"{parameter}", color=f"C{index % 10}")
+            for centre, value, bound in zip(centres, spread[:, index], bounds[:, index]):
+                mark = SPREAD_BOUND_MARK if bound else (SPREAD_ZERO_MARK if value < 5e-4 else "")
+                if mark and np.isfinite(value):  # a lower bound, or a bar too low to see (both ends alike)
+                    axis.annotate(mark, (centre, value), xytext=(0, 2), textcoords="offset points", ha="center",
+                                  va="bottom", fontsize=8)
         form = np.nanmax([fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()
                           for state in set(states)] + [np.nan]) if "beta_form" in fragility else np.nan
         if np.isfinite(form):
