@@ -392,7 +392,7 @@ def test_the_hazard_legend_gives_each_carried_sites_vs30():
     said rock's site is stiffer; the legend now gives each carried site's Vs30 and the caption what it means."""
     import dataclasses as dc
 
-    from rockfrag.report import CAPTIONS
+    from rockfrag.report import CAPTIONS, stiffer_site_words
     from rockfrag.site_hazard import SiteHazards
 
     given = np.geomspace(0.05, 3.0, 40)
@@ -403,7 +403,12 @@ def test_the_hazard_legend_gives_each_carried_sites_vs30():
         assert "rock (Vs30 1,080 m/s)" in [line.get_label() for line in figure.axes[0].get_lines()]
     finally:
         plt.close(figure)
-    assert "stiffer than the reference" in CAPTIONS["hazard"]
+    assert "stiffer than the reference" not in CAPTIONS["hazard"]  # said where such a site is drawn, only there
+    soil = dc.make_dataclass("Soil", ["name", "vs30"])
+    sites = SiteHazards({"rock": rock}, reference, 760.0)
+    assert "Rock: a site stiffer than the reference" in stiffer_site_words([soil("rock", 1080.0)], sites)
+    assert stiffer_site_words([soil("rock", 500.0)], sites) == ""  # cold read 11: the user study has none
+    assert stiffer_site_words([soil("clay", 1080.0)], sites) == ""  # not drawn
 
 
 def test_a_pages_notes_group_a_models_soils_so_ten_series_fit():

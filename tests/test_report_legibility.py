@@ -630,8 +630,8 @@ def test_a_contents_title_never_runs_into_its_page_number():
             assert len(numbers) >= count
             em = figure.dpi * 8.5 / 72 * 0.6  # about one character of the contents' largest type, in pixels
             for number, box in numbers:
-                same_line = [other for _, other in titles
-                             if abs(other.y1 - box.y1) < 2 and other.x0 < box.x0 and box.x0 - other.x0 < figure.bbox.width / 2]
+                same_line = [other for _, other in titles if abs(other.y1 - box.y1) < 2 and other.x0 < box.x0
+                             and box.x0 - other.x0 < figure.bbox.width / 2]
                 assert same_line, number.get_text()
                 gap = box.x0 - max(other.x1 for other in same_line)
                 assert gap >= 2 * em, (count, number.get_text(), gap)

@@ -648,8 +648,8 @@ def test_the_sensitivity_page_marks_a_lower_bound_and_a_zero_bar():
     parameter with no run. The first is marked ≥, the second 0, and no other bar is marked."""
     import matplotlib.pyplot as plt
 
-    from rockfrag.report import CAPTIONS
-    from rockfrag.report.figures import SPREAD_BOUND_MARK, SPREAD_ZERO_MARK, sensitivity_page
+    from rockfrag.report import SENSITIVITY_MARK_WORDS
+    from rockfrag.report.figures import SPREAD_BOUND_MARK, SPREAD_ZERO_MARK, sensitivity_marks, sensitivity_page
 
     parameters = ["restitution", "friction", "stiffness"]
     spread = np.array([0.0, 0.136, 0.015])[:, None, None, None]
@@ -667,4 +667,5 @@ def test_the_sensitivity_page_marks_a_lower_bound_and_a_zero_bar():
         assert marks == {(0.0, SPREAD_ZERO_MARK), (0.136, SPREAD_BOUND_MARK)}, marks
     finally:
         plt.close(figure)
-    assert "marked ≥ is a lower bound" in CAPTIONS["sensitivity"] and "marked 0" in CAPTIONS["sensitivity"]
+    assert sensitivity_marks(fragility) == [SPREAD_BOUND_MARK, SPREAD_ZERO_MARK]
+    assert "marked ≥ is a lower bound" in SENSITIVITY_MARK_WORDS["≥"] and "marked 0" in SENSITIVITY_MARK_WORDS["0"]

@@ -67,7 +67,7 @@ from rockfrag.report.sections import (  # noqa: E402
 from rockfrag.report.summary import governing, summary_items  # noqa: E402
 from rockfrag.report.text import Item, draw_text_page, items_html, note, paginate, table  # noqa: E402
 from rockfrag.report.vertical import open_comparison, vertical_effect, vertical_items, vertical_page  # noqa: E402
-from rockfrag.report.words import glossary_items, references_items  # noqa: E402
+from rockfrag.report.words import glossary_items, listed, references_items  # noqa: E402
 from rockfrag.units import STANDARD_GRAVITY  # noqa: E402
 from rockfrag.version import __version__  # noqa: E402
 
@@ -207,9 +207,7 @@ CAPTIONS = {
               "(a point where a curve crosses one: the site's intensity of that return period, as the answer pages "
               "print it); grey shading: beyond the largest recorded intensity; the axis ends at the highest "
               "intensity studied. A soft soil's curve can fall below the reference site's at strong shaking: the "
-              "site term's "
-              "nonlinear part de-amplifies it (Methods); a site stiffer than the reference (a higher Vs30, "
-              "legend) lies below it: its ground amplifies the motion less.",
+              "site term's nonlinear part de-amplifies it (Methods).",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled (the "
                "Records section lists them); the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
@@ -269,18 +267,22 @@ CAPTIONS = {
                    "the σ of ln median over that parameter's range (restitution, friction, bed "
                    "stiffness), the others central; the dashed line is the model-form β (FEMA P695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
-                   "squares): the rating covers the parameters, so it replaces their spread, it is not added. A soil "
-                   "marked * ('no median') has no curve of its state below the highest intensity studied; a parameter "
-                   "without a bar had one run there (the answer page says so). A bar marked ≥ is a lower bound: one "
-                   "end of its range has no median below the highest intensity studied, so that end's median lies "
-                   "beyond it and the bar spans at least from the other end to that intensity (for friction, the "
-                   "answer page names such soils). A bar marked 0 has no height: both ends of its range gave the "
-                   "same median.",
+                   "squares): the rating covers the parameters, so it replaces their spread, it is not added.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
                   "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
                   "below the dashed line it does; the test of Luco & Cornell 2007).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
+
+SENSITIVITY_MARK_WORDS = {
+    "*": " A soil marked * ('no median') has no curve of its state below the highest intensity studied.",
+    "≥": " A bar marked ≥ is a lower bound: one end of its range has no median below the highest intensity studied, "
+         "so that end's median lies beyond it and the bar spans at least from the other end to that intensity (for "
+         "friction, the answer page names such soils).",
+    "0": " A bar marked 0 has no height: both ends of its range gave the same median (where the bed cannot tell "
+         "them apart they are one run; the answer page says so).",
+}
+"""The sensitivity caption's sentence on each mark its page draws (``figures.sensitivity_marks``), said only then."""
 
 OUTCOMES_SHADING = " (shaded orange where a panel has one pair of curves)"
 """The outcomes caption's words on the rocking band, on a page that shows it (``figures.rocking_shaded``)."""
@@ -321,7 +323,24 @@ def hazard_caption(results) -> str:
     from rockfrag.report.summary import hazard_caveat
 
     caveat = hazard_caveat(results)
-    return f" The curve: {caveat}." if caveat else " The curve: the site's, given with the study (Methods)."
+    text = stiffer_site_words(results.config.soils, results.site_hazards)
+    return text + (f" The curve: {caveat}." if caveat else " The curve: the site's, given with the study (Methods).")
+
+
+def stiffer_site_words(soils, sites) -> str:
+    """The hazard caption's sentence on the soils whose site is stiffer than the reference's ("" when none is).
+
+    Said only where such a site is drawn (cold read 11: the clause stood on the user study's page, which has none).
+    """
+    if sites is None or sites.reference is None:
+        return ""
+    stiffer = [soil.name for soil in soils
+               if soil.vs30 is not None and soil.vs30 > sites.reference_vs30 and soil.name in sites]
+    if not stiffer:
+        return ""
+    return (f" {listed(stiffer).capitalize()}: {'a site' if len(stiffer) == 1 else 'sites'} stiffer than the "
+            "reference (a higher Vs30, legend), so the curve lies below the reference's: the ground amplifies the "
+            "motion less.")
 
 
 def sweep_words(applicability) -> str:
@@ -506,7 +525,10 @@ def plan(results: Results) -> list[Page]:
     if "median_sensitivity" in fragility:
         governing_by_soil = governing_states(results)
         planned.append(_figure("sensitivity", "Fragility", pages.sensitivity_title(fragility, governing_by_soil),
-                               pages.sensitivity_page, fragility, caption=CAPTIONS["sensitivity"], names=names,
+                               pages.sensitivity_page, fragility, names=names,
+                               caption=CAPTIONS["sensitivity"] + "".join(
+                                   SENSITIVITY_MARK_WORDS[mark]
+                                   for mark in pages.sensitivity_marks(fragility, governing_by_soil)),
                                governing=governing_by_soil))
     for block in blocks:
         planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
@@ -610,13 +632,13 @@ def contents_width(columns: int) -> int:
 
 
 def contents_layout(rows, width: int = CONTENTS_WIDTH) -> list[tuple[int, int, str, str, int | None, bool]]:
-    """Where each line of the contents goes: (column, line, kind, text, page number or None, whether the line
-    continues a wrapped title), in order.
+    """Where each line of the contents goes: (column, line, kind, text, page number or None, continues).
 
-    Titles wrap at ``width`` characters, a bold section title with its page number a little shorter (bold is wider
-    and the number sits on its line: cold read 12, the number ran into "... (R = 9.39"); an entry's lines (and a section heading with the page row below it) stay
-    in one column: the column break never cuts an entry (cold read 8, user C13: "... 1.2 m × 3.0" ended one
-    column and "m, 4.5 t)" began the next).
+    ``continues``: the line continues a wrapped title (drawn with a hanging indent). Titles wrap at ``width``
+    characters, a bold section title with its page number a little shorter (bold is wider and the number sits on
+    its line: cold read 12, the number ran into "... (R = 9.39"); an entry's lines (and a section heading with the
+    page row below it) stay in one column: the column break never cuts an entry (cold read 8, user C13: "... 1.2 m
+    × 3.0" ended one column and "m, 4.5 t)" began the next).
     """
     entries = []  # the lines of each entry; a section heading without a number joins the page row below it
     for index, (kind, text, number) in enumerate(rows):

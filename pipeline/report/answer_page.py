@@ -51,6 +51,7 @@ from rockfrag.report.summary import (
     verdict_items,
 )
 from rockfrag.report.text import Item, heading, note, paragraph, table
+from rockfrag.report.words import listed
 from rockfrag.units import STANDARD_GRAVITY
 
 
@@ -99,7 +100,7 @@ def _band_reach(cube, block=None, results=None) -> str:
     asked = float(requested.where(short).max())
     reached = _grouped({soil: float(target.sel(soil=soil).where(short.sel(soil=soil)).max()) for soil in soils})
     # cold read 9, user B1: "a bed can always dissipate less" -- say what bounds its damping from below
-    text = (f" On {_and(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
+    text = (f" On {listed(soils)} the bed cannot dissipate as little as the restitution range's upper end asks "
             f"(r up to {asked:.3f}; it reaches at most {reached}): its damping has a floor, the least at which the "
             "block's free rocking on the bed is reproducible (below it the block bounces on a ringing bed and the "
             "measured r jumps between neighbouring dampings), and that floor already dissipates more. Those runs "
@@ -112,8 +113,8 @@ def _band_reach(cube, block=None, results=None) -> str:
                if bool(((centre_asked.sel(soil=s) - centre_run.sel(soil=s)) > 5e-4).any())]
         if low:
             values = [f"{float(centre_run.sel(soil=soil).min()):.3f}" for soil in low]
-            runs = values[0] if len(set(values)) == 1 else _and(values)
-            text += (f" On {_and(low)} the best-estimate run uses r = {runs}, below the middle of the range, "
+            runs = values[0] if len(set(values)) == 1 else listed(values)
+            text += (f" On {listed(low)} the best-estimate run uses r = {runs}, below the middle of the range, "
                      f"{float(centre_asked.max()):.3f}.")
             if results is not None and block is not None:
                 text += restitution_effect_words(results, block, low, target)
@@ -174,12 +175,12 @@ def restitution_effect_words(results, block, low, target) -> str:
                 crossed.append(f"{labels.get(judged.state, judged.state)} on {soil.soil}")
     if not shifts:
         return ""
-    moves = _and([f"the median of {labels.get(state, state)} {'drops' if ratio < 1 else 'rises'} by "
+    moves = listed([f"the median of {labels.get(state, state)} {'drops' if ratio < 1 else 'rises'} by "
                   f"{abs(100 * (ratio - 1)):.0f}%" for state, ratio in shifts.items()])
     same = "the same change" if len(shifts) == 1 else "the same changes"
     takes = "takes" if len(shifts) == 1 else "take"
-    verdict = (f"{same} on {_and(low)} would take {_and(crossed)} across its limit." if crossed else
-               f"{same} on {_and(low)} {takes} no damage state across its limit, so no verdict changes.")
+    verdict = (f"{same} on {listed(low)} would take {listed(crossed)} across its limit." if crossed else
+               f"{same} on {listed(low)} {takes} no damage state across its limit, so no verdict changes.")
     return (f" What that side is worth, measured on {proxy}, where the bed reaches r = {reached:.3f}: from the "
             f"best-estimate run to that one {moves}; {verdict}")
 
@@ -189,13 +190,7 @@ def _grouped(values: dict) -> str:
     groups: dict[str, list[str]] = {}
     for soil, value in values.items():
         groups.setdefault(f"{value:.3f}", []).append(soil)
-    return _and([f"{value} on {_and(soils)}" for value, soils in groups.items()])
-
-
-def _and(words) -> str:
-    """"a", "a and b", "a, b and c"."""
-    words = list(words)
-    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+    return listed([f"{value} on {listed(soils)}" for value, soils in groups.items()])
 
 
 def _band_collapse(cube, block) -> str:
@@ -217,7 +212,7 @@ def _band_collapse(cube, block) -> str:
     reached = target.sel(soil=collapsed)
     asked += (f" asked; it reaches {float(reached.max()):.3f} at most" if bool(reached.notnull().any())
               else " asked; it reaches none of them")
-    where = "every soil" if len(collapsed) == cube.soil.size else _and(collapsed)
+    where = "every soil" if len(collapsed) == cube.soil.size else listed(collapsed)
     text = (f" On {where} the restitution range collapses to one run for this block: the bed cannot tell its "
             f"restitutions apart ({asked}), so restitution adds nothing to the model dispersion there because there "
             "is one run, not because it is known; the model part of β there rests on FEMA P695's model-quality "
@@ -375,7 +370,7 @@ def friction_margin_words(results, answer) -> str:
                 moves.append(f"{short[state]} from {numbers.intensity(before, answer.unit)} to "
                              f"{numbers.intensity(after, answer.unit)}")
         if lost:
-            moves.append(f"{_and(lost)} {'loses its median' if len(lost) == 1 else 'lose their medians'} (above "
+            moves.append(f"{listed(lost)} {'loses its median' if len(lost) == 1 else 'lose their medians'} (above "
                          "the highest intensity studied)")
         if not moves:
             continue
@@ -419,20 +414,20 @@ def lift_off_by_soil_words(results, answer, soils) -> str:
         return np.mean([float(cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block,
                                                                 soil=s.name)) for s in group])
 
-    text = (f" On the bed it lifts off on {_and([s.name for s in lifts])} (at most "
-            f"{_and([numbers.probability(share[s.name]) for s in lifts])} of the records, at the highest levels)")
+    text = (f" On the bed it lifts off on {listed([s.name for s in lifts])} (at most "
+            f"{listed([numbers.probability(share[s.name]) for s in lifts])} of the records, at the highest levels)")
     if hardly:
         lowest = min(s.friction_static for s in config_soils(results))
-        text += (f", hardly on {_and([s.name for s in hardly])}"
+        text += (f", hardly on {listed([s.name for s in hardly])}"
                  + (f" (its friction, μ_s {hardly[0].friction_static:g}, is the lowest: the friction caps the base "
                     "shear that builds the rocking)" if len(hardly) == 1 and hardly[0].friction_static == lowest
                     else ""))
     if never:
         ratio = damping(never) / damping(lifts)
-        text += (f", and never on {_and([s.name for s in never])}"
+        text += (f", and never on {listed([s.name for s in never])}"
                  + (f", whose bed damping, set per soil by its calibration to the restitution, is {ratio:.1f} times "
                     "that of "
-                    f"{_and([s.name for s in lifts])}: the rocking that builds up on the springs dies out sooner"
+                    f"{listed([s.name for s in lifts])}: the rocking that builds up on the springs dies out sooner"
                     if ratio >= 1.2 else ": the bed's stiffness and damping do not single these soils out"))
     return text + "."
 
@@ -501,7 +496,7 @@ def slides_then_words(results, answer) -> str:
         said.append(f"on {soil.name} (μ_s {soil.friction_static:g}, μ_k {soil.friction_kinetic:g}) it lifts off at "
                     f"a median of {numbers.intensity(best, answer.unit)}, and at "
                     f"{numbers.intensity(high, answer.unit)} with the friction at the high end of its range")
-    return (f"On {_and([soil.name for soil in soils])} the base friction at rest is at least this block's "
+    return (f"On {listed([soil.name for soil in soils])} the base friction at rest is at least this block's "
             f"b/h = {slender:.2f}, so at rest it rocks before it slides, but its kinetic friction is below b/h: once "
             "the base slips, the friction force can no longer tip the block, which slides instead of rocking. "
             f"The friction decides what it does there: {'; '.join(said)}. Its rocking and "
@@ -511,7 +506,7 @@ def slides_then_words(results, answer) -> str:
 def _where(results, soils) -> str:
     """The soils by name, or "every soil" when they are all the study's (said once, not soil by soil)."""
     every = len(soils) == len(results.config.soils) and len(soils) > 1
-    return "every soil" if every else _and([soil.name for soil in soils])
+    return "every soil" if every else listed([soil.name for soil in soils])
 
 
 def friction_high_words(results, answer) -> str:
@@ -528,8 +523,8 @@ def friction_high_words(results, answer) -> str:
     names = _where(results, soils)
     rigid = "would slide before it could rock on a rigid base"  # on the bed a corner can still lift (cold read 7)
     how = rigid if not then else "cannot rock while it slides" if not first else \
-        f"{rigid} ({_and([soil.name for soil in first])}) or cannot rock while it slides " \
-        f"({_and([soil.name for soil in then])})"
+        f"{rigid} ({listed([soil.name for soil in first])}) or cannot rock while it slides " \
+        f"({listed([soil.name for soil in then])})"
     text = f"{FRICTION_MARK} friction-driven: on {names} the block {how}, so these values rest on the assumed base " \
            "friction."
     fragility, cube = results.fragility, results.cube
@@ -600,11 +595,11 @@ def _friction_high_verdict(results, answer, soils, states) -> str:
     if not found:
         return ""
     where = len({soil for soil, _, _ in found}) > 1
-    values = _and([f"{numbers.probability(value)} for {short[row.state]}" + (f" on {soil}" if where else "")
+    values = listed([f"{numbers.probability(value)} for {short[row.state]}" + (f" on {soil}" if where else "")
                    for soil, row, value in found])
     above = [f"{short[row.state]}" + (f" on {soil}" if where else "") for soil, row, value in found
              if value > row.limit]
-    judged = f"above its limit: {_and(above)}" if above else "within the limits"
+    judged = f"above its limit: {listed(above)}" if above else "within the limits"
     spread = f"{min(betas):.2f}" if round(min(betas), 2) == round(max(betas), 2) else \
         f"{min(betas):.2f} to {max(betas):.2f}"
     return (f" In {numbers.years(answer.design_life)} these medians give {values} (each with the largest β of its "
@@ -708,7 +703,7 @@ def bed_resonance_words(results, answer) -> str:
                  f"({'; '.join(f'{n} {hz(f)} Hz, {hz(1.0 / f)} s' for n, f in grounds[1:])})")
         if band is not None:
             inner = [name for name, frequency in grounds if inside(frequency)]
-            said = ("all within" if len(inner) == len(grounds) else f"{_and(inner)} within" if inner
+            said = ("all within" if len(inner) == len(grounds) else f"{listed(inner)} within" if inner
                     else "none within")
             text += (f", {said} the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s (their mean spectrum "
                      f"within {SPECTRUM_BAND:.0%} of its peak)")
@@ -750,8 +745,8 @@ def early_lift_words(results, answer) -> str:
     if not early:
         return ""
     band = records_band(getattr(results, "showcase", None))
-    values = _and([f"{numbers.intensity(medians[soil.name], answer.unit)} on {soil.name}" for soil in early])
-    shares = _and([f"{medians[soil.name] / rigid:.2f}" for soil in early])
+    values = listed([f"{numbers.intensity(medians[soil.name], answer.unit)} on {soil.name}" for soil in early])
+    shares = listed([f"{medians[soil.name] / rigid:.2f}" for soil in early])
     modes = []
     frequencies = {soil.name: bed_frequencies(config, block, soil) for soil in early}
     for soil in early:
@@ -1366,9 +1361,9 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str, 
         runs = []
         for name in sorted({m for m, _ in cells}):
             soils = sorted({s for m, s in cells if m == name}, key=list(map(str, efficiency.soil.values)).index)
-            on = "" if len(soils) == efficiency.sizes["soil"] else f" on {_and(soils)}"
+            on = "" if len(soils) == efficiency.sizes["soil"] else f" on {listed(soils)}"
             runs.append(f"{model_info(name).label}{on}")
-        where = (f" in the runs of {_and(runs)}, the only runs the test covers; the recommended model's were not "
+        where = (f" in the runs of {listed(runs)}, the only runs the test covers; the recommended model's were not "
                  "tested (its base slides, and the study refines overturning capacities, which the test needs, only "
                  "where the base is tied), so whether they depend on it is not known")
     return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)}{where} (the "

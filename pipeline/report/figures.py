@@ -1449,6 +1449,39 @@ def _one_end_missing(fragility, block: str, soils: list[str], states: list[str],
     return bounds
 
 
+def _sensitivity_bars(fragility, block: str, soils: list[str], states: list[str], parameters: list[str]):
+    """(spread, bounds), each (soil, parameter): the bars' heights and which are lower bounds."""
+    spread = np.array([fragility.median_sensitivity.sel(block=block, soil=soil, damage_state=state,
+                                                        parameter=parameters).values
+                       for soil, state in zip(soils, states)])
+    return spread, _one_end_missing(fragility, block, soils, states, parameters)
+
+
+def _bar_mark(value: float, bound: bool) -> str:
+    """The mark above one bar: ≥ on a lower bound, 0 on a bar too low to see, else ""."""
+    if not np.isfinite(value):
+        return ""
+    return SPREAD_BOUND_MARK if bound else (SPREAD_ZERO_MARK if value < 5e-4 else "")
+
+
+def sensitivity_marks(fragility, governing: dict | None = None) -> list[str]:
+    """The marks the sensitivity page draws, in this order, so its caption explains only those.
+
+    "*": a soil with no median; ``SPREAD_BOUND_MARK``: a lower bound; ``SPREAD_ZERO_MARK``: a bar of no height.
+    """
+    governing, default = governing or {}, sensitivity_state(fragility)
+    parameters, soils = [str(p) for p in fragility.parameter.values], list(map(str, fragility.soil.values))
+    used = set()
+    for block in map(str, fragility.block.values):
+        states = [governing.get((block, soil), default) for soil in soils]
+        spread, bounds = _sensitivity_bars(fragility, block, soils, states, parameters)
+        missing = [not np.isfinite(row).any() for row in spread]
+        if any(missing) and not all(missing):
+            used.add("*")
+        used.update(_bar_mark(v, b) for v, b in zip(spread.ravel(), bounds.ravel()))
+    return [mark for mark in ("*", SPREAD_BOUND_MARK, SPREAD_ZERO_MARK) if mark in used]
+
+
 def sensitivity_page(fragility, caption, names: dict | None = None, governing: dict | None = None):
     """Which sampled parameter moves the recommended median most, per block and soil (``median_sensitivity``).
 
@@ -1474,16 +1507,13 @@ def sensitivity_page(fragility, caption, names: dict | None = None, governing: d
     x = np.arange(len(soils))
     for axis, block in zip(axes, blocks):
         states = [governing.get((block, soil), default) for soil in soils]
-        spread = np.array([fragility.median_sensitivity.sel(block=block, soil=soil, damage_state=state,
-                                                            parameter=parameters).values
-                           for soil, state in zip(soils, states)])  # (soil, parameter)
-        bounds = _one_end_missing(fragility, block, soils, states, parameters)  # (soil, parameter)
+        spread, bounds = _sensitivity_bars(fragility, block, soils, states, parameters)  # (soil, parameter)
         for index, parameter in enumerate(parameters):
             centres = x + (index - (len(parameters) - 1) / 2) * width
             axis.bar(centres, np.nan_to_num(spread[:, index]), width, label=f"{parameter}", color=f"C{index % 10}")
             for centre, value, bound in zip(centres, spread[:, index], bounds[:, index]):
-                mark = SPREAD_BOUND_MARK if bound else (SPREAD_ZERO_MARK if value < 5e-4 else "")
-                if mark and np.isfinite(value):  # a lower bound, or a bar too low to see (both ends alike)
+                mark = _bar_mark(value, bound)
+                if mark:  # a lower bound, or a bar too low to see (both ends alike)
                     axis.annotate(mark, (centre, value), xytext=(0, 2), textcoords="offset points", ha="center",
                                   va="bottom", fontsize=8)
         form = np.nanmax([fragility.beta_form.sel(model="recommended", block=block, damage_state=state).max().item()

@@ -70,7 +70,7 @@ from rockfrag.report.layout import pretty
 from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, hazard_caveat, per_metre
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
-from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, formulas, plain, state_short_label
+from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, formulas, listed, plain, state_short_label
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS, ec8_ground_type
 from rockfrag.units import STANDARD_GRAVITY
@@ -786,14 +786,8 @@ def site_term_words(sites: SiteHazards, soil: str, periods) -> str:
     if not ups:
         return "de-amplified"
     downs = [period for period in periods if period not in ups]
-    return (f"amplified at {_and_words([numbers.years(t).removesuffix(' years') for t in ups])} years, "
-            f"de-amplified at {_and_words([numbers.years(t).removesuffix(' years') for t in downs])} years")
-
-
-def _and_words(words) -> str:
-    """"a", "a and b", "a, b and c"."""
-    words = list(words)
-    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+    return (f"amplified at {listed([numbers.years(t).removesuffix(' years') for t in ups])} years, "
+            f"de-amplified at {listed([numbers.years(t).removesuffix(' years') for t in downs])} years")
 
 
 VS_GAP = 1.25

@@ -21,6 +21,7 @@ from rockfrag.answer import ANCHOR, CHECK_SLIDING, NO_ACTION, NO_VERDICT, displa
 from rockfrag.report import numbers
 from rockfrag.report.adapters import block_name, is_soil, short_block_name, state_labels
 from rockfrag.report.text import Item, bullet, note, paragraph, strong, table
+from rockfrag.report.words import listed
 
 ACTION_WORDS = {ANCHOR: "anchor or restrain", CHECK_SLIDING: "specialist check",
                 NO_ACTION: "no action", NO_VERDICT: "no verdict"}
@@ -188,7 +189,7 @@ def structural_bases(results) -> list[str]:
 def structural_base_words(results) -> str:
     """``STRUCTURAL_BASE_WORDS`` for the study's structural bases ("" where it has none)."""
     bases = structural_bases(results)
-    return STRUCTURAL_BASE_WORDS.format(names=_and(bases)) if bases else ""
+    return STRUCTURAL_BASE_WORDS.format(names=listed(bases)) if bases else ""
 
 
 def governing(soil) -> object | None:
@@ -323,7 +324,7 @@ def weaker_direction_words(results) -> str:
     text = ("Judged across the width only, not across a less stable depth: " + "; ".join(said) + ".") if said else ""
     if strips:
         # a sentence with its verb (cold read 9: "Per metre of a long wall-like block (...): solid block ..." had none)
-        text += (" " if text else "") + (f"The {_and(strips)} {'is' if len(strips) == 1 else 'are'} computed per "
+        text += (" " if text else "") + (f"The {listed(strips)} {'is' if len(strips) == 1 else 'are'} computed per "
                                          "metre of a long wall-like block (the plane model; no less stable depth).")
     return text
 
@@ -567,11 +568,11 @@ def verdict_items(results, answer) -> list[Item]:
     lead = f"With {caveat}, the {name}: " if caveat else f"Verdict for the {name}: "
     parts = []
     for verdict, soils in groups.items():
-        where = _and([soil.soil for soil in soils])
+        where = listed([soil.soil for soil in soils])
         parts.append(f"{action(verdict, hazard=hazard_tag(results))} on {where}")
     tied = [soil.soil for soil in answer.soils if _tied(soil)]
     if tied:
-        parts.append(f"sliding was not computed on {_and(tied)} (the study ties the base there), so those verdicts "
+        parts.append(f"sliding was not computed on {listed(tied)} (the study ties the base there), so those verdicts "
                      "cover rocking and overturning only")
     items = [strong(lead + "; ".join(parts) + ".")]
     for soil in answer.soils:
@@ -579,11 +580,6 @@ def verdict_items(results, answer) -> list[Item]:
         state = f" ({short_names(results)[row.state]})" if row is not None and soil.verdict != CHECK_SLIDING else ""
         items.append(bullet(f"On {soil.soil}{state}: {reason(results, answer, soil)}"))
     return items
-
-
-def _and(words) -> str:
-    words = list(words)
-    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 __all__ = ["ACTION_WORDS", "EXAMPLE_TAG", "GOVERNING_WORDS", "ILLUSTRATIVE_TAG", "PLANE_DEPTH",

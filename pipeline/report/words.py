@@ -146,6 +146,12 @@ REFERENCES = {
 """The works the report cites, by the short name the pages use."""
 
 
+def listed(words) -> str:
+    """"a", "a and b", "a, b and c": names in running text."""
+    words = list(words)
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
 def references_items(cited: str | None = None) -> list[Item]:
     """The references page: the seed paper first, then the others in the order of the dict.
 
