@@ -93,6 +93,10 @@ SOIL_RANGES = {
 KINETIC_OVER_STATIC = 0.85
 """mu_k / mu_s of the shipped soils: a modelling choice inside the 0.8-0.9 that the study's design takes for
 concrete and steel sliding on soil and rock (no table of NAVFAC DM-7.02 gives kinetic values)."""
+CLAY_ADHESION = {"soft clay": (10e3, 35e3), "stiff clay": (35e3, 60e3)}
+"""Ultimate adhesion c_a [Pa] of formed concrete against clay, undrained, whatever the weight: NAVFAC DM-7.02 (1986)
+Table 1 ('soft clay and clayey silt', 'stiff and hard clay'), in kPa as Carter & Bentley (1991) Table 11.1 give it.
+The report compares it with mu_s times a block's contact pressure: which of the two holds a base on clay."""
 DEFAULT_FRICTION = (0.5, 0.4)
 """(mu_s, mu_k) of a soil that does not state its own (a ``[soils_custom.NAME]`` table without them): the
 steel-on-steel pair below, and the coefficient the report's sliding check used before friction was per soil."""
@@ -164,6 +168,21 @@ def interface_stiffness(shear_modulus, block_modulus, footprint_area, soil_depth
     if min(shear_modulus, block_modulus, footprint_area, soil_depth) <= 0:
         raise ConfigError("interface_stiffness", "G_s, E_b, A and H must all be > 0")
     return footprint_area / soil_depth / (1.0 / shear_modulus + 1.0 / block_modulus)
+
+
+def half_space_stiffness(shear_modulus: float, poisson_ratio: float, length: float, width: float) -> float:
+    """Static vertical stiffness [N/m] of a rigid rectangular surface footing on an elastic half-space.
+
+    The footing is ``length`` x ``width`` [m] (Gazetas 1991, Table 1; NIST GCR 12-917-21 Table 2-2a).
+    K_z = 2 G L / (1 - nu) (0.73 + 1.54 chi^0.75), L and B the half-sides (L >= B), chi = A_b / (4 L^2) = B / L.
+    A check on the paper's eq. 19, which takes the soil as a column of depth H under the footprint: the report
+    compares the two, it does not run this one.
+    """
+    if min(shear_modulus, length, width) <= 0 or not 0 <= poisson_ratio < 0.5:
+        raise ConfigError("half_space_stiffness", "G, the footing's length and width must be > 0 and nu in [0, 0.5)")
+    half_long, half_short = max(length, width) / 2.0, min(length, width) / 2.0
+    chi = half_short / half_long
+    return 2.0 * shear_modulus * half_long / (1.0 - poisson_ratio) * (0.73 + 1.54 * chi ** 0.75)
 
 
 def soil_block_stiffness(soil: SoilClass, block) -> float:

@@ -669,3 +669,58 @@ def test_the_sensitivity_page_marks_a_lower_bound_and_a_zero_bar():
         plt.close(figure)
     assert sensitivity_marks(fragility) == [SPREAD_BOUND_MARK, SPREAD_ZERO_MARK]
     assert "marked ≥ is a lower bound" in SENSITIVITY_MARK_WORDS["≥"] and "marked 0" in SENSITIVITY_MARK_WORDS["0"]
+
+
+def test_the_methods_compare_eq19_with_an_elastic_half_space():
+    """Cold read 12, user B3: eq. 19 gave the enclosure 66.8 MN/m on clay where Gazetas' rigid footing on a
+    half-space of the same G and nu gives 162 MN/m (2.4 times, beyond the sensitivity runs' x 2), and the report did
+    not say so. The methods now give both and which way the difference acts; a per-metre block is left out (a long
+    strip has no finite static half-space stiffness); a steel base is no soil."""
+    from types import SimpleNamespace
+
+    from rockfrag.blocks import Block
+    from rockfrag.report.sections import half_space_words
+    from rockfrag.soils import SoilClass, soil_block_stiffness
+
+    clay = SoilClass("clay", 37.142857e6, 0.3, 1800.0)
+    steel = SoilClass("steel", 80e9, 0.3, 7850.0)
+    enclosure = Block("enclosure", b=0.6, h=1.5, mass=4500.0, footprint_area=1.8, soil_depth=1.0, E_b=30e9)
+    strip = Block("wall", b=2.0, h=5.0, mass=50e3, E_b=30e9)  # per metre of length
+    blocks, soils = [enclosure, strip], [clay, steel]
+    stiffness = xr.DataArray([[soil_block_stiffness(s, b) for b in blocks] for s in soils],
+                             coords={"soil": ["clay", "steel"], "block": ["enclosure", "wall"]})
+    cube = xr.Dataset({"interface_stiffness": stiffness,
+                       "soil_shear_modulus": ("soil", [s.shear_modulus for s in soils])})
+    config = SimpleNamespace(blocks=blocks, soils=soils, design=SimpleNamespace(stiffness_factor=2.0),
+                             raw={})
+    text = half_space_words(config, cube)
+    assert "enclosure (H 1 m): 2.4 × eq. 19's k (clay 162 MN/m), beyond the sensitivity runs' × or ÷ 2" in text, text
+    assert "is stiffer" in text
+    assert "steel" not in text and "Not compared: wall" in text
+    assert half_space_words(SimpleNamespace(blocks=blocks, soils=soils, raw={},
+                                            design=SimpleNamespace(stiffness_factor=3.0)), cube).count("within") == 1
+
+
+def test_the_clay_adhesion_caveat_errs_the_way_each_blocks_contact_pressure_says():
+    """Cold read 12, user B2: the enclosure presses 24.5 kPa, so μ_s p = 8.6 kPa, below the adhesion of even a soft
+    clay (10-35 kPa, NAVFAC DM-7.02): undrained it grips more, and the caveat said it slides more easily. A block
+    whose μ_s p exceeds a stiff clay's 60 kPa slides more easily; between, it depends on the clay."""
+    from types import SimpleNamespace
+
+    from rockfrag.blocks import Block
+    from rockfrag.report.sections import adhesion_words
+    from rockfrag.soils import SoilClass
+
+    clay = SoilClass("clay", 37.142857e6, 0.3, 1800.0, friction_static=0.35, friction_kinetic=0.3)
+    light = Block("enclosure", b=0.6, h=1.5, mass=4500.0, footprint_area=1.8, soil_depth=1.0, E_b=30e9)
+    heavy = Block("tower", b=1.0, h=8.0, mass=60e3, footprint_area=2.0, E_b=30e9)  # 294 kPa: μ_s p 103 kPa
+    middle = Block("skid", b=1.5, h=2.0, mass=30e3, footprint_area=9.0, E_b=30e9)  # 32.7 kPa: μ_s p 11 kPa
+    config = SimpleNamespace(blocks=[light, heavy, middle], soils=[clay], raw={})
+    cube = xr.Dataset(coords={"block": ["enclosure", "tower", "skid"], "soil": ["clay"]})
+    text = adhesion_words(config, cube, ["clay"])
+    assert "enclosure on clay 24.5 kPa, μ_s p 8.58 kPa" in text, text
+    assert "tower on clay 294 kPa, μ_s p 103 kPa" in text
+    assert "For enclosure on clay that is below the adhesion of even a soft clay" in text
+    assert "slip probabilities here are, if anything, high" in text
+    assert "For tower on clay it is above the adhesion of even a stiff clay" in text
+    assert "For skid on clay it lies within" in text

@@ -70,3 +70,21 @@ def test_bad_blocks_name_the_field(kwargs, field):
 def test_bad_soil_is_refused():
     with pytest.raises(ConfigError, match="poisson"):
         SoilClass("mud", 1e6, 0.5, 1500.0)
+
+
+def test_the_half_space_stiffness_is_gazetas_and_meets_the_rigid_disc():
+    """Gazetas (1991) for a rigid rectangular surface footing: a square is within 1% of the rigid disc of the same
+    area, 4 G R / (1 - nu) (Boussinesq's closed form); a 2:1 rectangle gives 2GL/(1 - nu) (0.73 + 1.54 0.5^0.75);
+    the enclosure of the user study (1.2 m x 1.5 m on G 37.1 MPa, nu 0.3) 162 MN/m, as a cold reader computed."""
+    from rockfrag.soils import half_space_stiffness
+
+    shear, nu = 50e6, 0.3
+    square = half_space_stiffness(shear, nu, 2.0, 2.0)
+    radius = 2.0 / math.sqrt(math.pi)
+    assert square == pytest.approx(4 * shear * radius / (1 - nu), rel=0.01)
+    assert half_space_stiffness(shear, nu, 4.0, 2.0) == pytest.approx(
+        2 * shear * 2.0 / (1 - nu) * (0.73 + 1.54 * 0.5 ** 0.75), rel=1e-12)
+    assert half_space_stiffness(shear, nu, 2.0, 4.0) == half_space_stiffness(shear, nu, 4.0, 2.0)
+    assert half_space_stiffness(37.142857e6, nu, 1.2, 1.5) / 1e6 == pytest.approx(162, abs=0.5)
+    with pytest.raises(ConfigError):
+        half_space_stiffness(shear, 0.5, 1.0, 1.0)

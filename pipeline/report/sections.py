@@ -335,6 +335,100 @@ def grounds(cube) -> str:
     return " and ".join(parts)
 
 
+def half_space_words(config, cube) -> str:
+    """Eq. 19's bed stiffness against an elastic half-space's under the same footing, and which way it acts.
+
+    Cold read 12, user B3: eq. 19 takes the soil as a column of depth H under the footprint; Gazetas' (1991) rigid
+    rectangular surface footing on a half-space of the soil's G and nu was 2.4 times stiffer for the enclosure,
+    beyond the sensitivity runs' x 2, and nothing said so. A block modelled per metre of a long base is left out: a
+    long strip has no finite static half-space stiffness. "" when no block and soil can be compared.
+    """
+    from rockfrag.report.summary import per_metre
+    from rockfrag.soils import half_space_stiffness
+
+    stiffness = cube.interface_stiffness if "interface_stiffness" in cube else None
+    if stiffness is None:
+        return ""
+    factor = config.design.stiffness_factor
+    compared, strips, ratios = [], [], []
+    for block in config.blocks:
+        if block.name not in cube.block.values:
+            continue
+        depth = block.footprint_area / (2 * block.b)
+        if per_metre(depth):
+            strips.append(short_block_name(config, block.name))
+            continue
+        values, own = [], []
+        for soil in config.soils:
+            if soil.name not in cube.soil.values or not is_soil(cube, soil.name):
+                continue
+            elastic = half_space_stiffness(soil.shear_modulus, soil.poisson_ratio, 2 * block.b, depth)
+            own.append(elastic / float(stiffness.sel(soil=soil.name, block=block.name)))
+            values.append(f"{soil.name} {_three_figures(elastic / 1e6)}")
+        if not own:
+            continue
+        ratios += own
+        low, high = f"{min(own):.1f}", f"{max(own):.1f}"
+        where = ("beyond" if max(own) > factor or min(own) < 1 / factor else "within")
+        compared.append(f"{short_block_name(config, block.name)} (H {_g(block.soil_depth)} m): "
+                        f"{low if low == high else f'{low}-{high}'} × eq. 19's k ({', '.join(values)} MN/m), "
+                        f"{where} the sensitivity runs' × or ÷ {factor:g} on the bed stiffness")
+    if not compared:
+        return ""
+    compare = "stiffer" if min(ratios) > 1 else ("softer" if max(ratios) < 1 else "different")
+    text = ("The paper's eq. 19 takes the soil under the footprint as a column of depth H. An elastic half-space of "
+            "the soil's G and ν under a rigid rectangular surface footing (Gazetas 1991: K_z = 2GL/(1 − ν) (0.73 + "
+            f"1.54 χ^0.75), L and B the half-sides, χ = B/L) is {compare}: {'; '.join(compared)}. ")
+    text += ("A stiffer bed lifts the block off later, nearer the rigid base's g·tanα, and rocks it more like the "
+             "rigid base; the sensitivity page shows how far each governing median moves over the runs' range.")
+    if strips:
+        text += (f" Not compared: {listed(strips)}, modelled per metre of a long base (a long strip has no finite "
+                 "static half-space stiffness).")
+    return text
+
+
+def adhesion_words(config, cube, clays: list[str]) -> str:
+    """The 'Sliding' paragraph on clay: friction against the clay's undrained adhesion, and which way each block errs.
+
+    Cold read 11 (user B1) asked which way the caveat errs; cold read 12 (user B2) found it backwards for a light
+    block: the enclosure presses 24.5 kPa, so mu_s p = 8.6 kPa, below the adhesion of even a soft clay (NAVFAC
+    DM-7.02: 10-35 kPa): undrained, its base grips more than the friction lets it, and slides less. Each block's
+    mu_s p on each clay is set against ``CLAY_ADHESION``.
+    """
+    from rockfrag.soils import CLAY_ADHESION
+
+    (soft_low, soft_high), (stiff_low, stiff_high) = CLAY_ADHESION["soft clay"], CLAY_ADHESION["stiff clay"]
+    grips, slides, either = [], [], []
+    resisted = []
+    for block in config.blocks:
+        if block.name not in cube.block.values:
+            continue
+        pressure = block.mass * STANDARD_GRAVITY / block.footprint_area
+        for soil in (s for s in config.soils if s.name in clays):
+            shear = soil.friction_static * pressure
+            name = f"{short_block_name(config, block.name)} on {soil.name}"
+            resisted.append(f"{name} {_three_figures(pressure / 1e3)} kPa, μ_s p {_three_figures(shear / 1e3)} kPa")
+            (grips if shear < soft_low else slides if shear > stiff_high else either).append(name)
+    text = (f"On {listed(clays)} the friction is a drained friction factor (Coulomb: the shear the base can take "
+            "grows with the block's weight, μ_s times its contact pressure p = m g / A). In the fast loading of an "
+            "earthquake a base on saturated clay slides on the clay's undrained adhesion instead, whatever the "
+            f"weight: for formed concrete {soft_low / 1e3:.0f}-{soft_high / 1e3:.0f} kPa on soft clay and "
+            f"{stiff_low / 1e3:.0f}-{stiff_high / 1e3:.0f} kPa on stiff clay (NAVFAC DM-7.02, Table 1). This study "
+            "does not model adhesion; a site investigation's undrained strength says which governs. The contact "
+            f"pressures and what the friction resists: {'; '.join(resisted)}.")
+    if grips:
+        text += (f" For {listed(grips)} that is below the adhesion of even a soft clay: a base that grips undrained "
+                 "slides less than this study lets it, so its slip probabilities here are, if anything, high and its "
+                 "rocking ones low (the sensitivity runs with the higher friction show that side).")
+    if slides:
+        text += (f" For {listed(slides)} it is above the adhesion of even a stiff clay: undrained, the base slides "
+                 "more easily, so its slip probabilities here are low and its rocking ones, if anything, high.")
+    if either:
+        text += (f" For {listed(either)} it lies within the clays' adhesion: which way the study errs depends on the "
+                 "clay's undrained strength.")
+    return text
+
+
 def _any_per_metre(config) -> bool:
     """Whether a block of the study is modelled per metre of its length (the plane model's 1 m depth)."""
     from rockfrag.report.summary import per_metre
@@ -1000,6 +1094,9 @@ def methods_items(results: Results) -> list[Item]:
                            for b in cube.block.values)
     items.append(note(f"Static settlement m·g/k of each block on its bed [mm], from which a lift is counted ('Reading "
                       f"the answer pages'): {settlement}."))  # cold read 8, user B4: referred to, never printed
+    half_space = half_space_words(config, cube)
+    if half_space:
+        items.append(note(half_space))
 
     pga = record_pga_g(cube)
     events = len(set(map(str, cube.record_event.values))) if "record_event" in cube.coords else "?"
@@ -1492,15 +1589,7 @@ def limitations_items(results: Results) -> list[Item]:
                            "and the methods. It is the soil class's, not the block's own base."))
     clays = [str(soil) for soil in cube.soil.values if "clay" in str(soil).lower()]
     if clays:  # cold read 8: a base on clay slides, in fast loading, on the clay's undrained strength
-        items.append(paragraph(
-            f"On {', '.join(clays)} the friction is a drained friction factor (Coulomb: the shear the base can take "
-            "grows with the block's weight). In the fast loading of an earthquake a base on saturated clay slides on "
-            "the clay's undrained adhesion instead, bounded by its undrained shear strength whatever the weight, "
-            "which can be lower than μ_s times the contact pressure under a heavy block; the sensitivity runs' "
-            "lower friction covers only part of that. A site investigation's undrained strength says which governs; "
-            "this study does not model adhesion. Where the adhesion governs, the base slides more easily: the slip "
-            "probabilities of this report are then low (and its rocking ones, if anything, high: a base that slides "
-            "rocks less)."))
+        items.append(paragraph(adhesion_words(config, cube, clays)))
     items += [paragraph(text) for text in friction_runs_words(results)]
     flag = friction_flag(cube)
     for model in models:
