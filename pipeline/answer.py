@@ -273,6 +273,10 @@ class StateAnswer:
         The share of ``annual_frequency`` that is the bound for the hazard above the highest intensity studied
         (every stronger motion counted as reaching the state: fragility.nc ``annual_frequency_above_cap``); a
         value that is mostly this term is a bound, not a computed probability (cold read 9).
+    records_above : tuple of (int, int, float) or None
+        What the records did at the level run next above the largest return period's intensity (as ``records``):
+        with the last of ``records``, the two levels either side of it (cold read 12, user B1: "0 of 44 at 0.52 g"
+        for a 0.60 g intensity, where 1 of 44 overturned at 0.65 g). None where no level lies above it.
     below_lowest : tuple of (float, int, int) or None
         Where the fitted median lies below the lowest level run (the records reached the state already
         there): that level (shown unit) and how many of how many records reached the state at it. The
@@ -292,6 +296,7 @@ class StateAnswer:
     supported_probability: float = float("nan")
     below_lowest: tuple | None = None
     above_cap_share: float = 0.0
+    records_above: tuple | None = None
 
     @property
     def exceeds(self) -> bool:
@@ -409,6 +414,15 @@ def _records_at(levels: np.ndarray, empirical: np.ndarray, n_records: int, im: f
     if level is None or not empirical.size or not np.isfinite(empirical[level]):
         return (-1, n_records, float("nan"))
     return (records_reaching(empirical[level], n_records), n_records, float(levels[level]))
+
+
+def _records_above(levels: np.ndarray, empirical: np.ndarray, n_records: int, im: float) -> tuple | None:
+    """(records reaching the state, of how many, the level) at the level next above ``im``; None: none above."""
+    at_or_below = level_at_or_below(levels, im)
+    above = 0 if at_or_below is None else at_or_below + 1
+    if above >= len(levels) or not empirical.size or not np.isfinite(empirical[above]):
+        return None
+    return (records_reaching(empirical[above], n_records), n_records, float(levels[above]))
 
 
 def _first_reached(levels: np.ndarray, empirical: np.ndarray) -> float | None:
@@ -575,6 +589,8 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | Mapping[str, Haza
                         float(row["median"]) * scale, float(row["beta"]), site, lower=first), design_life))
                 records = tuple(_records_at(levels, empirical, n_records, im) for im in at_site) \
                     if n_records and empirical.size else ()
+                records_above = _records_above(levels, empirical, n_records, at_site[-1]) \
+                    if records and len(at_site) else None
                 at = tuple(_at(row, im, scale, levels, empirical) for im in at_site)
                 below = None
                 median = float(row["median"]) * scale
@@ -591,7 +607,7 @@ def block_answers(fragility: xr.Dataset, hazard: HazardCurve | Mapping[str, Haza
                 cap_share = above / frequency if np.isfinite(above) and frequency > 0 and below is None \
                     and not_reached is None else 0.0
                 rows.append(StateAnswer(state, at, frequency, probability, limits.get(state), not_reached, records,
-                                        first, supported, below, cap_share))
+                                        first, supported, below, cap_share, records_above))
             rows = nested(rows, families)
             share = float((sliding or {}).get((block, soil), np.nan))
             if hazard is None:

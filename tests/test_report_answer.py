@@ -564,3 +564,27 @@ def test_a_lower_bound_of_every_record_is_printed_as_a_certainty():
 
     assert bound(1.0, "\u2265") == "100%" and bound(0.61, "\u2265") == "\u2265 61%"
     assert bound(0.996, "\u2265") == "> 99%"
+
+
+def test_the_summary_reason_gives_the_records_at_the_levels_either_side_of_the_intensity():
+    """Cold read 12, user B1: the sand's 2,475-year PGA is 0.60 g, between the levels 0.52 g (0 of 44 overturned)
+    and 0.65 g (1 of 44); the reason read "0 of 44 at 0.52 g: fitted tail" alone. Where none reached the state at
+    the level below and some at the level above, it names both."""
+    from types import SimpleNamespace
+
+    from rockfrag.report import numbers
+    from rockfrag.report.summary import reason
+
+    levels = np.geomspace(0.1, 4.0, 8)
+    im = (K0 * 2475.0) ** (1 / K)
+    above = int(np.flatnonzero(levels > im)[0])
+    shape = (levels.size, 2, 1, 2, 2)
+    reached = np.clip((np.arange(levels.size) - above + 1) * 0.3, 0.0, 1.0)  # none below the intensity, 3 above
+    fragility = _fragility([[[[0.5, 1.0]]]], betas=0.6, empirical=reached[:, None, None, None, None]
+                           * np.ones(shape)).assign(n_records=10)
+    answer = block_answers(fragility, _power_law(), limits={"overturning": 0.5})[0]
+    overturning = answer.soils[0].states[1]
+    assert overturning.records[-1] == (0, 10, pytest.approx(levels[above - 1]))
+    assert overturning.records_above == (3, 10, pytest.approx(levels[above]))
+    said = reason(SimpleNamespace(facts=numbers.Facts()), answer, answer.soils[0])
+    assert said == f"0 of 10 at {levels[above - 1]:.2g} g, 3 at {levels[above]:.2g} g", said

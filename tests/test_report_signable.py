@@ -724,3 +724,20 @@ def test_the_clay_adhesion_caveat_errs_the_way_each_blocks_contact_pressure_says
     assert "slip probabilities here are, if anything, high" in text
     assert "For tower on clay it is above the adhesion of even a stiff clay" in text
     assert "For skid on clay it lies within" in text
+
+
+def test_the_summary_says_which_soils_are_representative_classes_not_the_sites():
+    """Cold read 12, user B4: the summary, the page that is signed, called them "the site's clay and sand" while
+    their moduli are the paper's representative values and their friction a class's; only the methods said so."""
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from rockfrag.report.summary import representative_soils_words
+    from rockfrag.soils import SOILS
+
+    measured = replace(SOILS["sand"], shear_modulus=95e6)  # a site investigation's modulus: not a shipped class
+    results = SimpleNamespace(config=SimpleNamespace(soils=[SOILS["clay"], measured]), cube=xr.Dataset())
+    assert representative_soils_words(results) == ("Clay: representative class of ground (the paper's moduli, "
+                                                   "NAVFAC friction), not site measurements (Methods).")
+    results.config.soils = [measured]
+    assert representative_soils_words(results) == ""

@@ -352,8 +352,9 @@ def reason(results, answer, soil) -> str:
 
     The probability and its limit are in the row already; the sentence says where they come from: how many
     records reach the governing state at the level run at or below the largest return period's intensity (the
-    level the sliding check reads too), or that none did up to the largest recorded intensity, or that the
-    verdict rests on the fitted curve's tail or on a bound. Short enough for one line of the summary's table.
+    level the sliding check reads too; where none do there but some at the level next above, both levels), or
+    that none did up to the largest recorded intensity, or that the verdict rests on the fitted curve's tail or on
+    a bound. Short enough for one line of the summary's table.
     """
     row = governing(soil)
     unit = answer.unit
@@ -381,6 +382,10 @@ def reason(results, answer, soil) -> str:
         reached, total, level = row.records[-1]
         results.facts.say("records reaching", (answer.block, soil.soil, row.state, answer.return_periods[-1]),
                           str(reached))
+        if reached == 0 and row.records_above is not None and row.records_above[0] > 0:
+            # none at the level below the intensity, some at the level above: both, so "0 of 44" is not read alone
+            return (f"{numbers.count(reached, total)} at {numbers.intensity(level, unit)}, {row.records_above[0]} "
+                    f"at {numbers.intensity(row.records_above[2], unit)}")
         if reached == 0:  # a non-zero P beside "0 of 44" says where it comes from
             return f"{numbers.count(reached, total)} at {numbers.intensity(level, unit)}: fitted tail"
         return f"{numbers.count(reached, total)} reach it at {numbers.intensity(level, unit)}"
@@ -462,13 +467,31 @@ def summary_items(results) -> list[Item]:
                    "studied, so no curve is fitted; its probabilities come from the records' share at each level.")
     items.append(note(" ".join(filter(None, [
         said, GOVERNING_WORDS, bounds, scaled_medians_words(results), structural_base_words(results),
-        weaker_direction_words(results),
-        "Reason: the records at the level run at or below the largest return period's intensity; where none "
-        "reach the state there, its probabilities are the fitted curve's tail. β (records / model): the total, "
+        weaker_direction_words(results), representative_soils_words(results),
+        "Reason: the records at the level run at or below the largest return period's intensity"
+        + (" (and above it where only there some reach the state)" if any(", " in row[-1] for row in rows) else "")
+        + "; where none reach it, its probabilities are the fitted curve's tail. β (records / model): the total, "
         "√(records² + model²), of the variability from record to record and the model's own uncertainty. The "
         "answer pages give every state and its records."
     ]))))
     return items
+
+
+def representative_soils_words(results) -> str:
+    """The summary's sentence on soils that are the shipped classes, not the site's measurements ("" when none).
+
+    Cold read 12, user B4: the verdicts are on "the site's clay and sand", whose moduli are the paper's
+    representative values and whose friction is a class's; only the methods said so, not the page that is signed.
+    """
+    from rockfrag.soils import SOILS
+
+    config = getattr(results, "config", None)
+    names = [soil.name for soil in getattr(config, "soils", ()) or ()
+             if SOILS.get(soil.name) == soil and is_soil(results.cube, soil.name)]
+    if not names:
+        return ""
+    return (f"{listed(names).capitalize()}: representative class{'' if len(names) == 1 else 'es'} of ground (the "
+            "paper's moduli, NAVFAC friction), not site measurements (Methods).")
 
 
 def scaled_medians_words(results) -> str:
