@@ -741,3 +741,15 @@ def test_the_summary_says_which_soils_are_representative_classes_not_the_sites()
                                                    "NAVFAC friction), not site measurements (Methods).")
     results.config.soils = [measured]
     assert representative_soils_words(results) == ""
+
+
+def test_the_appendix_names_the_exchange_files_the_run_wrote(tmp_path):
+    """Cold read 12, user C17: fragility_pelicun.csv and the OpenQuake files were named nowhere in the report."""
+    from rockfrag.report.sections import NAVFAC_RANGES, exchange_files
+
+    assert exchange_files(tmp_path) == []
+    (tmp_path / "fragility_pelicun.csv").write_text("ID\n")
+    (tmp_path / "fragility_openquake.xml").write_text("<nrml/>")
+    assert exchange_files(tmp_path) == ["fragility_pelicun.csv", "fragility_openquake.xml"]
+    # user C12: which way the sand's low friction end errs is said beside it
+    assert "more sliding and less rocking" in NAVFAC_RANGES["sand"]

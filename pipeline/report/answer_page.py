@@ -763,7 +763,7 @@ def early_lift_words(results, answer) -> str:
         text += f" (rocking frequency with the whole base down: {'; '.join(modes)}"
         text += (f"; the records' strongest band {band[0]:.2g} to {band[1]:.2g} s)" if band is not None else ")")
     text += (", and ground motion near that period builds the rocking up until a corner loses contact; on a rigid "
-             "base the block does not move before the ground reaches g·tanα. The bed's static give alone lowers "
+             "base the block does not rock before the ground reaches g·tanα. The bed's static give alone lowers "
              f"the lift-off by the share h·δ/b² of it (δ the static settlement), {numbers.two_figures(100 * give)}% "
              "at most here.")
     return text
@@ -1027,7 +1027,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                 text += _poor_fit_mark(results, answer, soil, row)
             cells.append(text)
         rows.append(cells)
-    rows.append(["β of the recommended curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
+    rows.append(["β of the governing state's curve", "", *(_beta_cell(results, answer, soil) for soil in answer.soils)])
     from rockfrag.report.summary import action, hazard_tag
 
     tag = hazard_tag(results)

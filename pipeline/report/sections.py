@@ -462,6 +462,15 @@ def _result_files(results: Results) -> list[str]:
                                                     if dataset is not None and len(dataset.data_vars)]
 
 
+def exchange_files(output) -> list[str]:
+    """The exchange files (pelicun, OpenQuake) the run wrote into ``output``, by name; [] where none."""
+    from rockfrag.exchange import OPENQUAKE_FILE, OPENQUAKE_SLIP_FILE, PELICUN_FILE
+
+    folder = Path(output) if output is not None else None
+    return [name for name in (PELICUN_FILE, OPENQUAKE_FILE, OPENQUAKE_SLIP_FILE)
+            if folder is not None and (folder / name).is_file()]
+
+
 def title_items(results: Results) -> list[Item]:
     """The title page below the title: study, size of the run, what the report holds."""
     config, cube = results.config, results.cube
@@ -637,6 +646,10 @@ def reproduce_items(results: Results) -> list[Item]:
             ["run time", run_time_line(results.runtime_s, results.run)],
             ["result files read", ", ".join(_result_files(results))],
             ["tables of every fitted curve", "fragility.csv (confidence bounds, goodness of fit, fit warnings)"]]
+    exchange = exchange_files(results.output)
+    if exchange:  # cold read 12, user C17: the files a loss tool reads were named nowhere
+        rows.append(["files for loss tools", f"{', '.join(exchange)}: every model's curves for pelicun and "
+                     "OpenQuake; the answer's are the recommended model's rows (ROCK.<block>.<soil>.recommended)"])
     damping_items = []
     for model in models_of(cube):
         if calibrated_damping(cube, model.name):  # the methods say it is calibrated; its values are an operator's
@@ -752,7 +765,8 @@ def fitted_items(results: Results) -> list[Item]:
                           "the friction and the ground motion matter), so its slip rows can repeat from block to "
                           "block."))
     if any("exact-thresholds" == str(m) for m in np.unique(fragility.fit_method.values)):
-        items.append(note("An uplift row of the rigid base or the paper's model has the same median on every soil, "
+        items.append(note("An uplift row of the rigid base or the paper's model has the same median on every soil "
+                          "where it lifts off (where the rigid base slides instead, its cell is '-'), "
                           "the lognormal median of the records' own uplift intensities (each g·tanα × the record's "
                           "pair RotD50 over its own peak; Methods, 'Fragility fits'), close to the uplift intensity "
                           "the levels are set from (g·tanα × the records' median ratio), and a β of about 0.15: their "
@@ -1178,8 +1192,10 @@ def methods_items(results: Results) -> list[Item]:
 
 
 NAVFAC_RANGES = {"rock": "clean sound rock 0.70",
-                 "gravel": "clean gravel and coarse sand 0.55-0.60, its low end taken",
-                 "sand": "clean fine to medium sand 0.45-0.55, its low end taken",
+                 "gravel": "clean gravel and coarse sand 0.55-0.60, its low end taken: more sliding and less "
+                           "rocking than its high end, which the sensitivity runs' higher friction reaches",
+                 "sand": "clean fine to medium sand 0.45-0.55, its low end taken: more sliding and less rocking "
+                         "than its high end, which the sensitivity runs' higher friction reaches",
                  "clay": "medium stiff and stiff clay 0.30-0.35, its high end taken, below the 0.40-0.50 of very "
                          "stiff clay"}
 """The ranges of NAVFAC DM-7.02 Table 1 each shipped soil's μ_s is taken from (rockfrag.soils.FRICTION_SOURCES)."""
@@ -1354,6 +1370,11 @@ def sources_items(results: Results) -> list[Item]:
             "reproduce this report')"
         items.append(bullet(f"Limit of the verdict for '{pretty(labels.get(state, state))}', "
                             f"{numbers.stated_probability(limit)} in the design life: {source}."))
+    if any(state in labels for state in results.decision["max_probability_in_life"]):
+        items.append(bullet("The limits are the study's choices, modelled on the references named: the owner "
+                            "confirms them against the code that governs the site (in Europe EN 1998-1 with its "
+                            "National Annex, in the United States ASCE 7), which sets the anchorage of equipment "
+                            "whatever this report's verdict."))
     life = float(fragility.attrs.get("design_life_years", config.design_life))
     items.append(bullet(f"Design life {life:g} years: {CHOICE_WORDS}; 50 years is the span over which ASCE 7-22 "
                         "and the return periods below are stated."))

@@ -224,8 +224,9 @@ GLOSSARY = (
     ("restitution", "the share of rocking speed a block keeps at each impact; Housner's rigid base gives "
                     "r = 1 − 1.5 sin²α, and experiments on rigid bases find about that value or a few percent more "
                     "(ElGawady et al. 2011; Kalliontzis et al. 2016; Ther & Kollár 2017)."),
-    ("record sets", "the sets of earthquake records the tool ships: FEMA P695's far-field set, and its near-field "
-                    "set (records with and without a velocity pulse); the methods name the set this study runs."),
+    ("record sets", "the sets of earthquake records available to a study: FEMA P695's far-field set, and its "
+                    "near-field set (records with and without a velocity pulse); the methods name the set this "
+                    "study runs."),
     ("flies, free flight", "the whole base leaves the ground, a corner at least the uplift size: after an "
                            "impact on a bed (the block bounces), or in free flight, where the ground drops faster "
                            "than gravity (g + a_v < 0 under the vertical component, only where a study applies "
@@ -249,7 +250,8 @@ GLOSSARY = (
                           "model-quality rating, the counterpart of FEMA P-58's modelling dispersion β_q, or the "
                           "sensitivity runs' spread where larger) to the record-to-record part."),
     ("highest intensity studied", "the highest intensity the study runs (its value and reason are in the "
-                                  "methods: 3 g PGA lies above the largest horizontal PGA ever recorded); no "
+                                  "methods: 3 g PGA lies above the largest horizontal PGA in the strong-motion "
+                                  "databases); no "
                                   "level, fit or median lies above it, and a probability adds the site's chance "
                                   "of exceeding it as an upper bound."),
     ("RotD50", "the median over all horizontal orientations of a station's two components (Boore 2010), the "
