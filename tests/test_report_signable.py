@@ -753,3 +753,27 @@ def test_the_appendix_names_the_exchange_files_the_run_wrote(tmp_path):
     assert exchange_files(tmp_path) == ["fragility_pelicun.csv", "fragility_openquake.xml"]
     # user C12: which way the sand's low friction end errs is said beside it
     assert "more sliding and less rocking" in NAVFAC_RANGES["sand"]
+
+
+def test_a_reference_models_points_are_open_and_the_answers_filled(small_pipeline):
+    """Cold read 12, user C8: on one soil the recommended model's and the rigid base's points had one colour and one
+    marker. The rigid base's points are now open (white inside), the page's model's filled."""
+    import matplotlib.colors as mcolors
+    import matplotlib.pyplot as plt
+
+    from rockfrag.report.adapters import models_of
+    from rockfrag.report.figures import fragility_by_soil_page
+
+    results = pipeline_results(small_pipeline.output, small_pipeline.study)
+    fragility = results.fragility
+    model = next(m for m in models_of(fragility) if not m.rigid_base)  # the SSI model, solid; Housner dashed
+    figure = fragility_by_soil_page(fragility, str(fragility.block.values[0]), model, "")
+    try:
+        points = [line for axis in figure.axes for line in axis.get_lines()
+                  if line.get_marker() == "o" and line.get_linestyle() in ("None", "none", "")]
+        assert points
+        white = mcolors.to_rgba("white")
+        filled = [mcolors.to_rgba(p.get_markerfacecolor()) != white for p in points]
+        assert any(filled) and not all(filled)  # the page's model filled, the rigid base open
+    finally:
+        plt.close(figure)

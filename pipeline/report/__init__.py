@@ -230,14 +230,16 @@ CAPTIONS = {
            "overturn at one level and survive a higher one (it counts as overturned from its first overturning "
            "level on).",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
-                       "the soil changes it: points, the fraction of records reaching the state at each level; lines, "
+                       "the soil changes it: points, the fraction of records reaching the state at each level (open "
+                       "for the rigid base's); lines, "
                        "the fitted lognormal, {lines}, one colour per soil (where soils' lines coincide, the last "
                        "drawn shows); light shading around a line, the confidence bounds of its median; {rigid}. "
                        "Grey shading: extrapolation by scaling.",
     "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil, bottom the "
-                        "stiffest. Points: records; lines: fits, one style per model (legend); light shading around "
-                        "a line: the confidence bounds of its median. Dotted: the site's return-period intensities; "
-                        "grey shading: extrapolation by scaling.",
+                        "stiffest. Points: records (open for the rigid base's); lines: fits, "
+                        "one style per model (legend); light shading around a line: the confidence bounds of its "
+                        "median. Dotted: the site's return-period intensities; grey shading: extrapolation by "
+                        "scaling.",
     "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
                 "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
                 "bed); dashed, that it overturns; between them it rocks and stays up{shading}. Grey shading: "

@@ -625,8 +625,11 @@ def ida_page(ida, block, caption, marks: CredibleMarks | None = None, name: str 
     return figure
 
 
-def _fragility_series(axis, fragility, levels, picked, state, style, label, span=None):
+def _fragility_series(axis, fragility, levels, picked, state, style, label, span=None, hollow=False):
     """Points and the fitted curve of one model (and soil) for one state; the reason when there is no curve.
+
+    ``hollow``: the records' points open (white inside), as a reference's are beside the model a page is about
+    (cold read 12, user C8: the recommended model's and the rigid base's points on one soil looked alike).
 
     Returns
     -------
@@ -638,8 +641,8 @@ def _fragility_series(axis, fragility, levels, picked, state, style, label, span
     grid = np.geomspace(*(span or (levels[0], levels[-1])), 200)
     median, beta = float(values["median"]), float(values["beta"])
     colour = style.get("color")
-    axis.plot(levels, values.empirical_fraction.values, "o", ms=3, color=colour, alpha=0.75,
-              zorder=style.get("zorder", 2))
+    axis.plot(levels, values.empirical_fraction.values, "o", ms=3.4, color=colour, alpha=0.8,
+              mfc="white" if hollow else colour, zorder=style.get("zorder", 2))
     if np.isfinite(median) and np.isfinite(beta):
         axis.plot(grid, lognormal_cdf(grid, median, beta), label=label, **style)
         soil = getattr(axis, "rockfrag_soil", None)
@@ -963,7 +966,7 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
                 style = dict(styles[reference.name], **({} if soil is None else {"color": soil_colour(soil, index)}))
                 label = short_label(reference) + ("" if soil is None else f" on {soil}")
                 reasons.append(_fragility_series(axis, fragility, levels, cell(fragility, reference, block, soil),
-                                                 state, style, label, span))
+                                                 state, style, label, span, hollow=True))
         title = state_title(labels[state])
         _no_curve_note(axis, reasons, short[state])
         _empty_if_nothing(axis, fragility, block, state, [model, *(m for m in models if m.rigid_base)],
@@ -993,7 +996,8 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
             axis = axes[row, column] if len(soils) > 1 else axes.flat[column]
             axis.rockfrag_soil = soil
             reasons = [_fragility_series(axis, fragility, levels, cell(fragility, model, block, soil), state,
-                                         styles[model.name], short_label(model), span) for model in models]
+                                         styles[model.name], short_label(model), span, hollow=model.rigid_base)
+                       for model in models]
             title = f"{state_title(labels[state])} on {soil}"
             _no_curve_note(axis, reasons, short[state], soil)
             _empty_if_nothing(axis, fragility, block, state, models, soil, short=short[state])
