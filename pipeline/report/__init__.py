@@ -206,16 +206,19 @@ CAPTIONS = {
               "ends, at its rarest frequency); dotted, the frequencies of the return periods "
               "(a point where a curve crosses one: the site's intensity of that return period, as the answer pages "
               "print it); grey shading: beyond the largest recorded intensity; the axis ends at the highest "
-              "intensity studied. A soft soil's curve can fall below the reference site's at strong shaking: the "
-              "site term's nonlinear part de-amplifies it (Methods).",
+              "intensity studied, and a curve that drops below the frequency axis is cut by the axis only: the risk "
+              "integral takes it to the highest intensity studied. A soft soil's curve can fall below the reference "
+              "site's at strong shaking: the site term's nonlinear part de-amplifies it (Methods).",
     "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled (the "
                "Records section lists them); the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
                "intensity level.",
     "showcase-processing": "Read what processing changes: raw as published (grey) and processed (blue: band-pass "
-                           "filtered and baseline-corrected, Methods). The filter removes the long-period drift, "
-                           "which shows in the displacement; where grey is hidden under blue the two are the same "
-                           "at this scale.",
+                           "filtered and baseline-corrected, Methods). The band-pass trims long-period content the "
+                           "published record kept, which shows in the displacement; it is zero-phase, so acausal: "
+                           "where the processed displacement moves before the shaking, that is its precursor, of "
+                           "negligible acceleration. Where grey is hidden under blue the two are the same at this "
+                           "scale.",
     "showcase-response": "Read how the soil changes the rocking under one real record, unscaled: θ (left, one scale "
                          "for all panels) and Δy (right), the vertical displacement from rest of the base's centre "
                          "on the tensionless bed, or of the active pivot in the paper's model, up +: a block rocking "
@@ -271,8 +274,11 @@ CAPTIONS = {
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
                    "squares): the rating covers the parameters, so it replaces their spread, it is not added.",
     "efficiency": "Read which intensity measure predicts overturning with the least scatter (top: lower bars are "
-                  "better) and whether the capacity still depends on magnitude, distance or pulse period (bottom: "
-                  "below the dashed line it does; the test of Luco & Cornell 2007).",
+                  "better; each bar is the dispersion of ln capacity over the records that overturned by the "
+                  "highest intensity studied, their number in the legend: those that did not are left out, so a "
+                  "bar can lie below the fitted curve's β, which counts them too) and whether the capacity still "
+                  "depends on magnitude, distance or pulse period (bottom: below the dashed line it does; the test "
+                  "of Luco & Cornell 2007).",
 }
 """What each figure page lets the reader read, one caption per kind of page."""
 
