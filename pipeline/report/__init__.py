@@ -224,7 +224,8 @@ CAPTIONS = {
                          "on the tensionless bed, or of the active pivot in the paper's model, up +: a block rocking "
                          "about an edge lifts its base centre by about b·θ, so a rise is rocking, and a drop below "
                          "0 is the bed giving under the block; grey: the strong-motion window (5-95% Arias). As in "
-                         "the paper's Figs. 4, 7 and 10.",
+                         "the paper's Figs. 4, 7 and 10. One record: how much the models differ under it need not "
+                         "hold over the record set, which the IDA and fragility pages give.",
     "ida": "Read at which intensity the block starts to rock and where it overturns: thin grey lines, one record "
            "each; the 16% (blue dashed), 50% (black) and 84% (red dotted) fractiles of θmax/α. Overturning is drawn "
            "at the right edge. Dotted: the site's return-period intensities (the legend names them); shaded: "
