@@ -637,3 +637,16 @@ def test_a_contents_title_never_runs_into_its_page_number():
                 assert gap >= 2 * em, (count, number.get_text(), gap)
         finally:
             plt.close(figure)
+
+
+def test_a_section_that_starts_part_way_down_a_page_is_listed_with_the_heading_it_prints():
+    """Cold read 12, user C2: 'Fitted curves ... 8' stood in the contents with no entry under it, while page 8 heads
+    that section 'Fitted fragility functions'. The contents list the heading the page prints."""
+    from rockfrag.report import contents_rows
+    from rockfrag.report.layout import Page
+
+    planned = [Page("answer", "Answer: enclosure", "Answer: enclosure (4/4)", draw=lambda: None,
+                    heading="Answer: enclosure", also=("Fitted curves",),
+                    also_headings=("Fitted fragility functions",))]
+    assert contents_rows(planned, 2)[-2:] == [("section", "Fitted curves", 1),
+                                              ("page", "Fitted fragility functions", 1)]

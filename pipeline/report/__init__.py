@@ -112,10 +112,13 @@ def _packed_pages(parts) -> list[Page]:
         counters[part] = counters.get(part, 0) + 1
         suffix = f" ({holding.index(number) + 1}/{len(holding)})" if len(holding) > 1 else ""
         pages_of_part = sum(1 for p in first_part if p == part)
-        also = tuple(dict.fromkeys(parts[item.part][1] for item in chunk if item.part != part))
+        others = list(dict.fromkeys(item.part for item in chunk if item.part != part))
+        also = tuple(dict.fromkeys(parts[other][1] for other in others))
+        headings = tuple(dict(zip((parts[other][1] for other in others), (parts[other][2] for other in others)))
+                         .values())
         planned.append(Page(f"{name}-{counters[part]}" if pages_of_part > 1 else name, section, title + suffix,
                             lambda chunk=chunk, t=title + suffix: draw_text_page(t, chunk), "", items_html(chunk),
-                            also=also, heading=title))
+                            also=also, heading=title, also_headings=headings))
     return planned
 
 
@@ -624,9 +627,10 @@ def contents_rows(planned: list[Page], position: int = 2) -> list[tuple[str, str
         if heading != listed and heading != page.section:  # a text section over pages: once, without "(2/5)"
             rows.append(("page", heading, shown))
         listed = heading
-        for section in page.also:  # a section that starts part-way down this page
+        for index, section in enumerate(page.also):  # a section that starts part-way down this page
             rows.append(("section", section, shown))
-            last, listed = section, first_heading.get(section, section)
+            printed = page.also_headings[index] if index < len(page.also_headings) else section
+            last, listed = section, first_heading.get(section, printed)
             if listed != section:
                 rows.append(("page", listed, shown))
     return rows

@@ -77,6 +77,8 @@ class Page:
         The rendered page (empty until ``rockfrag.report.render`` has drawn it).
     also : tuple of str
         Further sections that start on this page (text sections packed onto one page when they fit).
+    also_headings : tuple of str
+        The heading each of ``also`` is printed under on this page, in the same order.
     heading : str
         The title without the PDF's page count ("Limitations", not "Limitations (2/9)"): the HTML heading,
         printed once for a text section that runs over several PDF pages ("" when it is the title).
@@ -91,6 +93,7 @@ class Page:
     png: bytes = field(default=b"", repr=False)
     also: tuple[str, ...] = ()
     heading: str = ""
+    also_headings: tuple[str, ...] = ()  # the heading each of ``also`` starts with on this page (the contents')
 
 
 CAPTION_LINE = CAPTION_SIZE * 1.25 / (PAGE_SIZE[1] * 72.0)  # one caption line, as a fraction of the page height
