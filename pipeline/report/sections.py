@@ -1193,9 +1193,9 @@ def methods_items(results: Results) -> list[Item]:
 
 NAVFAC_RANGES = {"rock": "clean sound rock 0.70",
                  "gravel": "clean gravel and coarse sand 0.55-0.60, its low end taken: more sliding and less "
-                           "rocking than its high end, which the sensitivity runs' higher friction reaches",
+                           "rocking than at the range's top, which the sensitivity runs' higher friction reaches",
                  "sand": "clean fine to medium sand 0.45-0.55, its low end taken: more sliding and less rocking "
-                         "than its high end, which the sensitivity runs' higher friction reaches",
+                         "than at the range's top, which the sensitivity runs' higher friction reaches",
                  "clay": "medium stiff and stiff clay 0.30-0.35, its high end taken, below the 0.40-0.50 of very "
                          "stiff clay"}
 """The ranges of NAVFAC DM-7.02 Table 1 each shipped soil's μ_s is taken from (rockfrag.soils.FRICTION_SOURCES)."""
