@@ -987,6 +987,10 @@ def test_an_answer_page_says_what_flying_is_where_many_records_fly(monkeypatch):
     monkeypatch.setattr(answer_page, "motion_tallies", lambda *args: [{m: 0 for m in answer_page.MOTIONS} |
                                                                        {"at rest": 44}])
     assert answer_page.flight_words(results, answer, 1.0) == ""
+    # cold read 12, default B2: a soil with a few flights is named beside the one with many
+    monkeypatch.setattr(answer_page, "motion_tallies", lambda cube, block, model, soil, *args: [
+        {m: 0 for m in answer_page.MOTIONS} | {"flies": {"clay": 7, "sand": 38}[soil]}])
+    assert answer_page.flight_words(results, answer, 1.0).startswith("'Flies' on clay and sand: after an impact")
 
 
 def test_a_sliding_blocks_lift_off_by_soil_is_explained():
@@ -1129,6 +1133,18 @@ def test_a_lift_off_well_below_g_tan_alpha_is_explained_by_the_beds_rocking_mode
     clay = config.soils[0]
     static = block.h * bed_frequencies(config, block, clay)[2] / block.b ** 2
     assert f"{numbers.two_figures(100 * static)}% at most" in words and static < 0.02
+    # cold read 12, default B1: a median below the lowest level run is the fit's extrapolation, and says so
+    fraction = xr.DataArray(np.array([24, 22, 15, 2, 0])[None, :, None, None, None] / 44.0,
+                            dims=("im_level", "soil", "block", "model", "damage_state"),
+                            coords={"soil": soils, "block": [block.name], "model": ["recommended"],
+                                    "damage_state": ["uplift"]})
+    results.fragility = xr.Dataset({"median": medians, "empirical_fraction": fraction, "n_records": 44,
+                                    "studied_im_min": ("block", [0.0995])}, coords={"block": [block.name]})
+    words = early_lift_words(results, answer)
+    assert "0.097 g on clay (*), 0.099 g on sand (*) and 0.12 g on gravel (0.49" in words, words
+    assert words.endswith("(*) below the lowest level run, 0.0995 g: the fit's extrapolation, where 24 of 44 records "
+                          "on clay and 22 of 44 on sand already lift off (the fitted table marks such a median).")
+    results.fragility = xr.Dataset({"median": medians})
     medians[:] = [[[[0.2, 0.2, 0.12, 0.2, 0.2]]]]  # an early dip below its neighbours: bed_resonance_words' case
     assert 0.12 < EARLY_LIFT * rigid and early_lift_words(results, answer) == ""
     medians[:] = [[[[0.19, 0.19, 0.19, 0.2, 0.21]]]]

@@ -745,7 +745,12 @@ def early_lift_words(results, answer) -> str:
     if not early:
         return ""
     band = records_band(getattr(results, "showcase", None))
-    values = listed([f"{numbers.intensity(medians[soil.name], answer.unit)} on {soil.name}" for soil in early])
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    lowest = float(fragility.studied_im_min.sel(block=answer.block)) * scale if "studied_im_min" in fragility \
+        else np.nan
+    below = [soil for soil in early if medians[soil.name] < lowest * (1 - 1e-9)]  # the fit's extrapolation
+    values = listed([f"{numbers.intensity(medians[soil.name], answer.unit)} on {soil.name}"
+                     + (BELOW_LOWEST_MARK if soil in below else "") for soil in early])
     shares = listed([f"{medians[soil.name] / rigid:.2f}" for soil in early])
     modes = []
     frequencies = {soil.name: bed_frequencies(config, block, soil) for soil in early}
@@ -766,7 +771,21 @@ def early_lift_words(results, answer) -> str:
              "base the block does not rock before the ground reaches g·tanα. The bed's static give alone lowers "
              f"the lift-off by the share h·δ/b² of it (δ the static settlement), {numbers.two_figures(100 * give)}% "
              "at most here.")
+    if below:  # cold read 12, default B1: 0.097 g quoted plainly below the lowest level run, 0.0995 g
+        n_records = int(fragility["n_records"]) if "n_records" in fragility else 0
+        counts = []
+        for soil in below:
+            share = float(fragility.empirical_fraction.isel(im_level=0).sel(
+                model=answer.model, block=answer.block, soil=soil.name, damage_state="uplift"))
+            counts.append(f"{numbers.count(int(round(share * n_records)), n_records)}"
+                          f"{' records' if not counts else ''} on {soil.name}")
+        text += (f" {BELOW_LOWEST_MARK.strip()} below the lowest level run, {lowest:.3g} {answer.unit}: the fit's "
+                 f"extrapolation, where {listed(counts)} already lift off (the fitted table marks such a median).")
     return text
+
+
+BELOW_LOWEST_MARK = " (*)"
+"""Beside a lift-off median below the lowest level run (``early_lift_words``): the fit's extrapolation there."""
 
 
 MOTIONS = ("at rest", TILT_WORDS, "slides", "rocks", "slides and rocks", "flies", "overturns")
@@ -844,7 +863,9 @@ def motion_counts(cube, block: str, model: str, soil: str, intensities, scale: f
 
 
 FLIGHT_SHARE = 0.25
-"""Above this share of the records flying at a return period's level, the answer page says what the hops are."""
+"""Above this share of the records flying at a return period's level, the answer page says what the hops are (and
+then names every soil on which any record flies: cold read 12, default B2 found 7 of 44 flying on rock and steel
+unnamed beside gravel's 40)."""
 
 
 def flight_words(results, answer, scale: float) -> str:
@@ -863,11 +884,11 @@ def flight_words(results, answer, scale: float) -> str:
     for soil in answer.soils:
         tallies = motion_tallies(cube, answer.block, answer.model, soil.soil, soil_intensities(answer, soil), scale)
         shares = [tally["flies"] / max(sum(tally.values()), 1) for tally in tallies if isinstance(tally, dict)]
-        if shares and max(shares) > FLIGHT_SHARE:
+        if shares and max(shares) > 0:
             most[soil.soil] = (max(shares), [tally["flies"] for tally in tallies if isinstance(tally, dict)])
-    if not most:
+    if not most or max(share for share, _ in most.values()) <= FLIGHT_SHARE:
         return ""
-    soils = ", ".join(most)
+    soils = listed(most)
     text = (f"'Flies' on {soils}: after an impact the block rebounds off the bed's springs in short hops, how much "
             "set by the bed damping calibrated to keep the rocking restitution, not by a measured property of the "
             "ground; a real footing also radiates energy into the ground (radiation damping, Gazetas 1991), which "
