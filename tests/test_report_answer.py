@@ -588,3 +588,16 @@ def test_the_summary_reason_gives_the_records_at_the_levels_either_side_of_the_i
     assert overturning.records_above == (3, 10, pytest.approx(levels[above]))
     said = reason(SimpleNamespace(facts=numbers.Facts()), answer, answer.soils[0])
     assert said == f"0 of 10 at {levels[above - 1]:.2g} g, 3 at {levels[above]:.2g} g", said
+
+
+def test_a_soil_whose_bed_falls_short_only_within_tolerance_is_said_to_run_at_the_middle():
+    """Cold read 12, default C3: gravel's bed reached at most 0.742, below the middle 0.746, yet only rock and steel
+    were said to run their best estimate below the middle. Gravel's shortfall is within the calibration's tolerance
+    (5% of the loss 1 - r: ± 0.013), so its best estimate counts as at the middle; the page now says so."""
+    from rockfrag.report.answer_page import _band_reach
+
+    requested = np.array([[0.728, 0.746, 0.764]])
+    cube = _restitution_cube(requested, np.array([[0.728, 0.746, 0.742]]), np.array([[0.1, 0.06, 0.06]]), ["paper"])
+    text = _band_reach(cube)
+    assert "the bed's most, r 0.742, lies within the calibration's tolerance of the middle (± 0.013)" in text, text
+    assert "best-estimate run uses" not in text

@@ -118,6 +118,17 @@ def _band_reach(cube, block=None, results=None) -> str:
                      f"{float(centre_asked.max()):.3f}.")
             if results is not None and block is not None:
                 text += restitution_effect_words(results, block, low, target)
+        # cold read 12, default C3: gravel reached at most 0.742 yet was not listed beside rock's 0.728 below 0.746
+        middle = float(centre_asked.max())
+        near = {soil: float(target.sel(soil=soil).where(short.sel(soil=soil)).max()) for soil in soils
+                if soil not in low and float(target.sel(soil=soil).where(short.sel(soil=soil)).max()) < middle - 5e-4}
+        if near:
+            from rockfrag.models.restitution import tolerance
+
+            said = {f"{value:.3f}" for value in near.values()}
+            said = said.pop() if len(said) == 1 else _grouped(near)
+            text += (f" On {listed(near)} the bed's most, r {said}, lies within the calibration's tolerance of the "
+                     f"middle (± {tolerance(middle):.3f}), so the best-estimate run counts as at the middle.")
     return text
 
 
