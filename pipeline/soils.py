@@ -97,6 +97,69 @@ CLAY_ADHESION = {"soft clay": (10e3, 35e3), "stiff clay": (35e3, 60e3)}
 """Ultimate adhesion c_a [Pa] of formed concrete against clay, undrained, whatever the weight: NAVFAC DM-7.02 (1986)
 Table 1 ('soft clay and clayey silt', 'stiff and hard clay'), in kPa as Carter & Bentley (1991) Table 11.1 give it.
 The report compares it with mu_s times a block's contact pressure: which of the two holds a base on clay."""
+UNDRAINED_BEARING_FACTOR = 2.0 + math.pi
+"""N_c of a strip on the surface of undrained clay (Prandtl 1921): q_ult = N_c s_u, no embedment, no shape factor."""
+CLAY_STRENGTH = {"soft": (12.5e3, 25e3), "medium stiff": (25e3, 50e3), "stiff": (50e3, 100e3),
+                 "very stiff": (100e3, 200e3)}
+"""Undrained shear strength s_u [Pa] of clay by consistency: half the unconfined compressive strength of Terzaghi &
+Peck's (1967) classes (soft 25-50 kPa, medium 50-100, stiff 100-200, very stiff 200-400)."""
+SAND_BEARING_FRICTION_ANGLE = 30.0
+"""phi [deg] of the drained bearing check on sand and gravel: a loose-to-medium sand's, the low side of the
+granular classes (the friction factor 0.45-0.60 of NAVFAC DM-7.02 is an interface's, not the soil's phi)."""
+
+
+def undrained_bearing(strength: float) -> float:
+    """Ultimate bearing pressure [Pa] of a surface strip on clay of undrained strength ``strength`` [Pa] (Prandtl)."""
+    return UNDRAINED_BEARING_FACTOR * strength
+
+
+def drained_bearing(density: float, width: float, friction_angle: float = SAND_BEARING_FRICTION_ANGLE) -> float:
+    """Ultimate bearing pressure [Pa] of a surface strip ``width`` [m] wide on sand: 0.5 gamma B N_gamma.
+
+    N_gamma = 2 (N_q + 1) tan phi, N_q = e^(pi tan phi) tan^2(45 + phi/2) (Vesic 1973; 22.4 at 30 degrees); gamma =
+    rho g of the soil, dry (a water table at the base would halve it).
+    """
+    phi = math.radians(friction_angle)
+    n_q = math.exp(math.pi * math.tan(phi)) * math.tan(math.pi / 4 + phi / 2) ** 2
+    return 0.5 * density * STANDARD_GRAVITY * width * 2.0 * (n_q + 1.0) * math.tan(phi)
+
+
+ROCK_MODULUS = 1e9
+"""G [Pa] from which a bed is rock or a structural base: its bearing is far above any block's contact pressure."""
+
+
+@dataclass(frozen=True)
+class BearingCase:
+    """A block's contact pressure at rest on a soil and what carries it (a static check, not a design).
+
+    Attributes
+    ----------
+    pressure : float
+        m g / A [Pa], the block's weight over its footprint.
+    kind : str
+        "clay" (undrained: ``needed_strength``), "granular" (drained: ``capacity``) or "rock" (no check).
+    needed_strength : float
+        The undrained strength s_u [Pa] a clay needs for its ultimate bearing to equal the pressure (NaN otherwise).
+    capacity : float
+        The ultimate bearing pressure [Pa] of a sand or gravel under the block's width (NaN otherwise).
+    """
+
+    pressure: float
+    kind: str
+    needed_strength: float = math.nan
+    capacity: float = math.nan
+
+
+def bearing_case(soil: SoilClass, block) -> BearingCase:
+    """The static bearing check of ``block`` at rest on ``soil``: clay by its name, rock by ``ROCK_MODULUS``."""
+    pressure = block.mass * STANDARD_GRAVITY / block.footprint_area
+    if soil.shear_modulus >= ROCK_MODULUS:
+        return BearingCase(pressure, "rock")
+    if "clay" in soil.name.lower():
+        return BearingCase(pressure, "clay", needed_strength=pressure / UNDRAINED_BEARING_FACTOR)
+    return BearingCase(pressure, "granular", capacity=drained_bearing(soil.density, 2.0 * block.b))
+
+
 DEFAULT_FRICTION = (0.5, 0.4)
 """(mu_s, mu_k) of a soil that does not state its own (a ``[soils_custom.NAME]`` table without them): the
 steel-on-steel pair below, and the coefficient the report's sliding check used before friction was per soil."""

@@ -777,3 +777,26 @@ def test_a_reference_models_points_are_open_and_the_answers_filled(small_pipelin
         assert any(filled) and not all(filled)  # the page's model filled, the rigid base open
     finally:
         plt.close(figure)
+
+
+def test_the_limitations_check_that_the_ground_carries_each_block():
+    """Cold read 12, default A1: no page said whether a clay carries the paper's block (400 kPa). The limitations'
+    'Bearing' gives every block's pressure and what carries it, names the block a clay may not carry, and its
+    answer page says the verdict presumes ground or a foundation that does."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.sections import bearing_items
+    from rockfrag.soils import SOILS
+
+    paper = SimpleNamespace(name="paper", mass=326197.0, footprint_area=8.0, b=4.0)
+    light = SimpleNamespace(name="light", mass=2000.0, footprint_area=0.48, b=0.3)
+    config = SimpleNamespace(blocks=[paper, light], soils=[SOILS["clay"], SOILS["sand"]], raw={})
+    cube = xr.Dataset(coords={"block": ["paper", "light"], "soil": ["clay", "sand"]})
+    items = bearing_items(config, cube)
+    text = " ".join(item.text for item in items if item.kind == "paragraph")
+    assert "Where the ground may not carry the block (paper on clay)" in text, text
+    rows = {(row[0], row[1]): row for row in next(item for item in items if item.kind == "table").rows}
+    assert rows[("paper", "clay")][2:] == ["400", "s_u ≥ 78 kPa (233 kPa with a factor of safety 3): only the "
+                                                  "stiffer part of the class"]
+    assert rows[("light", "clay")][3].endswith("any clay of the class")
+    assert rows[("light", "sand")][3].startswith("ultimate 125 kPa under its width: p is 33% of it")

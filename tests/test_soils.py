@@ -88,3 +88,22 @@ def test_the_half_space_stiffness_is_gazetas_and_meets_the_rigid_disc():
     assert half_space_stiffness(37.142857e6, nu, 1.2, 1.5) / 1e6 == pytest.approx(162, abs=0.5)
     with pytest.raises(ConfigError):
         half_space_stiffness(shear, 0.5, 1.0, 1.0)
+
+
+def test_the_bearing_check_is_prandtl_on_clay_and_vesic_on_sand():
+    """Cold read 12, default A1: the paper's block presses 400 kPa; a clay carries it only with s_u >= 400 / 5.14 =
+    78 kPa (Prandtl 1921, N_c = 2 + pi). On sand N_gamma(30 deg) = 22.4 (Vesic 1973's table), so a 1 m strip on
+    ground of 1,900 kg/m3 bears 0.5 x 18.6 kN/m3 x 1 m x 22.4 = 209 kPa."""
+    from types import SimpleNamespace
+
+    from rockfrag.soils import SOILS, bearing_case, drained_bearing, undrained_bearing
+
+    assert undrained_bearing(1.0) == pytest.approx(5.14, abs=0.005)
+    assert drained_bearing(1900.0, 1.0) / (0.5 * 1900.0 * 9.80665) == pytest.approx(22.4, abs=0.05)
+    paper = SimpleNamespace(mass=326197.0, footprint_area=8.0, b=4.0)
+    clay = bearing_case(SOILS["clay"], paper)
+    assert clay.kind == "clay" and clay.pressure / 1e3 == pytest.approx(399.9, abs=0.1)
+    assert clay.needed_strength / 1e3 == pytest.approx(77.8, abs=0.1)
+    sand = bearing_case(SOILS["sand"], paper)
+    assert sand.kind == "granular" and sand.capacity == pytest.approx(drained_bearing(SOILS["sand"].density, 8.0))
+    assert bearing_case(SOILS["rock"], paper).kind == "rock"

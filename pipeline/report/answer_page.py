@@ -454,6 +454,34 @@ median differs from the best estimate's by more than this fraction (steel under 
 1.5 g); where it does not (gravel: 0.2 g both), the block rocks before it ever slides and the friction is moot."""
 
 
+def bearing_words(results, answer) -> str:
+    """A sentence on the clays that carry this block at rest only if stiffer than the class's weaker end; "" else.
+
+    Cold read 12 (default A1): the paper's block presses 400 kPa, which a clay carries only with s_u >= 78 kPa
+    (Prandtl: 5.14 s_u), yet the clay's 'no action' said nothing of it. The limitations' 'Bearing' has every block
+    and soil (``rockfrag.report.sections.bearing_items``).
+    """
+    from rockfrag.report.sections import clay_bearing_words, clay_class_strength
+    from rockfrag.soils import bearing_case
+
+    block = next((block for block in results.config.blocks if block.name == answer.block), None)
+    if block is None:
+        return ""
+    low, _ = clay_class_strength()
+    said = []
+    for soil in results.config.soils:
+        if soil.name not in [s.soil for s in answer.soils]:
+            continue
+        case = bearing_case(soil, block)
+        if case.kind == "clay" and case.needed_strength > low:
+            said.append(f"on {soil.name} it presses {case.pressure / 1e3:,.0f} kPa at rest, which needs "
+                        f"{clay_bearing_words(case)}")
+    if not said:
+        return ""
+    return (f"Bearing: {'; '.join(said)}. The verdict there presumes ground or a foundation that carries the block "
+            "(Limitations, 'Bearing').")
+
+
 def slides_then_soils(results, answer) -> list:
     """The soils (``SoilClass``) on which this block rocks at rest but cannot while it slides, and does slide.
 
@@ -461,6 +489,11 @@ def slides_then_soils(results, answer) -> list:
     force, μ_k m g at most, cannot tip it (that needs b/h m g); it counts where the high-friction sensitivity run
     shows the friction decides (``KINETIC_SENSITIVE``). Only soils whose runs have base friction.
     """
+    return [soil for soil, decides in _kinetic_cases(results, answer) if decides]
+
+
+def _kinetic_cases(results, answer) -> list:
+    """(soil, whether the friction decides) for each soil with base friction where μ_k < b/h ≤ μ_s for this block."""
     cube, fragility = getattr(results, "cube", None), results.fragility
     if cube is None or "block_b" not in cube.coords and "block_b" not in cube or "member_median" not in fragility \
             or "friction_high" not in fragility.member.values:
@@ -480,8 +513,8 @@ def slides_then_soils(results, answer) -> list:
                                                      damage_state="uplift"))
         except KeyError:
             continue
-        if np.isfinite(best) and np.isfinite(high) and abs(best - high) > KINETIC_SENSITIVE * min(best, high):
-            soils.append(soil)
+        if np.isfinite(best) and np.isfinite(high):
+            soils.append((soil, abs(best - high) > KINETIC_SENSITIVE * min(best, high)))
     return soils
 
 
@@ -507,11 +540,18 @@ def slides_then_words(results, answer) -> str:
         said.append(f"on {soil.name} (μ_s {soil.friction_static:g}, μ_k {soil.friction_kinetic:g}) it lifts off at "
                     f"a median of {numbers.intensity(best, answer.unit)}, and at "
                     f"{numbers.intensity(high, answer.unit)} with the friction at the high end of its range")
-    return (f"On {listed([soil.name for soil in soils])} the base friction at rest is at least this block's "
+    text = (f"On {listed([soil.name for soil in soils])} the base friction at rest is at least this block's "
             f"b/h = {slender:.2f}, so at rest it rocks before it slides, but its kinetic friction is below b/h: once "
             "the base slips, the friction force can no longer tip the block, which slides instead of rocking. "
             f"The friction decides what it does there: {'; '.join(said)}. Its rocking and "
             f"overturning there rest on the assumed friction (marked {FRICTION_MARK} in the design-life table).")
+    # cold read 12, default C1: gravel's μ_k 0.47 is below b/h 0.471 too, and nothing said why it does not matter
+    calm = [soil for soil, decides in _kinetic_cases(results, answer) if not decides]
+    if calm:
+        text += (f" On {listed([f'{soil.name} (μ_k {soil.friction_kinetic:g})' for soil in calm])} the kinetic "
+                 "friction is below b/h too, but the friction at the high end of its range hardly moves the lift-off "
+                 "there: the friction does not decide.")
+    return text
 
 
 def _where(results, soils) -> str:
@@ -970,9 +1010,11 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                     if cube is not None else "", measure_label(cube).split(" [")[0]
                                     if cube is not None else measure, answer.model)
     # one paragraph per subject (restitution, friction, the bed's lift-off, the measure): not one wall of text
+    # the friction's margin above b/h and its kinetic part are one subject: one paragraph (cold read 12, default C1)
+    friction = " ".join(filter(None, (friction_margin_words(results, answer).strip(),
+                                      slides_then_words(results, answer).strip())))
     for text in (curve_reason(results, answer.model, answer.block), slides_first_words(results, answer),
-                 friction_margin_words(results, answer),
-                 slides_then_words(results, answer), bed_resonance_words(results, answer),
+                 friction, bearing_words(results, answer), bed_resonance_words(results, answer),
                  early_lift_words(results, answer), sufficiency):
         if text:
             items.append(paragraph(text.strip()))

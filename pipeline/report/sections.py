@@ -429,6 +429,82 @@ def adhesion_words(config, cube, clays: list[str]) -> str:
     return text
 
 
+BEARING_SAFETY = 3.0
+"""The factor of safety of a static bearing check (the conventional 3 on the ultimate bearing pressure)."""
+
+
+def clay_class_strength() -> tuple[float, float]:
+    """s_u range [Pa] of the clay class the shipped clay stands for (NAVFAC's 'medium stiff and stiff clay')."""
+    from rockfrag.soils import CLAY_STRENGTH
+
+    return CLAY_STRENGTH["medium stiff"][0], CLAY_STRENGTH["stiff"][1]
+
+
+def clay_bearing_words(case) -> str:
+    """What a clay needs to carry a block at rest, against the clay class's strengths (a ``BearingCase``)."""
+    low, high = clay_class_strength()
+    needed, safe = case.needed_strength, BEARING_SAFETY * case.needed_strength
+    text = f"s_u ≥ {needed / 1e3:,.0f} kPa ({safe / 1e3:,.0f} kPa with a factor of safety {BEARING_SAFETY:g}): "
+    if safe <= low:
+        return text + "any clay of the class"
+    if needed <= low:
+        return text + "the class's weaker clays with less than that factor"
+    if needed <= high:
+        return text + "only the stiffer part of the class"
+    return text + "more than the class: a very stiff clay or a foundation"
+
+
+def bearing_items(config, cube) -> list[Item]:
+    """The limitations' 'Bearing': each block's contact pressure at rest against what each soil can carry.
+
+    Cold read 12 (default A1): the paper's block presses 400 kPa on a clay whose undrained bearing, 5.14 s_u, is
+    130-390 kPa for s_u 25-75 kPa, and no page said whether the ground carries the blocks; the bed is elastic, so
+    toe yielding under rocking is not modelled either. A static check: a surface strip, no embedment or shape
+    factor (``rockfrag.soils.bearing_case``).
+    """
+    from rockfrag.soils import SAND_BEARING_FRICTION_ANGLE, bearing_case
+
+    low, high = clay_class_strength()
+    rows, short = [], []
+    for block in config.blocks:
+        if block.name not in cube.block.values:
+            continue
+        for soil in config.soils:
+            if soil.name not in cube.soil.values:
+                continue
+            case = bearing_case(soil, block)
+            if case.kind == "rock":
+                carried = "rock or a structural base: far above it"
+            elif case.kind == "clay":
+                carried = clay_bearing_words(case)
+                if case.needed_strength > low:
+                    short.append(f"{short_block_name(config, block.name)} on {soil.name}")
+            else:
+                carried = (f"ultimate {_three_figures(case.capacity / 1e3)} kPa under its width: p is "
+                           f"{numbers.two_figures(100 * case.pressure / case.capacity)}% of it")
+                if BEARING_SAFETY * case.pressure > case.capacity:
+                    short.append(f"{short_block_name(config, block.name)} on {soil.name}")
+            rows.append([block_name(config, block.name), soil.name, _three_figures(case.pressure / 1e3), carried])
+    if not rows:
+        return []
+    text = ("The bed under each block is elastic: it does not fail, yield or settle for good, so the study presumes "
+            "the ground carries the block. A static check of that at rest, the block's weight over its footprint "
+            "(p = m g / A) against the ultimate bearing of a surface strip: on clay, undrained, 5.14 s_u (Prandtl "
+            "1921), the shipped clay standing for a medium stiff to stiff clay (as its friction factor does), s_u "
+            f"{low / 1e3:.0f}-{high / 1e3:.0f} kPa (Terzaghi & Peck 1967); on sand and gravel, drained, "
+            f"0.5 γ B N_γ with φ {SAND_BEARING_FRICTION_ANGLE:g}° (N_γ 22.4, Vesic 1973), γ the soil's unit weight "
+            "and B the block's width 2b, dry. No shape, depth or load-inclination factor: a site's footing design "
+            "replaces it.")
+    if short:
+        text += (f" Where the ground may not carry the block ({listed(short)}), its verdict presumes ground or a "
+                 "foundation that does.")
+    text += (" While the block rocks its weight moves onto the toe, whose pressure rises far above p: toe yielding, "
+             "the settlement and permanent tilt it leaves and the energy it dissipates (Gajan & Kutter 2008) are "
+             "not modelled, and the nearer p lies to the bearing, the more they matter.")
+    return [heading("Bearing"), paragraph(text),
+            table(["block", "soil or base", "p at rest [kPa]", "what carries it"], rows)]
+
+
 def _any_per_metre(config) -> bool:
     """Whether a block of the study is modelled per metre of its length (the plane model's 1 m depth)."""
     from rockfrag.report.summary import per_metre
@@ -1629,6 +1705,8 @@ def limitations_items(results: Results) -> list[Item]:
             "answer pages count the records at the level run at or below each return-period intensity. Fraction of "
             "runs above μ_s over all levels:"))
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
+
+    items += bearing_items(config, cube)
 
     items.append(heading("Extrapolated fragility medians"))
     status = extrapolation(fragility, results.output)

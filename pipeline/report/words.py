@@ -136,8 +136,18 @@ REFERENCES = {
     "Ther & Kollár 2017": "Ther, T., Kollár, L. P. (2017). Refinement of Housner's model on rocking blocks. "
                           "Bulletin of Earthquake Engineering 15(5), 2305-2319.",
     "NAVFAC DM-7.02": "NAVFAC (1986). Foundations and Earth Structures, Design Manual 7.02. Naval Facilities "
-                      "Engineering Command, Alexandria VA (Table 1: ultimate friction factors for dissimilar "
-                      "materials).",
+                      "Engineering Command, Alexandria VA (Table 1: ultimate friction factors and adhesion for "
+                      "dissimilar materials).",
+    "Prandtl 1921": "Prandtl, L. (1921). Über die Eindringungsfestigkeit (Härte) plastischer Baustoffe und die "
+                    "Festigkeit von Schneiden. Zeitschrift für angewandte Mathematik und Mechanik 1(1), 15-20 "
+                    "(N_c = 2 + π of a strip on undrained clay).",
+    "Vesic 1973": "Vesic, A. S. (1973). Analysis of ultimate loads of shallow foundations. Journal of the Soil "
+                  "Mechanics and Foundations Division 99(SM1), 45-73 (N_γ = 2(N_q + 1) tan φ).",
+    "Terzaghi & Peck 1967": "Terzaghi, K., Peck, R. B. (1967). Soil Mechanics in Engineering Practice, 2nd ed. "
+                            "Wiley, New York (consistency of clay by unconfined compressive strength).",
+    "Gajan & Kutter 2008": "Gajan, S., Kutter, B. L. (2008). Capacity, settlement, and energy dissipation of shallow "
+                           "footings subjected to rocking. Journal of Geotechnical and Geoenvironmental Engineering "
+                           "134(8), 1129-1141.",
     "AISC 360-16": "AISC (2016). Specification for Structural Steel Buildings, ANSI/AISC 360-16. American Institute "
                    "of Steel Construction, Chicago (J3.8: slip coefficient of faying surfaces).",
     "Makris & Vassiliou 2012": "Makris, N., Vassiliou, M. F. (2012). Sizing the slenderness of free-standing rocking "
