@@ -1213,3 +1213,40 @@ def test_a_state_whose_value_is_mostly_the_bound_above_the_cap_does_not_govern_a
     results = pipeline_results(small_pipeline.output, small_pipeline.study)
     shares = [row.above_cap_share for answer in results.answers for soil in answer.soils for row in soil.states]
     assert shares and all(0.0 <= share <= 1.0 + 1e-9 for share in shares) and max(shares) > 0
+
+
+def test_a_lift_off_above_g_tan_alpha_on_a_bed_is_explained_by_the_uplift_size():
+    """Cold read 12, default B3: the cabinet lifted off at 0.243 g on the steel base, 22% above the rigid base's
+    0.20 g, against "earlier on a compliant bed". At the first level above g·tanα most records lift a corner but
+    few by the uplift size (1 mm) that a bed's lift needs: the page counts both."""
+    from types import SimpleNamespace
+
+    import xarray as xr
+
+    from rockfrag.config import load_study
+    from rockfrag.report.answer_page import late_lift_words
+    from tests.helpers import ROOT
+
+    config = load_study(ROOT / "pipeline" / "defaults.toml")
+    soils = [soil.name for soil in config.soils]
+    block = "slender-cabinet"
+    medians = xr.DataArray([[[[0.097, 0.099, 0.12, 0.17, 0.243]]]], dims=("model", "block", "damage_state", "soil"),
+                           coords={"model": ["recommended"], "block": [block], "damage_state": ["uplift"],
+                                   "soil": soils}, attrs={"units": "9.80665 m s-2"})
+    levels = np.array([0.168, 0.218, 0.284])
+    lift = np.zeros((44, 3, len(soils), 1, 1))
+    lift[:33, 1, -1] = 0.5e-3  # steel at 0.218 g: 33 corners rose, 21 of them short of 1 mm
+    lift[:12, 1, -1] = 2e-3
+    cube = xr.Dataset({"peak_uplift": (("record", "im_level", "soil", "block", "model"), lift),
+                       "intensity": (("block", "im_level"), levels[None, :], {"units": "9.80665 m s-2"})},
+                      coords={"soil": soils, "block": [block], "model": ["recommended"]},
+                      attrs={"intensity_measure": "pga"})
+    results = SimpleNamespace(fragility=xr.Dataset({"median": medians}), config=config, cube=cube)
+    answer = SimpleNamespace(model="recommended", block=block, unit="g")
+    assert late_lift_words(results, answer) == (
+        "Above the rigid base's g·tanα = 0.20 g: this block lifts off on steel at a median of 0.24 g; at 0.22 g a "
+        "corner of 33 of 44 records rose, of 12 by the uplift size. On a bed a lift counts only once a base corner "
+        "rises the uplift size (1 mm here), where the rigid base counts any pivoting: the block first rocks through "
+        "angles too small for that (a tilt on the bed), so its lift-off is counted later.")
+    medians[:] = [[[[0.097, 0.099, 0.12, 0.17, 0.21]]]]  # within 10% of g·tanα: nothing to explain
+    assert late_lift_words(results, answer) == ""

@@ -768,6 +768,55 @@ def bed_resonance_words(results, answer) -> str:
 
 EARLY_LIFT = 0.8
 """A lift-off median below this share of the rigid base's g·tanα is explained on the answer page (early_lift_words)."""
+LATE_LIFT = 1.1
+"""A lift-off median above this share of g·tanα on a bed is explained on the answer page (late_lift_words)."""
+
+
+def late_lift_words(results, answer) -> str:
+    """A sentence on the soils where the block lifts off above g·tanα on its bed, with the runs that show why.
+
+    Cold read 12 (default B3): the cabinet lifted off at 0.243 g on the steel base, 22% above the rigid base's
+    0.20 g, against "earlier on a compliant bed". On a bed a lift counts only once a base corner rises the uplift
+    size (``rockfrag.damage_states.uplift_lift``), where a rigid base counts any pivoting: at the first level above
+    g·tanα the page counts the records whose corner rose at all and those that rose that far (cube.nc
+    ``peak_uplift``). "" for a PGA-less measure, a model without a bed, or where no median is that high.
+    """
+    from rockfrag.damage_states import uplift_lift
+
+    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
+    if (answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None
+            or "peak_uplift" not in cube or str(cube.attrs.get("intensity_measure", "")).lower() != "pga"
+            or answer.unit != "g" or not getattr(config, "calibrates_bed", False)):
+        return ""
+    block = next((block for block in config.blocks if block.name == answer.block), None)
+    if block is None:
+        return ""
+    rigid = block.b / block.h  # g tan(alpha), in g
+    soils, medians = uplift_by_stiffness(results, answer)
+    sliding = {soil.name for soil in friction_driven_soils(results, answer)}  # their lift waits on the friction
+    late = [soil for soil in soils if np.isfinite(medians[soil.name]) and medians[soil.name] > LATE_LIFT * rigid
+            and soil.friction_kinetic >= rigid and soil.name not in sliding]
+    if not late:
+        return ""
+    scale = display_scale(cube.intensity.attrs.get("units", ""))[0]
+    levels = np.asarray(cube.intensity.sel(block=answer.block).values if "block" in cube.intensity.dims
+                        else cube.intensity.values, float) * scale
+    above = np.flatnonzero(levels > rigid)
+    if not above.size:
+        return ""
+    level, size = int(above[0]), uplift_lift(block.b)
+    said = []
+    for soil in late:
+        lift = np.asarray(cube.peak_uplift.sel(model=answer.model, block=answer.block, soil=soil.name)
+                          .isel(im_level=level).values, float)
+        lift = lift[np.isfinite(lift)]
+        said.append(f"on {soil.name} at a median of {numbers.intensity(medians[soil.name], answer.unit)}; at "
+                    f"{numbers.intensity(levels[level], answer.unit)} a corner of {int((lift > 0).sum())} of "
+                    f"{lift.size} records rose, of {int((lift >= size).sum())} by the uplift size")
+    return (f"Above the rigid base's g·tanα = {numbers.intensity(rigid, answer.unit)}: this block lifts off "
+            f"{'; '.join(said)}. On a bed a lift counts only once a base corner rises the uplift size "
+            f"({size * 1000:.2g} mm here), where the rigid base counts any pivoting: the block first rocks through "
+            "angles too small for that (a tilt on the bed), so its lift-off is counted later.")
 
 
 def early_lift_words(results, answer) -> str:
@@ -1015,7 +1064,7 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
                                       slides_then_words(results, answer).strip())))
     for text in (curve_reason(results, answer.model, answer.block), slides_first_words(results, answer),
                  friction, bearing_words(results, answer), bed_resonance_words(results, answer),
-                 early_lift_words(results, answer), sufficiency):
+                 early_lift_words(results, answer), late_lift_words(results, answer), sufficiency):
         if text:
             items.append(paragraph(text.strip()))
     if not answer.return_periods:
