@@ -307,6 +307,32 @@ SWEEP_NEXT = (" The next page ties every base and leaves the bed's damping uncal
 """The applicability caption's last sentence, where the sweep's page follows it (a study run with the sweep)."""
 
 
+def kinetic_slip_words(results, block: str, model: str | None = None) -> str:
+    """A caption sentence on the soils where ``block`` rocks at rest but, once its base slips, cannot tip ("" if none).
+
+    μ_k < b/h <= μ_s (Shenton 1996): which records slip changes with the scaling, so the share that lifts off need
+    not rise with the intensity, and the lift-off curve lies far from the rigid base's tied one (cold read 12,
+    default figures B1: the paper block's lift-off on steel went 20, 17, 29, 22 of 44 over four levels).
+    """
+    config, cube = results.config, results.cube
+    found = next((b for b in config.blocks if b.name == block), None)
+    if found is None or "friction_static" not in cube:
+        return ""
+    slender = found.b / found.h
+    friction = cube.friction_static.sel(block=block)
+    if model is not None and "model" in friction.dims:  # only a model whose base can slide there
+        friction = friction.sel(model=model) if model in friction.model.values else friction * np.nan
+    soils = [soil for soil in config.soils if soil.name in cube.soil.values
+             and soil.friction_kinetic < slender <= soil.friction_static
+             and np.isfinite(friction.sel(soil=soil.name)).any()]
+    if not soils:
+        return ""
+    names = listed([f"{soil.name} (μ_k {soil.friction_kinetic:g})" for soil in soils])
+    return (f" On {names} the kinetic friction is below this block's b/h = {slender:.2f}: once its base slips it "
+            "cannot tip, and which records slip changes with the scaling, so the share that lifts off need not rise "
+            "with the intensity, and its lift-off lies far from the rigid base's (the answer page says why).")
+
+
 def _rigid_words(fragility, block) -> str:
     """How the fragility-by-soil page draws the rigid base of ``block``: the caption says the style it has."""
     rigid = [m for m in models_of(fragility) if m.rigid_base]
@@ -525,6 +551,7 @@ def plan(results: Results) -> list[Page]:
                                    pages.fragility_by_soil_page, fragility, block, model,
                                    caption=CAPTIONS["fragility-soils"].format(rigid=_rigid_words(fragility, block),
                                                                               lines=pages.line_words(fragility, model))
+                                   + kinetic_slip_words(results, block, model.name)
                                    + (NOTES_WORDS if pages.has_page_notes(
                                        fragility, block, [model, *(m for m in models_of(fragility) if m.rigid_base)])
                                       else ""),
@@ -546,7 +573,8 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure(f"outcomes-{block}", "Outcomes", f"Outcomes by intensity: {names[block]}",
                                pages.outcomes_page, fragility, block,
                                caption=CAPTIONS["outcomes"].format(
-                                   shading=OUTCOMES_SHADING if pages.rocking_shaded(fragility, block) else ""),
+                                   shading=OUTCOMES_SHADING if pages.rocking_shaded(fragility, block) else "")
+                               + kinetic_slip_words(results, block),
                                marks=results.marks(block), name=names[block]))
     if results.vertical is not None:
         planned += _text_pages("vertical", "Vertical component", "Vertical component: medians with and without it",
@@ -565,9 +593,10 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure("applicability-sweep", "Applicability", pages.sweep_title(results.applicability),
                                pages.sweep_page, results.applicability,
                                caption=CAPTIONS["applicability-sweep"] + sweep_words(results.applicability)
-                                       + f" Median over "
-                                       f"{results.applicability.attrs.get('n_records', '?')} records that survived "
-                                       "in both models.", names=names))
+                                       + " Median over the records (of "
+                                       f"{results.applicability.attrs.get('n_records', '?')}) that survived in "
+                                       "both models at each level: at the higher levels, fewer (cold read 12).",
+                               names=names))
     if results.efficiency is not None and "dispersion" in results.efficiency:
         planned.append(_figure("efficiency", "Measure efficiency", pages.EFFICIENCY_TITLE,
                                pages.efficiency_page, results.efficiency,

@@ -520,7 +520,8 @@ def frame_note(edp, fractiles, q: float = 0.84) -> str:
     highest = np.asarray(fractiles, float)
     if np.isfinite(highest).all() and (highest < VISIBLE_ROCKING).all():
         return (f"θmax/α below {VISIBLE_ROCKING:g} in most records ({q:.0%} fractile): on the left axis; "
-                f"{int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs reach more")
+                f"{int((run >= VISIBLE_ROCKING).sum())} of {run.size} runs "
+                f"{'reaches' if int((run >= VISIBLE_ROCKING).sum()) == 1 else 'reach'} more")
     return ""
 
 
@@ -1218,7 +1219,7 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
                  label="300-1000 MPa: above it the paper finds the rigid base good enough")
     axis.axhline(1.0, color="k", lw=0.8)
     log_axis(axis, (0.7 * min(shear.min(), 300.0), 1.4 * max(shear.max(), 1000.0)))  # every soil on the top axis
-    axis.set_xlabel("soil shear modulus G_s [MPa]")
+    axis.set_xlabel("soil shear modulus $G_s$ [MPa]")
     axis.set_ylabel(f"median θmax (model) / median θmax ({panel_label(reference)}) [-]")
     axis.grid(alpha=0.3, which="both")
     top = axis.secondary_xaxis("top")
@@ -1251,14 +1252,15 @@ def sweep_page(dataset, caption, names: dict | None = None):
             for e_index, modulus in enumerate(dataset.block_modulus.values):
                 for l_index, level in enumerate(dataset.level.values):
                     axis.plot(shear, ratios[e_index, l_index], color=f"C{l_index}", ls=dash[e_index % 4],
-                              marker=".", label=f"E_b = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
+                              marker=".",
+                              label=f"block modulus $E_b$ = {modulus / 1e9:.0f} GPa, PGA = {level:g}·g·tanα")
             axis.axhspan(1 - tolerance, 1 + tolerance, color="0.8", zorder=0)
             axis.axvspan(300, 1000, color="#2ca02c", alpha=0.12, zorder=0)
             axis.axhline(1.0, color="k", lw=0.7)
             axis.set_title(textwrap.fill(f"{(names or {}).get(str(block), block)}: {label}", chars_across(axis, 9)),
                            fontsize=9)
             log_axis(axis)
-            axis.set_xlabel("soil shear modulus G_s [MPa]")
+            axis.set_xlabel("soil shear modulus $G_s$ [MPa]")
             axis.grid(alpha=0.3, which="both")
         axes[row, 0].set_ylabel("median θmax model / Housner [-]")
     ratios = np.asarray(dataset.peak_angle_ratio_to_housner.values, float)
