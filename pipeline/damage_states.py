@@ -140,8 +140,8 @@ register_damage_state(DamageState(
 register_damage_state(DamageState("slip-0.05", "peak_slip", 0.05,
                                   "the base slid 0.05 m or more (cables, pipes and anchors strained)"))
 register_damage_state(DamageState(
-    "slip-0.30", "peak_slip", 0.30, "the base slid 0.30 m or more: enough to leave a plinth whose edge is 0.30 m "
-    "beyond the base (an assumed, typical edge distance)", limit=0.10,
+    "slip-0.30", "peak_slip", 0.30, "the base slid 0.30 m or more: a large slip, enough to leave a plinth whose "
+    "edge is 0.30 m beyond the base (an assumed, typical edge distance) where the block stands on one", limit=0.10,
     limit_source="the 10% in 50 years of the conventional 475-year design level, as for θmax/α ≥ 0.5: " + STUDY_CHOICE))
 
 

@@ -248,6 +248,17 @@ def half_space_stiffness(shear_modulus: float, poisson_ratio: float, length: flo
     return 2.0 * shear_modulus * half_long / (1.0 - poisson_ratio) * (0.73 + 1.54 * chi ** 0.75)
 
 
+def half_space_strip_stiffness(shear_modulus: float, poisson_ratio: float) -> float:
+    """Static vertical stiffness [N/m per metre of length] of a long rigid strip on an elastic half-space.
+
+    0.73 G / (1 - nu) (Gazetas 1991, Table 1, strip): an approximation, since a strip's exact static settlement
+    under a finite load grows without bound; the plane model's per-metre blocks are compared with it.
+    """
+    if shear_modulus <= 0 or not 0 <= poisson_ratio < 0.5:
+        raise ConfigError("half_space_strip_stiffness", "G must be > 0 and nu in [0, 0.5)")
+    return 0.73 * shear_modulus / (1.0 - poisson_ratio)
+
+
 def soil_block_stiffness(soil: SoilClass, block) -> float:
     """Interface stiffness k [N/m] of ``block`` standing on ``soil`` (eq. 19)."""
     return interface_stiffness(soil.shear_modulus, block.E_b, block.footprint_area, block.soil_depth)

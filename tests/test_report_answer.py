@@ -601,3 +601,33 @@ def test_a_soil_whose_bed_falls_short_only_within_tolerance_is_said_to_run_at_th
     text = _band_reach(cube)
     assert "the bed's most, r 0.742, lies within the calibration's tolerance of the middle (± 0.013)" in text, text
     assert "best-estimate run uses" not in text
+
+
+def test_the_answer_page_gives_each_verdicts_margin_and_the_srss_alternative():
+    """Cold read 12, user B1 and B4: how far the governing median may fall before the verdict changes (the factor at
+    which P in 50 years reaches the limit), and the probabilities with the model's two parts added by SRSS. Both
+    checked here against the closed form of a power-law hazard: lambda = K0 m^-K exp(K^2 beta^2 / 2)."""
+    from types import SimpleNamespace
+
+    from rockfrag.report import numbers
+    from rockfrag.report.answer_page import robustness_words
+
+    fragility = _fragility([[[[0.5, 1.0]]]], betas=0.6, models=("recommended",)).assign(
+        beta_record_to_record=lambda d: d.beta * 0 + 0.5, beta_form=lambda d: d.beta * 0 + 0.35,
+        beta_parameters=lambda d: d.beta * 0 + 0.2)
+    fragility["beta"] = np.hypot(fragility.beta_record_to_record, fragility.beta_form)  # the larger of the two
+    answer = block_answers(fragility, _power_law(), limits={"overturning": 0.01})[0]
+    results = SimpleNamespace(fragility=fragility, hazard=_power_law(), site_hazards=None, facts=numbers.Facts(),
+                              answers=[answer], cube=None, config=None)
+    words = robustness_words(results, answer)
+
+    def p50(median, beta):  # the closed form, with the curve's own range ignored (its ends far from the median)
+        return 1 - math.exp(-50 * K0 * median ** -K * math.exp(K * K * beta * beta / 2))
+
+    beta = math.hypot(0.5, 0.35)
+    # the factor f at which P50 reaches 1%: K0 (f m)^-K exp(K² β²/2) = -ln(0.99)/50
+    factor = (K0 * math.exp(K * K * beta * beta / 2) / (-math.log(0.99) / 50)) ** (1 / K) / 1.0
+    way = f"fall {100 * (1 - factor):.0f}%" if factor < 1 else f"rise {100 * (factor - 1):.0f}%"
+    assert f"would have to {way} on clay (overturning" in words, (words, factor)
+    srss = math.sqrt(0.5 ** 2 + 0.35 ** 2 + 0.2 ** 2)
+    assert f"{numbers.probability(p50(1.0, srss))} on clay (β {numbers.dispersion(srss)})" in words, words

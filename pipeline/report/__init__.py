@@ -307,6 +307,26 @@ SWEEP_NEXT = (" The next page ties every base and leaves the bed's damping uncal
 """The applicability caption's last sentence, where the sweep's page follows it (a study run with the sweep)."""
 
 
+def showcase_slide_words(results) -> str:
+    """The showcase caption's sentence on soils where the block slides before it can rock ("" where none).
+
+    Cold read 12, user B5: on clay the rigid base only slides, so its θ is 0 and hidden under the other lines, and
+    the slip that governs clay's verdict is not drawn: the caption says both.
+    """
+    showcase, config = results.showcase, results.config
+    block = next((b for b in config.blocks if showcase is not None
+                  and b.name == showcase.attrs.get("showcase_block")), None)
+    if block is None:
+        return ""
+    soils = [soil.name for soil in config.soils if soil.friction_static < block.b / block.h
+             and soil.name in set(map(str, showcase.case_soil.values))]
+    if not soils:
+        return ""
+    return (f" On {listed(soils)} the base friction is below b/h = {block.b / block.h:.2f}: the rigid base slides "
+            "without rocking, so its θ stays 0 under the other lines, and the bed mostly slides too; the slip that "
+            "judges it is not drawn here (its answer page has it).")
+
+
 def kinetic_slip_words(results, block: str, model: str | None = None) -> str:
     """A caption sentence on the soils where ``block`` rocks at rest but, once its base slips, cannot tip ("" if none).
 
@@ -536,7 +556,8 @@ def plan(results: Results) -> list[Page]:
         planned.append(_figure("showcase-response", "Showcase record",
                                pages.showcase_response_title(showcase, showcase_name),
                                pages.showcase_response_page, showcase,
-                               caption=CAPTIONS["showcase-response"] + pages.quiet_words(showcase),
+                               caption=CAPTIONS["showcase-response"] + pages.quiet_words(showcase)
+                               + showcase_slide_words(results),
                                name=showcase_name))
     models = models_of(cube)
     soils = list(map(str, cube.soil.values))

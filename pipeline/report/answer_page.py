@@ -196,6 +196,85 @@ def restitution_effect_words(results, block, low, target) -> str:
             f"best-estimate run to that one {moves}; {verdict}")
 
 
+def _governing_fits(results, answer):
+    """Per soil with a judged governing state that has a curve: (soil answer, its state row, the fit, curve, cap)."""
+    from rockfrag.hazard import hazard_of
+    from rockfrag.report.summary import governing
+
+    fragility = results.fragility
+    hazard = getattr(results, "site_hazards", None) or getattr(results, "hazard", None)
+    if hazard is None or answer.model != RECOMMENDED:
+        return []
+    cap = float(fragility.credible_max.sel(block=answer.block)) if "credible_max" in fragility else np.inf
+    found = []
+    for soil in answer.soils:
+        row = governing(soil)
+        if row is None or not row.limit or not np.isfinite(row.probability_in_life) or row.below_lowest is not None:
+            continue
+        fit = fragility.sel(block=answer.block, soil=soil.soil, model=answer.model, damage_state=row.state)
+        if not (np.isfinite(float(fit["median"])) and np.isfinite(float(fit["beta"]))) or float(fit["beta"]) <= 0:
+            continue
+        found.append((soil, row, fit, hazard_of(hazard, soil.soil), cap))
+    return found
+
+
+def robustness_words(results, answer) -> str:
+    """How far each soil's verdict stands from its limit, and what adding the model's two parts would change.
+
+    Cold read 12 (user B1, B4): the clay verdict rests on a slip median that planar, one-component runs without the
+    vertical motion may overstate, and the model part of β is the larger of the form rating and the sensitivity
+    spread where FEMA P695 and P-58 add such parts. Per soil: the factor on the governing median at which its
+    probability in the design life reaches the limit (bisection on ``capped_frequency``), and that probability
+    with β = √(β_records² + β_form² + β_parameters²). "" where no governing state has a curve.
+    """
+    from scipy.optimize import brentq
+
+    from rockfrag.fragility import capped_frequency
+    from rockfrag.risk import probability_in_life
+
+    cases = _governing_fits(results, answer)
+    if not cases:
+        return ""
+    labels, scale = short_names(results), display_scale(results.fragility["median"].attrs.get("units", ""))[0]
+    margins, added, crossed = [], [], []
+    for soil, row, fit, curve, cap in cases:
+        median, beta = float(fit["median"]), float(fit["beta"])
+
+        def excess(factor, median=median, beta=beta, curve=curve, cap=cap, limit=row.limit):
+            return float(probability_in_life(capped_frequency(median * factor, beta, curve, cap),
+                                             answer.design_life)) - limit
+
+        name = labels.get(row.state, row.state)
+        try:
+            factor = brentq(excess, 0.02, 50.0, xtol=1e-4)
+        except ValueError:
+            factor = np.nan
+        if np.isfinite(factor):
+            way = f"fall {100 * (1 - factor):.0f}%" if factor < 1 else f"rise {100 * (factor - 1):.0f}%"
+            margins.append(f"{way} on {soil.soil} ({name}, from {numbers.intensity(median * scale, answer.unit)} "
+                           f"to {numbers.intensity(median * factor * scale, answer.unit)})")
+        parts = [float(fit[name]) for name in ("beta_record_to_record", "beta_form", "beta_parameters")
+                 if name in fit]
+        if len(parts) == 3 and all(np.isfinite(parts)):
+            wider = float(np.sqrt(sum(part ** 2 for part in parts)))
+            p = float(probability_in_life(capped_frequency(median, wider, curve, cap), answer.design_life))
+            added.append(f"{numbers.probability(p)} on {soil.soil} (β {numbers.dispersion(wider)})")
+            if (p > row.limit) != row.exceeds:
+                crossed.append(soil.soil)
+    text = ""
+    if margins:
+        text += (f"How far each verdict stands from its limit: the governing median would have to {listed(margins)} "
+                 "for its probability in the design life to reach the limit. A bias in the median smaller than that "
+                 "leaves the verdict as it is (the planar runs, one horizontal component at a time and without the "
+                 "vertical motion, may understate the slip: Limitations, 'Sliding').")
+    if added:
+        text += (" The model part of β is the larger of the form rating and the sensitivity runs' spread, the "
+                 "study's choice; FEMA P695 and P-58 add such parts (√ of the sum of squares). So added, the "
+                 f"governing probabilities in the design life would be {listed(added)}: "
+                 + (f"the verdict on {listed(crossed)} would change." if crossed else "no verdict changes."))
+    return text.strip()
+
+
 def _grouped(values: dict) -> str:
     """Soil -> r as "0.750 on sand, 0.742 on gravel and 0.728 on rock and steel" (equal values said once)."""
     groups: dict[str, list[str]] = {}
@@ -1160,6 +1239,9 @@ def answer_items(results, answer: BlockAnswer) -> list[Item]:
         items.append(note(friction_high_words(results, answer)))
     if below_floor_with_period(rows):
         items.append(note(FLOOR_WITH_PERIOD_WORDS))
+    robust = robustness_words(results, answer)
+    if robust:
+        items.append(paragraph(robust))
     return items
 
 

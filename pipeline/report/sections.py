@@ -335,6 +335,39 @@ def grounds(cube) -> str:
     return " and ".join(parts)
 
 
+def stiffer_end_words(results) -> str:
+    """How the governing medians move at the sensitivity runs' stiffer bed (" At twice the stiffness ..."), or "".
+
+    Cold read 12, user B2: the half-space stiffness lies beyond the runs' x 2; what the stiffer end does to the
+    medians that decide the verdicts says whether that matters (fragility.nc ``member_median``, stiffness_high).
+    """
+    from rockfrag.report.summary import governing
+
+    fragility = results.fragility
+    if "member_median" not in fragility or "stiffness_high" not in fragility.member.values or not results.answers:
+        return ""
+    scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
+    moves = []
+    for answer in results.answers:
+        cells = []
+        for soil in answer.soils:
+            row = governing(soil)
+            if row is None or not is_soil(results.cube, soil.soil):
+                continue
+            where = dict(block=answer.block, soil=soil.soil, damage_state=row.state)
+            centre = float(fragility["median"].sel(model=answer.model, **where)) * scale
+            stiff = float(fragility.member_median.sel(member="stiffness_high", **where)) * scale
+            if np.isfinite(centre) and np.isfinite(stiff):
+                cells.append(f"{soil.soil} {centre:.3g} → {stiff:.3g}")
+        if cells:
+            moves.append(f"{short_block_name(results.config, answer.block)}: {', '.join(cells)} {answer.unit}")
+    if not moves:
+        return ""
+    factor = results.config.design.stiffness_factor
+    return (f" At the sensitivity runs' stiffer end (× {factor:g}) each soil's governing median (the answer pages' "
+            f"state) moves: {'; '.join(moves)}.")
+
+
 def half_space_words(config, cube) -> str:
     """Eq. 19's bed stiffness against an elastic half-space's under the same footing, and which way it acts.
 
@@ -344,33 +377,34 @@ def half_space_words(config, cube) -> str:
     long strip has no finite static half-space stiffness. "" when no block and soil can be compared.
     """
     from rockfrag.report.summary import per_metre
-    from rockfrag.soils import half_space_stiffness
+    from rockfrag.soils import half_space_stiffness, half_space_strip_stiffness
 
     stiffness = cube.interface_stiffness if "interface_stiffness" in cube else None
     if stiffness is None:
         return ""
     factor = config.design.stiffness_factor
-    compared, strips, ratios = [], [], []
+    compared, ratios, strips = [], [], False
     for block in config.blocks:
         if block.name not in cube.block.values:
             continue
         depth = block.footprint_area / (2 * block.b)
-        if per_metre(depth):
-            strips.append(short_block_name(config, block.name))
-            continue
+        strip = per_metre(depth)  # a long base modelled per metre: Gazetas' strip, per metre too
+        strips |= strip
         values, own = [], []
         for soil in config.soils:
             if soil.name not in cube.soil.values or not is_soil(cube, soil.name):
                 continue
-            elastic = half_space_stiffness(soil.shear_modulus, soil.poisson_ratio, 2 * block.b, depth)
+            elastic = half_space_strip_stiffness(soil.shear_modulus, soil.poisson_ratio) * depth if strip else \
+                half_space_stiffness(soil.shear_modulus, soil.poisson_ratio, 2 * block.b, depth)
             own.append(elastic / float(stiffness.sel(soil=soil.name, block=block.name)))
             values.append(f"{soil.name} {_three_figures(elastic / 1e6)}")
         if not own:
             continue
         ratios += own
-        low, high = f"{min(own):.1f}", f"{max(own):.1f}"
+        low, high = f"{min(own):.2g}", f"{max(own):.2g}"
         where = ("beyond" if max(own) > factor or min(own) < 1 / factor else "within")
-        compared.append(f"{short_block_name(config, block.name)} (H {_g(block.soil_depth)} m): "
+        compared.append(f"{short_block_name(config, block.name)} (H {_g(block.soil_depth)} m"
+                        f"{', per metre, as a strip' if strip else ''}): "
                         f"{low if low == high else f'{low}-{high}'} × eq. 19's k ({', '.join(values)} MN/m), "
                         f"{where} the sensitivity runs' × or ÷ {factor:g} on the bed stiffness")
     if not compared:
@@ -378,12 +412,11 @@ def half_space_words(config, cube) -> str:
     compare = "stiffer" if min(ratios) > 1 else ("softer" if max(ratios) < 1 else "different")
     text = ("The paper's eq. 19 takes the soil under the footprint as a column of depth H. An elastic half-space of "
             "the soil's G and ν under a rigid rectangular surface footing (Gazetas 1991: K_z = 2GL/(1 − ν) (0.73 + "
-            f"1.54 χ^0.75), L and B the half-sides, χ = B/L) is {compare}: {'; '.join(compared)}. ")
+            "1.54 χ^0.75), L and B the half-sides, χ = B/L"
+            + ("; a long strip 0.73 G/(1 − ν) per metre, an approximation" if strips else "")
+            + f") is {compare}: {'; '.join(compared)}. ")
     text += ("A stiffer bed lifts the block off later, nearer the rigid base's g·tanα, and rocks it more like the "
-             "rigid base; the sensitivity page shows how far each governing median moves over the runs' range.")
-    if strips:
-        text += (f" Not compared: {listed(strips)}, modelled per metre of a long base (a long strip has no finite "
-                 "static half-space stiffness).")
+             "rigid base.")
     return text
 
 
@@ -1146,10 +1179,14 @@ def methods_items(results: Results) -> list[Item]:
         f"overturning, or a failed integration (excluded from the fits){_vertical_outcome(cube)}; the answer "
         "pages' motion tables split them further by what the block did (at rest, tilts on the bed, slides, "
         "rocks, slides and rocks, flies, overturns: 'Reading the answer pages')."))
-    items.append(paragraph("G_s is the soil's small-strain shear modulus; E_d its constrained (oedometric) modulus, "
-                           "E_d = 2G_s(1 - ν)/(1 - 2ν), from which the interface stiffness k follows (the paper's "
-                           "eq. 19); ξ the soil's stated damping ratio (the recommended model's bed runs with a "
-                           "damping calibrated to the restitution instead: see 'Models and their assumptions')."))
+    # cold read 12, user B2: "E_d ..., from which k follows" while k is computed from G_s, as eq. 19 has it
+    items.append(paragraph("G_s is the soil's small-strain shear modulus, from which the interface stiffness follows, "
+                           "the paper's eq. 19: k = (A/H) / (1/G_s + 1/E_b), the soil a column of depth H under the "
+                           "footprint A in series with the block of Young's modulus E_b; E_d is its constrained "
+                           "(oedometric) modulus, E_d = 2G_s(1 - ν)/(1 - 2ν), the paper's 'dynamic elastic modulus', "
+                           "given for reference (eq. 19 does not use it); ξ the soil's stated damping ratio (the "
+                           "recommended model's bed runs with a damping calibrated to the restitution instead: see "
+                           "'Models and their assumptions')."))
     header = ["soil or base", "G_s [MPa]", "E_d [MPa]", "damping ratio ξ [-]"]
     rows = [[str(soil) if is_soil(cube, soil) else f"{soil} (structural base, not a soil)",
              _g(float(cube.soil_shear_modulus.sel(soil=soil)) / 1e6),
@@ -1184,7 +1221,7 @@ def methods_items(results: Results) -> list[Item]:
                            for b in cube.block.values)
     items.append(note(f"Static settlement m·g/k of each block on its bed [mm], from which a lift is counted ('Reading "
                       f"the answer pages'): {settlement}."))  # cold read 8, user B4: referred to, never printed
-    half_space = half_space_words(config, cube)
+    half_space = half_space_words(config, cube) + stiffer_end_words(results)
     if half_space:
         items.append(note(half_space))
 
@@ -1687,6 +1724,14 @@ def limitations_items(results: Results) -> list[Item]:
     clays = [str(soil) for soil in cube.soil.values if "clay" in str(soil).lower()]
     if clays:  # cold read 8: a base on clay slides, in fast loading, on the clay's undrained strength
         items.append(paragraph(adhesion_words(config, cube, clays)))
+    # cold read 12, user B1: a verdict governed by slip, and nothing said what the planar runs leave out
+    vertical = "" if vertical_applied(cube) else (", and without the vertical motion, whose acceleration changes the "
+                                                  "normal force, and with it the friction, during the motion")
+    items.append(paragraph(
+        "The slip is computed in the plane of rocking, one horizontal component at a time" + vertical + ": two "
+        "components together share one friction resistance, so the resultant slip is larger than either planar "
+        f"run's. {'Both make' if vertical else 'That makes'} slip more likely than computed here. Each answer page "
+        "gives how far its governing median stands from the value at which the verdict would change."))
     items += [paragraph(text) for text in friction_runs_words(results)]
     flag = friction_flag(cube)
     for model in models:
