@@ -803,3 +803,20 @@ def test_the_limitations_check_that_the_ground_carries_each_block():
                                                   "stiffer part of the class"]
     assert rows[("light", "clay")][3].endswith("any clay of the class")
     assert rows[("light", "sand")][3].startswith("ultimate 125 kPa under its width: p is 33% of it")
+
+
+def test_the_efficiency_caption_names_a_sufficient_measure_beside_a_better_one_that_fails():
+    """Cold read 12, default figures B2: the caption named AvgSa (0.25, failing sufficiency) as scattering less than
+    PGA (0.43) for the slender block and left out PGV (0.29), which scatters less too and passes every test."""
+    from rockfrag.report import measure_choice_words
+
+    measures = ["pga", "pgv", "avgsa"]
+    dims = ("soil", "block", "model", "measure")
+    shape = (1, 1, 1, 3)
+    data = xr.Dataset({"dispersion": (dims, np.array([0.43, 0.29, 0.25]).reshape(shape)),
+                       "p_pulse_period": (dims, np.array([0.0001, 0.21, 0.001]).reshape(shape))},
+                      coords={"soil": ["rock"], "block": ["slender"], "model": ["recommended"], "measure": measures},
+                      attrs={"study_measure": "pga"})
+    text = measure_choice_words(data, {"slender": "slender block"})
+    assert "though it fails the sufficiency test too (against pulse period); PGV (0.29) has less scatter too and " \
+           "passes every sufficiency test" in text, text

@@ -931,7 +931,7 @@ def site_hazard_items(results: Results) -> list[Item]:
             rows.append([soil.name, f"{soil.vs30:,.0f}", f"{soil.site_class} / {ec8_ground_type(soil.vs30)}",
                          site_term_words(sites, soil.name, results.return_periods), under])
             if soil.vs30 > VS_GAP * math.sqrt(soil.shear_modulus / soil.density):
-                gaps.append(soil.name)
+                gaps.append(soil)
     if len(reference) == len(config.soils):
         return []
     steel = [name for name in reference if not is_soil(results.cube, name)]
@@ -953,9 +953,16 @@ def site_hazard_items(results: Results) -> list[Item]:
              "is its Vs30, the average over the upper 30 m, which is stiffer with depth than the ground right under "
              "the base.")
     if gaps:
-        text += (f" On {', '.join(gaps)} the Vs30 is more than {VS_GAP:g} times the bed's own speed: the hazard's "
-                 "site is stiffer ground than the bed (for rock, another site class); a site investigation gives "
-                 "both, and its values replace these (the appendix names the settings).")
+        from rockfrag.soils import site_class
+
+        classes = [f"{soil.name} class {soil.site_class} by its Vs30, {site_class(speed)} by the bed's speed"
+                   for soil in gaps if site_class(speed := math.sqrt(soil.shear_modulus / soil.density))
+                   != soil.site_class]  # cold read 12, user C10: "(for rock, another site class)" was unclear
+        text += (f" On {listed([soil.name for soil in gaps])} the Vs30 is more than {VS_GAP:g} times the bed's own "
+                 "speed: the hazard's site is stiffer ground than the bed"
+                 + (f" (ASCE 7 site {'; '.join(classes)})" if classes else "")
+                 + "; a site investigation gives both, and its values replace these (the appendix names the "
+                 "settings).")
     return [paragraph(text), table(["soil or base", "Vs30 [m/s]", "site class: ASCE 7 / EC8", "site hazard",
                                     "√(G/ρ) of the bed [m/s]"], rows)]
 
