@@ -820,3 +820,15 @@ def test_the_efficiency_caption_names_a_sufficient_measure_beside_a_better_one_t
     text = measure_choice_words(data, {"slender": "slender block"})
     assert "though it fails the sufficiency test too (against pulse period); PGV (0.29) has less scatter too and " \
            "passes every sufficiency test" in text, text
+
+
+def test_the_limitations_say_what_two_corner_springs_leave_out():
+    """Cold read 12, default B4: 'the tensionless Winkler bed' is two springs, k/2 under each corner, whose rocking
+    stiffness k b² is three times a distributed bed's k b²/3; the limitations now say so, for that bed only."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.sections import bed_form_words
+
+    text = bed_form_words(SimpleNamespace(bed="two-spring"))
+    assert "k b², three times a distributed bed's k b²/3" in text and "Psycharis & Jennings 1983" in text
+    assert bed_form_words(SimpleNamespace(bed="continuous")) == ""

@@ -462,6 +462,26 @@ def adhesion_words(config, cube, clays: list[str]) -> str:
     return text
 
 
+def bed_form_words(config) -> str:
+    """What two corner springs leave out against a bed spread over the footprint ("" for another bed).
+
+    Cold read 12 (default B4): "the tensionless Winkler bed" is two springs, k/2 under each corner (Psycharis &
+    Jennings 1983's two-spring foundation): its rocking stiffness is k b², three times a distributed bed's k b²/3,
+    and its heel stays down until the resultant reaches the toe, where a distributed bed's starts to lift once the
+    resultant leaves the middle third.
+    """
+    if getattr(config, "bed", "") != "two-spring":
+        return ""
+    return ("The bed under the block is two springs and dashpots, k/2 under each corner (the two-spring foundation "
+            "of Psycharis & Jennings 1983), not springs spread over the footprint (a distributed Winkler bed) of the "
+            "same vertical stiffness k. Its rocking stiffness with the whole base down is k b², three times a "
+            "distributed bed's k b²/3, so its rocking frequencies are up to √3 times higher; and its heel stays down until "
+            "the base's reaction reaches the toe, where a distributed bed's heel starts to part once the reaction "
+            "leaves the middle third of the base (the block tipping by about a third of its uplift acceleration). "
+            "On a distributed bed the block would tilt earlier and more softly; the uplift state counts a corner "
+            "lifting the uplift size on either.")
+
+
 BEARING_SAFETY = 3.0
 """The factor of safety of a static bearing check (the conventional 3 on the ultimate bearing pressure)."""
 
@@ -1759,6 +1779,9 @@ def limitations_items(results: Results) -> list[Item]:
         items.append(_fraction_table(fraction, cube.soil.values, cube.block.values, config))
 
     items += bearing_items(config, cube)
+    bed_form = bed_form_words(config)
+    if bed_form:
+        items += [heading("Bed form"), paragraph(bed_form)]
 
     items.append(heading("Extrapolated fragility medians"))
     status = extrapolation(fragility, results.output)
