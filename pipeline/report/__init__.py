@@ -212,8 +212,8 @@ CAPTIONS = {
               "intensity studied, and a curve that drops below the frequency axis is cut by the axis only: the risk "
               "integral takes it to the highest intensity studied. A soft soil's curve can fall below the reference "
               "site's at strong shaking: the site term's nonlinear part de-amplifies it (Methods).",
-    "spectra": "Read how strong and how varied the records are: each grey line is one record unscaled (the "
-               "Records section lists them); the 16% "
+    "spectra": "Read how strong and how varied the records are: each grey line is one record component "
+               "unscaled (the Records section lists them); the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "
                "intensity level.",
     "showcase-processing": "Read what processing changes: raw as published (grey) and processed (blue: band-pass "
@@ -234,8 +234,9 @@ CAPTIONS = {
            "at the right edge. Dotted: the site's return-period intensities (the legend names them); shaded: "
            "beyond the largest recorded intensity (extrapolation by scaling). "
            "A block that slides instead of rocking stays at θmax/α = 0. Curves are not smoothed: a record may "
-           "overturn at one level and survive a higher one (it counts as overturned from its first overturning "
-           "level on).",
+           "overturn at one level and survive a higher one; the lines and fractiles here show each run as it ran, "
+           "while the fragility fits count such a record as overturned from its first overturning level on, so a "
+           "fractile can stay below the edge where the fits count more records overturned.",
     "fragility-soils": "Read how likely each damage state is at the site's intensities (dotted lines) and whether "
                        "the soil changes it: points, the fraction of records reaching the state at each level (open "
                        "for the rigid base's); lines, "
