@@ -476,8 +476,8 @@ def bed_form_words(config) -> str:
             "of Psycharis & Jennings 1983), not springs spread over the footprint (a distributed Winkler bed) of the "
             "same vertical stiffness k. Its rocking stiffness with the whole base down is k b², three times a "
             "distributed bed's k b²/3, so its rocking frequencies are up to √3 times higher; and its heel stays "
-            "down until the base's reaction reaches the toe, where a distributed bed's heel starts to part once the reaction "
-            "leaves the middle third of the base (the block tipping by about a third of its uplift acceleration). "
+            "down until the base's reaction reaches the toe, where a distributed bed's heel starts to part once "
+            "the reaction leaves the middle third of the base (the block tipping by about a third of its uplift acceleration). "
             "On a distributed bed the block would tilt earlier and more softly; the uplift state counts a corner "
             "lifting the uplift size on either.")
 
