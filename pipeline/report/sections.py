@@ -477,9 +477,9 @@ def bed_form_words(config) -> str:
             "same vertical stiffness k. Its rocking stiffness with the whole base down is k b², three times a "
             "distributed bed's k b²/3, so its rocking frequencies are up to √3 times higher; and its heel stays "
             "down until the base's reaction reaches the toe, where a distributed bed's heel starts to part once "
-            "the reaction leaves the middle third of the base (the block tipping by about a third of its uplift acceleration). "
-            "On a distributed bed the block would tilt earlier and more softly; the uplift state counts a corner "
-            "lifting the uplift size on either.")
+            "the reaction leaves the middle third of the base (the block tipping by about a third of its uplift "
+            "acceleration). On a distributed bed the block would tilt earlier and more softly; the uplift state "
+            "counts a corner lifting the uplift size on either.")
 
 
 BEARING_SAFETY = 3.0
