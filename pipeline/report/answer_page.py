@@ -337,9 +337,10 @@ def curve_reason(results, model: str, block=None) -> str:
         text = ("The answers use the recommended curve: the tensionless Winkler bed with friction at the base, at "
                 "the middle of the experimental range of impact restitution (where the bed reaches it: below, where "
                 "not) and the soil's stated friction and stiffness (the best estimate). Its β adds the model "
-                "dispersion to the record-to-record one: the larger of the spread of its median over sensitivity runs (restitution, friction and bed stiffness "
-                "each at both ends of its range) and FEMA P695's rating of the model's form (a planar rigid block: "
-                "no three-dimensional rocking, no flexible superstructure).")
+                "dispersion to the record-to-record one: the larger of the spread of its median over sensitivity "
+                "runs (restitution, friction and bed stiffness each at both ends of its range) and FEMA P695's "
+                "rating of the model's form (a planar rigid block: no three-dimensional rocking, no flexible "
+                "superstructure).")
         if block is not None:
             return (_band_reach(getattr(results, "cube", None), block, results)
                     + _band_collapse(getattr(results, "cube", None), block)).strip()
