@@ -632,7 +632,7 @@ def plan(results: Results) -> list[Page]:
                                caption=CAPTIONS["applicability-sweep"] + sweep_words(results.applicability)
                                        + " Median over the records (of "
                                        f"{results.applicability.attrs.get('n_records', '?')}) that survived in "
-                                       "both models at each level: at the higher levels, fewer (cold read 12).",
+                                       "both models at each level: at the higher levels, fewer.",
                                names=names))
     if results.efficiency is not None and "dispersion" in results.efficiency:
         planned.append(_figure("efficiency", "Measure efficiency", pages.EFFICIENCY_TITLE,
