@@ -215,9 +215,9 @@ studied is ranked as a bound by ``governing`` (cold read 9: overturning governed
 its limit, 93% of it that bound, over a computed slip at 3.0%)."""
 
 GOVERNING_WORDS = ("Governing: the state furthest above its limit; where none is above, the computed state nearest "
-                   "its limit as a share of it, a value under the print floor at its own value (a state no record "
-                   "reached, or whose value is mostly the bound for the shaking above the highest intensity studied, "
-                   "governs only where all are such bounds).")
+                   "its limit as a share of it, a value under the print floor at its own value. A bound (no record "
+                   "reached the state, or its value is mostly the bound above the highest intensity studied) governs "
+                   "only where every judged state is one.")
 """How the summary picks the state it prints (``governing``), said in its note."""
 
 
