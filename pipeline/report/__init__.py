@@ -205,8 +205,7 @@ STATION_NAMES = ("Stations are named as the records' source catalogue spells the
 
 CAPTIONS = {
     "hazard": "Read how often each intensity is exceeded at the site, per year: each soil's curve (its colour) and "
-              "the reference site's it is carried from (black dashed; a soil's curve stops where the given one "
-              "ends, at its rarest frequency); dotted, the frequencies of the return periods "
+              "the reference site's it is carried from (black dashed); dotted, the frequencies of the return periods "
               "(a point where a curve crosses one: the site's intensity of that return period, as the answer pages "
               "print it); grey shading: beyond the largest recorded intensity; the axis ends at the highest "
               "intensity studied, and a curve that drops below the frequency axis is cut by the axis only: the risk "
@@ -383,6 +382,12 @@ def hazard_caption(results) -> str:
 
     caveat = hazard_caveat(results)
     text = stiffer_site_words(results.config.soils, results.site_hazards)
+    sites = results.site_hazards
+    highest = max((float(v) for v in results.credible_limits.values()), default=np.inf) \
+        if getattr(results, "credible_limits", None) else np.inf
+    if sites is not None and sites.reference is not None and np.isfinite(highest) \
+            and float(np.max(sites.reference.intensity)) < highest:  # cold read 12, default C5: said only then
+        text += " A soil's curve stops where the given one ends, at its rarest frequency."
     return text + (f" The curve: {caveat}." if caveat else " The curve: the site's, given with the study (Methods).")
 
 
