@@ -422,6 +422,9 @@ def test_a_pages_notes_group_a_models_soils_so_ten_series_fit():
     assert words == "SSI, paper's model on clay, sand, gravel, rock, steel; Housner (rigid base) on gravel, rock, steel"
     assert len(words) < len("; ".join(series)) * 0.6
     assert figures._series_words(["recommended", "recommended"]) == "recommended"
+    # cold read 12, default figures: "Recommended on gravel, steel, clay, sand, rock": the report's soil order now
+    shuffled = [f"Recommended on {soil}" for soil in ("gravel", "steel", "clay", "sand", "rock")]
+    assert figures._series_words(shuffled, soils) == "Recommended on clay, sand, gravel, rock, steel"
 
 
 @pytest.mark.slow

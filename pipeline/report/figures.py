@@ -765,7 +765,7 @@ def _panel_words(panels_of) -> str:
     return ", ".join(f"{s} on {o}" for s, o in dict.fromkeys(panels_of))
 
 
-def _series_words(series) -> str:
+def _series_words(series, order=None) -> str:
     """Series labels in a note, one model's soils joined: "Housner (rigid base) on clay, sand, rock; recommended".
 
     Ten series listed one by one overflowed the legend's column (default C, pp. 30, 36: the notes fell back to a
@@ -775,8 +775,9 @@ def _series_words(series) -> str:
     for label in series:
         model, _, soil = label.rpartition(" on ") if " on " in label else (label, "", "")
         grouped.setdefault(model, []).extend([soil] if soil else [])
-    return "; ".join(f"{model} on {', '.join(dict.fromkeys(soils))}" if soils else model
-                     for model, soils in grouped.items())
+    rank = {soil: index for index, soil in enumerate(order or ())}  # the report's soil order (cold read 12)
+    return "; ".join(f"{model} on {', '.join(sorted(dict.fromkeys(soils), key=lambda s: rank.get(s, len(rank))))}"
+                     if soils else model for model, soils in grouped.items())
 
 
 def page_notes(figure) -> None:
@@ -811,7 +812,8 @@ def page_notes(figure) -> None:
                                                              for state, series in failing.items()) + ".", width)
     lines = textwrap.wrap("No curve, points only (the limitations list each):", width) if notes else []
     for reason, series in notes.items():
-        lines += textwrap.wrap(f"{reason}: {_series_words(series)}.", width, initial_indent="- ",
+        lines += textwrap.wrap(f"{reason}: {_series_words(series, getattr(figure, 'rockfrag_soil_order', None))}.",
+                               width, initial_indent="- ",
                                subsequent_indent="  ")
     room = (bottom - 0.015 - (CAPTION_Y + 0.015)) * figure.get_figheight() * 72.0 / (1.2 * NOTE_SIZE)  # lines
     if notes and len(first) + len(lines) > room:  # more than the column holds: the count, and where the list is
@@ -953,6 +955,7 @@ def fragility_by_soil_page(fragility, block, model, caption, marks: CredibleMark
     states, axes = _state_axes(figure, fragility)
     labels, short = state_labels(fragility), short_states(fragility)
     figure.rockfrag_short = short
+    figure.rockfrag_soil_order = list(map(str, fragility.soil.values))
     levels = block_levels(fragility, block)
     span = curve_range(levels, marks)  # the curves; the axes get a margin
     for axis, state in zip(axes.flat, states):
@@ -989,6 +992,7 @@ def fragility_by_model_page(fragility, block, soils, caption, marks: CredibleMar
     states, axes = _state_axes(figure, fragility, n_rows=len(soils))
     labels, short = state_labels(fragility), short_states(fragility)
     figure.rockfrag_short = short
+    figure.rockfrag_soil_order = list(map(str, fragility.soil.values))
     levels = block_levels(fragility, block)
     span = curve_range(levels, marks)  # the curves; the axes get a margin
     for row, soil in enumerate(soils):
