@@ -506,3 +506,19 @@ def test_the_ida_rigid_row_of_a_block_that_slides_on_every_soil_says_so(small_pi
     assert figures.RIGID_SLIDES in headings(still)
     tied = still.assign_coords(soil_friction_static=("soil", np.full(ida.sizes["soil"], 1.1 * ratio)))
     assert figures.RIGID_SLIDES not in headings(tied)
+
+
+def test_the_return_period_lines_say_whose_hazard_they_mark():
+    """Cold read 12, default figures: the dotted return-period lines did not say they come from the example hazard,
+    so a page copied out alone showed 'the site's intensities' as if real. The legend entry carries the tag."""
+    from rockfrag.report.adapters import CredibleMarks
+
+    figure, axis = plt.subplots()
+    try:
+        axis.set_xscale("log")
+        axis.set_xlim(0.1, 3.0)
+        figures.mark_intensities(axis, CredibleMarks((475, 2475), (0.3, 0.6), 0.8, tag="example hazard"))
+        labels = [line.get_label() for line in axis.get_lines()]
+        assert any(label.endswith("475, 2,475 years (example hazard)") for label in labels), labels
+    finally:
+        plt.close(figure)

@@ -452,17 +452,20 @@ class CredibleMarks:
     by_soil : tuple of (str, tuple of float)
         Each soil's own site intensity at each return period (its site hazard), where the soils differ; empty
         when one hazard serves every soil (then ``intensities`` are every soil's).
+    tag : str
+        Beside the return periods where the hazard is not a site's ("(example hazard)"; ``summary.hazard_tag``).
     """
 
     return_periods: tuple = ()
     intensities: tuple = ()
     largest: float | None = None
     by_soil: tuple = ()
+    tag: str = ""
 
     def for_soil(self, soil) -> CredibleMarks:
         """The marks of a panel of one soil: that soil's own site intensities (unchanged for an unknown soil)."""
         own = dict(self.by_soil).get(None if soil is None else str(soil))
-        return self if own is None else CredibleMarks(self.return_periods, tuple(own), self.largest)
+        return self if own is None else CredibleMarks(self.return_periods, tuple(own), self.largest, tag=self.tag)
 
 
 GOF_LEVEL = 0.05

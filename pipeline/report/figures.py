@@ -129,7 +129,7 @@ def mark_intensities(axis, marks: CredibleMarks | None, along: str = "x", soil=N
         line(marks.largest, color="0.35", lw=0.9, ls="-", label="largest recorded intensity (unscaled records)")
     groups = mark_groups(axis, marks, along)
     periods = sorted(float(t) for t in marks.return_periods)
-    named = ", ".join(f"{t:,.0f}" for t in periods) + " years"
+    named = ", ".join(f"{t:,.0f}" for t in periods) + " years" + (f" ({marks.tag})" if marks.tag else "")
     for intensities, _ in groups:
         for intensity in intensities:
             line(intensity, color=colour, lw=0.9, ls=":", label=None if label != HAZARD_LABEL else
@@ -161,7 +161,8 @@ def soil_marks(axis, marks: CredibleMarks, along: str = "x") -> None:
     low, high = axis.get_xlim() if along == "x" else axis.get_ylim()
     line = axis.axvline if along == "x" else axis.axhline
     mark_intensities(axis, CredibleMarks(largest=marks.largest), along)  # the shade and the largest recorded
-    periods = ", ".join(f"{float(t):,.0f}" for t in sorted(marks.return_periods)) + " years"
+    periods = ", ".join(f"{float(t):,.0f}" for t in sorted(marks.return_periods)) + " years" + (
+        f" ({marks.tag})" if marks.tag else "")
     for index, (soil, intensities) in enumerate(marks.by_soil):
         for intensity in intensities:
             if low <= intensity <= high:

@@ -213,7 +213,10 @@ class Results:
                         if soil.intensities) if answer is not None else ()
         if len({values for _, values in by_soil}) == 1:  # one site hazard for every soil: one set of marks
             intensities, by_soil = by_soil[0][1], ()
-        return CredibleMarks(periods, intensities, self.largest_recorded[str(block)] / scale, by_soil)
+        from rockfrag.report.summary import hazard_tag
+
+        return CredibleMarks(periods, intensities, self.largest_recorded[str(block)] / scale, by_soil,
+                             tag=hazard_tag(self))  # a page copied out alone still says whose hazard it marks
 
 
 def _level_units(dataset) -> str:
