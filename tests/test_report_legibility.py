@@ -650,3 +650,20 @@ def test_a_section_that_starts_part_way_down_a_page_is_listed_with_the_heading_i
                     also_headings=("Fitted fragility functions",))]
     assert contents_rows(planned, 2)[-2:] == [("section", "Fitted curves", 1),
                                               ("page", "Fitted fragility functions", 1)]
+
+
+def test_a_short_table_goes_whole_to_the_next_page_rather_than_split():
+    """Cold read 12 (default text, second round): a design-life table's steel part was split after its six state
+    rows, so its β and action rows stood alone under a repeated header on the next page. A table of at most
+    SHORT_TABLE rows that fits a page is not split: it starts the next page whole."""
+    from rockfrag.report.text import SHORT_TABLE, paginate, paragraph, table
+
+    rows = [[f"state {i}", f"{i}%"] for i in range(8)]
+    assert len(rows) <= SHORT_TABLE
+    for lead in range(25, 40):
+        items = [paragraph(f"line {i}") for i in range(lead)] + [table(["damage state", "on steel"], rows)]
+        pages = paginate(items)
+        holding = [index for index, page in enumerate(pages) if any(item.kind == "table" for item in page)]
+        assert len(holding) == 1, (lead, holding)
+        placed = next(item for item in pages[holding[0]] if item.kind == "table")
+        assert placed.rows == rows

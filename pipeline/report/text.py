@@ -21,6 +21,7 @@ WRAP = 150  # characters per line of 9.5 pt text across the page
 CHAR = 0.0062  # width of one 8.5 pt table character [figure fraction], for column positions
 LEFT = 0.02
 STRETCH = 7  # lines the last page of a run may hold beyond its capacity, set closer together
+SHORT_TABLE = 10  # rows of a table that is never split across pages where it fits one page
 MIN_HEADER = 12  # characters: a header is not wrapped narrower than this to make a table fit
 
 
@@ -143,7 +144,10 @@ def _paginate(items, capacity: int, stretch: int = STRETCH) -> list[list[Item]]:
         need = _lines(item)
         if item.kind == "table" and need > capacity - used:
             room = capacity - used - 1 - _header_lines(item)
-            if room < 3 and current:
+            # a short table that would leave a few rows (its verdict rows, say) alone on the next page goes there
+            # whole (cold read 12: a design-life table's steel part had its β and action rows cut off)
+            whole = need <= capacity and len(item.rows) <= SHORT_TABLE
+            if (room < 3 or whole) and current:
                 carried = []
                 while current and _leads_to_table(current[-1]):  # a heading or lead-in goes with its table
                     carried.insert(0, current.pop())
