@@ -31,6 +31,9 @@ def test_the_sweep_page_draws_one_panel_per_model_and_block_from_the_sweep_file(
     drawn = first.get_lines()[0].get_ydata()
     np.testing.assert_array_equal(drawn, dataset.peak_angle_ratio_to_housner.sel(model="winkler",
                                                                                   block="cabinet").values[0, 0])
+    import matplotlib.pyplot as plt
+
+    plt.close(figure)  # a figure left open fails test_report's no-open-figures check when they share a process
 
 
 def test_log_minor_ticks_only_inside_the_view_and_the_drawing_unchanged():
