@@ -673,16 +673,16 @@ def test_the_sufficiency_sentence_names_the_runs_its_test_rests_on():
                             coords={"soil": ["clay", "sand"], "block": ["box"], "model": ["housner", "recommended"],
                                     "measure": ["pga"]})
     words = sufficiency_words(efficiency, "box", "pga", "PGA", "recommended")
-    assert words.startswith("At a given PGA this block's overturning still depends on the records' pulse period in "
-                            "the runs of Housner (rigid base) on sand, the only runs the test covers; the recommended "
-                            "model's were not tested (its base slides, and the study refines overturning capacities, "
-                            "which the test needs, only where the base is tied), so whether they depend on it is not "
-                            "known (the "
-                            "measure-efficiency page"), words  # cold read 7: 'not in' read as 'tested, no dependence'
+    assert words.startswith("Whether PGA alone predicts this block's overturning: at a given PGA the overturning "
+                            "still depends on the records' pulse period in the runs of Housner (rigid base) on sand, "
+                            "the only model for which this was checked (the check needs each record's exact "
+                            "overturning intensity, which the study finds only for a base held against sliding); for "
+                            "the recommended model, whose base slides, it is not known (the measure-efficiency page"), \
+        words  # cold read 7: 'not in' read as 'tested, no dependence'; cold read 12: no tool words
 
     p[0, 0, 0, 0] = 1e-3  # the same on every soil (a tied rigid base): no soil named
     words = sufficiency_words(efficiency.assign(p_pulse_period=(dims, p)), "box", "pga", "PGA", "recommended")
-    assert "in the runs of Housner (rigid base), the only runs the test covers" in words
+    assert "in the runs of Housner (rigid base), the only model for which this was checked" in words
     p[1, 0, 1, 0] = 1e-3  # the answering model tested too: the sentence is about its curve, no qualification
     words = sufficiency_words(efficiency.assign(p_pulse_period=(dims, p)), "box", "pga", "PGA", "recommended")
     assert "in the runs of" not in words and "pulse period" in words

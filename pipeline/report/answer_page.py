@@ -1569,13 +1569,14 @@ def sufficiency_words(efficiency, block: str, study_measure: str, measure: str, 
             soils = sorted({s for m, s in cells if m == name}, key=list(map(str, efficiency.soil.values)).index)
             on = "" if len(soils) == efficiency.sizes["soil"] else f" on {listed(soils)}"
             runs.append(f"{model_info(name).label}{on}")
-        where = (f" in the runs of {listed(runs)}, the only runs the test covers; the recommended model's were not "
-                 "tested (its base slides, and the study refines overturning capacities, which the test needs, only "
-                 "where the base is tied), so whether they depend on it is not known")
-    return (f"At a given {measure} this block's overturning still depends on {' and '.join(failing)}{where} (the "
-            "measure-efficiency page; Luco & Cornell 2007): these curves hold for ground motions like the study's "
-            "records. For a site whose motions differ in that (near a fault: velocity pulses), the study must run "
-            "records like the site's (for example the near-field set).")
+        # cold read 12 (default text, round 2): "the test", "refines overturning capacities" were the tool's words
+        where = (f" in the runs of {listed(runs)}, the only model for which this was checked (the check needs each "
+                 "record's exact overturning intensity, which the study finds only for a base held against "
+                 "sliding); for the recommended model, whose base slides, it is not known")
+    return (f"Whether {measure} alone predicts this block's overturning: at a given {measure} the overturning still "
+            f"depends on {' and '.join(failing)}{where} (the measure-efficiency page; Luco & Cornell 2007). These "
+            "curves hold for ground motions like the study's records; for a site near a fault, whose motions carry "
+            "velocity pulses, the study must be run again with pulse-type records (FEMA P695's near-field set).")
 
 
 __all__ = ["ANCHOR_DESIGN", "MOTIONS", "NO_LEVEL", "answer_items", "curve_reason", "motion_counts",
