@@ -832,3 +832,22 @@ def test_the_limitations_say_what_two_corner_springs_leave_out():
     text = bed_form_words(SimpleNamespace(bed="two-spring"))
     assert "k b², three times a distributed bed's k b²/3" in text and "Psycharis & Jennings 1983" in text
     assert bed_form_words(SimpleNamespace(bed="continuous")) == ""
+
+
+def test_a_heavy_blocks_clay_verdict_says_it_holds_for_a_drained_base():
+    """Cold read 12 (default text, round 2): the limitations said the paper block's slip on saturated clay is
+    unconservative (μ_s p 140 kPa above any clay's adhesion, 10-60 kPa), and its answer page did not. It now says the
+    equivalent friction (0.03-0.15 under 400 kPa) and that the clay verdict holds for a drained base."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.answer_page import bearing_words
+    from rockfrag.soils import SOILS
+
+    paper = SimpleNamespace(name="paper", mass=326197.0, footprint_area=8.0, b=4.0)
+    light = SimpleNamespace(name="light", mass=4500.0, footprint_area=1.8, b=0.6)
+    results = SimpleNamespace(config=SimpleNamespace(blocks=[paper, light], soils=[SOILS["clay"], SOILS["sand"]]))
+    soils = [SimpleNamespace(soil="clay"), SimpleNamespace(soil="sand")]
+    text = bearing_words(results, SimpleNamespace(block="paper", soils=soils))
+    assert "an equivalent friction of only 0.03-0.15 under its 400 kPa, against μ_s 0.35" in text, text
+    assert "holds for a drained base" in text
+    assert bearing_words(results, SimpleNamespace(block="light", soils=soils)) == ""

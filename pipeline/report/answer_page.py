@@ -542,13 +542,14 @@ def bearing_words(results, answer) -> str:
     and soil (``rockfrag.report.sections.bearing_items``).
     """
     from rockfrag.report.sections import clay_bearing_words, clay_class_strength
-    from rockfrag.soils import bearing_case
+    from rockfrag.soils import CLAY_ADHESION, bearing_case
 
     block = next((block for block in results.config.blocks if block.name == answer.block), None)
     if block is None:
         return ""
     low, _ = clay_class_strength()
-    said = []
+    adhesion = (CLAY_ADHESION["soft clay"][0], CLAY_ADHESION["stiff clay"][1])
+    said, slips = [], []
     for soil in results.config.soils:
         if soil.name not in [s.soil for s in answer.soils]:
             continue
@@ -556,10 +557,20 @@ def bearing_words(results, answer) -> str:
         if case.kind == "clay" and case.needed_strength > low:
             said.append(f"on {soil.name} it presses {case.pressure / 1e3:,.0f} kPa at rest, which needs "
                         f"{clay_bearing_words(case)}")
-    if not said:
-        return ""
-    return (f"Bearing: {'; '.join(said)}. The verdict there presumes ground or a foundation that carries the block "
-            "(Limitations, 'Bearing').")
+        if case.kind == "clay" and soil.friction_static * case.pressure > adhesion[1]:
+            # cold read 12 (default text, round 2): the limitations said this cell's slip is unconservative on
+            # saturated clay, and its answer page did not
+            slips.append(f"on {soil.name} the undrained adhesion of formed concrete ({adhesion[0] / 1e3:.0f}-"
+                         f"{adhesion[1] / 1e3:.0f} kPa) is an equivalent friction of only "
+                         f"{adhesion[0] / case.pressure:.2f}-{adhesion[1] / case.pressure:.2f} under its "
+                         f"{case.pressure / 1e3:,.0f} kPa, against μ_s {soil.friction_static:g}")
+    text = (f"Bearing: {'; '.join(said)}. The verdict there presumes ground or a foundation that carries the block "
+            "(Limitations, 'Bearing').") if said else ""
+    if slips:
+        text += (f" Sliding on saturated clay: {'; '.join(slips)}. Where the base slides undrained it slides more "
+                 "than computed here, so the verdict there holds for a drained base, or once a site's undrained "
+                 "strength shows the adhesion is not lower (Limitations, 'Sliding').")
+    return text.strip()
 
 
 def slides_then_soils(results, answer) -> list:

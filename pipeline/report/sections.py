@@ -347,7 +347,8 @@ def stiffer_end_words(results) -> str:
     from rockfrag.report.summary import governing
 
     fragility = results.fragility
-    if "member_median" not in fragility or "stiffness_high" not in fragility.member.values or not results.answers:
+    if "member_median" not in fragility or not {"stiffness_low", "stiffness_high"} <= set(
+            map(str, fragility.member.values)) or not results.answers:
         return ""
     scale = display_scale(fragility["median"].attrs.get("units", ""))[0]
     moves = []
@@ -359,16 +360,18 @@ def stiffer_end_words(results) -> str:
                 continue
             where = dict(block=answer.block, soil=soil.soil, damage_state=row.state)
             centre = float(fragility["median"].sel(model=answer.model, **where)) * scale
-            stiff = float(fragility.member_median.sel(member="stiffness_high", **where)) * scale
-            if np.isfinite(centre) and np.isfinite(stiff):
-                cells.append(f"{soil.soil} {centre:.3g} → {stiff:.3g}")
+            soft, stiff = (float(fragility.member_median.sel(member=f"stiffness_{end}", **where)) * scale
+                           for end in ("low", "high"))
+            if np.isfinite(centre) and np.isfinite(stiff) and np.isfinite(soft):
+                cells.append(f"{soil.soil} {soft:#.3g} / {centre:#.3g} / {stiff:#.3g}")
         if cells:
             moves.append(f"{short_block_name(results.config, answer.block)}: {', '.join(cells)} {answer.unit}")
     if not moves:
         return ""
     factor = results.config.design.stiffness_factor
-    return (f" At the sensitivity runs' stiffer end (× {factor:g}) each soil's governing median (the answer pages' "
-            f"state) moves: {'; '.join(moves)}.")
+    return (f" Each soil's governing median (the answer pages' state) with the bed ÷ {factor:g} / as modelled / "
+            f"× {factor:g} (the sensitivity runs): {'; '.join(moves)}. The answer pages say how far each median may "
+            "move before its verdict changes.")
 
 
 def half_space_words(config, cube) -> str:
@@ -1787,6 +1790,13 @@ def limitations_items(results: Results) -> list[Item]:
         items += [heading("Bed form"), paragraph(bed_form)]
 
     items.append(heading("Extrapolated fragility medians"))
+    # cold read 12 (default text, round 2): the verdicts rest on medians of records scaled 2-12 times; is that fair?
+    items.append(paragraph(
+        "Medians above the largest intensity any record reached unscaled (marked †) come from records scaled up. "
+        "Scaling keeps a record's duration and frequency content, which a real stronger record would change, and "
+        "amplitude scaling can bias a nonlinear response (Luco & Bazzurro 2007); for sliding and rocking that bias "
+        "is not sized here. The answer pages give how far each governing median may move before its verdict "
+        "changes: the bias a verdict absorbs."))
     status = extrapolation(fragility, results.output)
     # a rigid base once per block (on the first soil, soil "(any)"), unless friction makes its soils differ
     rigid = {(m.name, str(b)) for m in models_of(fragility) if m.rigid_base for b in fragility.block.values

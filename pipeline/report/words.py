@@ -145,6 +145,9 @@ REFERENCES = {
                   "Mechanics and Foundations Division 99(SM1), 45-73 (N_γ = 2(N_q + 1) tan φ).",
     "Terzaghi & Peck 1967": "Terzaghi, K., Peck, R. B. (1967). Soil Mechanics in Engineering Practice, 2nd ed. "
                             "Wiley, New York (consistency of clay by unconfined compressive strength).",
+    "Luco & Bazzurro 2007": "Luco, N., Bazzurro, P. (2007). Does amplitude scaling of ground motion records result "
+                            "in biased nonlinear structural drift responses? Earthquake Engineering & Structural "
+                            "Dynamics 36(13), 1813-1835.",
     "Gajan & Kutter 2008": "Gajan, S., Kutter, B. L. (2008). Capacity, settlement, and energy dissipation of shallow "
                            "footings subjected to rocking. Journal of Geotechnical and Geoenvironmental Engineering "
                            "134(8), 1129-1141.",
