@@ -587,7 +587,7 @@ def test_the_summary_reason_gives_the_records_at_the_levels_either_side_of_the_i
     assert overturning.records[-1] == (0, 10, pytest.approx(levels[above - 1]))
     assert overturning.records_above == (3, 10, pytest.approx(levels[above]))
     said = reason(SimpleNamespace(facts=numbers.Facts()), answer, answer.soils[0])
-    assert said == f"0 of 10 at {levels[above - 1]:.2g} g, 3 at {levels[above]:.2g} g", said
+    assert said == f"0-3 of 10 at {levels[above - 1]:.2g}-{levels[above]:.2g} g", said
 
 
 def test_a_soil_whose_bed_falls_short_only_within_tolerance_is_said_to_run_at_the_middle():

@@ -382,10 +382,13 @@ def reason(results, answer, soil) -> str:
         reached, total, level = row.records[-1]
         results.facts.say("records reaching", (answer.block, soil.soil, row.state, answer.return_periods[-1]),
                           str(reached))
-        if reached == 0 and row.records_above is not None and row.records_above[0] > 0:
-            # none at the level below the intensity, some at the level above: both, so "0 of 44" is not read alone
-            return (f"{numbers.count(reached, total)} at {numbers.intensity(level, unit)}, {row.records_above[0]} "
-                    f"at {numbers.intensity(row.records_above[2], unit)}")
+        above = row.records_above
+        if above is not None and (reached, above[0]) != (0, 0):
+            # the levels either side of the intensity (cold read 12: "0 of 44 at 0.52 g" for 0.60 g, where 1 of 44
+            # overturned at 0.65 g; "14 of 44 at 0.37 g" for 0.45 g, 20 at 0.48 g)
+            counts = f"{reached}" if reached == above[0] else f"{reached}-{above[0]}"
+            return (f"{counts} of {total} at {numbers.intensity(level, unit).removesuffix(' ' + unit)}-"
+                    f"{numbers.intensity(above[2], unit)}")
         if reached == 0:  # a non-zero P beside "0 of 44" says where it comes from
             return f"{numbers.count(reached, total)} at {numbers.intensity(level, unit)}: fitted tail"
         return f"{numbers.count(reached, total)} reach it at {numbers.intensity(level, unit)}"
@@ -468,11 +471,10 @@ def summary_items(results) -> list[Item]:
     items.append(note(" ".join(filter(None, [
         said, GOVERNING_WORDS, bounds, scaled_medians_words(results), structural_base_words(results),
         weaker_direction_words(results), representative_soils_words(results),
-        "Reason: the records at the level run at or below the largest return period's intensity"
-        + (" (and above it where only there some reach the state)" if any(", " in row[-1] for row in rows) else "")
-        + "; where none reach it, its probabilities are the fitted curve's tail. β (records / model): the total, "
-        "√(records² + model²), of the variability from record to record and the model's own uncertainty. The "
-        "answer pages give every state and its records."
+        "Reason: the records that reach the state at the levels run either side of the largest return period's "
+        "intensity; where none reach it at the level below, its probabilities are the fitted curve's tail. β "
+        "(records / model): the total, √(records² + model²), of the record-to-record and the model's own "
+        "variability (the answer pages give every state)."
     ]))))
     return items
 
