@@ -691,9 +691,7 @@ def test_the_sufficiency_sentence_names_the_runs_its_test_rests_on():
 def test_a_table_split_by_a_page_break_leaves_no_single_row_on_the_next_page():
     """Cold read 3 nit (found on the read-4 reports): the paper block's design-life table broke with its last row,
     'action', alone under a repeated header on the next page. A split leaves at least two rows to the next page."""
-    from rockfrag.report.text import paginate, paragraph, table
-
-    from rockfrag.report.text import SHORT_TABLE
+    from rockfrag.report.text import SHORT_TABLE, paginate, paragraph, table
 
     rows = [[f"state {i}", "1%"] for i in range(SHORT_TABLE + 4)]  # a short table is never split (cold read 12)
     split = 0
