@@ -190,7 +190,7 @@ GLOSSARY = (
     (TILT_WORDS, "a base corner parts from a compliant bed by less than the uplift size: the bed gives under the "
                  "toe and the block leans, but it does not rock about its edge."),
     ("tied base", "a base held against sliding in a model's runs (no friction limit), so the block can only rock; "
-                  "the limitations' 'Sliding' says which runs tie it and how often their base would have slid."),
+                  "the limitations' 'Sliding' says which runs tie it."),
     ("rocks", "the block pivots about a bottom edge with a base corner lifted at least the uplift size."),
     ("at rest, slides, slides and rocks, overturns", "the other words of the answer pages' motion tables: no "
      "corner lifts and the base does not slip (at rest); the base slips on the ground without rocking (slides); it "
