@@ -851,3 +851,29 @@ def test_a_heavy_blocks_clay_verdict_says_it_holds_for_a_drained_base():
     assert "an equivalent friction of only 0.03-0.15 under its 400 kPa, against μ_s 0.35" in text, text
     assert "holds for a drained base" in text
     assert bearing_words(results, SimpleNamespace(block="light", soils=soils)) == ""
+
+
+def test_the_kinetic_slip_caption_is_said_only_where_the_lift_off_share_falls():
+    """Cold read 12: the paper block's lift-off share on steel fell (20 to 17 of 44) unexplained; the sentence added
+    for it then stood on the user study's sand, whose share rises. It is said only where the share falls."""
+    from types import SimpleNamespace
+
+    from rockfrag.report import kinetic_slip_words
+    from rockfrag.soils import SOILS
+
+    block = SimpleNamespace(name="paper", b=4.0, h=8.5)
+    levels = np.array([0.8, 1.0, 1.25, 1.56])
+    share = np.array([16, 20, 17, 25]) / 44.0
+    dims = ("im_level", "soil", "block", "model", "damage_state")
+    fragility = xr.Dataset({"empirical_fraction": (dims, share[:, None, None, None, None]), "n_records": 44},
+                           coords={"soil": ["steel"], "block": ["paper"], "model": ["recommended"],
+                                   "damage_state": ["uplift"],
+                                   "intensity": (("block", "im_level"), levels[None, :], {"units": "9.80665 m s-2"})})
+    cube = xr.Dataset({"friction_static": (("soil", "block", "model"), [[[0.5]]])},
+                      coords={"soil": ["steel"], "block": ["paper"], "model": ["recommended"]})
+    results = SimpleNamespace(config=SimpleNamespace(blocks=[block], soils=[SOILS["steel"]]), cube=cube,
+                              fragility=fragility)
+    text = kinetic_slip_words(results, "paper", "recommended")
+    assert "on steel (μ_k 0.4) it falls from 20 to 17 of 44 between 1.00 and 1.25 g" in text, text
+    fragility["empirical_fraction"][:] = (np.array([16, 20, 22, 25]) / 44.0)[:, None, None, None, None]
+    assert kinetic_slip_words(results, "paper", "recommended") == ""

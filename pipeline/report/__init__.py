@@ -40,7 +40,7 @@ import xarray as xr  # noqa: E402
 from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
 from tqdm import tqdm  # noqa: E402
 
-from rockfrag.answer import display_scale  # noqa: E402
+from rockfrag.answer import RECOMMENDED, display_scale  # noqa: E402
 from rockfrag.config import StudyConfig  # noqa: E402
 from rockfrag.damage_states import damage_states_from_config  # noqa: E402
 from rockfrag.outputs import atomic_path  # noqa: E402
@@ -345,12 +345,28 @@ def kinetic_slip_words(results, block: str, model: str | None = None) -> str:
     soils = [soil for soil in config.soils if soil.name in cube.soil.values
              and soil.friction_kinetic < slender <= soil.friction_static
              and np.isfinite(friction.sel(soil=soil.name)).any()]
-    if not soils:
+    fragility = results.fragility
+    if not soils or "empirical_fraction" not in fragility or "uplift" not in fragility.damage_state.values:
         return ""
-    names = listed([f"{soil.name} (μ_k {soil.friction_kinetic:g})" for soil in soils])
-    return (f" On {names} the kinetic friction is below this block's b/h = {slender:.2f}: once its base slips it "
-            "cannot tip, and which records slip changes with the scaling, so the share that lifts off need not rise "
-            "with the intensity, and its lift-off lies far from the rigid base's (the answer page says why).")
+    n = int(fragility["n_records"]) if "n_records" in fragility else 0
+    levels = np.asarray(fragility.intensity.sel(block=block).values if "intensity" in fragility.coords
+                        and "block" in fragility.intensity.dims else [], float)
+    scale, unit = display_scale(str(fragility.intensity.attrs.get("units", ""))) if levels.size else (1.0, "")
+    said = []
+    for soil in soils:  # only where the share does fall between levels (cold read 12, user round 3: sand's rose)
+        share = fragility.empirical_fraction.sel(model=model or RECOMMENDED, block=block, soil=soil.name,
+                                                 damage_state="uplift").values * n
+        drops = [i for i in range(1, len(share)) if share[i] <= share[i - 1] - 2]
+        if drops and levels.size:
+            i = drops[0]
+            said.append(f"on {soil.name} (μ_k {soil.friction_kinetic:g}) it falls from {share[i - 1]:.0f} to "
+                        f"{share[i]:.0f} of {n} between {levels[i - 1] * scale:#.3g} and {levels[i] * scale:#.3g} "
+                        f"{unit}")
+    if not said:
+        return ""
+    return (f" Where the kinetic friction is below this block's b/h = {slender:.2f}, a base that slips cannot tip, "
+            "and which records slip changes with the scaling, so the share that lifts off need not rise with the "
+            f"intensity: {'; '.join(said)} (the answer page says why).")
 
 
 def _rigid_words(fragility, block) -> str:

@@ -458,8 +458,13 @@ def friction_margin_words(results, answer) -> str:
             if not np.isfinite(after):
                 lost.append(short[state])
             elif abs(after / before - 1.0) > MARGIN_MOVE:
+                # a median just under the top level read "3.0 g", as if pinned there (cold read 12, user round 3)
+                top = float(fragility.studied_im_max.sel(block=answer.block)) * scale \
+                    if "studied_im_max" in fragility else np.inf
+                near = after > 0.95 * top
                 moves.append(f"{short[state]} from {numbers.intensity(before, answer.unit)} to "
-                             f"{numbers.intensity(after, answer.unit)}")
+                             + (f"{after:.3g} {answer.unit}, just below the highest level run" if near
+                                else numbers.intensity(after, answer.unit)))
         if lost:
             moves.append(f"{listed(lost)} {'loses its median' if len(lost) == 1 else 'lose their medians'} (above "
                          "the highest intensity studied)")
