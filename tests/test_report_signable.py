@@ -877,3 +877,36 @@ def test_the_kinetic_slip_caption_is_said_only_where_the_lift_off_share_falls():
     assert "on steel (μ_k 0.4) it falls from 20 to 17 of 44 between 1.00 and 1.25 g" in text, text
     fragility["empirical_fraction"][:] = (np.array([16, 20, 22, 25]) / 44.0)[:, None, None, None, None]
     assert kinetic_slip_words(results, "paper", "recommended") == ""
+
+
+def test_a_gripping_base_on_clay_gets_the_held_bases_overturning_probability():
+    """Cold read 12 (user, round 3): the enclosure's 8.58 kPa lies below any clay's adhesion, so undrained it grips
+    and rocks; the reader computed the held base's overturning on the clay's hazard (0.04%) and asked for it in the
+    report. The limitations give it from the model whose base is held there, against the closed form of a
+    power-law hazard."""
+    from types import SimpleNamespace
+
+    from rockfrag.hazard import HazardCurve
+    from rockfrag.report.sections import gripping_base_words
+    from rockfrag.soils import SOILS
+
+    k0, k = 1e-4, 2.5
+    s = np.geomspace(0.001, 100.0, 400)
+    hazard = HazardCurve(s, k0 * s ** -k, "pga", None, "site.csv")
+    block = SimpleNamespace(name="enclosure", b=0.6, h=1.5, mass=4500.0, footprint_area=1.8)
+    dims = ("soil", "block", "model", "damage_state")
+    fragility = xr.Dataset({"median": (dims, [[[[1.0], [1.85]]]], {"units": "9.80665 m s-2"}),
+                            "beta": (dims, [[[[0.5], [0.5]]]])},
+                           coords={"soil": ["clay"], "block": ["enclosure"], "model": ["recommended", "ssi"],
+                                   "damage_state": ["overturning"]}, attrs={"design_life_years": 50.0})
+    cube = xr.Dataset({"friction_static": (("soil", "block", "model"), [[[0.35, np.nan]]])},
+                      coords={"soil": ["clay"], "block": ["enclosure"], "model": ["recommended", "ssi"]})
+    results = SimpleNamespace(cube=cube, fragility=fragility, site_hazards=None, hazard=hazard,
+                              config=SimpleNamespace(blocks=[block], soils=[SOILS["clay"]], raw={}, design_life=50.0),
+                              decision={"max_probability_in_life": {"overturning": 0.01}})
+    text = gripping_base_words(results, ["clay"])
+    expected = 1 - np.exp(-50 * k0 * 1.85 ** -k * np.exp(k * k * 0.25 / 2))
+    from rockfrag.report import numbers
+
+    assert f"overturns in 50 years with {numbers.probability(expected)} against the 1% limit" in text, (text, expected)
+    assert "whose base is held there" in text

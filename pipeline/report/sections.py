@@ -458,7 +458,7 @@ def adhesion_words(config, cube, clays: list[str]) -> str:
     if grips:
         text += (f" For {listed(grips)} that is below the adhesion of even a soft clay: a base that grips undrained "
                  "slides less than this study lets it, so its slip probabilities here are, if anything, high and its "
-                 "rocking ones low (the sensitivity runs with the higher friction show that side).")
+                 "rocking ones low (the sensitivity runs' higher friction shows only the start of that side).")
     if slides:
         text += (f" For {listed(slides)} it is above the adhesion of even a stiff clay: undrained, the base slides "
                  "more easily, so its slip probabilities here are low and its rocking ones, if anything, high.")
@@ -562,6 +562,54 @@ def bearing_items(config, cube) -> list[Item]:
              "not modelled, and the nearer p lies to the bearing, the more they matter.")
     return [heading("Bearing"), paragraph(text),
             table(["block", "soil or base", "p at rest [kPa]", "what carries it"], rows)]
+
+
+def gripping_base_words(results, clays: list[str]) -> str:
+    """What a base that grips on clay gives: the overturning of a model whose base is held there, in the design life.
+
+    Cold read 12 (user, round 3): "the sensitivity runs with the higher friction show that side" while a stiff
+    clay grips like a friction of 1.4-2.4 on the enclosure, so it would rock instead; the reader's check (a held
+    base's overturning curve on the clay's hazard: 0.04%) belongs in the report. For each block whose μ_s p lies
+    below a soft clay's adhesion, the first model with an overturning curve on that clay whose base is tied there
+    (cube.nc ``friction_static`` NaN) gives the probability. "" where there is none or no hazard.
+    """
+    from rockfrag.fragility import capped_frequency
+    from rockfrag.hazard import hazard_of
+    from rockfrag.risk import probability_in_life
+    from rockfrag.soils import CLAY_ADHESION
+
+    cube, fragility, config = results.cube, results.fragility, results.config
+    hazard = results.site_hazards or results.hazard
+    if hazard is None or "friction_static" not in cube or "overturning" not in fragility.damage_state.values:
+        return ""
+    life = float(fragility.attrs.get("design_life_years", config.design_life))
+    limit = results.decision.get("max_probability_in_life", {}).get("overturning")
+    said = []
+    for block in config.blocks:
+        if block.name not in cube.block.values:
+            continue
+        pressure = block.mass * STANDARD_GRAVITY / block.footprint_area
+        for soil in (s for s in config.soils if s.name in clays):
+            if soil.friction_static * pressure >= CLAY_ADHESION["soft clay"][0]:
+                continue
+            for model in models_of(fragility):
+                if model.name not in cube.model.values or np.isfinite(float(cube.friction_static.sel(
+                        model=model.name, block=block.name, soil=soil.name))):
+                    continue  # its base slides there: not a held base
+                fit = fragility.sel(model=model.name, block=block.name, soil=soil.name, damage_state="overturning")
+                median, beta = float(fit["median"]), float(fit["beta"])
+                if not (np.isfinite(median) and np.isfinite(beta)):
+                    continue
+                cap = float(fragility.credible_max.sel(block=block.name)) if "credible_max" in fragility else np.inf
+                p = float(probability_in_life(capped_frequency(median, beta, hazard_of(hazard, soil.name), cap),
+                                              life))
+                said.append(f"{short_block_name(config, block.name)} on {soil.name}: {short_label(model)}, whose "
+                            f"base is held there, overturns in {life:g} years with {numbers.probability(p)}"
+                            + (f" against the {numbers.stated_probability(limit)} limit" if limit else ""))
+                break
+    if not said:
+        return ""
+    return (f" A base that grips rocks instead of sliding: {'; '.join(said)} (its record-to-record β only).")
 
 
 def _any_per_metre(config) -> bool:
@@ -1756,7 +1804,7 @@ def limitations_items(results: Results) -> list[Item]:
                            "and the methods. It is the soil class's, not the block's own base."))
     clays = [str(soil) for soil in cube.soil.values if "clay" in str(soil).lower()]
     if clays:  # cold read 8: a base on clay slides, in fast loading, on the clay's undrained strength
-        items.append(paragraph(adhesion_words(config, cube, clays)))
+        items.append(paragraph(adhesion_words(config, cube, clays) + gripping_base_words(results, clays)))
     # cold read 12, user B1: a verdict governed by slip, and nothing said what the planar runs leave out
     vertical = "" if vertical_applied(cube) else (", and without the vertical motion, whose acceleration changes the "
                                                   "normal force, and with it the friction, during the motion")
