@@ -389,7 +389,8 @@ def _twins_words(efficiency) -> str:
     if not twins:
         return ""
     pairs = "; ".join(f"{pages.measure_words(m)} repeats {pages.measure_words(o)}" for m, o in twins.items())
-    return f" Not drawn ({pairs}): identical by construction (a constant of the block divides them)."
+    defined = " (p = √(3g/4R), Housner's frequency parameter)" if "·p/" in pairs else ""  # cold read 12, user
+    return f" Not drawn ({pairs}){defined}: identical by construction (a constant of the block divides them)."
 
 
 def hazard_caption(results) -> str:

@@ -251,8 +251,8 @@ def robustness_words(results, answer) -> str:
             factor = np.nan
         if np.isfinite(factor):
             way = f"fall {100 * (1 - factor):.0f}%" if factor < 1 else f"rise {100 * (factor - 1):.0f}%"
-            margins.append(f"{way} on {soil.soil} ({name}, from {numbers.intensity(median * scale, answer.unit)} "
-                           f"to {numbers.intensity(median * factor * scale, answer.unit)})")
+            margins.append(f"{way} on {soil.soil} ({name}, from {median * scale:#.3g} to "
+                           f"{median * factor * scale:#.3g} {answer.unit})")  # 3 figures: the % reads off them
         parts = [float(fit[name]) for name in ("beta_record_to_record", "beta_form", "beta_parameters")
                  if name in fit]
         if len(parts) == 3 and all(np.isfinite(parts)):
