@@ -350,6 +350,9 @@ def draw_text_page(title, items, caption="", top=TOP, figure=None):
     # straight after the last bullet); counted here, so a full page sets its lines a little closer instead
     list_ends = [index for index, item in enumerate(items[:-1])
                  if item.kind == "bullet" and items[index + 1].kind not in ("bullet", "heading")]
+    # likewise after a note followed by body text (cold read 12, user: the note and the paragraph ran together)
+    list_ends += [index for index, item in enumerate(items[:-1])
+                  if item.kind == "note" and items[index + 1].kind in ("paragraph", "strong", "bullet")]
     lines = sum(_lines(item) for item in items) + LIST_GAP * len(list_ends)
     line = min(LINE, (top - BOTTOM) / lines) if lines else LINE  # a stretched last page: lines set closer
     for index, item in enumerate(items):
