@@ -874,7 +874,7 @@ def test_the_kinetic_slip_caption_is_said_only_where_the_lift_off_share_falls():
     results = SimpleNamespace(config=SimpleNamespace(blocks=[block], soils=[SOILS["steel"]]), cube=cube,
                               fragility=fragility)
     text = kinetic_slip_words(results, "paper", "recommended")
-    assert "on steel (μ_k 0.4) it falls from 20 to 17 of 44 between 1.00 and 1.25 g" in text, text
+    assert "on steel (μ_k 0.400 against 0.471) it falls from 20 to 17 of 44 between 1.00 and 1.25 g" in text, text
     fragility["empirical_fraction"][:] = (np.array([16, 20, 22, 25]) / 44.0)[:, None, None, None, None]
     assert kinetic_slip_words(results, "paper", "recommended") == ""
 

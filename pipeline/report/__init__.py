@@ -359,7 +359,8 @@ def kinetic_slip_words(results, block: str, model: str | None = None) -> str:
         drops = [i for i in range(1, len(share)) if share[i] <= share[i - 1] - 2]
         if drops and levels.size:
             i = drops[0]
-            said.append(f"on {soil.name} (μ_k {soil.friction_kinetic:g}) it falls from {share[i - 1]:.0f} to "
+            said.append(f"on {soil.name} (μ_k {soil.friction_kinetic:.3f} against {slender:.3f}) it falls from "
+                        f"{share[i - 1]:.0f} to "
                         f"{share[i]:.0f} of {n} between {levels[i - 1] * scale:#.3g} and {levels[i] * scale:#.3g} "
                         f"{unit}")
     if not said:

@@ -643,10 +643,11 @@ def slides_then_words(results, answer) -> str:
             f"overturning there rest on the assumed friction (marked {FRICTION_MARK} in the design-life table).")
     # cold read 12, default C1: gravel's μ_k 0.47 is below b/h 0.471 too, and nothing said why it does not matter
     calm = [soil for soil, decides in _kinetic_cases(results, answer) if not decides]
-    if calm:
-        text += (f" On {listed([f'{soil.name} (μ_k {soil.friction_kinetic:g})' for soil in calm])} the kinetic "
-                 "friction is below b/h too, but the friction at the high end of its range hardly moves the lift-off "
-                 "there: the friction does not decide.")
+    if calm:  # three digits: "μ_k 0.47 below b/h 0.47" read as a slip (cold read 12, default figures round 2)
+        pairs = [f"{soil.name} (μ_k {soil.friction_kinetic:.3f} against b/h {slender:.3f})" for soil in calm]
+        text += (f" On {listed(pairs)} "
+                 "the kinetic friction is below b/h too, by a hair's breadth, but the friction at the high end of its "
+                 "range hardly moves the lift-off there: the friction does not decide.")
     return text
 
 
