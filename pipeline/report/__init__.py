@@ -242,8 +242,8 @@ CAPTIONS = {
                        "the fitted lognormal, {lines}, one colour per soil (where soils' lines coincide, the last "
                        "drawn shows); light shading around a line, the confidence bounds of its median; {rigid}. "
                        "Grey shading: extrapolation by scaling.",
-    "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil, bottom the "
-                        "stiffest. Points: records (open for the rigid base's); lines: fits, "
+    "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil or base, "
+                        "bottom the stiffest (by shear modulus). Points: records (open for the rigid base's); lines: fits, "
                         "one style per model (legend); light shading around a line: the confidence bounds of its "
                         "median. Dotted: the site's return-period intensities; grey shading: extrapolation by "
                         "scaling.",

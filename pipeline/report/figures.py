@@ -226,7 +226,7 @@ def spectra_page(showcase, caption):
     spectra = showcase.record_spectrum.values / G
     for row in spectra:
         axis.loglog(periods, row, color="0.75", lw=0.6)
-    axis.plot([], [], color="0.75", lw=0.6, label=f"each record ({spectra.shape[0]})")
+    axis.plot([], [], color="0.75", lw=0.6, label=f"each record component ({spectra.shape[0]})")
     for q, style in FRACTILE_STYLES.items():
         axis.loglog(periods, np.quantile(spectra, q, axis=0), label=f"{q:.0%} fractile", **style)
     axis.set_xlabel("period T [s]")
