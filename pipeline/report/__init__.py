@@ -243,10 +243,10 @@ CAPTIONS = {
                        "drawn shows); light shading around a line, the confidence bounds of its median; {rigid}. "
                        "Grey shading: extrapolation by scaling.",
     "fragility-models": "Read how much the choice of model moves the curves: top row the softest soil or base, "
-                        "bottom the stiffest (by shear modulus). Points: records (open for the rigid base's); lines: fits, "
-                        "one style per model (legend); light shading around a line: the confidence bounds of its "
-                        "median. Dotted: the site's return-period intensities; grey shading: extrapolation by "
-                        "scaling.",
+                        "bottom the stiffest (by shear modulus). Points: records (open for the rigid base's); "
+                        "lines: fits, one style per model (legend); light shading around a line: the confidence "
+                        "bounds of its median. Dotted: the site's return-period intensities; grey shading: "
+                        "extrapolation by scaling.",
     "outcomes": "Read what the block does at the site's intensities (dotted lines): solid, the probability that it "
                 "lifts off (uplift: a base corner lifts at least the uplift size; a smaller lift is a tilt on the "
                 "bed); dashed, that it overturns; between them it rocks and stays up{shading}. Grey shading: "
