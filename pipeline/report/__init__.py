@@ -323,8 +323,8 @@ def showcase_slide_words(results) -> str:
     if not soils:
         return ""
     return (f" On {listed(soils)} the base friction is below b/h = {block.b / block.h:.2f}: the rigid base slides "
-            "without rocking, so its θ stays 0 under the other lines, and the bed mostly slides too; the slip that "
-            "judges it is not drawn here (its answer page has it).")
+            "without rocking, so its θ stays 0 under the other lines; its slip is not drawn here (the answer page "
+            "has the slip states).")
 
 
 def kinetic_slip_words(results, block: str, model: str | None = None) -> str:
