@@ -27,7 +27,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, Locator, LogLocator, 
 PAGE_SIZE = (11.69, 8.27)  # A4 landscape [in]
 GRID = dict(left=0.07, right=0.835, bottom=0.145, top=0.885, wspace=0.2, hspace=0.32)  # axes area
 LEGEND_ANCHOR = (0.85, 0.885)  # upper left corner of the page legend, right of the axes
-LEGEND_CHARS = 21  # characters of 7.5 pt per legend line: the entry, its line sample and a print margin fit the page
+LEGEND_CHARS = 23  # characters of 7.5 pt per legend line: the entry, its line sample and the padding fit the page
 CAPTION_Y = 0.082
 CAPTION_SIZE = 7.5
 CAPTION_WRAP = 205  # characters of 7.5 pt italic across the page width (tests check the drawn extent)
