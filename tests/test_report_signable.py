@@ -910,3 +910,22 @@ def test_a_gripping_base_on_clay_gets_the_held_bases_overturning_probability():
 
     assert f"overturns in 50 years with {numbers.probability(expected)} against the 1% limit" in text, (text, expected)
     assert "whose base is held there" in text
+
+
+def test_the_showcase_caption_says_where_the_rigid_base_slides_without_rocking():
+    """Cold read 12 (user round 2 B5; default figures round 2 B1): on clay the rigid base only slides, its θ = 0 hid
+    under the other lines unexplained; the sentence then claimed the bed slides too on sand, where it rocks. It names
+    the soils whose μ_s is below b/h and says only what the rigid base does there."""
+    from types import SimpleNamespace
+
+    from rockfrag.report import showcase_slide_words
+    from rockfrag.soils import SOILS
+
+    block = SimpleNamespace(name="paper", b=4.0, h=8.5)
+    showcase = xr.Dataset(coords={"case_soil": ("case", ["clay", "sand", "rock"])},
+                          attrs={"showcase_block": "paper"})
+    results = SimpleNamespace(showcase=showcase, config=SimpleNamespace(
+        blocks=[block], soils=[SOILS["clay"], SOILS["sand"], SOILS["rock"]]))
+    text = showcase_slide_words(results)
+    assert text.startswith(" On clay and sand the base friction is below b/h = 0.47: the rigid base slides"), text
+    assert "its θ stays 0 under the other lines" in text and "the bed mostly slides" not in text
