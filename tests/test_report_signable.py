@@ -740,8 +740,8 @@ def test_the_summary_says_which_soils_are_representative_classes_not_the_sites()
 
     measured = replace(SOILS["sand"], shear_modulus=95e6)  # a site investigation's modulus: not a shipped class
     results = SimpleNamespace(config=SimpleNamespace(soils=[SOILS["clay"], measured]), cube=xr.Dataset())
-    assert representative_soils_words(results) == ("Clay: representative class of ground (the paper's moduli, "
-                                                   "NAVFAC friction), not site measurements (Methods).")
+    assert representative_soils_words(results) == ("Clay: representative class of ground, not site measurements "
+                                                   "(Methods).")
     results.config.soils = [measured]
     assert representative_soils_words(results) == ""
 
@@ -929,3 +929,19 @@ def test_the_showcase_caption_says_where_the_rigid_base_slides_without_rocking()
     text = showcase_slide_words(results)
     assert text.startswith(" On clay and sand the base friction is below b/h = 0.47: the rigid base slides"), text
     assert "its θ stays 0 under the other lines" in text and "the bed mostly slides" not in text
+
+
+def test_the_summary_marks_a_clay_verdict_that_holds_for_a_drained_base():
+    """Cold read 12 (default text, round 3): the paper block's clay verdict holds for a drained base only (its
+    undrained adhesion is an equivalent friction of 0.03-0.15 under 400 kPa); its answer page said so, the summary's
+    row did not. The action carries ◊ there, and only there."""
+    from types import SimpleNamespace
+
+    from rockfrag.report.summary import DRAINED_WORDS, drained_words
+    from rockfrag.soils import SOILS
+
+    paper = SimpleNamespace(name="paper", mass=326197.0, footprint_area=8.0, b=4.0)
+    light = SimpleNamespace(name="light", mass=4500.0, footprint_area=1.8, b=0.6)
+    results = SimpleNamespace(config=SimpleNamespace(blocks=[paper, light], soils=[SOILS["clay"], SOILS["sand"]]))
+    assert drained_words(results, "paper", "clay") == DRAINED_WORDS
+    assert drained_words(results, "paper", "sand") == "" and drained_words(results, "light", "clay") == ""

@@ -23,6 +23,7 @@ from rockfrag.report.adapters import (
     CredibleMarks,
     block_levels,
     cell,
+    is_soil,
     measure_label,
     model_styles,
     models_of,
@@ -1196,8 +1197,15 @@ def applicability_page(cube, caption, limit=0.10, names: dict | None = None):
             drew, with_ratio = True, with_ratio | np.isfinite(ratio)
             joined[model.name] |= bool(np.isfinite(ratio).sum() >= 2)
             style = styles[model.name]
-            axis.plot(shear[order], ratio[order], marker=markers[b_index % len(markers)], ms=5, mfc="white",
+            # a structural base (steel) stands apart, not joined: no run lies between it and rock (cold read 12,
+            # default figures round 3: the line read as a stiffness trend nobody computed)
+            ground = np.array([is_soil(cube, str(soil)) for soil in cube.soil.values])[order]
+            x, y = shear[order], ratio[order]
+            axis.plot(x[ground], y[ground], marker=markers[b_index % len(markers)], ms=5, mfc="white",
                       color=style["color"], ls=style["ls"], lw=1.3)
+            if (~ground).any():
+                axis.plot(x[~ground], y[~ground], marker=markers[b_index % len(markers)], ms=5, mfc="white",
+                          color=style["color"], ls="none")
         name = names.get(str(block), str(block))
         gaps = [str(soil) for soil, has in zip(cube.soil.values, with_ratio) if not has]
         pointless -= {str(soil) for soil, has in zip(cube.soil.values, with_ratio) if has}

@@ -71,6 +71,7 @@ from rockfrag.report.summary import EXAMPLE_HAZARD_WORDS, hazard_caveat, per_met
 from rockfrag.report.text import Item, bullet, heading, note, paragraph, strong, table
 from rockfrag.report.vertical import VerticalEffect
 from rockfrag.report.words import PAPER_CITATION, PAPER_TITLE, formulas, listed, plain, state_short_label
+from rockfrag.site_amplification import ROCK_PGA_LIMIT
 from rockfrag.site_hazard import SiteHazards, study_site_hazards
 from rockfrag.soils import SOILS, ec8_ground_type
 from rockfrag.units import STANDARD_GRAVITY
@@ -1011,7 +1012,8 @@ def site_hazard_items(results: Results) -> list[Item]:
     steel = [name for name in reference if not is_soil(results.cube, name)]
     text = (f"Each soil's site hazard is the hazard curve of the reference site (Vs30 {sites.reference_vs30:,.0f} "
             "m/s) carried to the soil's site by the NGA-West2 site term of Boore et al. 2014 (the site amplification "
-            "model of Seyhan & Stewart 2014: linear in ln Vs30 and nonlinear in the rock's PGA), the spread of the "
+            "model of Seyhan & Stewart 2014: linear in ln Vs30 and nonlinear in the rock's PGA, that PGA held at "
+            f"{ROCK_PGA_LIMIT:g} g in the nonlinear term above it, where the model is not fitted), the spread of the "
             f"soil's Vs30 within its site class (a standard deviation of ln Vs30 of {config.vs30_sigma:g}) "
             "convolved into the curve (Bazzurro & Cornell 2004). Each soil's Vs30 is the value that stands for its "
             "site class in the USGS hazard tools (ASCE 7-16 Table 20.3-1's classes), not a measurement: a site's "
@@ -1587,6 +1589,13 @@ def sources_items(results: Results) -> list[Item]:
                             + f". {_kinetic_words(shipped_soils)}: " + CHOICE_WORDS + "."))
     if own:
         items.append(bullet(f"Soils {', '.join(own)}: the study file's own values."))
+    depths = [f"{short_block_name(config, block.name)} {_g(block.soil_depth)} m" for block in config.blocks
+              if block.name in results.cube.block.values]
+    if depths:  # cold read 12 (user, round 4): k is inversely proportional to H, and H was sourced nowhere
+        items.append(bullet(f"Depth H of the soil column under each block in eq. 19 ({'; '.join(depths)}): "
+                            f"{CHOICE_WORDS}; the paper defines it as the depth of soil that takes part in the "
+                            "deformation and gives no rule for it. k is inversely proportional to H; the methods "
+                            "compare k with an elastic half-space's, which has no such depth."))
     design = config.design
     band = tuple(float(v) for v in design.restitution_range)
     if any(not m.rigid_base and m.uses_bed for m in models_of(fragility)):

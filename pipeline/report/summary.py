@@ -173,8 +173,7 @@ BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a pr
 """How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
-STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level under the reference site's motion, not a floor of a "
-                         "structure (no floor spectrum).")
+STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level, not a floor of a structure (no floor spectrum).")
 """What a structural base of the study (steel) stands for, said once, in the summary's note (cold read 3, A2)."""
 
 
@@ -269,8 +268,8 @@ def no_curve_words(answer) -> str:
     total = next((record[1] for soil in answer.soils for row in soil.states for record in row.records), None)
     example = f"'{no_curve_cell(total)}'" if total else "'≈ 0 (0/n)'"
     return (f"{example}: no fitted curve (its median lies above the highest intensity studied) and none of the "
-            f"{total or 'n'} records reached the state at that level: small, not zero; the design-life value bounds "
-            "it.")
+            f"{total or 'n'} records reached the state at that level: small, not zero; the design-life value is "
+            "estimated from the records' share at each level.")
 
 
 def say_p_at(results, answer, soil, row, index: int) -> str:
@@ -442,24 +441,23 @@ def summary_items(results) -> list[Item]:
     for answer in answers:
         rows.append([block_name(results.config, answer.block)] + [""] * (len(header) - 1))
         for line in verdict_rows(results, answer):
-            rows.append([line["soil"], line["action"], line["state"], *line["at"], line["life"], line["beta"],
-                         line["reason"]])
+            rows.append([line["soil"], line["action"] + drained_words(results, answer.block, line["soil"]),
+                         line["state"], *line["at"], line["life"], line["beta"], line["reason"]])
     items.append(paragraph(
-        f"Per asset and soil: the action, the damage state that governs it, that state's probability at the site's "
-        f"intensity of each return period and in the design life of {life}, with {hazard_words(results, first)}; the "
-        "dispersion β of its fragility curve with its two parts; and what the verdict rests on."))
+        f"Per asset and soil: the action, the governing damage state, its probability at each return period's site "
+        f"intensity and in the design life of {life} ({hazard_words(results, first)}), the β of its curve with its "
+        "two parts, and what the verdict rests on."))
     items.append(table(header, rows))
     used = {line[1] for line in rows}
     legend = [("anchor or restrain", "'Anchor or restrain': a probability in the design life is above its limit; the "
                                      "block must not stand free."),
               ("specialist check", "'Specialist check': the base would slide, and its sliding was not computed."),
-              ("no action", "'No action': every judged damage state is within its limit; a verdict on the "
-                            "computed risk, not on a code's anchorage ('Reading the answer pages')."),
+              ("no action", "'No action': every judged damage state is within its limit, a verdict on the "
+                            "computed risk; a code's anchorage rule (IEEE 693, ASCE 7 Ch. 13) still applies."),
               (ROCKING_ONLY, "'Rocking only': the study did not compute this base's sliding, so the verdict covers "
                              "rocking and overturning only."),
-              (EXAMPLE_TAG, "'(Example hazard)': what the example hazard gives, not a site's verdict."),
-              (ILLUSTRATIVE_TAG, "'(Illustrative hazard)': what the illustrative hazard gives, not the site's "
-                                 "verdict.")]
+              (EXAMPLE_TAG, "'(Example hazard)': not a site's verdict."),
+              (ILLUSTRATIVE_TAG, "'(Illustrative hazard)': not the site's verdict.")]
     said = " ".join(words for key, words in legend if any(key in cell for cell in used))
     cells = " ".join(cell for row in rows for cell in row[3:3 + len(periods) + 1])
     bounds = " ".join(words for words, shown in ((BOUND_WORDS, "< "), (no_curve_words(first), "≈ 0 ("))
@@ -471,12 +469,38 @@ def summary_items(results) -> list[Item]:
     items.append(note(" ".join(filter(None, [
         said, GOVERNING_WORDS, bounds, scaled_medians_words(results), structural_base_words(results),
         weaker_direction_words(results), representative_soils_words(results),
+        DRAINED_NOTE if any(row[1].endswith(DRAINED_WORDS) for row in rows) else "",
         "Reason: the records that reach the state at the levels run either side of the largest return period's "
         "intensity; where none reach it at the level below, its probabilities are the fitted curve's tail. β "
         "(records / model): the total, √(records² + model²), of the record-to-record and the model's own "
-        "variability (the answer pages give every state)."
+        "variability."
     ]))))
     return items
+
+
+DRAINED_WORDS = " ◊"
+"""Beside a clay verdict that holds for a drained base only (``drained_words``); the summary's note says what."""
+DRAINED_NOTE = ("◊ for a drained base: undrained, the clay's adhesion holds the block less than its friction does "
+                "(answer page).")
+
+
+def drained_words(results, block: str, soil: str) -> str:
+    """``DRAINED_WORDS`` where the block's μ_s p on this clay exceeds any clay's undrained adhesion, else "".
+
+    Cold read 12 (default text, round 3): the paper block's clay verdict holds for a drained base only (undrained,
+    its adhesion is an equivalent friction of 0.03-0.15 under 400 kPa, against μ_s 0.35); its answer page said so,
+    its summary row did not. The answer page's ``bearing_words`` gives the numbers.
+    """
+    from rockfrag.soils import CLAY_ADHESION, bearing_case
+
+    config = getattr(results, "config", None)
+    found = next((b for b in getattr(config, "blocks", ()) or () if b.name == block), None)
+    clay = next((s for s in getattr(config, "soils", ()) or () if s.name == soil), None)
+    if found is None or clay is None:
+        return ""
+    case = bearing_case(clay, found)
+    return DRAINED_WORDS if case.kind == "clay" and clay.friction_static * case.pressure > \
+        CLAY_ADHESION["stiff clay"][1] else ""
 
 
 def representative_soils_words(results) -> str:
@@ -492,8 +516,8 @@ def representative_soils_words(results) -> str:
              if SOILS.get(soil.name) == soil and is_soil(results.cube, soil.name)]
     if not names:
         return ""
-    return (f"{listed(names).capitalize()}: representative class{'' if len(names) == 1 else 'es'} of ground (the "
-            "paper's moduli, NAVFAC friction), not site measurements (Methods).")
+    return (f"{listed(names).capitalize()}: representative class{'' if len(names) == 1 else 'es'} of ground, not "
+            "site measurements (Methods).")
 
 
 def scaled_medians_words(results) -> str:
@@ -549,7 +573,8 @@ def verdict_rows(results, answer) -> list[dict]:
             life_text = f"{say_p_in_life(results, answer, soil, row)} ({numbers.stated_probability(row.limit)})"
             beta = beta_words(results, answer, soil.soil, row.state) if row.not_reached_below is None else "-"
         lines.append({"soil": soil.soil, "action": action(soil.verdict, soil, tag), "state": state, "at": at,
-                      "life": life_text, "beta": beta, "reason": reason(results, answer, soil)})
+                      "life": life_text, "beta": beta,
+                      "reason": reason(results, answer, soil)})
     return lines
 
 
