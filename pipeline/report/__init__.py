@@ -357,12 +357,11 @@ def kinetic_slip_words(results, block: str, model: str | None = None) -> str:
         share = fragility.empirical_fraction.sel(model=model or RECOMMENDED, block=block, soil=soil.name,
                                                  damage_state="uplift").values * n
         drops = [i for i in range(1, len(share)) if share[i] <= share[i - 1] - 2]
-        if drops and levels.size:
-            i = drops[0]
-            said.append(f"on {soil.name} (μ_k {soil.friction_kinetic:.3f} against {slender:.3f}) it falls from "
-                        f"{share[i - 1]:.0f} to "
-                        f"{share[i]:.0f} of {n} between {levels[i - 1] * scale:#.3g} and {levels[i] * scale:#.3g} "
-                        f"{unit}")
+        if drops and levels.size:  # every fall, not the first alone (cold read 12, default figures round 3)
+            falls = [f"from {share[i - 1]:.0f} to {share[i]:.0f} of {n} between {levels[i - 1] * scale:#.3g} and "
+                     f"{levels[i] * scale:#.3g} {unit}" for i in drops]
+            said.append(f"on {soil.name} (μ_k {soil.friction_kinetic:.3f} against {slender:.3f}) it falls "
+                        + listed(falls))
     if not said:
         return ""
     return (f" Where the kinetic friction is below this block's b/h = {slender:.2f}, a base that slips cannot tip, "
