@@ -160,9 +160,9 @@ SLIP_NESTING = ("A slip state counts a record that overturns too (it is beyond e
                 "without lifting off, so a slip state may be more likely than uplift.")
 """How the slip states and overturning are ordered, said once on the page 'Reading the answer pages'."""
 
-BOUND_WORDS = ("'< X': no record reached the state at any level up to the highest intensity studied (Methods), "
-               "so its probability is at most X, that of the site's intensity exceeding it. '< 0.1%' alone is the "
-               "print floor: a value below 0.1%, computed or bounded.")
+BOUND_WORDS = ("'< X': no record reached the state up to the highest intensity studied (Methods), so its "
+               "probability is at most X, the site's chance of exceeding that intensity. '< 0.1%' alone is the print "
+               "floor: a value below 0.1%, computed or bounded.")
 """What a "< X" cell means, on the summary and the answer pages (rockfrag.answer's not-reached limit)."""
 
 BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a probability ('< X', '≥ X') these pages "
@@ -173,7 +173,8 @@ BOUND_POLICY = ("One policy for bounds and nesting: where the records bound a pr
 """How the pages and the result files print the same quantity (said once, on the page 'Reading the answer pages')."""
 
 
-STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level, not a floor of a structure (no floor spectrum).")
+STRUCTURAL_BASE_WORDS = ("'{names}': a steel plate at ground level under the reference site's motion, not a floor of a "
+                         "structure (no floor spectrum).")
 """What a structural base of the study (steel) stands for, said once, in the summary's note (cold read 3, A2)."""
 
 
@@ -480,8 +481,7 @@ def summary_items(results) -> list[Item]:
 
 DRAINED_WORDS = " ◊"
 """Beside a clay verdict that holds for a drained base only (``drained_words``); the summary's note says what."""
-DRAINED_NOTE = ("◊ for a drained base: undrained, the clay's adhesion holds the block less than its friction does "
-                "(answer page).")
+DRAINED_NOTE = "◊ for a drained base: undrained, the clay's adhesion holds the block less (answer page)."
 
 
 def drained_words(results, block: str, soil: str) -> str:
