@@ -487,7 +487,7 @@ def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed
     assert f"a vertical frequency of {two(vertical)} Hz" in words
     assert f"a rocking frequency (whole base down) of {two(rocking)} Hz, {two(1 / rocking)} s" in words
     assert f"the records' strongest band, {band[0]:.2g} to {band[1]:.2g} s" in words
-    assert "damping, calibrated to the impact restitution, is the study's lowest on gravel" in words
+    assert "damping, calibrated to the impact restitution, is this block's lowest on gravel" in words
     assert words.index("damping") < words.index("vertical frequency")  # the likely reason comes first
     assert f"static settlement, {settlement * 1000:.2g} mm on gravel" in words
     assert "loss of contact" in words and "not from rest" in words

@@ -817,7 +817,7 @@ def bed_resonance_words(results, answer) -> str:
 
     Lift-off on a bed is not monotonic in its stiffness there, so the page gives the bed's vertical and rocking
     frequencies under the block against the records' strongest band (``records_band``), says where the bed's
-    damping calibrated to the restitution is the study's lowest (its value is not printed: the precision policy),
+    damping calibrated to the restitution is the block's lowest (its value is not printed: the precision policy),
     and from where a lift is measured: the bed's unloaded surface (loss of contact), so a corner first rises by
     the static settlement. "" where the medians rise with the stiffness, or without the recommended curve.
     """
@@ -843,8 +843,9 @@ def bed_resonance_words(results, answer) -> str:
         if "damping_ratio_calibrated" in cube and answer.model in cube.model.values:
             xi = cube.damping_ratio_calibrated.sel(model=answer.model, block=answer.block)
             if "soil" in xi.dims and str(xi.idxmin("soil").values) == soil.name:
-                text += (f" A likely reason: the bed's damping, calibrated to the impact restitution, is the "
-                         f"study's lowest on {soil.name}, and a less damped bed lets the block rebound off it sooner.")
+                # "this block's", not "the study's": another block's bed can be less damped (cold read 12, round 3)
+                text += (f" A likely reason: the bed's damping, calibrated to the impact restitution, is this "
+                         f"block's lowest on {soil.name}, and a less damped bed lets the block rebound off it sooner.")
         hz = numbers.two_figures  # "2.0 Hz", not "2 Hz": both figures (cold read 8)
         text += (f" The bed on {soil.name} has a vertical frequency of {hz(vertical)} Hz and a rocking frequency "
                  f"(whole base down) of {hz(rocking)} Hz, {hz(1.0 / rocking)} s "
