@@ -448,7 +448,7 @@ def test_a_lift_off_median_below_both_neighbouring_soils_is_explained_by_the_bed
     """Cold read 3, default B4: the paper's block lifted off on gravel at a median (0.20 g) below sand's and rock's,
     with no word why, and no word from where a lift is measured (the static settlement, 2.7 mm, exceeds the 1 mm
     lift-off size). The answer page gives, for such a soil, the bed's vertical and rocking frequencies against the
-    records' strongest spectral band, the calibrated damping where it is the study's lowest, and that a lift counts
+    records' strongest spectral band, the calibrated damping where it is the block's lowest, and that a lift counts
     from the bed's unloaded surface (loss of contact), after the static settlement. Medians that rise with the
     stiffness get no sentence."""
     from types import SimpleNamespace
