@@ -208,9 +208,9 @@ CAPTIONS = {
               "the reference site's it is carried from (black dashed); dotted, the frequencies of the return periods "
               "(a point where a curve crosses one: the site's intensity of that return period, as the answer pages "
               "print it); grey shading: beyond the largest recorded intensity; the axis ends at the highest "
-              "intensity studied, and a curve that drops below the frequency axis is cut by the axis only: the risk "
-              "integral takes it to the highest intensity studied. A soft soil's curve can fall below the reference "
-              "site's at strong shaking: the site term's nonlinear part de-amplifies it (Methods).",
+              "intensity studied, and a curve that leaves the frequency axis (above or below) is cut by the axis "
+              "only: the risk integral takes it to the highest intensity studied. A soft soil's curve can fall below "
+              "the reference site's at strong shaking: the site term's nonlinear part de-amplifies it (Methods).",
     "spectra": "Read how strong and how varied the records are: each grey line is one record component "
                "unscaled (the Records section lists them); the 16% "
                "(blue dashed), 50% (black) and 84% (red dotted) fractiles. The study scales every record to each "

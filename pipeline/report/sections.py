@@ -1380,8 +1380,10 @@ def methods_items(results: Results) -> list[Item]:
         periods = ", ".join(f"{t:,.0f}" for t in results.return_periods)
         items += [heading("Hazard and risk"), *site_hazard_items(results),
                   paragraph(f"Hazard curve: {_hazard_words(results)}. "
-                            "Mean annual frequency of each damage state λ = ∫ P(DS | im) |dλ(im)|, the hazard "
-                            "interpolated log-log (Cornell et al. 2002); probability in the design life "
+                            "Mean annual frequency of each damage state λ = ∫ P(DS | im) |dλ(im)| up to the highest "
+                            "intensity studied, plus the site's rate of exceeding it (every state counted as reached "
+                            "there: an upper bound on that part), the hazard interpolated log-log (Cornell et al. "
+                            "2002); probability in the design life "
                             f"{float(fragility.attrs.get('design_life_years', config.design_life)):g} years: "
                             f"1 − exp(−λ·years). Return periods of the answer pages: {periods} years.")]
     return items
