@@ -213,8 +213,8 @@ def uplift_intensity(config, record_im, record_pga) -> np.ndarray:
 
 
 DEFAULT_CREDIBLE_REASON = (
-    "3 g PGA: above the largest horizontal PGA recorded, 2.7 g (K-NET MYG004, N-S component, 2011 Tohoku "
-    "earthquake)")
+    "3 g PGA: above the largest horizontal PGA ever recorded anywhere, 2.7 g (K-NET MYG004, N-S component, 2011 "
+    "Tohoku earthquake), not a record of this study")
 """Why the shipped cap is 3 g PGA (``[intensity] credible_max``, ``credible_measure = "pga"``)."""
 
 

@@ -272,7 +272,7 @@ CAPTIONS = {
                            "green: 300-1000 MPa, the stiffness above which the paper finds the rigid base good "
                            "enough; colours: the intensity level; solid concrete block, dashed steel block.",
     "sensitivity": "Read which uncertain parameter of the recommended model moves its median most on each soil, "
-                   "for the damage state that governs that soil's verdict (named under the soil): each bar is "
+                   "for the damage state that governs that soil's verdict (named under each panel): each bar is "
                    "the σ of ln median over that parameter's range (restitution, friction, bed "
                    "stiffness), the others central; the dashed line is the model-form β (FEMA P695's rating). The "
                    "model part of β is the larger of the model-form β and the bars combined (√ of the sum of "
