@@ -150,9 +150,14 @@ class BearingCase:
     capacity: float = math.nan
 
 
+def contact_pressure(block) -> float:
+    """The contact pressure m g / A [Pa] of a block at rest: its weight over its footprint."""
+    return block.mass * STANDARD_GRAVITY / block.footprint_area
+
+
 def bearing_case(soil: SoilClass, block) -> BearingCase:
     """The static bearing check of ``block`` at rest on ``soil``: clay by its name, rock by ``ROCK_MODULUS``."""
-    pressure = block.mass * STANDARD_GRAVITY / block.footprint_area
+    pressure = contact_pressure(block)
     if soil.shear_modulus >= ROCK_MODULUS:
         return BearingCase(pressure, "rock")
     if "clay" in soil.name.lower():

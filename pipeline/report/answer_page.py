@@ -795,6 +795,25 @@ def bed_frequencies(config, block, soil) -> tuple[float, float, float]:
     return found.vertical_frequency / (2 * np.pi), omega_r / (2 * np.pi), found.settlement
 
 
+def _lift_setting(results, answer, needs=()):
+    """(block, g·tanα in g, soils by stiffness, lift-off medians) for the lift-off sentences, or None.
+
+    None unless the answer is the recommended model's, in g of PGA, on a calibrated bed, with an uplift state and
+    the cube variables ``needs``: the conditions ``early_lift_words`` and ``late_lift_words`` share.
+    """
+    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
+    if (answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None
+            or any(name not in cube for name in needs)
+            or str(cube.attrs.get("intensity_measure", "")).lower() != "pga" or answer.unit != "g"
+            or not getattr(config, "calibrates_bed", False)):
+        return None
+    block = next((block for block in config.blocks if block.name == answer.block), None)
+    if block is None:
+        return None
+    soils, medians = uplift_by_stiffness(results, answer)
+    return block, block.b / block.h, soils, medians
+
+
 def uplift_by_stiffness(results, answer) -> tuple[list, dict]:
     """The study's soils by shear modulus and the answering curve's lift-off median on each [shown unit]."""
     fragility = results.fragility
@@ -881,16 +900,11 @@ def late_lift_words(results, answer) -> str:
     """
     from rockfrag.damage_states import uplift_lift
 
-    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
-    if (answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None
-            or "peak_uplift" not in cube or str(cube.attrs.get("intensity_measure", "")).lower() != "pga"
-            or answer.unit != "g" or not getattr(config, "calibrates_bed", False)):
+    setting = _lift_setting(results, answer, needs=("peak_uplift",))
+    if setting is None:
         return ""
-    block = next((block for block in config.blocks if block.name == answer.block), None)
-    if block is None:
-        return ""
-    rigid = block.b / block.h  # g tan(alpha), in g
-    soils, medians = uplift_by_stiffness(results, answer)
+    block, rigid, soils, medians = setting
+    cube = results.cube
     sliding = {soil.name for soil in friction_driven_soils(results, answer)}  # their lift waits on the friction
     late = [soil for soil in soils if np.isfinite(medians[soil.name]) and medians[soil.name] > LATE_LIFT * rigid
             and soil.friction_kinetic >= rigid and soil.name not in sliding]
@@ -927,16 +941,11 @@ def early_lift_words(results, answer) -> str:
     builds the rocking up. Soils ``bed_resonance_words`` explains (a median below both neighbours') are left to
     it. "" for a PGA-less measure, a model without a bed, or where every median is at least ``EARLY_LIFT`` of it.
     """
-    fragility, cube, config = results.fragility, getattr(results, "cube", None), results.config
-    if (answer.model != RECOMMENDED or "uplift" not in fragility.damage_state.values or cube is None
-            or str(cube.attrs.get("intensity_measure", "")).lower() != "pga" or answer.unit != "g"
-            or not getattr(config, "calibrates_bed", False)):
+    setting = _lift_setting(results, answer)
+    if setting is None:
         return ""
-    block = next((block for block in config.blocks if block.name == answer.block), None)
-    if block is None:
-        return ""
-    rigid = block.b / block.h  # g tan(alpha), in g
-    soils, medians = uplift_by_stiffness(results, answer)
+    block, rigid, soils, medians = setting
+    fragility, config = results.fragility, results.config
     explained = {soils[i].name for i in lift_off_dips(soils, medians)}
     early = [soil for soil in soils if np.isfinite(medians[soil.name]) and medians[soil.name] < EARLY_LIFT * rigid
              and soil.name not in explained]

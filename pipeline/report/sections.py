@@ -435,7 +435,7 @@ def adhesion_words(config, cube, clays: list[str]) -> str:
     DM-7.02: 10-35 kPa): undrained, its base grips more than the friction lets it, and slides less. Each block's
     mu_s p on each clay is set against ``CLAY_ADHESION``.
     """
-    from rockfrag.soils import CLAY_ADHESION
+    from rockfrag.soils import CLAY_ADHESION, contact_pressure
 
     (soft_low, soft_high), (stiff_low, stiff_high) = CLAY_ADHESION["soft clay"], CLAY_ADHESION["stiff clay"]
     grips, slides, either = [], [], []
@@ -443,7 +443,7 @@ def adhesion_words(config, cube, clays: list[str]) -> str:
     for block in config.blocks:
         if block.name not in cube.block.values:
             continue
-        pressure = block.mass * STANDARD_GRAVITY / block.footprint_area
+        pressure = contact_pressure(block)
         for soil in (s for s in config.soils if s.name in clays):
             shear = soil.friction_static * pressure
             name = f"{short_block_name(config, block.name)} on {soil.name}"
@@ -577,7 +577,7 @@ def gripping_base_words(results, clays: list[str]) -> str:
     from rockfrag.fragility import capped_frequency
     from rockfrag.hazard import hazard_of
     from rockfrag.risk import probability_in_life
-    from rockfrag.soils import CLAY_ADHESION
+    from rockfrag.soils import CLAY_ADHESION, contact_pressure
 
     cube, fragility, config = results.cube, results.fragility, results.config
     hazard = results.site_hazards or results.hazard
@@ -589,7 +589,7 @@ def gripping_base_words(results, clays: list[str]) -> str:
     for block in config.blocks:
         if block.name not in cube.block.values:
             continue
-        pressure = block.mass * STANDARD_GRAVITY / block.footprint_area
+        pressure = contact_pressure(block)
         for soil in (s for s in config.soils if s.name in clays):
             if soil.friction_static * pressure >= CLAY_ADHESION["soft clay"][0]:
                 continue
